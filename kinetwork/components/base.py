@@ -1,0 +1,268 @@
+"""Declaration machinery: a component is a class of ``Port`` and ``Param`` declarations.
+
+Ports and parameters are collected from the class body in order, so documentation, the file
+format and validation are all generated from the same declarations and never drift.
+"""
+
+import copy
+import difflib
+import math
+import re
+
+import numpy as np
+
+from ..errors import ModelError
+from ..expr import Expression
+
+REQUIRED = object()
+DOMAINS = ("frame", "rotational", "translational", "signal_in", "signal_out")
+#: placeholder domains: ONED is the class's ``domain`` (rotational or translational); ANY
+#: connects to every domain (a probe)
+ONED, ANY = "1d", "any"
+_NAME = re.compile(r"^[A-Za-z_][A-Za-z0-9_]*$")
+
+#: type name ("multibody.Revolute") -> class; files resolve types only through this table.
+REGISTRY = {}
+
+
+def suggest(name, choices):
+    """' (did you mean 'x'?)' for the closest of ``choices``, or ''."""
+    close = difflib.get_close_matches(str(name), list(choices), n=1)
+    return f" (did you mean {close[0]!r}?)" if close else ""
+
+
+class Port:
+    """A connector of one physical domain."""
+
+    def __init__(self, domain, doc="", optional=False):
+        if domain not in DOMAINS + (ONED, ANY):
+            raise ValueError(f"unknown domain {domain!r}")
+        self.domain, self.doc, self.optional = domain, doc, optional
+        self.name = None
+
+    def __set_name__(self, owner, name):
+        self.name = name
+
+    def __get__(self, instance, owner):
+        return self if instance is None else PortRef(instance, self.name)
+
+
+class PortRef:
+    """One port of one component instance, as passed to ``Model.connect``."""
+
+    __slots__ = ("component", "name")
+
+    def __init__(self, component, name):
+        self.component, self.name = component, name
+
+    @property
+    def domain(self):
+        return self.component.ports[self.name].domain
+
+    @property
+    def path(self):
+        return f"{self.component.name}.{self.name}"
+
+    def __eq__(self, other):
+        return (isinstance(other, PortRef) and other.component is self.component
+                and other.name == self.name)
+
+    def __hash__(self):
+        return hash((id(self.component), self.name))
+
+    def __repr__(self):
+        return f"<port {self.path} ({self.domain})>"
+
+
+class Param:
+    """A parameter: default, unit, bounds and a one-line doc.
+
+    A value is a number, or a string expression in model parameters (and in time ``t`` where
+    ``time=True``); ``shape`` (3,) takes three of those, (3, 3) a matrix or its diagonal.
+    ``kind`` "bool" and "names" take a flag and a list of strings.
+    """
+
+    def __init__(self, default=REQUIRED, *, unit="", min=None, max=None, shape=(), doc="",
+                 time=False, optional=False, nonzero=False, kind="real", choices=None,
+                 name=None):
+        self.default, self.unit, self.min, self.max = default, unit, min, max
+        self.shape, self.doc, self.time, self.optional = tuple(shape), doc, time, optional
+        self.nonzero, self.kind, self.choices = nonzero, kind, choices
+        # ``name`` lets a parameter share its file name with a port (a joint's "axis")
+        self.name = name
+
+    def __set_name__(self, owner, name):
+        self.name = self.name or name
+
+    def __get__(self, instance, owner):
+        return self if instance is None else instance._values[self.name]
+
+    @property
+    def required(self):
+        return self.default is REQUIRED
+
+    def describe(self):
+        unit = f" [{self.unit}]" if self.unit else ""
+        return f"{self.doc}{unit}"
+
+    def normalize(self, value, where):
+        """Check the structure of ``value``; return it in canonical nested-list form.
+
+        Numbers are bounds-checked here; expressions are checked once model parameters are
+        known (``check_number``).
+        """
+        if value is None:
+            if self.optional:
+                return None
+            raise ModelError(f"{where}: a value is required")
+        if self.kind == "bool":
+            if not isinstance(value, bool):
+                raise ModelError(f"{where}: must be true or false, got {value!r}")
+            return value
+        if self.kind == "names":
+            if not isinstance(value, (list, tuple)) or not all(isinstance(v, str) for v in value):
+                raise ModelError(f"{where}: must be a list of names, got {value!r}")
+            for v in value:
+                if self.choices is not None and v not in self.choices:
+                    raise ModelError(f"{where}: unknown {v!r}{suggest(v, self.choices)}; "
+                                     f"choose from {', '.join(self.choices)}")
+            if len(set(value)) != len(value):
+                raise ModelError(f"{where}: names repeated in {list(value)!r}")
+            return list(value)
+        if self.shape == ():
+            return self._scalar(value, where)
+        if isinstance(value, np.ndarray):
+            value = value.tolist()
+        if not isinstance(value, (list, tuple)):
+            raise ModelError(f"{where}: must be a list of shape {self.shape}, got {value!r}")
+        if self.shape == (3, 3) and len(value) == 3 and not any(
+                isinstance(v, (list, tuple)) for v in value):
+            value = [[value[0], 0, 0], [0, value[1], 0], [0, 0, value[2]]]
+        rows = value if len(self.shape) == 1 else value
+        if len(rows) != self.shape[0]:
+            raise ModelError(f"{where}: must have {self.shape[0]} entries, got {len(rows)}")
+        if len(self.shape) == 1:
+            out = [self._scalar(v, f"{where}[{i}]", bounds=False) for i, v in enumerate(value)]
+        else:
+            out = []
+            for i, row in enumerate(value):
+                if not isinstance(row, (list, tuple)) or len(row) != self.shape[1]:
+                    raise ModelError(f"{where}[{i}]: must be a row of {self.shape[1]} entries")
+                out.append([self._scalar(v, f"{where}[{i}][{j}]", bounds=False)
+                            for j, v in enumerate(row)])
+        if self.nonzero and all(isinstance(v, (int, float)) for v in out) and not any(out):
+            raise ModelError(f"{where}: must not be the zero vector")
+        return out
+
+    def _scalar(self, value, where, bounds=True):
+        if isinstance(value, np.generic):
+            value = value.item()
+        if isinstance(value, str):
+            expr = Expression(value) if value.strip() else None
+            if expr is None:
+                raise ModelError(f"{where}: empty expression")
+            if "t" in expr.names and not self.time:
+                raise ModelError(f"{where}: time 't' is not allowed in {value!r}; "
+                                 f"this parameter is constant")
+            return value
+        if isinstance(value, bool) or not isinstance(value, (int, float)):
+            raise ModelError(f"{where}: must be a number or an expression, got {value!r}")
+        if not math.isfinite(value):
+            raise ModelError(f"{where}: must be finite, got {value!r}")
+        if bounds:
+            self.check_number(value, where)
+        return value
+
+    def check_number(self, number, where):
+        """Bounds check of one evaluated scalar, worded for the person at the diagram."""
+        unit = f" {self.unit}" if self.unit else ""
+        if not math.isfinite(number):
+            raise ModelError(f"{where} = {number}{unit}: must be finite")
+        if self.min is not None and number < self.min:
+            raise ModelError(f"{where} = {number}{unit}: must be >= {self.min}")
+        if self.max is not None and number > self.max:
+            raise ModelError(f"{where} = {number}{unit}: must be <= {self.max}")
+
+
+class Component:
+    """Base of every component: a name, declared ports and declared parameters."""
+
+    #: library path used in files, e.g. "multibody.Revolute"; set by ``library=`` on subclasses
+    type_name = None
+    ports = {}
+    params = {}
+    #: what the component is to the solver: world, joint, body, compliant, source, fixed, probe
+    role = None
+    #: 1-D ports whose position is a joint coordinate (port -> coordinate index) or zero
+    coordinate_ports = {}
+    zero_ports = ()
+
+    def __init_subclass__(cls, library=None, **kwargs):
+        super().__init_subclass__(**kwargs)
+        cls.ports = {}
+        cls.params = {}
+        for klass in reversed(cls.__mro__):
+            for key, val in vars(klass).items():
+                if isinstance(val, Port):
+                    if val.domain == ONED and getattr(cls, "domain", None):
+                        val = copy.copy(val)
+                        val.domain = cls.domain
+                    cls.ports[key] = val
+                elif isinstance(val, Param):
+                    cls.params[val.name] = val
+        if library is not None and not cls.__name__.startswith("Partial"):
+            cls.type_name = f"{library}.{cls.__name__}" if library else cls.__name__
+            REGISTRY[cls.type_name] = cls
+
+    def __init__(self, name, *, _place=None, **params):
+        # ``_place`` formats the location of a parameter in messages; files pass their JSON path
+        place = _place or (lambda key: f"{name}.{key}")
+        where = f"{type(self).__name__} {name!r}"
+        if not isinstance(name, str) or not _NAME.match(name):
+            raise ModelError(f"{type(self).__name__} name {name!r}: must be an identifier "
+                             f"(letters, digits, underscore; not starting with a digit)")
+        self.name = name
+        problems = []
+        for key in params:
+            if key not in self.params:
+                problems.append(f"{where}: unknown parameter {key!r}{suggest(key, self.params)}; "
+                                f"parameters are {', '.join(self.params) or 'none'}")
+        self.given = {}
+        self._values = {}
+        for key, spec in self.params.items():
+            try:
+                if key in params:
+                    self.given[key] = spec.normalize(params[key], place(key))
+                    self._values[key] = self.given[key]
+                elif spec.required:
+                    problems.append(f"{place(key)}: a value is required ({spec.describe()})")
+                else:
+                    self._values[key] = spec.normalize(spec.default, place(key))
+            except ModelError as exc:
+                problems.extend(exc.problems)
+        if problems:
+            raise ModelError(problems)
+
+    def __getattr__(self, key):
+        # reached only when normal lookup fails: a misspelt port or parameter
+        if key.startswith("_"):
+            raise AttributeError(key)
+        raise ModelError(f"{type(self).__name__} {self.name!r} has no port or parameter "
+                         f"{key!r}{suggest(key, [*self.ports, *self.params])}; ports: "
+                         f"{', '.join(self.ports)}")
+
+    def port_ref(self, name):
+        """The ``PortRef`` called ``name``; a ModelError suggesting close names otherwise."""
+        if name not in self.ports:
+            raise ModelError(f"{type(self).__name__} {self.name!r} has no port {name!r}"
+                             f"{suggest(name, self.ports)}; ports: {', '.join(self.ports)}")
+        return PortRef(self, name)
+
+    def bound(self, values):
+        """A copy whose parameters read as ``values`` (numbers or CasADi symbols)."""
+        twin = copy.copy(self)
+        twin._values = dict(values)
+        return twin
+
+    def __repr__(self):
+        return f"<{self.type_name} {self.name!r}>"

@@ -1,0 +1,29 @@
+"""The two exceptions every user-facing refusal or failure goes through."""
+
+
+class ModelError(ValueError):
+    """Bad input: a model, file or parameter that cannot be accepted.
+
+    ``problems`` lists every diagnostic found (each a string naming its place); the message
+    joins them, so one raise reports all of them at once.
+    """
+
+    def __init__(self, problems):
+        if isinstance(problems, str):
+            problems = [problems]
+        self.problems = list(problems)
+        if len(self.problems) == 1:
+            message = self.problems[0]
+        else:
+            message = f"{len(self.problems)} problems:\n" + "\n".join(
+                f"  - {p}" for p in self.problems)
+        super().__init__(message)
+
+
+class SimulationError(RuntimeError):
+    """A failed integration; ``results`` holds what was computed up to ``t_reached``."""
+
+    def __init__(self, message, results=None, t_reached=None):
+        super().__init__(message)
+        self.results = results
+        self.t_reached = t_reached

@@ -1,0 +1,199 @@
+"""Model: the components, their wiring and the model parameters."""
+
+import math
+import re
+
+import numpy as np
+
+from ..components.base import ANY, Component, PortRef, suggest
+from ..errors import ModelError
+from ..expr import CONSTANTS, FUNCTIONS, Expression
+
+_IDENT = re.compile(r"^[A-Za-z_][A-Za-z0-9_]*$")
+RESERVED = {"t", *CONSTANTS, *FUNCTIONS}
+
+
+class Model:
+    """A wiring diagram: components, connections between their ports, named parameters.
+
+    Parameters
+    ----------
+    name : str
+        Model name.
+    parameters : dict, optional
+        Model parameters (name -> number); component parameters may be expressions in them.
+    description : str, optional
+        Free text.
+    simulation : dict, optional
+        Experiment settings travelling with the model (t_end, n_points, method, rtol, atol).
+    """
+
+    def __init__(self, name, parameters=None, description="", simulation=None):
+        if not isinstance(name, str) or not name:
+            raise ModelError(f"model name must be a non-empty string, got {name!r}")
+        self.name = name
+        self.description = description
+        self.components = {}
+        self.connections = []
+        self.parameters = {}
+        self.simulation = dict(simulation or {})
+        self.layout = {}
+        #: component name -> how messages locate it (files say 'components[3] "mass1"')
+        self.places = {}
+        for key, value in (parameters or {}).items():
+            self.set_parameter(key, value)
+
+    # -- building -----------------------------------------------------------------------
+    def set_parameter(self, name, value):
+        """Add or change a model parameter."""
+        if not isinstance(name, str) or not _IDENT.match(name):
+            raise ModelError(f"parameter name {name!r}: must be an identifier")
+        if name in RESERVED:
+            raise ModelError(f"parameter name {name!r} is reserved (time, constants, functions)")
+        self.parameters[name] = check_number(value, f"parameters.{name}")
+
+    def add(self, component):
+        """Add ``component`` and return it."""
+        if not isinstance(component, Component):
+            raise ModelError(f"model.add expects a component, got {component!r}")
+        if component.name in self.components:
+            raise ModelError(f"duplicate component name {component.name!r}")
+        self.components[component.name] = component
+        return component
+
+    def connect(self, a, b):
+        """Wire two ports, given as ``comp.port`` attributes or ``"comp.port"`` strings."""
+        pa, pb = self.port(a), self.port(b)
+        if pa == pb:
+            raise ModelError(f"cannot connect {pa.path} to itself")
+        da, db = pa.domain, pb.domain
+        if da != db and ANY not in (da, db):
+            raise ModelError(f"cannot connect {pa.path} ({da}) to {pb.path} ({db}): "
+                             f"ports of different domains")
+        for c in self.connections:
+            if {c[0], c[1]} == {pa, pb}:
+                raise ModelError(f"{pa.path} and {pb.path} are already connected")
+        self.connections.append((pa, pb))
+
+    def port(self, ref):
+        """Resolve a PortRef or a ``"comp.port"`` string to a PortRef of this model."""
+        if isinstance(ref, PortRef):
+            comp = self.components.get(ref.component.name)
+            if comp is not ref.component:
+                raise ModelError(f"{ref.path}: component {ref.component.name!r} is not in "
+                                 f"model {self.name!r} (add it first)")
+            return ref
+        if not isinstance(ref, str) or ref.count(".") != 1:
+            raise ModelError(f"port reference {ref!r}: expected 'component.port'")
+        cname, pname = ref.split(".")
+        if cname not in self.components:
+            raise ModelError(f"{ref}: no component {cname!r}{suggest(cname, self.components)}")
+        return self.components[cname].port_ref(pname)
+
+    # -- checking -----------------------------------------------------------------------
+    def place(self, component, key=None):
+        """Where a component (and one of its parameters) is, for messages."""
+        base = self.places.get(component.name)
+        if base is None:
+            return f"{component.name}.{key}" if key else component.name
+        return f"{base} params.{key}" if key else base
+
+    def parameter_values(self, overrides=None):
+        """Model parameters with ``overrides`` applied and checked."""
+        values = dict(self.parameters)
+        for key, value in (overrides or {}).items():
+            if key not in values:
+                raise ModelError(f"params: unknown model parameter {key!r}"
+                                 f"{suggest(key, values)}; parameters are "
+                                 f"{', '.join(values) or 'none'}")
+            values[key] = check_number(value, f"params.{key}")
+        return values
+
+    def numeric_values(self, overrides=None):
+        """Every component parameter evaluated to numbers: {component name: {param: value}}.
+
+        Gathers every unknown name, failed evaluation and violated bound into one ModelError.
+        Time-dependent parameters are evaluated at t = 0.
+        """
+        env = self.parameter_values(overrides)
+        env_t = {**env, "t": 0.0}
+        out, problems = {}, []
+        for comp in self.components.values():
+            vals = {}
+            for key, spec in comp.params.items():
+                where = self.place(comp, key)
+                try:
+                    vals[key] = evaluate(comp._values[key], spec, env_t, where)
+                except ModelError as exc:
+                    problems.extend(exc.problems)
+            out[comp.name] = vals
+        if problems:
+            raise ModelError(problems)
+        return out
+
+    def validate(self):
+        """Check the whole model; return its Topology or raise one ModelError listing all."""
+        from .topology import analyze
+        return analyze(self)
+
+    def compile(self):
+        """Validate and build the equations: a ``kn.System``."""
+        from ..solver.system import System
+        return System(self)
+
+    def save(self, path):
+        """Write the model as JSON (atomically: a failed save leaves the old file whole)."""
+        from .io import save
+        save(self, path)
+
+    def __repr__(self):
+        return (f"<Model {self.name!r}: {len(self.components)} components, "
+                f"{len(self.connections)} connections>")
+
+
+def check_number(value, where):
+    """A finite real number, or a ModelError naming ``where``."""
+    if isinstance(value, np.generic):
+        value = value.item()
+    if isinstance(value, bool) or not isinstance(value, (int, float)):
+        raise ModelError(f"{where}: must be a number, got {value!r}")
+    if not math.isfinite(value):
+        raise ModelError(f"{where}: must be finite, got {value!r}")
+    return value
+
+
+def evaluate(value, spec, env, where):
+    """A normalized parameter value evaluated with numbers; bounds checked."""
+    if value is None or spec.kind in ("bool", "names"):
+        return value
+    if spec.shape == ():
+        return _scalar(value, spec, env, where)
+    arr = np.array([[_scalar(v, spec, env, f"{where}[{i}][{j}]", bounds=False)
+                     for j, v in enumerate(row)] for i, row in enumerate(value)]
+                   if len(spec.shape) == 2 else
+                   [_scalar(v, spec, env, f"{where}[{i}]", bounds=False)
+                    for i, v in enumerate(value)])
+    if spec.nonzero and not np.any(arr):
+        raise ModelError(f"{where}: must not be the zero vector")
+    return arr
+
+
+def _scalar(value, spec, env, where, bounds=True):
+    if isinstance(value, str):
+        expr = Expression(value)
+        unknown = sorted(expr.names - set(env))
+        if unknown:
+            raise ModelError(f"{where} = {value!r}: unknown name {unknown[0]!r}"
+                             f"{suggest(unknown[0], env)}; model parameters are "
+                             f"{', '.join(k for k in env if k != 't') or 'none'}")
+        try:
+            number = float(expr.evaluate(env))
+        except (ZeroDivisionError, ValueError, OverflowError, TypeError) as exc:
+            raise ModelError(f"{where} = {value!r}: cannot be evaluated ({exc})") from None
+    else:
+        number = float(value)
+    if bounds:
+        spec.check_number(number, where)
+    elif not math.isfinite(number):
+        raise ModelError(f"{where}: must be finite, got {number}")
+    return number

@@ -1,0 +1,243 @@
+"""Topology: connection sets, the spanning tree from the ground, and what each set means.
+
+Ports are nodes and connections edges of a networkx graph; a connection set is a connected
+component (potentials equal, flows summing to zero). Frame sets are the nodes of a second
+graph whose edges are joints and rigid parts; its BFS tree from the ground orders the
+Newton-Euler recursion.
+"""
+
+from dataclasses import dataclass, field
+
+import networkx as nx
+
+from ..components.probe import QUANTITIES
+from ..errors import ModelError
+
+ONED_DOMAINS = ("rotational", "translational")
+
+
+@dataclass
+class Edge:
+    """A joint or rigid part of the spanning tree, traversed parent -> child."""
+    component: object
+    parent: int          # frame set towards the ground
+    child: int           # frame set away from the ground
+    reversed: bool       # True when frame_b faces the ground
+
+
+@dataclass
+class OneDSet:
+    """A 1-D connection set: its ports and the port that sets its position."""
+    index: int
+    domain: str
+    ports: list
+    definer: object = None    # PortRef of a joint flange or Fixed, or None
+
+
+@dataclass
+class Topology:
+    """What validation learned about a model; the solver's starting point."""
+    world: object
+    sets: list                          # connection sets (lists of PortRef)
+    set_of: dict                        # PortRef -> set index
+    root: int                           # frame set of the ground
+    tree: list = field(default_factory=list)      # Edge, parents before children
+    joints: list = field(default_factory=list)    # tree joints with dof > 0, model order
+    bodies: list = field(default_factory=list)    # (RigidBody, frame set)
+    oned: list = field(default_factory=list)      # OneDSet
+    probes: list = field(default_factory=list)    # (Probe, target PortRef)
+    loops: list = field(default_factory=list)     # lists of component names
+
+    @property
+    def dof(self):
+        return sum(j.dof for j in self.joints)
+
+
+def analyze(model):
+    """Validate ``model``'s wiring and return its Topology; one ModelError lists all problems."""
+    problems = []
+    values = None
+    try:
+        values = model.numeric_values()
+    except ModelError as exc:
+        problems.extend(exc.problems)
+
+    graph = nx.Graph()
+    for comp in model.components.values():
+        for pname in comp.ports:
+            graph.add_node(comp.port_ref(pname))
+    graph.add_edges_from(model.connections)
+    sets = [sorted(s, key=_order(model)) for s in nx.connected_components(graph)]
+    sets.sort(key=lambda s: _order(model)(s[0]))
+    set_of = {p: i for i, s in enumerate(sets) for p in s}
+
+    roles = {}
+    for comp in model.components.values():
+        roles.setdefault(comp.role, []).append(comp)
+
+    probes = _probes(model, graph, roles.get("probe", []), problems)
+    for comp in model.components.values():
+        if comp.role == "probe":
+            continue
+        for pname, port in comp.ports.items():
+            ref = comp.port_ref(pname)
+            if not port.optional and all(p.component.role == "probe"
+                                         for p in sets[set_of[ref]] if p != ref):
+                problems.append(f"{model.place(comp)}: port {ref.path} ({port.domain}) "
+                                f"is not connected")
+
+    worlds = roles.get("world", [])
+    if len(worlds) != 1:
+        names = ", ".join(w.name for w in worlds)
+        problems.append("the model needs exactly one multibody.Ground, found "
+                        f"{len(worlds)}{': ' + names if names else ''}")
+        if not worlds:
+            raise ModelError(problems)
+    world = worlds[0]
+    topo = Topology(world=world, sets=sets, set_of=set_of,
+                    root=set_of[world.port_ref("frame")], probes=probes)
+    _tree(model, topo, roles, problems)
+    _oned(model, topo, values, problems)
+    if problems:
+        raise ModelError(problems)
+    return topo
+
+
+def _order(model):
+    rank = {name: i for i, name in enumerate(model.components)}
+    return lambda ref: (rank[ref.component.name], list(ref.component.ports).index(ref.name))
+
+
+def _probes(model, graph, probes, problems):
+    out = []
+    for probe in probes:
+        ref = probe.port_ref("port")
+        wired = list(graph.neighbors(ref))
+        if len(wired) != 1:
+            what = "nothing" if not wired else ", ".join(p.path for p in wired)
+            problems.append(f"{model.place(probe)}: a probe is wired to exactly one port; "
+                            f"{probe.name}.port is wired to {what}")
+            continue
+        target = wired[0]
+        if target.component.role == "probe":
+            problems.append(f"{model.place(probe)}: wired to another probe ({target.path})")
+            continue
+        allowed = QUANTITIES.get(target.domain)
+        if allowed is None:
+            problems.append(f"{model.place(probe)}: cannot measure {target.path} "
+                            f"({target.domain} ports are not measured by probes)")
+            continue
+        asked = probe.quantities if probe.quantities is not None else list(allowed)
+        for q in asked:
+            if q not in allowed:
+                problems.append(f"{model.place(probe, 'quantities')}: {q!r} is not a quantity "
+                                f"of a {target.domain} port ({target.path}); choose from "
+                                f"{', '.join(allowed)}")
+            elif target.domain == "frame" and q in ("force", "torque"):
+                problems.append(f"{model.place(probe, 'quantities')}: cut {q} on a frame "
+                                f"({target.path}) is not available yet; position, velocity, "
+                                f"acceleration, orientation and angular quantities are")
+        out.append((probe, target))
+    return out
+
+
+def _tree(model, topo, roles, problems):
+    """Spanning tree of frame sets from the ground; loops and unreachable parts refused."""
+    frames = nx.MultiGraph()
+    frames.add_node(topo.root)
+    for comp in roles.get("joint", []):
+        a, b = topo.set_of[comp.port_ref("frame_a")], topo.set_of[comp.port_ref("frame_b")]
+        if a == b:
+            problems.append(f"{model.place(comp)}: frame_a and frame_b are connected to each "
+                            f"other, which locks the part")
+            continue
+        frames.add_edge(a, b, key=comp.name, component=comp)
+    for comp in roles.get("body", []):
+        frames.add_node(topo.set_of[comp.port_ref("frame_a")])
+
+    reached = nx.node_connected_component(frames, topo.root)
+    for comp in [*roles.get("joint", []), *roles.get("body", [])]:
+        if topo.set_of[comp.port_ref("frame_a")] not in reached:
+            problems.append(f"{model.place(comp)}: {comp.name} is not connected to the ground "
+                            f"{topo.world.name!r} through joints or rigid parts")
+
+    sub = frames.subgraph(reached)
+    seen = set()
+    for parent, child in nx.bfs_edges(sub, topo.root):
+        data = next(iter(sub.get_edge_data(parent, child).values()))
+        comp = data["component"]
+        seen.add(comp.name)
+        rev = topo.set_of[comp.port_ref("frame_a")] != parent
+        topo.tree.append(Edge(comp, parent, child, rev))
+    extra = [d["component"] for _, _, d in sub.edges(data=True)
+             if d["component"].name not in seen]
+    if extra:
+        simple = nx.Graph(sub)
+        for cycle in nx.cycle_basis(simple):
+            names = _loop_names(sub, cycle)
+            topo.loops.append(names)
+        for u, v in {(u, v) for u, v, _ in sub.edges(keys=True)}:
+            comps = sub.get_edge_data(u, v)
+            if len(comps) > 1:
+                topo.loops.append(sorted(comps))
+        for names in topo.loops:
+            problems.append(f"kinematic loop through {', '.join(names)}: closed loops are not "
+                            f"supported yet; open the loop (remove one joint)")
+    rank = {name: i for i, name in enumerate(model.components)}
+    topo.joints = sorted((e.component for e in topo.tree if e.component.dof > 0),
+                         key=lambda c: rank[c.name])
+    topo.bodies = [(b, topo.set_of[b.port_ref("frame_a")]) for b in roles.get("body", [])
+                   if topo.set_of[b.port_ref("frame_a")] in reached]
+
+
+def _loop_names(graph, cycle):
+    names = []
+    for u, v in zip(cycle, cycle[1:] + cycle[:1]):
+        names.append(next(iter(graph.get_edge_data(u, v))))
+    return names
+
+
+def _oned(model, topo, values, problems):
+    """Each 1-D set with force elements needs exactly one port that sets its position."""
+    tree_joints = {j.name for j in topo.joints}
+    for index, ports in enumerate(topo.sets):
+        domain = ports[0].domain
+        if domain not in ONED_DOMAINS:
+            continue
+        physical = [p for p in ports if p.component.role != "probe"]
+        definers = [p for p in physical if _defines(p)]
+        oned = OneDSet(index, domain, physical)
+        coords = [p for p in definers if p.name in p.component.coordinate_ports]
+        if coords and len(definers) > 1:
+            problems.append(f"connection set {{{', '.join(p.path for p in physical)}}} rigidly "
+                            f"ties joint flange {coords[0].path} to "
+                            f"{', '.join(p.path for p in definers if p != coords[0])}: this "
+                            f"locks or couples joints, which is not supported yet")
+        elif len(definers) > 1 and values is not None:
+            positions = {p.path: _fixed_position(p, values) for p in definers}
+            if len(set(positions.values())) > 1:
+                problems.append(f"connection set {{{', '.join(p.path for p in physical)}}} "
+                                f"holds fixed flanges at different positions: {positions}")
+        if not definers and len(physical) > 1:
+            problems.append(f"connection set {{{', '.join(p.path for p in physical)}}} has no "
+                            f"defined {domain} position: wire it to a joint flange or a Fixed")
+        for p in coords:
+            if p.component.name not in tree_joints:
+                problems.append(f"{p.path}: joint {p.component.name!r} is not part of the "
+                                f"tree, so its flange cannot be used")
+        oned.definer = definers[0] if definers else None
+        topo.oned.append(oned)
+
+
+def _defines(ref):
+    comp = ref.component
+    return (ref.name in comp.coordinate_ports
+            or ref.name in comp.zero_ports
+            or comp.role == "fixed")
+
+
+def _fixed_position(ref, values):
+    comp = ref.component
+    if comp.role == "fixed":
+        return comp.bound(values[comp.name]).position()
+    return 0.0

@@ -1,0 +1,144 @@
+"""simulate(): integrate a model with CasADi's integrators or scipy's, looked up in METHODS."""
+
+import math
+
+import casadi as ca
+import numpy as np
+from scipy.integrate import solve_ivp
+
+from ..components.base import suggest
+from ..errors import ModelError, SimulationError
+from .results import Results
+from .system import System
+
+DEFAULTS = {"t_end": 10.0, "n_points": 1001, "method": "cvodes", "rtol": 1e-6, "atol": 1e-8}
+
+
+def _casadi(plugin, **options):
+    """A CasADi integrator plugin: the whole integration runs in compiled code."""
+    def run(system, grid, x0, p, rtol, atol):
+        integ = system.integrator(plugin, grid, rtol, atol, options)
+        try:
+            out = integ(x0=x0, p=p)
+        except RuntimeError as exc:
+            return _casadi_partial(system, plugin, grid, x0, p, rtol, atol, options, exc)
+        X = np.vstack([x0, np.asarray(out["xf"]).T])
+        return X, None
+    return run
+
+
+def _casadi_partial(system, plugin, grid, x0, p, rtol, atol, options, exc):
+    """After a failure, step interval by interval to keep everything computed before it."""
+    X = [x0]
+    for k in range(len(grid) - 1):
+        integ = system.integrator(plugin, grid[k:k + 2], rtol, atol, options, cache=False)
+        try:
+            X.append(np.asarray(integ(x0=X[-1], p=p)["xf"]).ravel())
+        except RuntimeError as step_exc:
+            return np.array(X), _reason(str(step_exc) or str(exc))
+    return np.array(X), _reason(str(exc))
+
+
+def _reason(message):
+    lines = [ln.strip() for ln in message.splitlines() if ln.strip()]
+    keep = [ln for ln in lines if "CV_" in ln or "IDA_" in ln or "flag" in ln.lower()]
+    return (keep or lines or ["integrator failed"])[-1]
+
+
+def _scipy(name):
+    """A scipy solve_ivp method fed by the compiled CasADi right-hand side and Jacobian."""
+    implicit = name in ("Radau", "BDF", "LSODA")
+
+    def run(system, grid, x0, p, rtol, atol):
+        f = system.f_rhs
+        fun = lambda t, x: np.asarray(f(t, x, p)).ravel()     # noqa: E731
+        kwargs = {}
+        if implicit:
+            jac = system.jacobian_function()
+            kwargs["jac"] = lambda t, x: np.asarray(jac(t, x, p))
+        sol = solve_ivp(fun, (grid[0], grid[-1]), x0, method=name, t_eval=grid,
+                        rtol=rtol, atol=atol, **kwargs)
+        X = sol.y.T
+        if sol.status < 0 or not np.all(np.isfinite(X)):
+            good = np.all(np.isfinite(X), axis=1)
+            n = len(X) if good.all() else int(np.argmin(good))
+            return X[:n], sol.message
+        return X, None
+    return run
+
+
+#: method name (case-insensitive) -> runner
+METHODS = {
+    "cvodes": _casadi("cvodes"),
+    "idas": _casadi("idas"),
+    **{m.lower(): _scipy(m) for m in ("RK45", "DOP853", "Radau", "BDF", "LSODA")},
+}
+
+
+def simulate(model, t_end=None, n_points=None, method=None, rtol=None, atol=None,
+             params=None, t_start=0.0):
+    """Integrate ``model`` (a Model or a compiled System) and record its probes.
+
+    Settings not given come from the model's ``simulation`` block, then from DEFAULTS.
+
+    Parameters
+    ----------
+    model : Model or System
+    t_end : float
+        End time [s]; the output grid has ``n_points`` equally spaced points from ``t_start``.
+    method : str
+        One of METHODS: ``cvodes`` (default), ``idas``, or scipy's ``RK45``, ``DOP853``,
+        ``Radau``, ``BDF``, ``LSODA``.
+    rtol, atol : float
+        Integrator tolerances.
+    params : dict, optional
+        Model parameter values for this run; no recompilation.
+
+    Returns
+    -------
+    Results
+
+    Raises
+    ------
+    ModelError
+        Bad settings or parameters.
+    SimulationError
+        The integration failed; ``err.results`` holds the results up to ``err.t_reached``.
+    """
+    system = model if isinstance(model, System) else model.compile()
+    given = {"t_end": t_end, "n_points": n_points, "method": method, "rtol": rtol,
+             "atol": atol}
+    settings = {**DEFAULTS, **system.model.simulation,
+                **{k: v for k, v in given.items() if v is not None}}
+    t_end, n_points, method, rtol, atol = (settings[k] for k in DEFAULTS)
+    key = str(method).lower()
+    if key not in METHODS:
+        raise ModelError(f"method {method!r}: unknown{suggest(key, METHODS)}; methods are "
+                         f"{', '.join(METHODS)}")
+    _check_settings(t_start, t_end, n_points, rtol, atol)
+    p = system.param_vector(params)
+    x0 = system.initial_state(params)
+    grid = np.linspace(t_start, t_end, int(n_points))
+    X, failure = METHODS[key](system, grid, x0, p, float(rtol), float(atol))
+    t = grid[:len(X)]
+    results = Results(t, X, system.state_names, system.outputs(t, X, params) if len(t) else
+                      np.zeros((0, 0)), system.signal_names, system.signal_sizes,
+                      system.signal_units, method=key, state_units=system.state_units)
+    if failure is not None:
+        reached = float(t[-1]) if len(t) else float(t_start)
+        raise SimulationError(f"{key} failed after t = {reached:g} s (of {t_end:g} s): "
+                              f"{failure}", results=results, t_reached=reached)
+    return results
+
+
+def _check_settings(t_start, t_end, n_points, rtol, atol):
+    for name, value in (("t_end", t_end), ("rtol", rtol), ("atol", atol)):
+        if isinstance(value, bool) or not isinstance(value, (int, float)) \
+                or not math.isfinite(value):
+            raise ModelError(f"simulation.{name}: must be a finite number, got {value!r}")
+    if t_end <= t_start:
+        raise ModelError(f"simulation.t_end: must be > {t_start}, got {t_end}")
+    if isinstance(n_points, bool) or not isinstance(n_points, int) or n_points < 2:
+        raise ModelError(f"simulation.n_points: must be an integer >= 2, got {n_points!r}")
+    if rtol <= 0 or atol <= 0:
+        raise ModelError(f"simulation: rtol and atol must be > 0, got {rtol}, {atol}")

@@ -1,0 +1,132 @@
+"""Recursive Newton-Euler algorithms over a kinematic tree, in CasADi SX.
+
+Spatial vectors are 6-vectors [angular; linear] in body coordinates (Featherstone's
+convention). ``Body.R, Body.p`` place a body in its parent: a point with body coordinates x
+sits at ``R @ x + p`` in the parent's. Gravity enters as an upward acceleration of the world
+(a0 = [0; -g]), so bodies feel it as inertia. Every function is O(number of bodies) except
+``crba``, which fills the n x n mass matrix.
+"""
+
+from dataclasses import dataclass
+
+import casadi as ca
+
+from ..spatial import skew
+
+ZERO6 = ca.SX.zeros(6, 1)
+
+
+@dataclass
+class Body:
+    """One moving body of the tree: the part carried by one joint with degrees of freedom."""
+    name: str
+    parent: int          # index of the parent body, -1 for the world
+    R: ca.SX             # 3x3, body axes in parent coordinates (depends on q)
+    p: ca.SX             # 3x1, body origin in parent coordinates (depends on q)
+    S: ca.SX             # 6 x dof motion subspace, body coordinates
+    cJ: ca.SX            # 6x1 velocity-product acceleration of the joint (S-dot qd)
+    inertia: ca.SX       # 6x6 spatial inertia about the body origin, body coordinates
+    index: list          # positions of this joint's coordinates in q
+
+
+def transform(R, p):
+    """Plücker transform of motion vectors from parent to body coordinates."""
+    Rt = R.T
+    return ca.blockcat([[Rt, ca.SX.zeros(3, 3)], [-Rt @ skew(p), Rt]])
+
+
+def crm(v):
+    """Spatial cross product for motion vectors (v x)."""
+    w, u = skew(v[:3]), skew(v[3:])
+    return ca.blockcat([[w, ca.SX.zeros(3, 3)], [u, w]])
+
+
+def crf(v):
+    """Spatial cross product for force vectors (v x*) = -crm(v)^T."""
+    return -crm(v).T
+
+
+def spatial_inertia(mass, com, inertia_cm):
+    """Spatial inertia about a frame origin of a body with ``com`` and ``inertia_cm`` there."""
+    c = skew(com)
+    return ca.blockcat([[inertia_cm + mass * (c @ c.T), mass * c],
+                        [mass * c.T, mass * ca.SX.eye(3)]])
+
+
+def _solve(D, b):
+    """D^-1 b for the small dof x dof joint-space inertia of one joint."""
+    return b / D if D.shape == (1, 1) else ca.solve(D, b)
+
+
+def aba(bodies, qd, tau, a0):
+    """Articulated-body algorithm: joint accelerations qdd, O(n) in the number of bodies."""
+    n = len(bodies)
+    X = [transform(b.R, b.p) for b in bodies]
+    v, c, IA, pA = [None] * n, [None] * n, [None] * n, [None] * n
+    for k, b in enumerate(bodies):
+        vJ = b.S @ qd[b.index]
+        v[k] = (X[k] @ v[b.parent] if b.parent >= 0 else ZERO6) + vJ
+        c[k] = crm(v[k]) @ vJ + b.cJ
+        IA[k] = b.inertia
+        pA[k] = crf(v[k]) @ (b.inertia @ v[k])
+    U, D, u = [None] * n, [None] * n, [None] * n
+    for k in reversed(range(n)):
+        b = bodies[k]
+        U[k] = IA[k] @ b.S
+        D[k] = b.S.T @ U[k]
+        u[k] = tau[b.index] - b.S.T @ pA[k]
+        if b.parent >= 0:
+            Ia = IA[k] - U[k] @ _solve(D[k], U[k].T)
+            pa = pA[k] + Ia @ c[k] + U[k] @ _solve(D[k], u[k])
+            IA[b.parent] = IA[b.parent] + X[k].T @ Ia @ X[k]
+            pA[b.parent] = pA[b.parent] + X[k].T @ pa
+    qdd = ca.SX.zeros(qd.shape[0], 1)
+    a = [None] * n
+    for k, b in enumerate(bodies):
+        ap = X[k] @ (a[b.parent] if b.parent >= 0 else a0) + c[k]
+        qdd_k = _solve(D[k], u[k] - U[k].T @ ap)
+        qdd[b.index] = qdd_k
+        a[k] = ap + b.S @ qdd_k
+    return qdd
+
+
+def crba(bodies, n_q):
+    """Composite-rigid-body algorithm: the joint-space mass matrix M(q)."""
+    X = [transform(b.R, b.p) for b in bodies]
+    IC = [b.inertia for b in bodies]
+    for k in reversed(range(len(bodies))):
+        parent = bodies[k].parent
+        if parent >= 0:
+            IC[parent] = IC[parent] + X[k].T @ IC[k] @ X[k]
+    M = ca.SX.zeros(n_q, n_q)
+    for k, b in enumerate(bodies):
+        F = IC[k] @ b.S
+        M[b.index, b.index] = b.S.T @ F
+        j = k
+        while bodies[j].parent >= 0:
+            F = X[j].T @ F
+            j = bodies[j].parent
+            block = F.T @ bodies[j].S
+            M[b.index, bodies[j].index] = block
+            M[bodies[j].index, b.index] = block.T
+    return M
+
+
+def rnea(bodies, qd, qdd, a0):
+    """Inverse dynamics: generalized forces that produce qdd at (q, qd) (outward, inward)."""
+    n = len(bodies)
+    X = [transform(b.R, b.p) for b in bodies]
+    v, a, f = [None] * n, [None] * n, [None] * n
+    for k, b in enumerate(bodies):
+        vJ = b.S @ qd[b.index]
+        v[k] = (X[k] @ v[b.parent] if b.parent >= 0 else ZERO6) + vJ
+        a[k] = (X[k] @ a[b.parent] if b.parent >= 0 else X[k] @ a0) \
+            + b.S @ qdd[b.index] + crm(v[k]) @ vJ + b.cJ
+        f[k] = b.inertia @ a[k] + crf(v[k]) @ (b.inertia @ v[k])
+    tau = ca.SX.zeros(qd.shape[0], 1)
+    for k in reversed(range(n)):
+        b = bodies[k]
+        tau[b.index] = b.S.T @ f[k]
+        if b.parent >= 0:
+            f[b.parent] = f[b.parent] + X[k].T @ f[k]
+    return tau

@@ -1,0 +1,141 @@
+"""System: a compiled model, its states, parameters and CasADi Functions."""
+
+import casadi as ca
+import numpy as np
+
+from ..errors import ModelError
+from .assemble import assemble
+
+
+class System:
+    """The equations of a validated model, compiled once; parameters stay symbolic.
+
+    Attributes
+    ----------
+    state_names : list of str
+        Joint coordinates, then their speeds (``"shoulder.q"``, ..., ``"shoulder.qd"``).
+    x0 : numpy.ndarray
+        Initial state for the model's parameter values.
+    """
+
+    def __init__(self, model):
+        self.model = model
+        self.topology = model.validate()
+        self.asm = asm = assemble(model, self.topology)
+        self.param_names = asm.param_names
+        self.coordinate_names = asm.coordinate_names
+        self.state_names = asm.coordinate_names + [c + "d" for c in asm.coordinate_names]
+        self.state_units = asm.coordinate_units + [u + "/s" for u in asm.coordinate_units]
+        x = ca.vertcat(asm.q, asm.qd)
+        self._x = x
+        self.ode = ca.vertcat(asm.qd, asm.qdd)
+        self.f_rhs = ca.Function("rhs", [asm.t, x, asm.p], [self.ode], ["t", "x", "p"], ["xdot"])
+        self.f_x0 = ca.Function("x0", [asm.p], [asm.x0])
+        self.signal_names = [name for name, _, _ in asm.signals]
+        self.signal_units = {name: unit for name, unit, _ in asm.signals}
+        self.signal_sizes = {name: expr.numel() for name, _, expr in asm.signals}
+        outs = [ca.substitute(expr, asm.qdd_sym, asm.qdd) for _, _, expr in asm.signals]
+        self.f_out = ca.Function("outputs", [asm.t, x, asm.p],
+                                 [ca.vertcat(*outs) if outs else ca.SX(0, 1)])
+        self._f_mass = None
+        self._f_terms = None
+        self._f_jac = None
+        self._integrators = {}
+
+    # -- parameters -----------------------------------------------------------------------
+    def param_vector(self, params=None):
+        """Model parameters as the vector p, with ``params`` overrides checked."""
+        values = self.model.parameter_values(params)
+        if params:
+            self.model.numeric_values(params)     # bounds of everything that depends on them
+        return np.array([values[k] for k in self.param_names], dtype=float)
+
+    @property
+    def x0(self):
+        return self.initial_state()
+
+    def initial_state(self, params=None):
+        """Initial state for the given parameter overrides."""
+        return np.asarray(self.f_x0(self.param_vector(params))).ravel()
+
+    @property
+    def n_states(self):
+        return len(self.state_names)
+
+    # -- numbers --------------------------------------------------------------------------
+    def rhs(self, t, x, params=None):
+        """dx/dt of the ODE at (t, x), as numpy (n_states,)."""
+        x = self._vector(x, self.n_states, "x")
+        return np.asarray(self.f_rhs(t, x, self.param_vector(params))).ravel()
+
+    def mass_matrix(self, q, params=None):
+        """Joint-space mass matrix M(q) of the tree, numpy (n, n)."""
+        if self._f_mass is None:
+            a = self.asm
+            self._f_mass = ca.Function("M", [a.q, a.p], [a.mass_matrix()])
+        q = self._vector(q, len(self.coordinate_names), "q")
+        return np.asarray(self._f_mass(q, self.param_vector(params)))
+
+    def dynamics_terms(self, q, qd, params=None, t=0.0):
+        """(M, V, G) as numpy with M qdd + V + G = 0, in the form of the seed paper.
+
+        V holds the Coriolis and centripetal terms minus the generalized forces of the 1-D
+        elements (so a shoulder spring-damper adds c*q + d*qd); G holds gravity.
+        """
+        f = self._terms_function()
+        n = len(self.coordinate_names)
+        M, V, G = f(t, self._vector(q, n, "q"), self._vector(qd, n, "qd"),
+                    self.param_vector(params))
+        return np.asarray(M), np.asarray(V).ravel(), np.asarray(G).ravel()
+
+    def equations(self):
+        """Symbolic M, V, G (CasADi SX) with their symbols: q, qd, p (parameters), t."""
+        a = self.asm
+        M, V, G = a.terms()
+        return {"M": M, "V": V, "G": G, "q": a.q, "qd": a.qd, "p": a.p, "t": a.t,
+                "param_names": list(a.param_names)}
+
+    def outputs(self, t, x, params=None):
+        """Probe signals at the given times and states (x: (n_points, n_states))."""
+        t = np.atleast_1d(np.asarray(t, dtype=float))
+        X = np.atleast_2d(np.asarray(x, dtype=float))
+        f = self.f_out.map(len(t))
+        return np.asarray(f(t[None, :], X.T, self.param_vector(params))).T
+
+    def integrator(self, plugin, grid, rtol, atol, options=None, cache=True):
+        """A CasADi integrator over ``grid`` (outputs at grid[1:]), cached per settings."""
+        key = (plugin, grid[0], grid[-1], len(grid), rtol, atol, tuple(sorted((options or {}).items())))
+        if cache and key in self._integrators:
+            return self._integrators[key]
+        dae = {"x": self._x, "p": self.asm.p, "t": self.asm.t, "ode": self.ode}
+        opts = {"reltol": rtol, "abstol": atol, **(options or {})}
+        integ = ca.integrator("simulate", plugin, dae, float(grid[0]),
+                              [float(g) for g in grid[1:]], opts)
+        if cache:
+            self._integrators[key] = integ
+        return integ
+
+    def jacobian_function(self):
+        """d(xdot)/dx as a CasADi Function of (t, x, p), for implicit methods."""
+        if self._f_jac is None:
+            a = self.asm
+            self._f_jac = ca.Function("jacobian", [a.t, self._x, a.p],
+                                      [ca.jacobian(self.ode, self._x)])
+        return self._f_jac
+
+    def _terms_function(self):
+        if self._f_terms is None:
+            a = self.asm
+            self._f_terms = ca.Function("terms", [a.t, a.q, a.qd, a.p], list(a.terms()))
+        return self._f_terms
+
+    @staticmethod
+    def _vector(v, n, what):
+        arr = np.asarray(v, dtype=float).ravel()
+        if arr.shape != (n,):
+            raise ModelError(f"{what}: expected {n} values, got shape {np.shape(v)}")
+        return arr
+
+    def __repr__(self):
+        return (f"<System {self.model.name!r}: {self.n_states} states, "
+                f"{len(self.signal_names)} signals>")
