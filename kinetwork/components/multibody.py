@@ -26,7 +26,8 @@ class PartialRigidTransform(Component):
     dof = 0
     constant_subspace = True
     frame_a = Port("frame", "Frame a")
-    frame_b = Port("frame", "Frame b, at the fixed transform from frame_a")
+    # a dangling end of a rigid part is a marker frame (for probes), as in Modelica
+    frame_b = Port("frame", "Frame b, at the fixed transform from frame_a", optional=True)
 
 
 class FixedTranslation(PartialRigidTransform, library=MB):
@@ -55,6 +56,7 @@ class PartialJoint(PartialRigidTransform):
     taken, as in Modelica MultiBody, to rest in the world frame.
     """
     dof = 1
+    frame_b = Port("frame", "Frame b, moved by the joint coordinate")
     coordinate_ports = {"axis": 0}
     zero_ports = ("support",)
     axis = Port("1d", "Flange driving the joint coordinate", optional=True)

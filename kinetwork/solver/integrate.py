@@ -31,7 +31,8 @@ def _casadi_partial(system, plugin, grid, x0, p, rtol, atol, options, exc):
     """After a failure, step interval by interval to keep everything computed before it."""
     X = [x0]
     for k in range(len(grid) - 1):
-        integ = system.integrator(plugin, grid[k:k + 2], rtol, atol, options, cache=False)
+        integ = system.integrator(plugin, grid[k:k + 2], rtol, atol,
+                                  {**options, "disable_internal_warnings": True}, cache=False)
         try:
             X.append(np.asarray(integ(x0=X[-1], p=p)["xf"]).ravel())
         except RuntimeError as step_exc:
@@ -39,10 +40,29 @@ def _casadi_partial(system, plugin, grid, x0, p, rtol, atol, options, exc):
     return np.array(X), _reason(str(exc))
 
 
+#: SUNDIALS return flags, in plain words
+FLAGS = {
+    "TOO_MUCH_WORK": "too many steps before the next output time: the solution may blow up "
+                     "there, or the problem is stiff for this method",
+    "TOO_MUCH_ACC": "the tolerances asked for are below machine precision",
+    "ERR_FAIL": "the error test failed repeatedly: the step size collapsed",
+    "CONV_FAIL": "the Newton iteration failed to converge repeatedly: the step size collapsed",
+    "RHSFUNC_ERR": "the right-hand side became non-finite (Inf or NaN): a force or a "
+                   "parameter expression blows up",
+    "RHSFUNC_FAIL": "the right-hand side became non-finite (Inf or NaN): a force or a "
+                    "parameter expression blows up",
+    "RES_FAIL": "the residual became non-finite (Inf or NaN)",
+    "LSETUP_FAIL": "the linear solver setup failed (singular iteration matrix)",
+    "LSOLVE_FAIL": "the linear solver failed (singular iteration matrix)",
+}
+
+
 def _reason(message):
+    for flag, words in FLAGS.items():
+        if flag in message:
+            return words
     lines = [ln.strip() for ln in message.splitlines() if ln.strip()]
-    keep = [ln for ln in lines if "CV_" in ln or "IDA_" in ln or "flag" in ln.lower()]
-    return (keep or lines or ["integrator failed"])[-1]
+    return (lines or ["integrator failed"])[-1]
 
 
 def _scipy(name):
@@ -119,7 +139,10 @@ def simulate(model, t_end=None, n_points=None, method=None, rtol=None, atol=None
     p = system.param_vector(params)
     x0 = system.initial_state(params)
     grid = np.linspace(t_start, t_end, int(n_points))
-    X, failure = METHODS[key](system, grid, x0, p, float(rtol), float(atol))
+    if system.n_states:
+        X, failure = METHODS[key](system, grid, x0, p, float(rtol), float(atol))
+    else:                           # everything welded to the ground: nothing to integrate
+        X, failure = np.zeros((len(grid), 0)), None
     t = grid[:len(X)]
     results = Results(t, X, system.state_names, system.outputs(t, X, params) if len(t) else
                       np.zeros((0, 0)), system.signal_names, system.signal_sizes,

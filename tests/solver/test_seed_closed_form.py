@@ -259,10 +259,20 @@ def test_mass_matrix_matches_seed(system, seed):
                                  err_msg=f"params={p}, q={q}\nM=\n{M}\nexpected\n{M_ref}")
 
 
-def _residual_scale(M, qdd, V, G, p, q, qd):
-    """Elementwise sum of magnitudes of every term in ``M qdd + V + G``."""
-    return (np.abs(M) @ np.abs(qdd) + np.abs(V) + np.abs(G)
-            + np.array([abs(p["c"] * q[0]) + abs(p["d"] * qd[0]), 0.0]))
+def force_scale(q, qd, p):
+    """Per row, the size of the terms that make up V and G (before they cancel).
+
+    Returns
+    -------
+    v_scale, g_scale : ndarray, shape (2,)
+    """
+    L1, L2, m1, m2 = p["L1"], p["L2"], p["m1"], p["m2"]
+    inertial = L1 * L2 * m2
+    v_scale = np.array([inertial * abs(qd[1]) * (abs(qd[0]) + abs(qd[1]))
+                        + abs(p["c"] * q[0]) + abs(p["d"] * qd[0]),
+                        inertial * qd[0] ** 2])
+    g_scale = p["g"] * np.array([L1 * (m1 + m2) + L2 * m2, L2 * m2])
+    return v_scale, g_scale
 
 
 @pytest.mark.parametrize("seed", SEEDS)
@@ -283,12 +293,12 @@ def test_rhs_matches_seed(system, seed):
     M, V, G = seed_terms(q, qd, p)
     qdd = dx[2:]
     residual = M @ qdd + V + G
-    scale = _residual_scale(M, qdd, V, G, p, q, qd)
-    np.testing.assert_array_less(np.abs(residual), 1e-12 * scale + 1e-300,
+    scale = np.abs(M) @ np.abs(qdd) + sum(force_scale(q, qd, p))
+    np.testing.assert_array_less(np.abs(residual), 1e-11 * scale,
                                  err_msg=f"params={p}, x={x}, qdd={qdd}")
     # the forward consequence of that backward error: |dqdd| <= |M^-1| |residual|
     qdd_ref = seed_qdd(q, qd, p)
-    tol = 1e-12 * np.linalg.norm(np.linalg.inv(M), np.inf) * scale.max() + 1e-300
+    tol = 1e-11 * np.linalg.norm(np.linalg.inv(M), np.inf) * scale.max()
     np.testing.assert_allclose(qdd, qdd_ref, rtol=1e-11, atol=tol,
                                err_msg=f"params={p}, x={x}")
 
@@ -324,13 +334,10 @@ def test_dynamics_terms_match_seed(system, seed):
     assert M.shape == (2, 2) and V.shape == (2,) and G.shape == (2,)
     scale = np.sqrt(np.outer(np.diag(M_ref), np.diag(M_ref)))
     np.testing.assert_array_less(np.abs(M - M_ref), 1e-12 * scale, err_msg="M")
-    L1, L2, m2 = p["L1"], p["L2"], p["m2"]
-    v_scale = (L1 * L2 * m2 * (np.abs(qd[1]) * (np.abs(qd[0]) + np.abs(qd[1])) + qd[0] ** 2)
-               + np.array([abs(p["c"] * q[0]) + abs(p["d"] * qd[0]), 0.0]))
-    np.testing.assert_array_less(np.abs(V - V_ref), 1e-12 * v_scale + 1e-300,
+    v_scale, g_scale = force_scale(q, qd, p)
+    np.testing.assert_array_less(np.abs(V - V_ref), 1e-11 * v_scale + 1e-300,
                                  err_msg=f"V={V}, expected {V_ref}, params={p}, q={q}, qd={qd}")
-    g_scale = p["g"] * (L1 * (p["m1"] + p["m2"]) + L2 * m2)
-    np.testing.assert_array_less(np.abs(G - G_ref), 1e-12 * g_scale,
+    np.testing.assert_array_less(np.abs(G - G_ref), 1e-11 * g_scale,
                                  err_msg=f"G={G}, expected {G_ref}, params={p}, q={q}")
 
 
@@ -353,9 +360,12 @@ CASES = {
     "paper-large": (PAPER, (1.5, -2.0), (0.0, 0.0), "number"),
     "asymmetric": ({"L1": 0.7, "L2": 1.3, "m1": 2.0, "m2": 0.5, "c": 3.0, "d": 0.4,
                     "g": 9.81}, (1.5, -2.0), (0.3, -1.0), "parameter"),
-    "heavy-tip": ({"L1": 2.0, "L2": 0.5, "m1": 0.3, "m2": 4.0, "c": 10.0, "d": 2.0,
-                   "g": 9.81}, (-2.5, 3.0), (0.0, 0.0), "parameter"),
+    "long-tip": ({"L1": 0.5, "L2": 2.0, "m1": 4.0, "m2": 0.3, "c": 10.0, "d": 2.0,
+                  "g": 9.81}, (-2.5, 3.0), (0.0, 0.0), "parameter"),
 }
+# Every case is damped and only mildly sensitive: the reference itself moves by < 1e-8 from
+# rtol 1e-10 to 1e-13. (An undamped large swing is chaotic: 1e-12 perturbations grow to 1e-6
+# within 10 s, so it could not judge a solver at 1e-6.)
 METHODS = ["cvodes", "idas", "DOP853"]
 TRAJECTORY_CASES = [pytest.param(case, method, id=f"{case}-{method}")
                     for case in CASES for method in METHODS]
@@ -375,7 +385,10 @@ def _trajectory_model(case):
 
 @pytest.mark.parametrize("case, method", TRAJECTORY_CASES)
 def test_trajectory_matches_closed_form(case, method):
-    """All four probe quantities of both joints follow the closed-form reference to 1e-6."""
+    """All four probe quantities of both joints follow the closed-form reference to 1e-6.
+
+    The tolerance is absolute for signals of size up to 1 and relative beyond.
+    """
     p, q0, qd0, _ = CASES[case]
     model, params = _trajectory_model(case)
     res = kn.simulate(model, t_end=10.0, n_points=1001, method=method, rtol=1e-10,
@@ -387,7 +400,9 @@ def test_trajectory_matches_closed_form(case, method):
     states = np.asarray(res.states, dtype=float)
     assert states.shape == (1001, 4)
     assert list(res.state_names) == STATE_NAMES
-    np.testing.assert_allclose(states, ref["states"], rtol=0, atol=1e-6, err_msg="states")
+    tol = 1e-6 * np.maximum(1.0, np.abs(ref["states"]).max(axis=0))
+    np.testing.assert_array_less(np.abs(states - ref["states"]),
+                                 np.broadcast_to(tol, states.shape), err_msg="states")
 
     failures = []
     for probe in ("probe1", "probe2"):
