@@ -4,7 +4,6 @@ import math
 
 import casadi as ca
 import numpy as np
-from scipy.integrate import solve_ivp
 
 from ..components.base import suggest
 from ..errors import ModelError, SimulationError
@@ -70,6 +69,7 @@ def _scipy(name):
     implicit = name in ("Radau", "BDF", "LSODA")
 
     def run(system, grid, x0, p, rtol, atol):
+        from scipy.integrate import solve_ivp    # 0.4 s to import: only when asked for
         f = system.f_rhs
         fun = lambda t, x: np.asarray(f(t, x, p)).ravel()     # noqa: E731
         kwargs = {}

@@ -1,0 +1,35 @@
+"""The README's component table and example stay in step with the code."""
+
+import pathlib
+import re
+
+import numpy as np
+
+from kinetwork.components.base import REGISTRY
+
+README = (pathlib.Path(__file__).resolve().parents[1] / "README.md").read_text()
+
+
+def test_every_component_is_listed():
+    listed = set()
+    for row in re.findall(r"^\| `([^`]+)`(?: / `([^`]+)`)*(?: / `([^`]+)`)*", README, re.M):
+        first = row[0]
+        listed.add(first)
+        lib = first.rsplit(".", 1)[0] if "." in first else ""
+        listed.update(f"{lib}.{n}" for n in row[1:] if n)
+    table = README.split("## Components", 1)[1].split("##", 1)[0]
+    for extra in re.findall(r"/ `(\w+)`", table):
+        listed.update(f"{lib}.{extra}" for lib in ("rotational", "translational"))
+    missing = sorted(set(REGISTRY) - listed)
+    assert not missing, f"components missing from README: {missing}"
+
+
+def test_python_example_runs(tmp_path, monkeypatch):
+    code = README.split("## In Python", 1)[1].split("```python", 1)[1].split("```", 1)[0]
+    monkeypatch.chdir(tmp_path)
+    scope = {}
+    exec(compile(code, "README.md", "exec"), scope)          # our own README, not user input
+    res = scope["res"]
+    q, qd = res["shoulder.q"], res["shoulder.qd"]
+    np.testing.assert_allclose(res["probe1.torque"], -(2.0 * q + 1.0 * qd), atol=1e-12)
+    assert (tmp_path / "probes.png").stat().st_size > 10_000
