@@ -70,19 +70,17 @@ def _scipy(name):
 
     def run(system, grid, x0, p, rtol, atol):
         from scipy.integrate import solve_ivp    # 0.4 s to import: only when asked for
-        f = system.f_rhs
-        fun = lambda t, x: np.asarray(f(t, x, p)).ravel()     # noqa: E731
-        kwargs = {}
-        if implicit:
-            jac = system.jacobian_function()
-            kwargs["jac"] = lambda t, x: np.asarray(jac(t, x, p))
-        sol = solve_ivp(fun, (grid[0], grid[-1]), x0, method=name, t_eval=grid,
-                        rtol=rtol, atol=atol, **kwargs)
+        kwargs = {"jac": system.numeric(system.jacobian_function(), p)} if implicit else {}
+        fun = system.numeric(system.f_rhs, p)
+        with np.errstate(all="ignore"):      # a blow-up is reported below, not warned
+            sol = solve_ivp(fun, (grid[0], grid[-1]), x0, method=name, t_eval=grid,
+                            rtol=rtol, atol=atol, **kwargs)
         X = sol.y.T
-        if sol.status < 0 or not np.all(np.isfinite(X)):
-            good = np.all(np.isfinite(X), axis=1)
-            n = len(X) if good.all() else int(np.argmin(good))
-            return X[:n], sol.message
+        good = np.all(np.isfinite(X), axis=1)
+        if not good.all():
+            return X[:int(np.argmin(good))], "the state became non-finite (Inf or NaN)"
+        if sol.status < 0:
+            return X, sol.message
         return X, None
     return run
 

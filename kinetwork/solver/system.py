@@ -29,7 +29,9 @@ class System:
         x = ca.vertcat(asm.q, asm.qd)
         self._x = x
         self.ode = ca.vertcat(asm.qd, asm.qdd)
-        self.f_rhs = ca.Function("rhs", [asm.t, x, asm.p], [self.ode], ["t", "x", "p"], ["xdot"])
+        # dense outputs: Function.buffer callers read plain column-major arrays
+        self.f_rhs = ca.Function("rhs", [asm.t, x, asm.p], [ca.densify(self.ode)],
+                                 ["t", "x", "p"], ["xdot"])
         self.f_x0 = ca.Function("x0", [asm.p], [asm.x0])
         self.signal_names = [name for name, _, _ in asm.signals]
         self.signal_units = {name: unit for name, unit, _ in asm.signals}
@@ -120,8 +122,31 @@ class System:
         if self._f_jac is None:
             a = self.asm
             self._f_jac = ca.Function("jacobian", [a.t, self._x, a.p],
-                                      [ca.jacobian(self.ode, self._x)])
+                                      [ca.densify(ca.jacobian(self.ode, self._x))])
         return self._f_jac
+
+    def numeric(self, f, p):
+        """A fast Python callable ``(t, x) -> ndarray`` of a Function of (t, x, p).
+
+        Uses ``Function.buffer``: ~0.5 us a call instead of ~16 us for a plain call, which is
+        what scipy's integrators pay on every right-hand-side evaluation.
+        """
+        buf, trigger = f.buffer()
+        t_in, x_in = np.zeros(1), np.zeros(self.n_states)
+        p_in = np.array(p, dtype=float)
+        shape = f.size_out(0)
+        out = np.zeros(shape[0] * shape[1])          # dense, column-major like CasADi
+        for i, arr in enumerate((t_in, x_in, p_in)):
+            buf.set_arg(i, memoryview(arr))
+        buf.set_res(0, memoryview(out))
+
+        # CasADi keeps raw pointers: the buffer and every array must outlive the trigger
+        def call(t, x, _keep=(buf, p_in)):
+            t_in[0] = t
+            x_in[:] = x
+            trigger()
+            return out.reshape(shape, order="F").copy() if shape[1] > 1 else out.copy()
+        return call
 
     def _terms_function(self):
         if self._f_terms is None:
