@@ -7,7 +7,7 @@ coordinates, :func:`simulate` it and read the probes from the :class:`Results`.
 from .components import multibody, rotational, translational
 from .components.probe import Probe
 from .errors import ModelError, SimulationError
-from .graph.io import load
+from .graph.io import dumps, load, loads
 from .graph.model import Model
 from .solver.integrate import METHODS, simulate
 from .solver.results import Results
@@ -16,4 +16,4 @@ from .solver.system import System
 __version__ = "0.1.0"
 
 __all__ = ["METHODS", "Model", "ModelError", "Probe", "Results", "SimulationError", "System",
-           "load", "multibody", "rotational", "simulate", "translational"]
+           "dumps", "load", "loads", "multibody", "rotational", "simulate", "translational"]

@@ -38,10 +38,12 @@ class Expression:
             raise ModelError(f"expression longer than {_MAX_LENGTH} characters")
         try:
             tree = ast.parse(text.strip(), mode="eval")
+            self.names = set()
+            self._check(tree.body)
         except SyntaxError as exc:
             raise ModelError(f"cannot parse expression {text!r}: {exc.msg}") from None
-        self.names = set()
-        self._check(tree.body)
+        except (RecursionError, MemoryError):
+            raise ModelError(f"expression nested too deeply ({len(text)} characters)") from None
         self._tree = tree.body
 
     def _check(self, node):
@@ -62,13 +64,17 @@ class Expression:
             for arg in node.args:
                 self._check(arg)
         else:
-            what = type(node).__name__
             if isinstance(node, ast.Call):
                 name = getattr(node.func, "id", None)
-                close = difflib.get_close_matches(str(name), FUNCTIONS, n=1)
+                if name is None:
+                    raise ModelError(f"expression {self.text!r}: calling anything but a named "
+                                     f"function is not allowed")
+                close = difflib.get_close_matches(name, FUNCTIONS, n=1)
                 hint = f" (did you mean {close[0]!r}?)" if close else ""
-                what = f"call of {name!r}{hint}; allowed functions: {', '.join(sorted(FUNCTIONS))}"
-            raise ModelError(f"expression {self.text!r}: {what} is not allowed")
+                raise ModelError(f"expression {self.text!r}: call of {name!r} is not allowed"
+                                 f"{hint}; functions are {', '.join(sorted(FUNCTIONS))}")
+            raise ModelError(f"expression {self.text!r}: {type(node).__name__} is not allowed "
+                             f"(only numbers, names, + - * / ** and functions)")
 
     def evaluate(self, env, functions=None):
         """Evaluate with ``env`` mapping names to values; ``functions`` overrides FUNCTIONS."""
@@ -87,7 +93,10 @@ class Expression:
                 return _UNARY[type(node.op)](ev(node.operand))
             return funcs[node.func.id](*[ev(a) for a in node.args])
 
-        return ev(self._tree)
+        try:
+            return ev(self._tree)
+        except RecursionError:
+            raise ModelError(f"expression nested too deeply ({len(self.text)} characters)") from None
 
     def __repr__(self):
         return f"Expression({self.text!r})"

@@ -158,15 +158,21 @@ class Param:
         if isinstance(value, np.generic):
             value = value.item()
         if isinstance(value, str):
-            expr = Expression(value) if value.strip() else None
-            if expr is None:
+            if not value.strip():
                 raise ModelError(f"{where}: empty expression")
+            try:
+                expr = Expression(value)
+            except ModelError as exc:
+                raise ModelError(f"{where}: {exc}") from None
             if "t" in expr.names and not self.time:
                 raise ModelError(f"{where}: time 't' is not allowed in {value!r}; "
                                  f"this parameter is constant")
             return value
         if isinstance(value, bool) or not isinstance(value, (int, float)):
             raise ModelError(f"{where}: must be a number or an expression, got {value!r}")
+        if isinstance(value, int) and abs(value) > 2**1023:
+            raise ModelError(f"{where}: must be finite, got an integer of {len(str(value))} "
+                             f"digits")
         if not math.isfinite(value):
             raise ModelError(f"{where}: must be finite, got {value!r}")
         if bounds:
@@ -210,6 +216,8 @@ class Component:
                     cls.ports[key] = val
                 elif isinstance(val, Param):
                     cls.params[val.name] = val
+        # a subclass declared without ``library=`` is not a file type (not its parent's either)
+        cls.type_name = None
         if library is not None and not cls.__name__.startswith("Partial"):
             cls.type_name = f"{library}.{cls.__name__}" if library else cls.__name__
             REGISTRY[cls.type_name] = cls

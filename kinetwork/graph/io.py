@@ -1,9 +1,485 @@
-"""JSON load/save (placeholder until the io module lands)."""
+"""JSON model files (format "kinetwork.model", version 1): load, save and their refusals.
+
+A file names component types, never code: types resolve only through the component
+``REGISTRY`` and parameter strings go through the safe expression parser, so loading executes
+nothing from the file. Every problem is reported with its place in the file
+(``components[3] "mass1" params.mass``), all in one ``ModelError``; a model is returned only
+when the whole file is sound.
+"""
+
+import copy
+import json
+import math
+import os
+import secrets
+import stat
+
+from ..components.base import REGISTRY, suggest
+from ..errors import ModelError
+from ..expr import Expression
+from .model import Model
+
+FORMAT, VERSION, SUPPORTED = "kinetwork.model", 1, (1,)
+#: top-level keys, in the order files are written
+KEYS = ("format", "version", "name", "description", "parameters", "components", "connections",
+        "simulation", "layout")
+REQUIRED = ("format", "version", "name", "components")
+COMPONENT_KEYS = ("name", "type", "params")
+SIMULATION_KEYS = ("t_end", "n_points", "method", "rtol", "atol")
+#: among the names of broken components: some entry had no usable name (no identifier is "*")
+UNNAMED = "*"
+#: a list of scalars stays on one line up to this many characters
+WIDTH = 80
 
 
-def load(path):
-    raise NotImplementedError
+# -- reading ----------------------------------------------------------------------------------
+def load(path, validate=True):
+    """Read a model file.
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+    validate : bool, optional
+        Also check the wiring (``Model.validate``); False reads a model saved half-built.
+
+    Returns
+    -------
+    Model
+
+    Raises
+    ------
+    ModelError
+        Every problem with the file, each message starting with the file name and the place.
+    """
+    source = os.fspath(path)
+    try:
+        with open(source, "rb") as fh:
+            raw = fh.read()
+    except OSError as exc:
+        raise ModelError(f"{source}: cannot read the file ({exc.strerror or exc})") from exc
+    try:
+        text = raw.decode("utf-8-sig")     # tolerate the BOM some editors write
+    except UnicodeDecodeError as exc:
+        raise ModelError(f"{source}: not UTF-8 text (byte {exc.start})") from None
+    return loads(text, source=source, validate=validate)
+
+
+def loads(text, source=None, validate=True):
+    """Read a model from JSON text, as :func:`load` does.
+
+    Parameters
+    ----------
+    text : str
+    source : str, optional
+        Where the text came from, prefixed to every message.
+    """
+    try:
+        data = json.loads(text, object_pairs_hook=_Object.from_pairs, parse_int=_int)
+    except json.JSONDecodeError as exc:
+        end = " (the text ends early: truncated?)" if exc.pos >= len(text.rstrip()) else ""
+        raise ModelError(_at(source, f"line {exc.lineno} column {exc.colno}: invalid JSON: "
+                                     f"{exc.msg}{end}")) from None
+    except (ValueError, RecursionError) as exc:
+        raise ModelError(_at(source, f"invalid JSON ({exc})")) from None
+    return model_from_dict(data, source=source, validate=validate)
+
+
+def model_from_dict(data, source=None, validate=True):
+    """Build a Model from a file's parsed JSON, or refuse it whole.
+
+    Parameters
+    ----------
+    data : dict
+        The top-level object.
+    source : str, optional
+        File name, prefixed to every message.
+    validate : bool, optional
+        Also run ``Model.validate`` (wiring, loops, names used in expressions).
+    """
+    problems = []
+    model = _attempt(problems, "top level", _build, data, problems)
+    if problems:
+        raise ModelError([_at(source, p) for p in problems])
+    if validate:
+        try:
+            model.validate()
+        except ModelError as exc:
+            raise ModelError([_at(source, p) for p in exc.problems]) from None
+    return model
+
+
+def _build(data, problems):
+    if not isinstance(data, dict):
+        problems.append(f"top level: must be an object {{...}}, got {_kind(data)}")
+        return None
+    _repeated(data, "", problems)
+    problems.extend(f"{key!r}: unknown key{suggest(key, KEYS)}; keys are {', '.join(KEYS)}"
+                    for key in data if key not in KEYS)
+    problems.extend(f"{key}: required key missing" for key in REQUIRED if key not in data)
+    # another format or version: whatever else looks wrong is noise, so stop here
+    fmt, version = data.get("format", FORMAT), data.get("version", VERSION)
+    if fmt != FORMAT:
+        problems.append(f"format: {fmt!r} is not a kinetwork model file (expected {FORMAT!r})")
+        return None
+    if type(version) is not int or version not in SUPPORTED:
+        problems.append(f"version: {version!r} is not supported; this kinetwork reads version "
+                        f"{', '.join(map(str, SUPPORTED))}")
+        return None
+    name = data.get("name", "unnamed")
+    if not isinstance(name, str) or not name:
+        problems.append(f"name: must be a non-empty string, got {name!r:.40}")
+        name = "unnamed"
+    model = Model(name)
+    model.description = data.get("description", "")
+    if not isinstance(model.description, str):
+        problems.append(f"description: must be a string, got {_kind(model.description)}")
+    parameters = data.get("parameters", {})
+    if not isinstance(parameters, dict):
+        problems.append(f"parameters: must be an object of numbers, got {_kind(parameters)}")
+    else:
+        for key, value in parameters.items():
+            _attempt(problems, "parameters", model.set_parameter, key, value)
+    broken = (_components(model, data["components"], problems) if "components" in data
+              else {UNNAMED})
+    _connections(model, data.get("connections", []), broken, problems)
+    model.simulation = _simulation(data.get("simulation", {}), problems)
+    model.layout = _attempt(problems, "layout", _layout, model, data.get("layout", {}),
+                            broken, problems)
+    return model
+
+
+def _components(model, entries, problems):
+    """Add each entry; return the names of the failed ones, whose wiring goes unchecked."""
+    if not isinstance(entries, list):
+        problems.append(f"components: must be a list, got {_kind(entries)}")
+        return {UNNAMED}
+    broken, seen = set(), {}
+    for i, entry in enumerate(entries):
+        name = entry.get("name") if isinstance(entry, dict) else None
+        place = f'components[{i}] "{name}"' if isinstance(name, str) else f"components[{i}]"
+        if isinstance(name, str) and name in seen:
+            problems.append(f"{place}: duplicate name, already used by components[{seen[name]}]")
+            continue
+        before = len(problems)
+        comp = _attempt(problems, place, _component, entry, place, problems)
+        if isinstance(name, str):
+            seen[name] = i
+        if comp is None or len(problems) > before:
+            broken.add(name if isinstance(name, str) else UNNAMED)
+        else:
+            model.add(comp)
+            model.places[comp.name] = place
+    return broken
+
+
+def _component(entry, place, problems):
+    if not isinstance(entry, dict):
+        problems.append(f'{place}: must be an object {{"name", "type", "params"}}, '
+                        f"got {_kind(entry)}")
+        return None
+    problems.extend(f"{place}: unknown key {key!r}{suggest(key, COMPONENT_KEYS)}; keys are "
+                    f"{', '.join(COMPONENT_KEYS)}" for key in entry if key not in COMPONENT_KEYS)
+    missing = [key for key in ("name", "type") if key not in entry]
+    problems.extend(f"{place}: required key {key!r} missing" for key in missing)
+    kind, params = entry.get("type"), entry.get("params", {})
+    if missing:
+        return None
+    if not isinstance(kind, str) or kind not in REGISTRY:
+        # resolved only through the registry: a dotted path in a file is never imported
+        problems.append(f"{place}: unknown type {kind!r:.60}{suggest(kind, REGISTRY)}")
+        return None
+    if not isinstance(params, dict):
+        problems.append(f"{place} params: must be an object, got {_kind(params)}")
+        return None
+    cls = REGISTRY[kind]
+    where = lambda key: f"{place} params.{key}"   # noqa: E731
+    given = {}
+    for key, value in params.items():
+        if key not in cls.params:
+            problems.append(f"{where(key)}: unknown parameter{suggest(key, cls.params)}; "
+                            f"{kind} has {', '.join(cls.params) or 'none'}")
+        else:
+            real = cls.params[key].kind == "real"
+            given[key] = _vet(value, where(key), problems) if real else value
+    return cls(entry["name"], _place=where, **given)
+
+
+def _vet(value, where, problems, depth=0):
+    """``value`` with each unparseable expression reported at its place and replaced by "0".
+
+    A component reports such an expression without naming the parameter; the harmless
+    stand-in lets it still report its other problems.
+    """
+    if isinstance(value, str) and value.strip():
+        try:
+            Expression(value)
+        except ModelError as exc:
+            problems.extend(f"{where}: {p}" for p in exc.problems)
+            return "0"
+        except RecursionError:
+            problems.append(f"{where}: expression nested too deeply")
+            return "0"
+    elif isinstance(value, list) and depth < 2:
+        return [_vet(v, f"{where}[{j}]", problems, depth + 1) for j, v in enumerate(value)]
+    return value
+
+
+def _connections(model, pairs, broken, problems):
+    if not isinstance(pairs, list):
+        problems.append(f"connections: must be a list of pairs, got {_kind(pairs)}")
+        return
+    for i, pair in enumerate(pairs):
+        if not isinstance(pair, list) or len(pair) != 2:
+            problems.append(f'connections[{i}]: must be a pair ["component.port", '
+                            f'"component.port"], got {pair!r:.80}')
+            continue
+        refs = []
+        for j, ref in enumerate(pair):
+            place = f'connections[{i}][{j}] "{ref}"' if isinstance(ref, str) else \
+                f"connections[{i}][{j}]"
+            refs.append(_attempt(problems, place, _port, model, ref, broken))
+        if all(refs):
+            _attempt(problems, f"connections[{i}]", model.connect, *refs)
+
+
+def _port(model, ref, broken):
+    """The PortRef, or None when it belongs to a component that already failed."""
+    if not isinstance(ref, str) or ref.count(".") != 1:
+        raise ModelError(f"must be a string 'component.port', got {ref!r:.80}")
+    cname, pname = ref.split(".")
+    if cname in broken or (UNNAMED in broken and cname not in model.components):
+        return None
+    if cname not in model.components:
+        raise ModelError(f"no component {cname!r}{suggest(cname, model.components)}")
+    return model.components[cname].port_ref(pname)
+
+
+def _simulation(settings, problems):
+    """The experiment settings, checked as ``simulate`` will use them."""
+    if not isinstance(settings, dict):
+        problems.append(f"simulation: must be an object, got {_kind(settings)}")
+        return {}
+    for key, value in settings.items():
+        where = f"simulation.{key}"
+        number = isinstance(value, (int, float)) and not isinstance(value, bool)
+        if key not in SIMULATION_KEYS:
+            problems.append(f"{where}: unknown setting{suggest(key, SIMULATION_KEYS)}; "
+                            f"settings are {', '.join(SIMULATION_KEYS)}")
+        elif key == "method":
+            if not isinstance(value, str) or not value:
+                problems.append(f"{where}: must be a method name, got {value!r:.40}")
+        elif key == "n_points":
+            if not number or not isinstance(value, int) or value < 2:
+                problems.append(f"{where}: must be an integer >= 2, got {value!r:.40}")
+        elif not number or not _finite(value) or value <= 0:
+            problems.append(f"{where}: must be a finite number > 0, got {value!r:.40}")
+    return dict(settings)
+
+
+def _layout(model, layout, broken, problems):
+    """Editor positions: any JSON per component, kept as is."""
+    if not isinstance(layout, dict):
+        problems.append(f"layout: must be an object keyed by component name, got {_kind(layout)}")
+        return {}
+    for key, value in layout.items():
+        if key not in model.components and key not in broken and UNNAMED not in broken:
+            problems.append(f"layout.{key}: no component {key!r}"
+                            f"{suggest(key, model.components)}")
+        _plain(value, f"layout.{key}", problems)
+    return _copy(layout)
+
+
+# -- writing ----------------------------------------------------------------------------------
+def model_to_dict(model):
+    """The model as a file's top-level object: plain JSON values, in file order.
+
+    Component ``params`` hold only what was given, so a later change of a default reaches old
+    files. A model may be incomplete (an editor saves work in progress), but what :func:`load`
+    would refuse for its form is refused here, so a saved file always reads back.
+
+    Raises
+    ------
+    ModelError
+        A component type not in the registry, a bad ``simulation`` block, a layout entry for
+        no component, or a value that is not plain, finite JSON; each with its place.
+    """
+    problems, components = [], []
+    for i, comp in enumerate(model.components.values()):
+        if REGISTRY.get(comp.type_name) is not type(comp):
+            problems.append(f'components[{i}] "{comp.name}": type {type(comp).__name__} is not '
+                            f"in the component registry, so no file could load it")
+        components.append({"name": comp.name, "type": comp.type_name,
+                           "params": copy.deepcopy(comp.given)})
+    data = {"format": FORMAT, "version": VERSION, "name": model.name,
+            "description": "" if model.description is None else model.description,
+            "parameters": dict(model.parameters), "components": components,
+            "connections": [[a.path, b.path] for a, b in model.connections],
+            "simulation": copy.deepcopy(model.simulation), "layout": copy.deepcopy(model.layout)}
+    if not isinstance(data["description"], str):
+        problems.append(f"description: must be a string, got {_kind(data['description'])}")
+    _simulation(data["simulation"], problems)
+    if isinstance(data["layout"], dict):
+        problems.extend(f"layout.{key}: no component {key!r}" for key in data["layout"]
+                        if key not in model.components)
+    _plain(data, "", problems)
+    if problems:
+        raise ModelError(problems)
+    return data
+
+
+def dumps(model):
+    """The file's text for ``model``.
+
+    Indented JSON with the keys in file order, short lists of scalars on one line (vectors,
+    matrix rows, connection pairs) and a final newline; numbers keep their Python form.
+
+    Returns
+    -------
+    str
+    """
+    return _render(model_to_dict(model), 0) + "\n"
 
 
 def save(model, path):
-    raise NotImplementedError
+    """Write ``model`` to ``path`` atomically: a failed save leaves the old file whole.
+
+    The text goes to a temporary file in the same folder, is flushed to disk, then replaces
+    ``path`` in one step; on any failure the temporary file is removed.
+
+    Parameters
+    ----------
+    model : Model
+    path : str or os.PathLike
+
+    Raises
+    ------
+    ModelError
+        The model cannot be written as a file (see :func:`model_to_dict`); nothing is written.
+    OSError
+        The file system refused; the old file is unchanged.
+    """
+    text = dumps(model).encode("utf-8")       # every refusal comes before the disk is touched
+    path = os.path.realpath(os.fspath(path))      # through a symlink, not replacing it
+    folder, base = os.path.split(path)
+    tmp = os.path.join(folder, f".{base}.{secrets.token_hex(4)}.tmp")
+    try:
+        # 0o666 lets the umask apply, as to any new file (mkstemp would force 0o600)
+        with open(os.open(tmp, os.O_WRONLY | os.O_CREAT | os.O_EXCL, 0o666), "wb") as fh:
+            fh.write(text)
+            fh.flush()
+            os.fsync(fh.fileno())
+        if os.path.exists(path):
+            os.chmod(tmp, stat.S_IMODE(os.stat(path).st_mode))
+        os.replace(tmp, path)
+    except BaseException:
+        if os.path.exists(tmp):
+            os.unlink(tmp)
+        raise
+
+
+def _render(value, level):
+    """JSON as ``indent=2`` writes it, but a short list of scalars on one line.
+
+    So a vector, a matrix row and a connection pair each read on one line.
+    """
+    pad = "  " * level
+    if isinstance(value, dict) and value:
+        items = [f"{pad}  {json.dumps(k)}: {_render(v, level + 1)}" for k, v in value.items()]
+        return "{\n" + ",\n".join(items) + f"\n{pad}}}"
+    if isinstance(value, (list, tuple)) and value:
+        if not any(isinstance(v, (dict, list, tuple)) for v in value):
+            flat = json.dumps(value, allow_nan=False)
+            if len(flat) <= WIDTH:
+                return flat
+        items = [f"{pad}  {_render(v, level + 1)}" for v in value]
+        return "[\n" + ",\n".join(items) + f"\n{pad}]"
+    return json.dumps(value, allow_nan=False)
+
+
+# -- helpers ----------------------------------------------------------------------------------
+class _Object(dict):
+    """A parsed JSON object that remembers keys given twice (``json`` keeps the last)."""
+
+    @classmethod
+    def from_pairs(cls, pairs):
+        obj = cls()
+        obj.repeated = []
+        for key, value in pairs:
+            if key in obj:
+                obj.repeated.append(key)
+            obj[key] = value
+        return obj
+
+
+def _repeated(value, where, problems):
+    if isinstance(value, dict):
+        problems.extend(f"{where or 'top level'}: key {key!r} appears more than once"
+                        for key in getattr(value, "repeated", ()))
+        for key, item in value.items():
+            _repeated(item, f"{where}.{key}" if where else key, problems)
+    elif isinstance(value, list):
+        for j, item in enumerate(value):
+            _repeated(item, f"{where}[{j}]", problems)
+
+
+def _plain(value, where, problems):
+    """Report what is not plain, finite JSON (a file holds no NaN and no Python objects)."""
+    if isinstance(value, dict):
+        for key, item in value.items():
+            if not isinstance(key, str):
+                problems.append(f"{where}: key {key!r} is not a string")
+            _plain(item, f"{where}.{key}" if where else str(key), problems)
+    elif isinstance(value, (list, tuple)):
+        for j, item in enumerate(value):
+            _plain(item, f"{where}[{j}]", problems)
+    elif isinstance(value, (int, float)) and not _finite(value):
+        problems.append(f"{where}: must be finite, got {value!r:.40}")
+    elif value is not None and not isinstance(value, (str, int, float)):
+        problems.append(f"{where}: {type(value).__name__} is not a JSON value")
+
+
+def _attempt(problems, place, fn, *args):
+    """``fn(*args)``, or None with its failure recorded as a problem at ``place``."""
+    try:
+        return fn(*args)
+    except ModelError as exc:
+        problems.extend(p if p.startswith(place) else f"{place}: {p}" for p in exc.problems)
+    except Exception as exc:    # noqa: BLE001
+        # odd shapes in a file reach code written for well-formed values: a file may be
+        # refused, but never crash the loader
+        problems.append(f"{place}: cannot be read ({type(exc).__name__}: {exc})")
+    return None
+
+
+def _int(text):
+    # an integer beyond float range would overflow in later bounds checks: read it as the
+    # infinity it amounts to, then refused as non-finite at its place
+    try:
+        value = int(text)
+        float(value)
+        return value
+    except (ValueError, OverflowError):
+        return -math.inf if text.startswith("-") else math.inf
+
+
+def _copy(value):
+    # plain dicts and lists in the model, not the parser's _Object
+    return ({k: _copy(v) for k, v in value.items()} if isinstance(value, dict) else
+            [_copy(v) for v in value] if isinstance(value, list) else value)
+
+
+def _finite(value):
+    try:
+        return math.isfinite(value)
+    except OverflowError:       # an int too large for a float
+        return False
+
+
+def _kind(value):
+    kinds = ((dict, "an object"), (list, "a list"), (str, "a string"), (bool, "a boolean"),
+             (type(None), "null"))
+    return next((words for kind, words in kinds if isinstance(value, kind)), f"{value!r:.40}")
+
+
+def _at(source, problem):
+    return f"{source}: {problem}" if source else problem

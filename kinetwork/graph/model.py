@@ -157,6 +157,8 @@ def check_number(value, where):
         value = value.item()
     if isinstance(value, bool) or not isinstance(value, (int, float)):
         raise ModelError(f"{where}: must be a number, got {value!r}")
+    if isinstance(value, int) and abs(value) > 2**1023:
+        raise ModelError(f"{where}: must be finite, got an integer of {len(str(value))} digits")
     if not math.isfinite(value):
         raise ModelError(f"{where}: must be finite, got {value!r}")
     return value
