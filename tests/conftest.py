@@ -1,8 +1,15 @@
 """Shared builders for tests: small models through the public API."""
 
+import pathlib
+import sys
+
 import pytest
 
 import kinetwork as kn
+
+# bench/reference.py holds the independent references (the paper's closed form) for both
+# the tests and the benchmarks
+sys.path.insert(0, str(pathlib.Path(__file__).resolve().parents[1] / "bench"))
 
 SEED_PARAMS = {"L1": 1.0, "L2": 1.0, "m1": 1.0, "m2": 1.0, "c": 1.0, "d": 1.0, "g": 9.8}
 

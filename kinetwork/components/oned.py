@@ -1,7 +1,8 @@
 """Partials shared by the 1-D rotational and translational libraries.
 
-A library subclasses these with ``domain`` set; its components then only declare parameters
-and a law. Flows are positive into the component, as in Modelica.
+Each law is written once here; a library subclasses with ``domain`` set and declares the
+parameters with its own names and units (``rel0`` is ``phi_rel0`` in rotational and
+``s_rel0`` in translational). Flows are positive into the component, as in Modelica.
 """
 
 from .base import ONED, Component, Port
@@ -25,24 +26,41 @@ class PartialCompliant(Component):
         return {"flange_a": -f, "flange_b": f}
 
 
+class PartialSpringDamper(PartialCompliant):
+    """Linear spring and damper in parallel."""
+
+    def law(self, rel, rel_d):
+        return self.c * (rel - self.rel0) + self.d * rel_d
+
+
+class PartialSpring(PartialCompliant):
+    """Linear spring."""
+
+    def law(self, rel, rel_d):
+        return self.c * (rel - self.rel0)
+
+
+class PartialDamper(PartialCompliant):
+    """Linear damper."""
+
+    def law(self, rel, rel_d):
+        return self.d * rel_d
+
+
 class PartialSource(Component):
-    """A flow source: applies ``value(t)`` to flange; its reaction goes to support, if wired."""
+    """A flow source: applies ``amount`` to flange; its reaction goes to support, if wired."""
     role = "source"
     flange = Port(ONED, "Flange driven by the source")
     support = Port(ONED, "Reaction flange (unwired: the world)", optional=True)
 
-    def value(self, t):
-        raise NotImplementedError
-
     def flows(self, pos, vel, t):
-        f = self.value(t)
-        return {"flange": -f, "support": f}
+        return {"flange": -self.amount, "support": self.amount}
 
 
 class PartialFixed(Component):
-    """A flange held at a fixed position; it takes whatever flow the network sends it."""
+    """A flange held at ``position0``; it takes whatever flow the network sends it."""
     role = "fixed"
     flange = Port(ONED, "Fixed flange")
 
     def position(self):
-        raise NotImplementedError
+        return self.position0

@@ -1,17 +1,13 @@
 """Every method a user can pick reaches the seed scene's closed-form solution."""
 
 import gc
-import pathlib
-import sys
 
 import numpy as np
 import pytest
 
 import kinetwork as kn
 from conftest import double_pendulum
-
-sys.path.insert(0, str(pathlib.Path(__file__).resolve().parents[2] / "bench"))
-from reference import seed_reference  # noqa: E402
+from reference import seed_reference
 
 
 @pytest.fixture(scope="module")

@@ -31,6 +31,7 @@ import sympy as sp
 from scipy.integrate import solve_ivp
 
 import kinetwork as kn
+from reference import seed_mvg    # bench/reference.py: the paper's formulas, in numpy
 
 #: the paper's numerical values (section 3.15)
 PAPER = {"L1": 1.0, "L2": 1.0, "m1": 1.0, "m2": 1.0, "c": 1.0, "d": 1.0, "g": 9.8}
@@ -60,18 +61,7 @@ def seed_terms(q, qd, p):
         Coriolis and centripetal terms plus the shoulder spring-damper ``c*T1 + d*T1d``.
     G : ndarray, shape (2,)
     """
-    L1, L2, m1, m2, c, d, g = (p[k] for k in ("L1", "L2", "m1", "m2", "c", "d", "g"))
-    T1, T2 = q
-    T1d, T2d = qd
-    a = L1 * L2 * m2 * np.cos(T2)
-    M = np.array([[a + L2**2 * m2 / 4 + L1**2 * m1 / 4 + L1**2 * m2, L2**2 * m2 / 4 + a / 2],
-                  [L2**2 * m2 / 4 + a / 2, L2**2 * m2 / 4]])
-    V = np.array([-L1 * L2 * m2 * T2d * np.sin(T2) * (T1d + T2d / 2) + c * T1 + d * T1d,
-                  L1 * L2 * m2 * T1d**2 * np.sin(T2) / 2])
-    G = np.array([(np.sin(T1 + T2) * L2 * m2 / 2 + L1 * m1 * np.sin(T1) / 2
-                   + L1 * m2 * np.sin(T1)) * g,
-                  np.sin(T1 + T2) * g * L2 * m2 / 2])
-    return M, V, G
+    return seed_mvg(q, qd, **{k: p[k] for k in PAPER})
 
 
 def seed_qdd(q, qd, p):
