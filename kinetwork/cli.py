@@ -1,0 +1,273 @@
+"""The ``kinetwork`` command: run, validate and derive the equations of a model file.
+
+Exit codes: 0 success, 1 a refused model or an unwritable output, 2 a usage error (argparse),
+3 a failed integration (whatever was computed before the failure is still written).
+"""
+
+import argparse
+import collections
+import os
+import sys
+import textwrap
+import time
+
+import kinetwork as kn
+
+from .solver.integrate import METHODS
+
+EXIT_MODEL, EXIT_SIMULATION = 1, 3         # usage errors exit with argparse's 2
+
+
+def _parameter(text):
+    """argparse type of ``--param NAME=VALUE``."""
+    name, sep, value = text.partition("=")
+    try:
+        if not sep or not name.strip():
+            raise ValueError
+        return name.strip(), float(value)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"expected NAME=VALUE with a number, got {text!r}") \
+            from None
+
+
+class _HelpFormatter(argparse.HelpFormatter):
+    """argparse's formatter, leaving room for the indented subcommand names.
+
+    Before Python 3.13 argparse measures subcommands without their extra indent, which pushes
+    the help of the longest one ("equations") onto its own line.
+    """
+
+    def __init__(self, prog):
+        super().__init__(prog, max_help_position=30)
+
+    def add_argument(self, action):
+        super().add_argument(action)
+        if action.nargs == argparse.PARSER:
+            self._action_max_length += self._indent_increment
+
+
+def build_parser():
+    """The argument parser of the ``kinetwork`` command."""
+    parser = argparse.ArgumentParser(
+        prog="kinetwork",
+        description="Acausal multibody models: simulate a model file, check it, or print "
+                    "its equations of motion.",
+        epilog="Run 'kinetwork COMMAND --help' for the options of one command. Exit codes: "
+               "0 done, 1 model refused or output not writable, 2 usage error, 3 integration "
+               "failed (what was computed before the failure is still written).",
+        formatter_class=_HelpFormatter)
+    parser.add_argument("--version", action="version", version=f"kinetwork {kn.__version__}")
+    sub = parser.add_subparsers(dest="command", required=True, metavar="COMMAND")
+
+    run = sub.add_parser(
+        "run", help="simulate a model and write its probe signals",
+        description="Simulate MODEL.json and write its probe signals (CSV) and probe plots. "
+                    "Options not given come from the model's 'simulation' block.")
+    run.add_argument("model", metavar="MODEL.json", help="model file")
+    run.add_argument("--t-end", type=float, metavar="T", help="end time [s]")
+    run.add_argument("--method", type=str.lower, choices=list(METHODS), metavar="M",
+                     help=f"integrator: {', '.join(METHODS)}")
+    run.add_argument("--rtol", type=float, metavar="R", help="relative tolerance")
+    run.add_argument("--atol", type=float, metavar="A", help="absolute tolerance")
+    run.add_argument("--n-points", type=int, metavar="N", help="points on the output grid")
+    run.add_argument("--param", type=_parameter, action="append", default=[],
+                     metavar="NAME=VALUE",
+                     help="set a model parameter for this run (repeat for several)")
+    run.add_argument("--out", metavar="FILE.csv", help="write t and the probe signals as CSV")
+    run.add_argument("--plot", metavar="FILE.png",
+                     help="write the probe plots (format from the extension: png, pdf, svg)")
+
+    val = sub.add_parser(
+        "validate", help="check a model and summarise it",
+        description="Check MODEL.json and summarise it: components, degrees of freedom, "
+                    "states, loops, equation size, parameters.")
+    val.add_argument("model", metavar="MODEL.json", help="model file")
+
+    eqs = sub.add_parser(
+        "equations", help="print the mass matrix M and force vectors V, G",
+        description="Print the equations of motion M(q) qdd + V(q, qd) + G(q) = 0 of "
+                    "MODEL.json in closed form, in its joint coordinates and parameters.")
+    eqs.add_argument("model", metavar="MODEL.json", help="model file")
+    eqs.add_argument("--format", choices=["text", "pretty", "latex"], default="text",
+                     help="plain expressions, 2-D pretty print, or LaTeX (default: text)")
+    eqs.add_argument("--simplify", action=argparse.BooleanOptionalAction,
+                     help="simplify into the paper's form, or print the Newton-Euler "
+                          "expressions as built, with shared parts named (default: simplify "
+                          "when that takes seconds, not hours)")
+    return parser
+
+
+def main(argv=None):
+    """Run the ``kinetwork`` command; returns the exit code."""
+    args = build_parser().parse_args(argv)
+    command = {"run": _run, "validate": _validate, "equations": _equations}[args.command]
+    try:
+        return command(args)
+    except kn.ModelError as exc:
+        _error(exc)
+        return EXIT_MODEL
+    except KeyboardInterrupt:
+        _error("interrupted")
+        return 130
+    except BrokenPipeError:
+        # the reader went away (kinetwork equations ... | head): stop quietly, and keep
+        # Python from complaining again when it flushes stdout at exit
+        os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
+        return EXIT_MODEL
+
+
+def _error(message):
+    print(f"kinetwork: error: {message}", file=sys.stderr)
+
+
+def _load(path):
+    try:
+        return kn.load(path)
+    except OSError as exc:
+        raise kn.ModelError(f"cannot read {path}: {exc.strerror or exc}") from None
+
+
+def _write(path, write, what):
+    """Write one output; an OSError becomes a message naming the file."""
+    try:
+        write(path)
+    except OSError as exc:
+        raise kn.ModelError(f"cannot write {path}: {exc.strerror or exc}") from None
+    print(f"wrote {what} {path}")
+
+
+def _outputs(args, results, title):
+    if args.out:
+        _write(args.out, results.to_csv,
+               f"{len(results.t)} points x {len(results.columns()[0])} columns to")
+    if args.plot:
+        from .plot import save_plot
+        _write(args.plot, lambda path: save_plot(results, path, title=title), "probe plots to")
+
+
+def _run(args):
+    model = _load(args.model)
+    if args.plot:
+        from .plot import check_plot_path
+        check_plot_path(args.plot)
+    start = time.perf_counter()
+    system = model.compile()
+    compiled = time.perf_counter()
+    try:
+        results = kn.simulate(system, t_end=args.t_end, n_points=args.n_points,
+                              method=args.method, rtol=args.rtol, atol=args.atol,
+                              params=dict(args.param))
+    except kn.SimulationError as exc:
+        _error(exc)
+        if exc.results is not None and len(exc.results.t):
+            try:
+                _outputs(args, exc.results, f"{model.name} (failed at t = {exc.t_reached:g} s)")
+            except kn.ModelError as write_exc:
+                _error(write_exc)
+        return EXIT_SIMULATION
+    done = time.perf_counter()
+    t = results.t
+    print(f"{model.name}: {system.n_states} states ({', '.join(system.state_names)})")
+    if args.param:
+        print("parameters set: " + ", ".join(f"{k} = {v:g}" for k, v in args.param))
+    print(f"simulated t = {t[0]:g} .. {t[-1]:g} s ({len(t)} points) with {results.method} in "
+          f"{done - compiled:.3g} s wall time (compile {compiled - start:.3g} s)")
+    _outputs(args, results, model.name)
+    return 0
+
+
+def _validate(args):
+    model = _load(args.model)
+    system = model.compile()          # validates; one ModelError lists every problem
+    topo = system.topology
+    comps = model.components.values()
+    kinds = collections.Counter(c.type_name for c in comps)
+    units = dict(zip(system.state_names, system.state_units))
+    n_values = sum(system.signal_sizes.values())
+    lines = [
+        f"model {model.name!r} ({args.model}): valid",
+        *([textwrap.fill(f"description: {model.description}", 88, subsequent_indent="  ",
+                         break_on_hyphens=False)] if model.description else []),
+        f"components: {len(model.components)} ("
+        + ", ".join(f"{n} {kind}" for kind, n in kinds.most_common()) + ")",
+        f"connections: {len(model.connections)}",
+        f"degrees of freedom: {topo.dof}",
+        f"states: {system.n_states}"
+        + (" (" + ", ".join(f"{s} [{units[s]}]" if units[s] else s
+                            for s in system.state_names) + ")" if system.n_states else ""),
+        f"loops: {len(topo.loops) or 'none'}"
+        + "".join(f"\n  {' - '.join(loop)}" for loop in topo.loops),
+        f"equations: {system.n_states} states, {len(system.signal_names)} probe signals "
+        f"({n_values} values), right-hand side {system.f_rhs.n_instructions()} operations",
+        f"parameters: {len(model.parameters)}"
+        + (" (" + ", ".join(f"{k} = {v:g}" for k, v in model.parameters.items()) + ")"
+           if model.parameters else ""),
+    ]
+    if model.simulation:
+        lines.append("simulation: " + ", ".join(f"{k} = {v}"
+                                                for k, v in model.simulation.items()))
+    print("\n".join(lines))
+    return 0
+
+
+def _equations(args):
+    import sympy as sp
+
+    from .symbolic import equations_sympy
+
+    model = _load(args.model)
+    system = model.compile()
+    eq = equations_sympy(system, simplified=args.simplify)
+    mats = {key: eq[key] for key in ("M", "V", "G")}
+    shared = eq["shared"]
+    if not eq["simplified"] and args.simplify is None:
+        print(f"kinetwork: note: M, V, G have {eq['size']} operations, too many to simplify "
+              f"quickly: printed as built, shared parts named w0, w1, ... (--simplify "
+              f"forces it)", file=sys.stderr)
+    coords = ", ".join(f"{s} = {c}" for s, c in zip(eq["q"], system.coordinate_names))
+
+    if args.format == "latex":
+        names = {s: _latex_name(s.name, prefix) for prefix in ("q", "qd") for s in eq[prefix]}
+
+        def show(expr):
+            return sp.latex(expr, symbol_names=names, mat_str="bmatrix", mat_delim="",
+                            full_prec=False)
+        print(f"% {model.name}: M(q) \\ddot q + V(q, \\dot q) + G(q) = 0; {coords}")
+        for key, expr in [*shared, *mats.items()]:
+            print(f"{show(sp.Symbol(str(key)))} = {show(expr)}")
+        return 0
+
+    print(f"{model.name}: M(q)*qdd + V(q, qd) + G(q) = 0")
+    print(f"coordinates: {coords}" if coords else "coordinates: none (no degrees of freedom)")
+    print("speeds: " + (", ".join(str(s) for s in eq["qd"]) or "none"))
+    print("parameters: " + (", ".join(eq["params"]) or "none"))
+    blocks = [[(str(w), expr) for w, expr in shared]] if shared else []
+    comma = "," if len(eq["q"]) > 9 else ""       # M1011 would be ambiguous: M10,11
+    for key, mat in mats.items():
+        blocks.append([(f"{key}{i + 1}{comma}{j + 1}" if key == "M" else f"{key}{i + 1}",
+                        mat[i, j]) for i in range(mat.rows) for j in range(mat.cols)])
+    for block in blocks:
+        print()
+        for label, expr in block:
+            if args.format == "pretty":
+                print(sp.pretty(sp.Eq(sp.Symbol(_subscript(label)), expr, evaluate=False),
+                                use_unicode=True, wrap_line=False, full_prec=False))
+            else:
+                print(f"{label} = {sp.sstr(expr, full_prec=False)}")
+    return 0
+
+
+def _subscript(label):
+    """M12 -> M_12, so pretty printing sets the index as a subscript."""
+    return label[0] + "_" + label[1:]
+
+
+def _latex_name(name, prefix):
+    """q_shoulder -> q_{\\mathrm{shoulder}}, qd_shoulder -> \\dot{q}_{\\mathrm{shoulder}}."""
+    rest = name[len(prefix) + 1:].replace("_", r"\_")
+    base = r"\dot{q}" if prefix == "qd" else "q"
+    return f"{base}_{{\\mathrm{{{rest}}}}}"
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,204 @@
+"""The kinetwork command: outputs, summaries, and exit codes without tracebacks."""
+
+import csv
+import subprocess
+import sys
+
+import numpy as np
+import pytest
+from conftest import double_pendulum
+
+import kinetwork as kn
+from kinetwork.cli import main
+
+QUANTITIES = ["angle", "speed", "acceleration", "torque"]
+
+
+@pytest.fixture
+def seed_file(tmp_path):
+    path = tmp_path / "double_pendulum.json"
+    double_pendulum().save(path)
+    return path
+
+
+@pytest.fixture
+def blowup_file(tmp_path):
+    """A torque 1/(1-t)^3 on the shoulder: every integrator fails just before t = 1."""
+    m = double_pendulum()
+    m.add(kn.rotational.Torque("blowup", tau="1/(1-t)**3"))
+    m.connect("blowup.flange", "shoulder.axis")
+    path = tmp_path / "blowup.json"
+    m.save(path)
+    return path
+
+
+def read_csv(path):
+    with open(path, newline="") as fh:
+        rows = list(csv.reader(fh))
+    return rows[0], np.array(rows[1:], dtype=float)
+
+
+def no_traceback(captured):
+    return "Traceback" not in captured.out + captured.err
+
+
+def test_run_writes_csv_and_plot(seed_file, tmp_path, capsys):
+    out, png = tmp_path / "res.csv", tmp_path / "probes.png"
+    assert main(["run", str(seed_file), "--t-end", "2", "--n-points", "21",
+                 "--out", str(out), "--plot", str(png)]) == 0
+    header, data = read_csv(out)
+    assert header == ["t"] + [f"{p}.{q}" for p in ("probe1", "probe2") for q in QUANTITIES]
+    ref = kn.simulate(double_pendulum(), t_end=2.0, n_points=21)
+    np.testing.assert_array_equal(data[:, 0], ref.t)
+    np.testing.assert_allclose(data[:, 1], ref["probe1.angle"], rtol=1e-12)
+    assert png.read_bytes()[:4] == b"\x89PNG"
+    printed = capsys.readouterr().out
+    assert "double_pendulum: 4 states (shoulder.q, elbow.q, shoulder.qd, elbow.qd)" in printed
+    assert "t = 0 .. 2 s (21 points) with cvodes" in printed and "wall time" in printed
+    assert f"wrote 21 points x 9 columns to {out}" in printed
+
+
+def test_run_options_and_parameters(seed_file, tmp_path):
+    out = tmp_path / "res.csv"
+    assert main(["run", str(seed_file), "--t-end", "1", "--n-points", "11", "--method",
+                 "RK45", "--rtol", "1e-9", "--atol", "1e-11", "--param", "c=5",
+                 "--param", "d=0.25", "--out", str(out)]) == 0
+    _, data = read_csv(out)
+    ref = kn.simulate(double_pendulum(), t_end=1.0, n_points=11, method="DOP853",
+                      rtol=1e-11, atol=1e-12, params={"c": 5.0, "d": 0.25})
+    np.testing.assert_allclose(data[:, 1], ref["probe1.angle"], atol=1e-7)
+
+
+def test_run_defaults_come_from_the_model(tmp_path):
+    m = double_pendulum()
+    m.simulation.update({"t_end": 0.5, "n_points": 6})
+    m.save(tmp_path / "m.json")
+    assert main(["run", str(tmp_path / "m.json"), "--out", str(tmp_path / "r.csv")]) == 0
+    _, data = read_csv(tmp_path / "r.csv")
+    np.testing.assert_allclose(data[:, 0], np.linspace(0, 0.5, 6))
+
+
+def test_validate_summarises(seed_file, capsys):
+    assert main(["validate", str(seed_file)]) == 0
+    out = capsys.readouterr().out
+    system = double_pendulum().compile()
+    for line in [
+        "components: 9 (2 multibody.Revolute, 2 multibody.RigidBody, 2 Probe, "
+        "1 multibody.Ground, 1 multibody.FixedTranslation, 1 rotational.SpringDamper)",
+        "degrees of freedom: 2",
+        "states: 4 (shoulder.q [rad], elbow.q [rad], shoulder.qd [rad/s], elbow.qd [rad/s])",
+        "loops: none",
+        f"equations: 4 states, 8 probe signals (8 values), right-hand side "
+        f"{system.f_rhs.n_instructions()} operations",
+        "parameters: 7 (L1 = 1, L2 = 1, m1 = 1, m2 = 1, c = 1, d = 1, g = 9.8)",
+    ]:
+        assert line in out.splitlines()
+
+
+def test_equations_text_reads_like_the_paper(seed_file, capsys):
+    assert main(["equations", str(seed_file)]) == 0
+    lines = capsys.readouterr().out.splitlines()
+    assert "coordinates: q_shoulder = shoulder.q, q_elbow = elbow.q" in lines
+    assert "M11 = L1**2*m1/4 + L1**2*m2 + L1*L2*m2*cos(q_elbow) + L2**2*m2/4" in lines
+    assert "M22 = L2**2*m2/4" in lines
+    assert "V2 = L1*L2*m2*qd_shoulder**2*sin(q_elbow)/2" in lines
+    assert "G2 = L2*g*m2*sin(q_elbow + q_shoulder)/2" in lines
+
+
+@pytest.mark.parametrize("fmt, expected", [
+    ("latex", r"\dot{q}_{\mathrm{shoulder}}"),
+    ("pretty", "M\u2082\u2082 ="),
+])
+def test_equations_other_formats(seed_file, capsys, fmt, expected):
+    assert main(["equations", str(seed_file), "--format", fmt]) == 0
+    assert expected in capsys.readouterr().out
+
+
+def test_equations_as_built(seed_file, capsys):
+    assert main(["equations", str(seed_file), "--no-simplify"]) == 0
+    out = capsys.readouterr()
+    assert "w0 = " in out.out and "M22 = " in out.out
+    assert out.err == ""                      # asked for: no note about the size
+
+
+@pytest.mark.parametrize("command", ["run", "validate", "equations"])
+def test_missing_file_exits_1(tmp_path, capsys, command):
+    missing = tmp_path / "missing.json"
+    assert main([command, str(missing)]) == 1
+    err = capsys.readouterr()
+    assert f"{missing}: cannot read" in err.err and no_traceback(err)
+
+
+@pytest.mark.parametrize("argv", [["--help"], ["run", "--help"], ["validate", "--help"],
+                                  ["equations", "--help"], ["--version"]])
+def test_help_exits_0(capsys, argv):
+    with pytest.raises(SystemExit) as info:
+        main(argv)
+    assert info.value.code == 0
+    assert "usage: kinetwork" in capsys.readouterr().out or "--version" in argv
+
+
+def test_invalid_model_exits_1(tmp_path, capsys):
+    bad = tmp_path / "bad.json"
+    bad.write_text('{"format": "kinetwork.model", "version": 1, "name": "x", '
+                   '"components": [{"name": "g", "type": "multibody.Groud"}], '
+                   '"connections": []}')
+    assert main(["validate", str(bad)]) == 1
+    err = capsys.readouterr()
+    assert "did you mean 'multibody.Ground'" in err.err and no_traceback(err)
+
+
+@pytest.mark.parametrize("option", [["--param", "cc=2"], ["--rtol", "-1"],
+                                    ["--plot", "probes.xyz"]])
+def test_refused_settings_exit_1(seed_file, tmp_path, capsys, option):
+    argv = ["run", str(seed_file), "--t-end", "0.1"] + option
+    assert main([a.replace("probes.xyz", str(tmp_path / "p.xyz")) for a in argv]) == 1
+    err = capsys.readouterr()
+    assert err.err.startswith("kinetwork: error: ") and no_traceback(err)
+
+
+@pytest.mark.parametrize("option", [["--method", "euler"], ["--param", "c"],
+                                    ["--t-end", "soon"], ["--frobnicate"]])
+def test_usage_errors_exit_2(seed_file, capsys, option):
+    with pytest.raises(SystemExit) as info:
+        main(["run", str(seed_file)] + option)
+    assert info.value.code == 2
+    assert no_traceback(capsys.readouterr())
+
+
+def test_bad_plot_format_is_refused_before_simulating(seed_file, tmp_path, capsys):
+    out = tmp_path / "res.csv"
+    assert main(["run", str(seed_file), "--out", str(out), "--plot",
+                 str(tmp_path / "probes")]) == 1
+    assert "without a file extension" in capsys.readouterr().err
+    assert not out.exists()
+
+
+def test_unwritable_output_exits_1_naming_the_path(seed_file, tmp_path, capsys):
+    out = tmp_path / "no" / "such" / "dir.csv"
+    assert main(["run", str(seed_file), "--t-end", "0.1", "--out", str(out)]) == 1
+    err = capsys.readouterr()
+    assert f"cannot write {out}" in err.err and no_traceback(err)
+
+
+def test_failed_integration_exits_3_with_partial_results(blowup_file, tmp_path, capsys):
+    out, png = tmp_path / "partial.csv", tmp_path / "partial.png"
+    code = main(["run", str(blowup_file), "--t-end", "2", "--n-points", "201",
+                 "--out", str(out), "--plot", str(png)])
+    assert code == 3
+    err = capsys.readouterr()
+    assert "cvodes failed after t = " in err.err and no_traceback(err)
+    _, data = read_csv(out)
+    assert 0.9 <= data[-1, 0] <= 1.0
+    assert png.exists()
+
+
+def test_console_entry_point(seed_file):
+    """The installed command: exit codes reach the shell, messages reach stderr."""
+    ok = subprocess.run([sys.executable, "-m", "kinetwork.cli", "validate", str(seed_file)],
+                        capture_output=True, text=True)
+    assert ok.returncode == 0 and "degrees of freedom: 2" in ok.stdout
+    bad = subprocess.run([sys.executable, "-m", "kinetwork.cli", "run", "nowhere.json"],
+                         capture_output=True, text=True)
+    assert bad.returncode == 1 and "nowhere.json" in bad.stderr
+    assert "Traceback" not in bad.stderr
