@@ -128,8 +128,9 @@ def _load(path):
 
 
 def _write(path, write, what):
-    """Write one output; an OSError becomes a message naming the file."""
+    """Write one output, making its folder; an OSError becomes a message naming the file."""
     try:
+        os.makedirs(os.path.dirname(os.path.abspath(path)), exist_ok=True)
         write(path)
     except OSError as exc:
         raise kn.ModelError(f"cannot write {path}: {exc.strerror or exc}") from None

@@ -175,10 +175,19 @@ def test_bad_plot_format_is_refused_before_simulating(seed_file, tmp_path, capsy
 
 
 def test_unwritable_output_exits_1_naming_the_path(seed_file, tmp_path, capsys):
-    out = tmp_path / "no" / "such" / "dir.csv"
+    blocker = tmp_path / "a_file"
+    blocker.write_text("not a folder")
+    out = blocker / "dir.csv"
     assert main(["run", str(seed_file), "--t-end", "0.1", "--out", str(out)]) == 1
     err = capsys.readouterr()
     assert f"cannot write {out}" in err.err and no_traceback(err)
+
+
+def test_output_folders_are_made(seed_file, tmp_path):
+    out, png = tmp_path / "new" / "res.csv", tmp_path / "plots" / "deep" / "p.png"
+    assert main(["run", str(seed_file), "--t-end", "0.5", "--out", str(out),
+                 "--plot", str(png)]) == 0
+    assert out.exists() and png.exists()
 
 
 def test_failed_integration_exits_3_with_partial_results(blowup_file, tmp_path, capsys):
