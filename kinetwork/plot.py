@@ -95,7 +95,10 @@ def plot_results(results, probes=None, title=None, figsize=None, **kwargs):
             name = f"{probe}.{quantity}"
             _draw(axes[i, j], t, results[name], kwargs)
             unit = results.units.get(name, "")
-            axes[i, j].set_title(f"{probe}: {quantity.replace('_', ' ')}", fontsize="medium")
+            target = results.probe_targets.get(probe)
+            where = f" ({target})" if target else ""
+            axes[i, j].set_title(f"{probe}{where}: {quantity.replace('_', ' ')}",
+                                 fontsize="medium")
             axes[i, j].set_ylabel(quantity.replace("_", " ")
                                   + (f" [{unit_label(unit)}]" if unit else ""))
             bottom[j] = i

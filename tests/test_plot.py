@@ -47,7 +47,8 @@ def test_seed_layout_is_the_papers(seed_results):
     fig = seed_results.plot()
     axes = np.array(fig.axes).reshape(2, 4)
     assert [[ax.get_title() for ax in row] for row in axes] == [
-        [f"{p}: {q}" for q in QUANTITIES] for p in ("probe1", "probe2")]
+        [f"{p} ({joint}.axis): {q}" for q in QUANTITIES]
+        for p, joint in (("probe1", "shoulder"), ("probe2", "elbow"))]
     assert [ax.get_ylabel() for ax in axes[0]] == [
         "angle [rad]", "speed [rad/s]", "acceleration [rad/s\u00b2]", "torque [N\u00b7m]"]
     assert [ax.get_xlabel() for ax in axes[1]] == ["time [s]"] * 4
@@ -65,7 +66,7 @@ def test_seed_layout_is_the_papers(seed_results):
 
 def test_select_probes_in_order(seed_results):
     fig = seed_results.plot(probes=["probe2"], title="elbow", linewidth=3)
-    assert [ax.get_title() for ax in visible(fig)] == [f"probe2: {q}" for q in QUANTITIES]
+    assert [ax.get_title() for ax in visible(fig)] == [f"probe2 (elbow.axis): {q}" for q in QUANTITIES]
     assert fig.axes[0].get_lines()[0].get_linewidth() == 3
     assert fig.get_suptitle() == "elbow"
     fig = seed_results.plot(probes="probe1")
@@ -87,8 +88,8 @@ def test_vectors_orientation_and_wrapping(tip_results):
     """Five frame quantities wrap onto a second row; vectors get x/y/z, R its nine entries."""
     fig = tip_results.plot(probes=["probe1", "tip"])
     axes = np.array(fig.axes).reshape(3, 4)
-    assert [ax.get_title() for ax in axes[1]] == [f"tip: {q}" for q in FRAME[:4]]
-    assert axes[2, 0].get_title() == "tip: angular velocity"
+    assert [ax.get_title() for ax in axes[1]] == [f"tip (elbow.frame_b): {q}" for q in FRAME[:4]]
+    assert axes[2, 0].get_title() == "tip (elbow.frame_b): angular velocity"
     assert axes[2, 0].get_ylabel() == "angular velocity [rad/s]"
     assert not any(ax.get_visible() for ax in axes[2, 1:])
     position = axes[1, 0]

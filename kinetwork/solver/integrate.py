@@ -144,7 +144,11 @@ def simulate(model, t_end=None, n_points=None, method=None, rtol=None, atol=None
     t = grid[:len(X)]
     results = Results(t, X, system.state_names, system.outputs(t, X, params) if len(t) else
                       np.zeros((0, 0)), system.signal_names, system.signal_sizes,
-                      system.signal_units, method=key, state_units=system.state_units)
+                      system.signal_units, method=key, state_units=system.state_units,
+                      settings={"t_start": t_start, "t_end": t_end, "n_points": int(n_points),
+                                "method": key, "rtol": rtol, "atol": atol,
+                                "params": dict(params or {})},
+                      probe_targets=system.probe_targets)
     if failure is not None:
         reached = float(t[-1]) if len(t) else float(t_start)
         raise SimulationError(f"{key} failed after t = {reached:g} s (of {t_end:g} s): "

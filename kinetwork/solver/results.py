@@ -14,7 +14,7 @@ class Results:
     """
 
     def __init__(self, t, states, state_names, signals, signal_names, sizes, units,
-                 method=None, stats=None, state_units=None):
+                 method=None, stats=None, state_units=None, settings=None, probe_targets=None):
         self.t = np.asarray(t, dtype=float)
         self.states = np.asarray(states, dtype=float).reshape(len(self.t), len(state_names))
         self.state_names = list(state_names)
@@ -22,6 +22,10 @@ class Results:
         self.units.update(zip(self.state_names, state_units or [""] * len(self.state_names)))
         self.method = method
         self.stats = dict(stats or {})
+        #: what was asked for: t_end, n_points, method, rtol, atol, params
+        self.settings = dict(settings or {})
+        #: probe name -> the port it measures ("shoulder.axis")
+        self.probe_targets = dict(probe_targets or {})
         self._signals = {}
         col = 0
         signals = np.asarray(signals, dtype=float).reshape(len(self.t), -1)

@@ -33,6 +33,7 @@ class System:
         self.f_rhs = ca.Function("rhs", [asm.t, x, asm.p], [ca.densify(self.ode)],
                                  ["t", "x", "p"], ["xdot"])
         self.f_x0 = ca.Function("x0", [asm.p], [asm.x0])
+        self.probe_targets = {probe.name: target.path for probe, target in self.topology.probes}
         self.signal_names = [name for name, _, _ in asm.signals]
         self.signal_units = {name: unit for name, unit, _ in asm.signals}
         self.signal_sizes = {name: expr.numel() for name, _, expr in asm.signals}
