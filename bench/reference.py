@@ -6,19 +6,22 @@ from scipy.integrate import solve_ivp
 PAPER = {"L1": 1.0, "L2": 1.0, "m1": 1.0, "m2": 1.0, "c": 1.0, "d": 1.0, "g": 9.8}
 
 
-def seed_mvg(q, qd, L1, L2, m1, m2, c, d, g):
-    """M, V, G of the seed paper (V with its two typos corrected), M qdd + V + G = 0."""
+def seed_mvg(q, qd, L1, L2, m1, m2, c, d, g, sin=np.sin, cos=np.cos, array=np.array):
+    """M, V, G of the seed paper (V with its two typos corrected), M qdd + V + G = 0.
+
+    Numbers by default; pass ``sin=sympy.sin, cos=sympy.cos, array=sympy.Matrix`` (and
+    symbols) for the closed forms themselves.
+    """
     T1, T2 = q
     T1d, T2d = qd
-    M = np.array([
-        [L1 * L2 * m2 * np.cos(T2) + L2**2 * m2 / 4 + L1**2 * m1 / 4 + L1**2 * m2,
-         L2**2 * m2 / 4 + L1 * L2 * m2 * np.cos(T2) / 2],
-        [L2**2 * m2 / 4 + L1 * L2 * m2 * np.cos(T2) / 2, L2**2 * m2 / 4]])
-    V = np.array([-L1 * L2 * m2 * T2d * np.sin(T2) * (T1d + T2d / 2) + c * T1 + d * T1d,
-                  L1 * L2 * m2 * T1d**2 * np.sin(T2) / 2])
-    G = np.array([(np.sin(T1 + T2) * L2 * m2 / 2 + L1 * m1 * np.sin(T1) / 2
-                   + L1 * m2 * np.sin(T1)) * g,
-                  np.sin(T1 + T2) * g * L2 * m2 / 2])
+    M = array([
+        [L1 * L2 * m2 * cos(T2) + L2**2 * m2 / 4 + L1**2 * m1 / 4 + L1**2 * m2,
+         L2**2 * m2 / 4 + L1 * L2 * m2 * cos(T2) / 2],
+        [L2**2 * m2 / 4 + L1 * L2 * m2 * cos(T2) / 2, L2**2 * m2 / 4]])
+    V = array([-L1 * L2 * m2 * T2d * sin(T2) * (T1d + T2d / 2) + c * T1 + d * T1d,
+               L1 * L2 * m2 * T1d**2 * sin(T2) / 2])
+    G = array([(sin(T1 + T2) * L2 * m2 / 2 + L1 * m1 * sin(T1) / 2 + L1 * m2 * sin(T1)) * g,
+               sin(T1 + T2) * g * L2 * m2 / 2])
     return M, V, G
 
 

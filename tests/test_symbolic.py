@@ -7,6 +7,7 @@ import numpy as np
 import pytest
 import sympy as sp
 from conftest import SEED_PARAMS, double_pendulum
+from reference import seed_mvg
 
 import kinetwork as kn
 from kinetwork.symbolic import (equations_sympy, function_to_sympy, number, tidy, to_sympy,
@@ -109,19 +110,9 @@ def test_tidy_removes_roundoff_only():
 
 
 def _paper(sym):
-    """The seed's closed forms, with DESIGN's two corrections to V."""
-    T1, T2, T1d, T2d = sym["q"] + sym["qd"]
-    L1, L2, m1, m2, c, d, g = (sym["params"][k] for k in SEED_PARAMS)
-    M = sp.Matrix([
-        [L1 * L2 * m2 * sp.cos(T2) + L2**2 * m2 / 4 + L1**2 * m1 / 4 + L1**2 * m2,
-         L2**2 * m2 / 4 + L1 * L2 * m2 * sp.cos(T2) / 2],
-        [L2**2 * m2 / 4 + L1 * L2 * m2 * sp.cos(T2) / 2, L2**2 * m2 / 4]])
-    V = sp.Matrix([-L1 * L2 * m2 * T2d * sp.sin(T2) * (T1d + T2d / 2) + c * T1 + d * T1d,
-                   L1 * L2 * m2 * T1d**2 * sp.sin(T2) / 2])
-    G = sp.Matrix([(sp.sin(T1 + T2) * L2 * m2 / 2 + L1 * m1 * sp.sin(T1) / 2
-                    + L1 * m2 * sp.sin(T1)) * g,
-                   sp.sin(T1 + T2) * g * L2 * m2 / 2])
-    return M, V, G
+    """The seed's closed forms (bench/reference.py), with DESIGN's two corrections to V."""
+    params = {k: sym["params"][k] for k in SEED_PARAMS}
+    return seed_mvg(sym["q"], sym["qd"], **params, sin=sp.sin, cos=sp.cos, array=sp.Matrix)
 
 
 def test_seed_equations_are_the_papers():

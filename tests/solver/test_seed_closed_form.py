@@ -31,6 +31,7 @@ import sympy as sp
 from scipy.integrate import solve_ivp
 
 import kinetwork as kn
+from conftest import double_pendulum
 from reference import seed_mvg    # bench/reference.py: the paper's formulas, in numpy
 
 #: the paper's numerical values (section 3.15)
@@ -132,30 +133,8 @@ def build_pendulum(parameters=PAPER, q0=(0.05, 0.05), qd0=(0.0, 0.0), inertia=Fa
         Give each link a rotary inertia ``J1``, ``J2`` about its centre of mass (z axis);
         the seed's links have none.
     """
-    model = kn.Model("double_pendulum", parameters=dict(parameters))
-    ground = model.add(kn.multibody.Ground("ground", gravity=[0, "-g", 0]))
-    shoulder = model.add(kn.multibody.Revolute("shoulder", axis=[0, 0, 1],
-                                               q0=q0[0], qd0=qd0[0]))
-    elbow = model.add(kn.multibody.Revolute("elbow", axis=[0, 0, 1], q0=q0[1], qd0=qd0[1]))
-    link1 = model.add(kn.multibody.FixedTranslation("link1", r=[0, "-L1", 0]))
-    j1, j2 = ("J1", "J2") if inertia else (0, 0)
-    mass1 = model.add(kn.multibody.RigidBody("mass1", mass="m1", r_cm=[0, "-L1/2", 0],
-                                             inertia=[[0, 0, 0], [0, 0, 0], [0, 0, j1]]))
-    mass2 = model.add(kn.multibody.RigidBody("mass2", mass="m2", r_cm=[0, "-L2/2", 0],
-                                             inertia=[[0, 0, 0], [0, 0, 0], [0, 0, j2]]))
-    spring = model.add(kn.rotational.SpringDamper("spring", c="c", d="d"))
-    probe1 = model.add(kn.Probe("probe1", quantities=QUANTITIES))
-    probe2 = model.add(kn.Probe("probe2", quantities=QUANTITIES))
-    model.connect(ground.frame, shoulder.frame_a)
-    model.connect(shoulder.frame_b, mass1.frame_a)
-    model.connect("shoulder.frame_b", "link1.frame_a")
-    model.connect(link1.frame_b, elbow.frame_a)
-    model.connect(elbow.frame_b, mass2.frame_a)
-    model.connect(spring.flange_a, shoulder.support)
-    model.connect(spring.flange_b, shoulder.axis)
-    model.connect(probe1.port, shoulder.axis)
-    model.connect(probe2.port, elbow.axis)
-    return model
+    return double_pendulum(q0=q0, qd0=qd0, inertia=("J1", "J2") if inertia else None,
+                           **parameters)
 
 
 @pytest.fixture(scope="module")
