@@ -20,9 +20,12 @@ def _casadi(plugin, **options):
         try:
             out = integ(x0=x0, p=p)
         except RuntimeError as exc:
-            return _casadi_partial(system, plugin, grid, x0, p, rtol, atol, options, exc)
+            X, reason = _casadi_partial(system, plugin, grid, x0, p, rtol, atol, options, exc)
+            return X, reason, {}
         X = np.vstack([x0, np.asarray(out["xf"]).T])
-        return X, None
+        stats = integ.stats()
+        return X, None, {"steps": int(stats["nsteps"]), "rhs_evaluations": int(stats["nfevals"]),
+                         "jacobian_evaluations": int(stats["n_call_jacF"])}
     return run
 
 
@@ -76,12 +79,11 @@ def _scipy(name):
             sol = solve_ivp(fun, (grid[0], grid[-1]), x0, method=name, t_eval=grid,
                             rtol=rtol, atol=atol, **kwargs)
         X = sol.y.T
+        stats = {"rhs_evaluations": int(sol.nfev), "jacobian_evaluations": int(sol.njev)}
         good = np.all(np.isfinite(X), axis=1)
         if not good.all():
-            return X[:int(np.argmin(good))], "the state became non-finite (Inf or NaN)"
-        if sol.status < 0:
-            return X, sol.message
-        return X, None
+            return X[:int(np.argmin(good))], "the state became non-finite (Inf or NaN)", stats
+        return X, (sol.message if sol.status < 0 else None), stats
     return run
 
 
@@ -138,13 +140,14 @@ def simulate(model, t_end=None, n_points=None, method=None, rtol=None, atol=None
     x0 = system.initial_state(params)
     grid = np.linspace(t_start, t_end, int(n_points))
     if system.n_states:
-        X, failure = METHODS[key](system, grid, x0, p, float(rtol), float(atol))
+        X, failure, stats = METHODS[key](system, grid, x0, p, float(rtol), float(atol))
     else:                           # everything welded to the ground: nothing to integrate
-        X, failure = np.zeros((len(grid), 0)), None
+        X, failure, stats = np.zeros((len(grid), 0)), None, {}
     t = grid[:len(X)]
     results = Results(t, X, system.state_names, system.outputs(t, X, params) if len(t) else
                       np.zeros((0, 0)), system.signal_names, system.signal_sizes,
-                      system.signal_units, method=key, state_units=system.state_units,
+                      system.signal_units, method=key, stats=stats,
+                      state_units=system.state_units,
                       settings={"t_start": t_start, "t_end": t_end, "n_points": int(n_points),
                                 "method": key, "rtol": rtol, "atol": atol,
                                 "params": dict(params or {})},

@@ -21,6 +21,7 @@ class Results:
         self.units = dict(units)
         self.units.update(zip(self.state_names, state_units or [""] * len(self.state_names)))
         self.method = method
+        #: integrator counters: rhs_evaluations, jacobian_evaluations, steps (CasADi methods)
         self.stats = dict(stats or {})
         #: what was asked for: t_end, n_points, method, rtol, atol, params
         self.settings = dict(settings or {})

@@ -20,6 +20,8 @@ def test_method_matches_closed_form(system, method):
     res = kn.simulate(system, t_end=3.0, n_points=301, method=method, rtol=1e-9, atol=1e-11)
     ref = seed_reference(res.t, x0=(0.8, -0.5, 0.0, 0.0))
     assert res.method == method
+    assert res.stats["rhs_evaluations"] > 0
+    assert res.settings["rtol"] == 1e-9 and res.settings["method"] == method
     np.testing.assert_allclose(res.states, ref, atol=2e-6)
 
 
