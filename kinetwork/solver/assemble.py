@@ -70,67 +70,8 @@ def assemble(model, topo):
         if n else ca.SX(0, 1)
     qdd_sym = ca.SX.sym("qdd", n)
 
-    # frame set -> (body index, R, p): where the set sits in its body; -1 is the world
-    place = {topo.root: (-1, ca.SX.eye(3), ca.SX.zeros(3))}
-    bodies = []
-    for edge in topo.tree:
-        comp = bound[edge.component.name]
-        qj = q[index[comp.name]] if comp.dof else ca.SX(0, 1)
-        Re, re = comp.transform(qj)
-        if edge.reversed:
-            Re, re = Re.T, -Re.T @ re
-        k, Rf, pf = place[edge.parent]
-        R, pos = Rf @ Re, pf + Rf @ re
-        if comp.dof == 0:
-            place[edge.child] = (k, R, pos)
-            continue
-        S = ca.horzcat(*[
-            ca.vertcat(vee(Re.T @ ca.reshape(ca.jacobian(ca.vec(Re), qj[j]), 3, 3)),
-                       Re.T @ ca.jacobian(re, qj[j]))
-            for j in range(comp.dof)])
-        if comp.constant_subspace:
-            S, cJ = ca.substitute(S, qj, ca.SX.zeros(comp.dof)), ca.SX.zeros(6)
-        else:
-            qdj = qd[index[comp.name]]
-            cJ = ca.jtimes(S @ qdj, qj, qdj)
-        bodies.append(Body(comp.name, k, R, pos, S, cJ, ca.SX.zeros(6, 6), index[comp.name]))
-        place[edge.child] = (len(bodies) - 1, ca.SX.eye(3), ca.SX.zeros(3))
-    for body, frame_set in topo.bodies:
-        k, Rs, ps = place[frame_set]
-        if k < 0:
-            continue            # welded to the ground: no motion, no state
-        m, c, Ic = bound[body.name].mass_properties()
-        bodies[k].inertia += spatial_inertia(m, ps + Rs @ c, Rs @ Ic @ Rs.T)
-
-    # 1-D network: potentials of each set, flows of each force element
-    pos, vel, acc = {}, {}, {}
-    for s in topo.oned:
-        if s.definer is None:
-            triple = (0, 0, 0)                 # an optional flange wired to nothing: world
-        else:
-            comp = bound[s.definer.component.name]
-            if s.definer.name in comp.coordinate_ports:
-                i = index[comp.name][comp.coordinate_ports[s.definer.name]]
-                triple = (q[i], qd[i], qdd_sym[i])
-            elif comp.role == "fixed":
-                triple = (comp.position(), 0, 0)
-            else:
-                triple = (0, 0, 0)
-        for ref in topo.sets[s.index]:
-            pos[ref], vel[ref], acc[ref] = triple
-    flow = {}
-    for comp in model.components.values():
-        if comp.role in ("compliant", "source"):
-            b = bound[comp.name]
-            refs = {pn: comp.port_ref(pn) for pn in comp.ports}
-            out = b.flows({pn: pos.get(r, 0) for pn, r in refs.items()},
-                          {pn: vel.get(r, 0) for pn, r in refs.items()}, t)
-            for pn, f in out.items():
-                flow[refs[pn]] = f
-    for s in topo.oned:
-        if s.definer is not None:
-            flow[s.definer] = -sum((flow.get(r, 0) for r in s.ports if r != s.definer),
-                                   ca.SX(0))
+    bodies, place = _bodies(topo, bound, q, qd, index)
+    pos, vel, acc, flow = _network(model, topo, bound, q, qd, qdd_sym, index, t)
     Q = ca.SX.zeros(n)
     for joint in topo.joints:
         for pname, j in joint.coordinate_ports.items():
@@ -145,6 +86,75 @@ def assemble(model, topo):
                    qdd_sym=qdd_sym)
     _probes(asm, topo, place, pos, vel, acc, flow)
     return asm
+
+
+def _bodies(topo, bound, q, qd, index):
+    """Moving bodies along the tree; rigid parts fold into the body before them.
+
+    Returns the bodies and, for each frame set, (body index, R, p): where the set sits in
+    its body (-1 is the world).
+    """
+    place = {topo.root: (-1, ca.SX.eye(3), ca.SX.zeros(3))}
+    bodies = []
+    for edge in topo.tree:
+        comp = bound[edge.component.name]
+        qj = q[index[comp.name]] if comp.dof else ca.SX(0, 1)
+        Re, re = comp.transform(qj)
+        if edge.reversed:
+            Re, re = Re.T, -Re.T @ re
+        k, Rf, pf = place[edge.parent]
+        R, pos = Rf @ Re, pf + Rf @ re
+        if comp.dof == 0:
+            place[edge.child] = (k, R, pos)
+            continue
+        # motion subspace in the child frame, from derivatives of the joint's transform
+        S = ca.horzcat(*[
+            ca.vertcat(vee(Re.T @ ca.reshape(ca.jacobian(ca.vec(Re), qj[j]), 3, 3)),
+                       Re.T @ ca.jacobian(re, qj[j]))
+            for j in range(comp.dof)])
+        if comp.constant_subspace:       # screw joints: exact constants, no S-dot term
+            S, cJ = ca.substitute(S, qj, ca.SX.zeros(comp.dof)), ca.SX.zeros(6)
+        else:
+            qdj = qd[index[comp.name]]
+            cJ = ca.jtimes(S @ qdj, qj, qdj)
+        bodies.append(Body(comp.name, k, R, pos, S, cJ, ca.SX.zeros(6, 6), index[comp.name]))
+        place[edge.child] = (len(bodies) - 1, ca.SX.eye(3), ca.SX.zeros(3))
+    for body, frame_set in topo.bodies:
+        k, Rs, ps = place[frame_set]
+        if k < 0:
+            continue            # welded to the ground: no motion, no state
+        m, c, Ic = bound[body.name].mass_properties()
+        bodies[k].inertia += spatial_inertia(m, ps + Rs @ c, Rs @ Ic @ Rs.T)
+    return bodies, place
+
+
+def _network(model, topo, bound, q, qd, qdd_sym, index, t):
+    """1-D network: position, speed, acceleration of every port, and the flow into it."""
+    pos, vel, acc = {}, {}, {}
+    for s in topo.oned:
+        triple = (0, 0, 0)                     # an optional flange wired to nothing: world
+        if s.definer is not None:
+            comp = bound[s.definer.component.name]
+            if s.definer.name in comp.coordinate_ports:
+                i = index[comp.name][comp.coordinate_ports[s.definer.name]]
+                triple = (q[i], qd[i], qdd_sym[i])
+            elif comp.role == "fixed":
+                triple = (comp.position(), 0, 0)
+        for ref in topo.sets[s.index]:
+            pos[ref], vel[ref], acc[ref] = triple
+    flow = {}
+    for comp in model.components.values():
+        if comp.role in ("compliant", "source"):
+            refs = {pn: comp.port_ref(pn) for pn in comp.ports}
+            out = bound[comp.name].flows({pn: pos.get(r, 0) for pn, r in refs.items()},
+                                         {pn: vel.get(r, 0) for pn, r in refs.items()}, t)
+            for pn, f in out.items():
+                flow[refs[pn]] = f
+    for s in topo.oned:        # the defining port takes what the rest sends (sum is zero)
+        if s.definer is not None:
+            flow[s.definer] = -sum((flow.get(r, 0) for r in s.ports if r != s.definer),
+                                   ca.SX(0))
+    return pos, vel, acc, flow
 
 
 def _symbolic(value, env, funcs):
