@@ -17,7 +17,7 @@ import stat
 from ..components.base import REGISTRY, suggest
 from ..errors import ModelError
 from ..expr import Expression
-from .model import Model
+from .model import Model, check_setting, finite
 
 FORMAT, VERSION, SUPPORTED = "kinetwork.model", 1, (1,)
 #: top-level keys, in the order files are written
@@ -25,7 +25,6 @@ KEYS = ("format", "version", "name", "description", "parameters", "components", 
         "simulation", "layout")
 REQUIRED = ("format", "version", "name", "components")
 COMPONENT_KEYS = ("name", "type", "params")
-SIMULATION_KEYS = ("t_end", "n_points", "method", "rtol", "atol")
 #: among the names of broken components: some entry had no usable name (no identifier is "*")
 UNNAMED = "*"
 #: a list of scalars stays on one line up to this many characters
@@ -259,20 +258,7 @@ def _simulation(settings, problems):
     if not isinstance(settings, dict):
         problems.append(f"simulation: must be an object, got {_kind(settings)}")
         return {}
-    for key, value in settings.items():
-        where = f"simulation.{key}"
-        number = isinstance(value, (int, float)) and not isinstance(value, bool)
-        if key not in SIMULATION_KEYS:
-            problems.append(f"{where}: unknown setting{suggest(key, SIMULATION_KEYS)}; "
-                            f"settings are {', '.join(SIMULATION_KEYS)}")
-        elif key == "method":
-            if not isinstance(value, str) or not value:
-                problems.append(f"{where}: must be a method name, got {value!r:.40}")
-        elif key == "n_points":
-            if not number or not isinstance(value, int) or value < 2:
-                problems.append(f"{where}: must be an integer >= 2, got {value!r:.40}")
-        elif not number or not _finite(value) or value <= 0:
-            problems.append(f"{where}: must be a finite number > 0, got {value!r:.40}")
+    problems.extend(filter(None, (check_setting(k, v) for k, v in settings.items())))
     return dict(settings)
 
 
@@ -432,7 +418,7 @@ def _plain(value, where, problems):
     elif isinstance(value, (list, tuple)):
         for j, item in enumerate(value):
             _plain(item, f"{where}[{j}]", problems)
-    elif isinstance(value, (int, float)) and not _finite(value):
+    elif isinstance(value, (int, float)) and not finite(value):
         problems.append(f"{where}: must be finite, got {value!r:.40}")
     elif value is not None and not isinstance(value, (str, int, float)):
         problems.append(f"{where}: {type(value).__name__} is not a JSON value")
@@ -466,13 +452,6 @@ def _copy(value):
     # plain dicts and lists in the model, not the parser's _Object
     return ({k: _copy(v) for k, v in value.items()} if isinstance(value, dict) else
             [_copy(v) for v in value] if isinstance(value, list) else value)
-
-
-def _finite(value):
-    try:
-        return math.isfinite(value)
-    except OverflowError:       # an int too large for a float
-        return False
 
 
 def _kind(value):

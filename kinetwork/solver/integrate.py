@@ -1,12 +1,11 @@
 """simulate(): integrate a model with CasADi's integrators or scipy's, looked up in METHODS."""
 
-import math
-
 import casadi as ca
 import numpy as np
 
 from ..components.base import suggest
 from ..errors import ModelError, SimulationError
+from ..graph.model import check_setting
 from .results import Results
 from .system import System
 
@@ -131,11 +130,15 @@ def simulate(model, t_end=None, n_points=None, method=None, rtol=None, atol=None
     settings = {**DEFAULTS, **system.model.simulation,
                 **{k: v for k, v in given.items() if v is not None}}
     t_end, n_points, method, rtol, atol = (settings[k] for k in DEFAULTS)
-    key = str(method).lower()
+    problems = [m for k in DEFAULTS if (m := check_setting(k, settings[k]))]
+    if not problems and t_end <= t_start:
+        problems.append(f"simulation.t_end: must be > t_start = {t_start}, got {t_end}")
+    if problems:
+        raise ModelError(problems)
+    key = method.lower()
     if key not in METHODS:
         raise ModelError(f"method {method!r}: unknown{suggest(key, METHODS)}; methods are "
                          f"{', '.join(METHODS)}")
-    _check_settings(t_start, t_end, n_points, rtol, atol)
     p = system.param_vector(params)
     x0 = system.initial_state(params)
     grid = np.linspace(t_start, t_end, int(n_points))
@@ -158,15 +161,3 @@ def simulate(model, t_end=None, n_points=None, method=None, rtol=None, atol=None
                               f"{failure}", results=results, t_reached=reached)
     return results
 
-
-def _check_settings(t_start, t_end, n_points, rtol, atol):
-    for name, value in (("t_end", t_end), ("rtol", rtol), ("atol", atol)):
-        if isinstance(value, bool) or not isinstance(value, (int, float)) \
-                or not math.isfinite(value):
-            raise ModelError(f"simulation.{name}: must be a finite number, got {value!r}")
-    if t_end <= t_start:
-        raise ModelError(f"simulation.t_end: must be > {t_start}, got {t_end}")
-    if isinstance(n_points, bool) or not isinstance(n_points, int) or n_points < 2:
-        raise ModelError(f"simulation.n_points: must be an integer >= 2, got {n_points!r}")
-    if rtol <= 0 or atol <= 0:
-        raise ModelError(f"simulation: rtol and atol must be > 0, got {rtol}, {atol}")
