@@ -139,17 +139,17 @@ def simulate(model, t_end=None, n_points=None, method=None, rtol=None, atol=None
     if key not in METHODS:
         raise ModelError(f"method {method!r}: unknown{suggest(key, METHODS)}; methods are "
                          f"{', '.join(METHODS)}")
-    p = system.param_vector(params)
-    x0 = system.initial_state(params)
+    p = system.param_vector(params)        # checks the overrides once for the whole run
+    x0 = system.initial_state_p(p)
     grid = np.linspace(t_start, t_end, int(n_points))
     if system.n_states:
         X, failure, stats = METHODS[key](system, grid, x0, p, float(rtol), float(atol))
     else:                           # everything welded to the ground: nothing to integrate
         X, failure, stats = np.zeros((len(grid), 0)), None, {}
     t = grid[:len(X)]
-    results = Results(t, X, system.state_names, system.outputs(t, X, params) if len(t) else
+    results = Results(t, X, system.state_names, system.outputs_p(t, X, p) if len(t) else
                       np.zeros((0, 0)), system.signal_names, system.signal_sizes,
-                      system.signal_units, method=key, stats=stats,
+                      system.signal_units, stats=stats,
                       state_units=system.state_units,
                       settings={"t_start": t_start, "t_end": t_end, "n_points": int(n_points),
                                 "method": key, "rtol": rtol, "atol": atol,

@@ -14,13 +14,12 @@ class Results:
     """
 
     def __init__(self, t, states, state_names, signals, signal_names, sizes, units,
-                 method=None, stats=None, state_units=None, settings=None, probe_targets=None):
+                 stats=None, state_units=None, settings=None, probe_targets=None):
         self.t = np.asarray(t, dtype=float)
         self.states = np.asarray(states, dtype=float).reshape(len(self.t), len(state_names))
         self.state_names = list(state_names)
         self.units = dict(units)
         self.units.update(zip(self.state_names, state_units or [""] * len(self.state_names)))
-        self.method = method
         #: integrator counters: rhs_evaluations, jacobian_evaluations, steps (CasADi methods)
         self.stats = dict(stats or {})
         #: what was asked for: t_end, n_points, method, rtol, atol, params
@@ -36,6 +35,11 @@ class Results:
             col += size
             self._signals[name] = (block[:, 0] if size == 1 else
                                    block if size == 3 else block.reshape(-1, 3, 3))
+
+    @property
+    def method(self):
+        """The integration method that produced these results (None if not recorded)."""
+        return self.settings.get("method")
 
     @property
     def signal_names(self):

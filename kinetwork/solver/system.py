@@ -59,7 +59,11 @@ class System:
 
     def initial_state(self, params=None):
         """Initial state for the given parameter overrides."""
-        return np.asarray(self.f_x0(self.param_vector(params))).ravel()
+        return self.initial_state_p(self.param_vector(params))
+
+    def initial_state_p(self, p):
+        """Initial state for a parameter vector already checked by ``param_vector``."""
+        return np.asarray(self.f_x0(p)).ravel()
 
     @property
     def n_states(self):
@@ -100,10 +104,14 @@ class System:
 
     def outputs(self, t, x, params=None):
         """Probe signals at the given times and states (x: (n_points, n_states))."""
+        return self.outputs_p(t, x, self.param_vector(params))
+
+    def outputs_p(self, t, x, p):
+        """Probe signals for a parameter vector already checked by ``param_vector``."""
         t = np.atleast_1d(np.asarray(t, dtype=float))
         X = np.atleast_2d(np.asarray(x, dtype=float))
         f = self.f_out.map(len(t))
-        return np.asarray(f(t[None, :], X.T, self.param_vector(params))).T
+        return np.asarray(f(t[None, :], X.T, p)).T
 
     def integrator(self, plugin, grid, rtol, atol, options=None, cache=True):
         """A CasADi integrator over ``grid`` (outputs at grid[1:]), cached per settings."""
