@@ -25,6 +25,27 @@ _NAME = re.compile(r"^[A-Za-z_][A-Za-z0-9_]*$")
 REGISTRY = {}
 
 
+def finite(value):
+    """math.isfinite that says False, not OverflowError, for a huge int."""
+    try:
+        return math.isfinite(value)
+    except OverflowError:
+        return False
+
+
+def check_number(value, where, what="a number"):
+    """A finite real number, or a ModelError naming ``where``."""
+    if isinstance(value, np.generic):
+        value = value.item()
+    if isinstance(value, bool) or not isinstance(value, (int, float)):
+        raise ModelError(f"{where}: must be {what}, got {value!r}")
+    if not finite(value):
+        got = (f"an integer of {len(str(value))} digits" if isinstance(value, int)
+               else repr(value))
+        raise ModelError(f"{where}: must be finite, got {got}")
+    return value
+
+
 def suggest(name, choices):
     """' (did you mean 'x'?)' for the closest of ``choices``, or ''."""
     close = difflib.get_close_matches(str(name), list(choices), n=1)
@@ -109,7 +130,7 @@ class Param:
         """Check the structure of ``value``; return it in canonical nested-list form.
 
         Numbers are bounds-checked here; expressions are checked once model parameters are
-        known (``check_number``).
+        known (``check_bounds``).
         """
         if value is None:
             if self.optional:
@@ -168,18 +189,12 @@ class Param:
                 raise ModelError(f"{where}: time 't' is not allowed in {value!r}; "
                                  f"this parameter is constant")
             return value
-        if isinstance(value, bool) or not isinstance(value, (int, float)):
-            raise ModelError(f"{where}: must be a number or an expression, got {value!r}")
-        if isinstance(value, int) and abs(value) > 2**1023:
-            raise ModelError(f"{where}: must be finite, got an integer of {len(str(value))} "
-                             f"digits")
-        if not math.isfinite(value):
-            raise ModelError(f"{where}: must be finite, got {value!r}")
+        value = check_number(value, where, "a number or an expression")
         if bounds:
-            self.check_number(value, where)
+            self.check_bounds(value, where)
         return value
 
-    def check_number(self, number, where):
+    def check_bounds(self, number, where):
         """Bounds check of one evaluated scalar, worded for the person at the diagram."""
         unit = f" {self.unit}" if self.unit else ""
         if not math.isfinite(number):

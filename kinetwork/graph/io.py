@@ -14,10 +14,10 @@ import os
 import secrets
 import stat
 
-from ..components.base import REGISTRY, suggest
+from ..components.base import REGISTRY, finite, suggest
 from ..errors import ModelError
 from ..expr import Expression
-from .model import Model, check_setting, finite
+from .model import Model, check_setting
 
 FORMAT, VERSION, SUPPORTED = "kinetwork.model", 1, (1,)
 #: top-level keys, in the order files are written

@@ -5,7 +5,7 @@ import re
 
 import numpy as np
 
-from ..components.base import ANY, Component, PortRef, suggest
+from ..components.base import ANY, Component, PortRef, check_number, finite, suggest
 from ..errors import ModelError
 from ..expr import CONSTANTS, FUNCTIONS, Expression
 
@@ -153,19 +153,6 @@ class Model:
                 f"{len(self.connections)} connections>")
 
 
-def check_number(value, where):
-    """A finite real number, or a ModelError naming ``where``."""
-    if isinstance(value, np.generic):
-        value = value.item()
-    if isinstance(value, bool) or not isinstance(value, (int, float)):
-        raise ModelError(f"{where}: must be a number, got {value!r}")
-    if isinstance(value, int) and abs(value) > 2**1023:
-        raise ModelError(f"{where}: must be finite, got an integer of {len(str(value))} digits")
-    if not math.isfinite(value):
-        raise ModelError(f"{where}: must be finite, got {value!r}")
-    return value
-
-
 def check_setting(key, value):
     """The problem with one experiment setting, or None; files and ``simulate`` share it."""
     where = f"simulation.{key}"
@@ -182,14 +169,6 @@ def check_setting(key, value):
     elif not number or not finite(value) or value <= 0:
         return f"{where}: must be a finite number > 0, got {value!r:.40}"
     return None
-
-
-def finite(value):
-    """math.isfinite that says False, not OverflowError, for a huge int."""
-    try:
-        return math.isfinite(value)
-    except OverflowError:       # an int too large for a float
-        return False
 
 
 def evaluate(value, spec, env, where):
@@ -223,7 +202,7 @@ def _scalar(value, spec, env, where, bounds=True):
     else:
         number = float(value)
     if bounds:
-        spec.check_number(number, where)
+        spec.check_bounds(number, where)
     elif not math.isfinite(number):
         raise ModelError(f"{where}: must be finite, got {number}")
     return number
