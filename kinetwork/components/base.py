@@ -159,18 +159,25 @@ class Param:
         if self.shape == (3, 3) and len(value) == 3 and not any(
                 isinstance(v, (list, tuple)) for v in value):
             value = [[value[0], 0, 0], [0, value[1], 0], [0, 0, value[2]]]
-        rows = value if len(self.shape) == 1 else value
-        if len(rows) != self.shape[0]:
-            raise ModelError(f"{where}: must have {self.shape[0]} entries, got {len(rows)}")
+        if len(value) != self.shape[0]:
+            raise ModelError(f"{where}: must have {self.shape[0]} entries, got {len(value)}")
+        problems = []
+
+        def scalar(v, at):          # every bad entry is reported, not only the first
+            try:
+                return self._scalar(v, at, bounds=False)
+            except ModelError as exc:
+                problems.extend(exc.problems)
         if len(self.shape) == 1:
-            out = [self._scalar(v, f"{where}[{i}]", bounds=False) for i, v in enumerate(value)]
+            out = [scalar(v, f"{where}[{i}]") for i, v in enumerate(value)]
         else:
             out = []
             for i, row in enumerate(value):
                 if not isinstance(row, (list, tuple)) or len(row) != self.shape[1]:
                     raise ModelError(f"{where}[{i}]: must be a row of {self.shape[1]} entries")
-                out.append([self._scalar(v, f"{where}[{i}][{j}]", bounds=False)
-                            for j, v in enumerate(row)])
+                out.append([scalar(v, f"{where}[{i}][{j}]") for j, v in enumerate(row)])
+        if problems:
+            raise ModelError(problems)
         if self.nonzero and all(isinstance(v, (int, float)) for v in out) and not any(out):
             raise ModelError(f"{where}: must not be the zero vector")
         return out
@@ -237,19 +244,29 @@ class Component:
             cls.type_name = f"{library}.{cls.__name__}" if library else cls.__name__
             REGISTRY[cls.type_name] = cls
 
-    def __init__(self, name, *, _place=None, **params):
-        # ``_place`` formats the location of a parameter in messages; files pass their JSON path
-        place = _place or (lambda key: f"{name}.{key}")
-        where = f"{type(self).__name__} {name!r}"
+    def __init__(self, name, **params):
+        self._declare(name, params, None)
+
+    @classmethod
+    def from_params(cls, name, params, place=None):
+        """Build from a dict of parameters, as a file gives them (any key, even "name").
+
+        ``place(key)`` locates a parameter in messages (files pass their JSON path).
+        """
+        comp = cls.__new__(cls)
+        comp._declare(name, params, place)
+        return comp
+
+    def _declare(self, name, params, place):
+        place = place or (lambda key: f"{name}.{key}")
         if not isinstance(name, str) or not _NAME.match(name):
             raise ModelError(f"{type(self).__name__} name {name!r}: must be an identifier "
                              f"(letters, digits, underscore; not starting with a digit)")
         self.name = name
-        problems = []
-        for key in params:
-            if key not in self.params:
-                problems.append(f"{where}: unknown parameter {key!r}{suggest(key, self.params)}; "
-                                f"parameters are {', '.join(self.params) or 'none'}")
+        kind = self.type_name or type(self).__name__
+        problems = [f"{place(key)}: unknown parameter{suggest(key, self.params)}; "
+                    f"{kind} has {', '.join(self.params) or 'none'}"
+                    for key in params if key not in self.params]
         self.given = {}
         self._values = {}
         for key, spec in self.params.items():

@@ -16,7 +16,6 @@ import stat
 
 from ..components.base import REGISTRY, finite, suggest
 from ..errors import ModelError
-from ..expr import Expression
 from .model import Model, check_setting
 
 FORMAT, VERSION, SUPPORTED = "kinetwork.model", 1, (1,)
@@ -190,37 +189,8 @@ def _component(entry, place, problems):
     if not isinstance(params, dict):
         problems.append(f"{place} params: must be an object, got {_kind(params)}")
         return None
-    cls = REGISTRY[kind]
-    where = lambda key: f"{place} params.{key}"   # noqa: E731
-    given = {}
-    for key, value in params.items():
-        if key not in cls.params:
-            problems.append(f"{where(key)}: unknown parameter{suggest(key, cls.params)}; "
-                            f"{kind} has {', '.join(cls.params) or 'none'}")
-        else:
-            real = cls.params[key].kind == "real"
-            given[key] = _vet(value, where(key), problems) if real else value
-    return cls(entry["name"], _place=where, **given)
-
-
-def _vet(value, where, problems, depth=0):
-    """``value`` with each unparseable expression reported at its place and replaced by "0".
-
-    A component reports such an expression without naming the parameter; the harmless
-    stand-in lets it still report its other problems.
-    """
-    if isinstance(value, str) and value.strip():
-        try:
-            Expression(value)
-        except ModelError as exc:
-            problems.extend(f"{where}: {p}" for p in exc.problems)
-            return "0"
-        except RecursionError:
-            problems.append(f"{where}: expression nested too deeply")
-            return "0"
-    elif isinstance(value, list) and depth < 2:
-        return [_vet(v, f"{where}[{j}]", problems, depth + 1) for j, v in enumerate(value)]
-    return value
+    return REGISTRY[kind].from_params(entry["name"], params,
+                                      place=lambda key: f"{place} params.{key}")
 
 
 def _connections(model, pairs, broken, problems):

@@ -65,6 +65,12 @@ def test_bad_parameters_refused(make, match):
         make()
 
 
+def test_every_bad_entry_of_a_vector_reported():
+    with pytest.raises(kn.ModelError) as info:
+        mb.FixedTranslation("f", r=["1 +", 0, "().__class__"])
+    assert [p.split(":")[0] for p in info.value.problems] == ["f.r[0]", "f.r[2]"]
+
+
 def test_every_problem_reported_at_once():
     with pytest.raises(kn.ModelError) as info:
         mb.RigidBody("m", mass=-1.0, r_cm=[0, 0], inertia="x")
