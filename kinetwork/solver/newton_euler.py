@@ -7,7 +7,7 @@ sits at ``R @ x + p`` in the parent's. Gravity enters as an upward acceleration 
 ``crba``, which fills the n x n mass matrix.
 """
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import casadi as ca
 
@@ -27,6 +27,10 @@ class Body:
     cJ: ca.SX            # 6x1 velocity-product acceleration of the joint (S-dot qd)
     inertia: ca.SX       # 6x6 spatial inertia about the body origin, body coordinates
     index: list          # positions of this joint's coordinates in q
+    X: ca.SX = field(init=False)     # parent-to-body motion transform, built once
+
+    def __post_init__(self):
+        self.X = transform(self.R, self.p)
 
 
 def transform(R, p):
@@ -61,7 +65,7 @@ def _solve(D, b):
 def aba(bodies, qd, tau, a0):
     """Articulated-body algorithm: joint accelerations qdd, O(n) in the number of bodies."""
     n = len(bodies)
-    X = [transform(b.R, b.p) for b in bodies]
+    X = [b.X for b in bodies]
     v, c, IA, pA = [None] * n, [None] * n, [None] * n, [None] * n
     for k, b in enumerate(bodies):
         vJ = b.S @ qd[b.index]
@@ -92,7 +96,7 @@ def aba(bodies, qd, tau, a0):
 
 def crba(bodies, n_q):
     """Composite-rigid-body algorithm: the joint-space mass matrix M(q)."""
-    X = [transform(b.R, b.p) for b in bodies]
+    X = [b.X for b in bodies]
     IC = [b.inertia for b in bodies]
     for k in reversed(range(len(bodies))):
         parent = bodies[k].parent
@@ -115,7 +119,7 @@ def crba(bodies, n_q):
 def rnea(bodies, qd, qdd, a0):
     """Inverse dynamics: generalized forces that produce qdd at (q, qd) (outward, inward)."""
     n = len(bodies)
-    X = [transform(b.R, b.p) for b in bodies]
+    X = [b.X for b in bodies]
     v, a, f = [None] * n, [None] * n, [None] * n
     for k, b in enumerate(bodies):
         vJ = b.S @ qd[b.index]
