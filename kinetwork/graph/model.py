@@ -12,7 +12,7 @@ from ..expr import CONSTANTS, FUNCTIONS, Expression
 _IDENT = re.compile(r"^[A-Za-z_][A-Za-z0-9_]*$")
 RESERVED = {"t", *CONSTANTS, *FUNCTIONS}
 #: the experiment settings a model carries (``Model.simulation``)
-SIMULATION_KEYS = ("t_end", "n_points", "method", "rtol", "atol")
+SIMULATION_KEYS = ("t_end", "n_points", "method", "rtol", "atol", "step")
 
 
 class Model:
@@ -27,7 +27,8 @@ class Model:
     description : str, optional
         Free text.
     simulation : dict, optional
-        Experiment settings travelling with the model (t_end, n_points, method, rtol, atol).
+        Experiment settings travelling with the model (t_end, n_points, method, rtol, atol,
+        step).
     """
 
     def __init__(self, name, parameters=None, description="", simulation=None):

@@ -1,39 +1,86 @@
 """simulate(): integrate a model with CasADi's integrators or scipy's, looked up in METHODS."""
 
-import casadi as ca
+from dataclasses import dataclass
+from typing import Callable
+
 import numpy as np
 
 from ..components.base import suggest
 from ..errors import ModelError, SimulationError
 from ..graph.model import check_setting
+from . import jit as _jit
 from .results import Results
 from .system import System
 
-DEFAULTS = {"t_end": 10.0, "n_points": 1001, "method": "cvodes", "rtol": 1e-6, "atol": 1e-8}
+DEFAULTS = {"t_end": 10.0, "n_points": 1001, "method": "auto", "rtol": 1e-6, "atol": 1e-8,
+            "step": None}
 
 
-def _casadi(plugin, **options):
+@dataclass(frozen=True)
+class Method:
+    """One integration method a user can pick.
+
+    ``run(system, grid, x0, p, settings)`` returns (states on the grid, failure reason or None,
+    statistics); ``fixed`` methods take ``settings["step"]`` instead of tolerances; ``newton``
+    methods iterate with the Jacobian (compiled with the right-hand side under JIT).
+    """
+    run: Callable
+    doc: str
+    fixed: bool = False
+    newton: bool = False
+
+
+def _casadi(plugin, newton, **options):
     """A CasADi integrator plugin: the whole integration runs in compiled code."""
-    def run(system, grid, x0, p, rtol, atol):
-        integ = system.integrator(plugin, grid, rtol, atol, options)
+    sundials = plugin in ("cvodes", "idas")
+
+    def run(system, grid, x0, p, settings):
+        opts = dict(options)
+        if sundials:
+            opts.update(reltol=settings["rtol"], abstol=settings["atol"])
+        else:       # fixed steps: CasADi counts them over the whole horizon
+            opts["number_of_finite_elements"] = \
+                _steps_per_interval(grid, settings["step"]) * (len(grid) - 1)
+        jit = settings["jit"]
+        integ = system.integrator(plugin, grid, opts, jit=jit, jacobian=newton)
         try:
             out = integ(x0=x0, p=p)
         except RuntimeError as exc:
-            X, reason = _casadi_partial(system, plugin, grid, x0, p, rtol, atol, options, exc)
+            X, reason = _casadi_partial(system, plugin, grid, x0, p, opts, jit, newton, exc)
             return X, reason, {}
         X = np.vstack([x0, np.asarray(out["xf"]).T])
         stats = integ.stats()
+        if not sundials:
+            X, failure = _finite(X)
+            m = opts["number_of_finite_elements"] // (len(grid) - 1)
+            return X, failure, {"steps": m * (len(X) - 1),
+                                "step": float(grid[1] - grid[0]) / m}
         return X, None, {"steps": int(stats["nsteps"]), "rhs_evaluations": int(stats["nfevals"]),
                          "jacobian_evaluations": int(stats["n_call_jacF"])}
     return run
 
 
-def _casadi_partial(system, plugin, grid, x0, p, rtol, atol, options, exc):
+def _steps_per_interval(grid, step):
+    dt = float(grid[1] - grid[0])
+    return max(1, int(np.ceil(dt / (step or dt) * (1 - 1e-12))))
+
+
+def _finite(X):
+    """States up to the first non-finite one, and the reason if there is one."""
+    good = np.all(np.isfinite(X), axis=1)
+    if good.all():
+        return X, None
+    return X[:int(np.argmin(good))], "the state became non-finite (Inf or NaN)"
+
+
+def _casadi_partial(system, plugin, grid, x0, p, options, jit, newton, exc):
     """After a failure, step interval by interval to keep everything computed before it."""
     X = [x0]
+    quiet = {**options, "disable_internal_warnings": True} if plugin in ("cvodes", "idas") \
+        else options
     for k in range(len(grid) - 1):
-        integ = system.integrator(plugin, grid[k:k + 2], rtol, atol,
-                                  {**options, "disable_internal_warnings": True}, cache=False)
+        integ = system.integrator(plugin, grid[k:k + 2], quiet, cache=False, jit=jit,
+                                  jacobian=newton)
         try:
             X.append(np.asarray(integ(x0=X[-1], p=p)["xf"]).ravel())
         except RuntimeError as step_exc:
@@ -70,32 +117,94 @@ def _scipy(name):
     """A scipy solve_ivp method fed by the compiled CasADi right-hand side and Jacobian."""
     implicit = name in ("Radau", "BDF", "LSODA")
 
-    def run(system, grid, x0, p, rtol, atol):
+    def run(system, grid, x0, p, settings):
         from scipy.integrate import solve_ivp    # 0.4 s to import: only when asked for
-        kwargs = {"jac": system.numeric(system.jacobian_function(), p)} if implicit else {}
-        fun = system.numeric(system.f_rhs, p)
+        jit = settings["jit"]
+        kwargs = {"jac": system.numeric(system.jacobian_numeric_function(jit), p)} \
+            if implicit else {}
+        fun = system.numeric(system.rhs_function(jit), p)
         with np.errstate(all="ignore"):      # a blow-up is reported below, not warned
             sol = solve_ivp(fun, (grid[0], grid[-1]), x0, method=name, t_eval=grid,
-                            rtol=rtol, atol=atol, **kwargs)
-        X = sol.y.T
+                            rtol=settings["rtol"], atol=settings["atol"], **kwargs)
         stats = {"rhs_evaluations": int(sol.nfev), "jacobian_evaluations": int(sol.njev)}
-        good = np.all(np.isfinite(X), axis=1)
-        if not good.all():
-            return X[:int(np.argmin(good))], "the state became non-finite (Inf or NaN)", stats
-        return X, (sol.message if sol.status < 0 else None), stats
+        X, failure = _finite(sol.y.T)
+        if failure is None and sol.status < 0:
+            failure = sol.message
+        return X, failure, stats
     return run
 
 
-#: method name (case-insensitive) -> runner
+def _midpoint(system, grid, x0, p, settings):
+    from .geometric import Midpoint
+    key = ("midpoint", settings["jit"])
+    if key not in system._compiled:
+        system._compiled[key] = Midpoint(system, settings["jit"])
+    return system._compiled[key].run(grid, x0, p, settings["step"] or grid[1] - grid[0])
+
+
+#: method name (case-insensitive) -> Method
 METHODS = {
-    "cvodes": _casadi("cvodes"),
-    "idas": _casadi("idas"),
-    **{m.lower(): _scipy(m) for m in ("RK45", "DOP853", "Radau", "BDF", "LSODA")},
+    "auto": Method(None, "cvodes-adams, or cvodes (BDF) when the stiffness test says so"),
+    "cvodes-adams": Method(_casadi("cvodes", False, linear_multistep_method="adams",
+                                   nonlinear_solver_iteration="functional"),
+                           "SUNDIALS CVODES, variable-order Adams-Moulton with functional "
+                           "iteration: non-stiff, no Jacobian"),
+    "cvodes": Method(_casadi("cvodes", True), "SUNDIALS CVODES, variable-order BDF with "
+                     "Newton iteration: stiff", newton=True),
+    "idas": Method(_casadi("idas", True), "SUNDIALS IDAS, variable-order BDF on the residual "
+                   "form: stiff", newton=True),
+    "rk": Method(_casadi("rk", False), "CasADi's classical Runge-Kutta 4, fixed step",
+                 fixed=True),
+    "collocation": Method(_casadi("collocation", True),
+                          "CasADi's Radau IIA collocation (order 5), fixed step: stiff",
+                          fixed=True, newton=True),
+    "midpoint": Method(_midpoint, "implicit midpoint rule in canonical coordinates, fixed "
+                       "step: symplectic, for long undamped runs", fixed=True, newton=True),
+    **{m.lower(): Method(_scipy(m), f"scipy solve_ivp {m}", newton=m in ("Radau", "BDF", "LSODA"))
+       for m in ("RK45", "DOP853", "Radau", "BDF", "LSODA")},
 }
 
 
+#: the stiffness test of ``auto``: see ``stiffness``
+STIFF_HORIZON_STEPS = 1e3
+STIFF_RATIO = 10.0
+
+
+def _jacobian_fd(f, t, x):
+    """Central finite differences: 2n evaluations, O(n) each; no O(n^2) symbolic Jacobian."""
+    J = np.empty((len(x), len(x)))
+    for i in range(len(x)):
+        dx = 1e-6 * max(1.0, abs(x[i]))
+        e = np.zeros(len(x))
+        e[i] = dx
+        J[:, i] = (f(t, x + e) - f(t, x - e)) / (2 * dx)
+    return J
+
+
+def stiffness(system, x0, p, t_start, t_end, jit=False):
+    """The stiffness test of the ``auto`` method, on the Jacobian at the initial state.
+
+    With λ the eigenvalues of d(xdot)/dx at (t_start, x0), the fastest decay rate is
+    σ = max(-Re λ) and the fastest other motion is ω = max(max Re λ, max |Im λ|). The problem is
+    stiff when σ (t_end - t_start) > STIFF_HORIZON_STEPS (an explicit or Adams method would
+    need over ~10^3 steps for stability alone) and σ > STIFF_RATIO ω (that decay is much
+    faster than anything the solution must follow). An undamped mechanism is never stiff by
+    this test (its eigenvalues come in ±λ pairs); a hard, heavily damped spring is.
+
+    Returns (stiff, σ, ω).
+    """
+    J = _jacobian_fd(system.numeric(system.rhs_function(jit), p), t_start, x0)
+    lam = np.linalg.eigvals(J) if J.size else np.zeros(0)
+    if not np.all(np.isfinite(lam)) or lam.size == 0:
+        return False, 0.0, 0.0
+    sigma = float(max(0.0, np.max(-lam.real)))
+    omega = float(max(0.0, np.max(lam.real), np.max(np.abs(lam.imag))))
+    stiff = sigma * (t_end - t_start) > STIFF_HORIZON_STEPS and sigma > STIFF_RATIO * omega
+    return stiff, sigma, omega
+
+
 def simulate(model, t_end=None, n_points=None, method=None, rtol=None, atol=None,
-             params=None, t_start=0.0):
+             params=None, t_start=0.0, step=None, jit=None):
     """Integrate ``model`` (a Model or a compiled System) and record its probes.
 
     Settings not given come from the model's ``simulation`` block, then from DEFAULTS.
@@ -106,16 +215,24 @@ def simulate(model, t_end=None, n_points=None, method=None, rtol=None, atol=None
     t_end : float
         End time [s]; the output grid has ``n_points`` equally spaced points from ``t_start``.
     method : str
-        One of METHODS: ``cvodes`` (default), ``idas``, or scipy's ``RK45``, ``DOP853``,
-        ``Radau``, ``BDF``, ``LSODA``.
+        One of METHODS (``kinetwork methods`` lists them). ``auto`` (default): CVODES Adams,
+        or CVODES BDF when ``stiffness`` finds the problem stiff at the start, or when Adams
+        fails on it.
     rtol, atol : float
-        Integrator tolerances.
+        Tolerances of the variable-step methods.
+    step : float, optional
+        Largest step [s] of the fixed-step methods (``rk``, ``collocation``, ``midpoint``);
+        default: the output spacing.
     params : dict, optional
         Model parameter values for this run; no recompilation.
+    jit : bool, optional
+        Compile the right-hand side to C (cached on disk, see ``kinetwork.solver.jit``).
+        Default: when a C compiler is found and ``KINETWORK_JIT`` is not 0.
 
     Returns
     -------
     Results
+        ``results.settings["method"]`` is the method that ran; ``results.stats`` its counts.
 
     Raises
     ------
@@ -126,33 +243,45 @@ def simulate(model, t_end=None, n_points=None, method=None, rtol=None, atol=None
     """
     system = model if isinstance(model, System) else model.compile()
     given = {"t_end": t_end, "n_points": n_points, "method": method, "rtol": rtol,
-             "atol": atol}
+             "atol": atol, "step": step}
     settings = {**DEFAULTS, **system.model.simulation,
                 **{k: v for k, v in given.items() if v is not None}}
-    t_end, n_points, method, rtol, atol = (settings[k] for k in DEFAULTS)
-    problems = [m for k in DEFAULTS if (m := check_setting(k, settings[k]))]
-    if not problems and t_end <= t_start:
-        problems.append(f"simulation.t_end: must be > t_start = {t_start}, got {t_end}")
+    problems = [m for k in DEFAULTS if settings[k] is not None
+                and (m := check_setting(k, settings[k]))]
+    if not problems and settings["t_end"] <= t_start:
+        problems.append(f"simulation.t_end: must be > t_start = {t_start}, "
+                        f"got {settings['t_end']}")
     if problems:
         raise ModelError(problems)
-    key = method.lower()
+    key = settings["method"].lower()
     if key not in METHODS:
-        raise ModelError(f"method {method!r}: unknown{suggest(key, METHODS)}; methods are "
-                         f"{', '.join(METHODS)}")
+        raise ModelError(f"method {settings['method']!r}: unknown{suggest(key, METHODS)}; "
+                         f"methods are {', '.join(METHODS)}")
     p = system.param_vector(params)        # checks the overrides once for the whole run
     x0 = system.initial_state_p(p)
-    grid = np.linspace(t_start, t_end, int(n_points))
-    if system.n_states:
-        X, failure, stats = METHODS[key](system, grid, x0, p, float(rtol), float(atol))
-    else:                           # everything welded to the ground: nothing to integrate
-        X, failure, stats = np.zeros((len(grid), 0)), None, {}
+    grid = np.linspace(t_start, settings["t_end"], int(settings["n_points"]))
+    settings.update(jit=_jit.enabled(jit) and system.n_states > 0, t_start=t_start,
+                    n_points=int(settings["n_points"]),
+                    rtol=float(settings["rtol"]), atol=float(settings["atol"]))
+    system.jit_stats.clear()
+    stats = {}
+    if not system.n_states:           # everything welded to the ground: nothing to integrate
+        X, failure, key = np.zeros((len(grid), 0)), None, "none"
+    elif key == "auto":
+        X, failure, stats, key = _auto(system, grid, x0, p, settings)
+    else:
+        X, failure, stats = METHODS[key].run(system, grid, x0, p, settings)
+    stats.update(jit=settings["jit"], **system.jit_stats)
     t = grid[:len(X)]
+    t_end = settings["t_end"]
     results = Results(t, X, system.state_names, system.outputs_p(t, X, p) if len(t) else
                       np.zeros((0, 0)), system.signal_names, system.signal_sizes,
                       system.signal_units, stats=stats,
                       state_units=system.state_units,
-                      settings={"t_start": t_start, "t_end": t_end, "n_points": int(n_points),
-                                "method": key, "rtol": rtol, "atol": atol,
+                      settings={"t_start": t_start, "t_end": t_end,
+                                "n_points": settings["n_points"], "method": key,
+                                "rtol": settings["rtol"], "atol": settings["atol"],
+                                "step": settings["step"], "jit": settings["jit"],
                                 "params": dict(params or {})},
                       probe_targets=system.probe_targets)
     if failure is not None:
@@ -161,3 +290,15 @@ def simulate(model, t_end=None, n_points=None, method=None, rtol=None, atol=None
                               f"{failure}", results=results, t_reached=reached)
     return results
 
+
+def _auto(system, grid, x0, p, settings):
+    """The default: Adams unless the stiffness test (or a failure of Adams) says BDF."""
+    stiff, sigma, omega = stiffness(system, x0, p, grid[0], grid[-1], settings["jit"])
+    why = {"stiff": bool(stiff), "decay_rate": sigma, "motion_rate": omega}
+    if not stiff:
+        X, failure, stats = METHODS["cvodes-adams"].run(system, grid, x0, p, settings)
+        if failure is None:
+            return X, None, {**stats, **why}, "cvodes-adams"
+        why["adams_failure"] = failure
+    X, failure, stats = METHODS["cvodes"].run(system, grid, x0, p, settings)
+    return X, failure, {**stats, **why}, "cvodes"

@@ -4,7 +4,13 @@ import casadi as ca
 import numpy as np
 
 from ..errors import ModelError
+from . import jit as _jit
 from .assemble import assemble
+
+#: Jacobians larger than this (instructions) are not compiled to C: Newton iterations use
+#: finite differences of the compiled right-hand side instead (an N = 128 chain's exact
+#: Jacobian is 2.5 million instructions, minutes of gcc)
+JACOBIAN_JIT_LIMIT = 200_000
 
 
 class System:
@@ -44,6 +50,8 @@ class System:
         self._f_terms = None
         self._f_jac = None
         self._integrators = {}
+        self._compiled = {}
+        self.jit_stats = {}
 
     # -- parameters -----------------------------------------------------------------------
     def param_vector(self, params=None):
@@ -113,13 +121,69 @@ class System:
         f = self.f_out.map(len(t))
         return np.asarray(f(t[None, :], X.T, p)).T
 
-    def integrator(self, plugin, grid, rtol, atol, options=None, cache=True):
-        """A CasADi integrator over ``grid`` (outputs at grid[1:]), cached per settings."""
-        key = (plugin, grid[0], grid[-1], len(grid), rtol, atol, tuple(sorted((options or {}).items())))
+    # -- size -----------------------------------------------------------------------------
+    def size(self):
+        """What the model costs: states, algebraic variables, right-hand-side operations.
+
+        ``operations`` counts the elementary operations of one right-hand-side evaluation
+        (CasADi instructions that are not inputs, outputs or constants).
+        """
+        f = self.f_rhs
+        ops = sum(1 for k in range(f.n_instructions())
+                  if f.instruction_id(k) not in (ca.OP_INPUT, ca.OP_OUTPUT, ca.OP_CONST,
+                                                 ca.OP_PARAMETER))
+        return {"states": self.n_states, "algebraic": 0, "parameters": len(self.param_names),
+                "operations": ops}
+
+    # -- compiled code ----------------------------------------------------------------------
+    def rhs_function(self, jit=False, jacobian=False):
+        """The right-hand side as a CasADi Function of (t, x, p): SX, or compiled C with ``jit``.
+
+        With ``jacobian`` the compiled library also holds the exact Jacobian, if it is small
+        enough (``JACOBIAN_JIT_LIMIT``); otherwise derivatives are finite differences.
+        """
+        if not jit:
+            return self.f_rhs
+        jacobian = jacobian and self._jacobian_small()
+        key = ("rhs", jacobian)
+        if key not in self._compiled:
+            self._compiled[key] = _jit.external(self.f_rhs, jacobian, self.jit_stats)
+        return self._compiled[key]
+
+    def jacobian_numeric_function(self, jit=False):
+        """d(xdot)/dx as a Function of (t, x, p) for scipy's implicit methods, compiled with
+        ``jit`` when small enough."""
+        if not (jit and self._jacobian_small()):
+            return self.jacobian_function()
+        if "jac" not in self._compiled:
+            self._compiled["jac"] = _jit.external(self.jacobian_function(), False, self.jit_stats)
+        return self._compiled["jac"]
+
+    def _jacobian_small(self):
+        return self.jacobian_function().n_instructions() <= JACOBIAN_JIT_LIMIT
+
+    def dae(self, jit=False, jacobian=False):
+        """The ODE as the DAE Function CasADi's integrators take (inputs t, x, z, p, u)."""
+        f = self.rhs_function(jit, jacobian)
+        t, x = ca.MX.sym("t"), ca.MX.sym("x", self.n_states)
+        p, empty = ca.MX.sym("p", len(self.param_names)), ca.MX(0, 1)
+        return ca.Function("dae", [t, x, ca.MX.sym("z", 0), p, ca.MX.sym("u", 0)],
+                           [f(t, x, p), empty, empty, empty], ca.dyn_in(), ca.dyn_out())
+
+    def integrator(self, plugin, grid, options=None, cache=True, jit=False, jacobian=True):
+        """A CasADi integrator over ``grid`` (outputs at grid[1:]), cached per settings.
+
+        ``options`` go to CasADi (``reltol``, ``abstol``, ...). With ``jit`` the right-hand
+        side is compiled C (``rhs_function``); ``jacobian`` says whether the method iterates
+        with Newton and so needs the exact Jacobian.
+        """
+        key = (plugin, grid[0], grid[-1], len(grid), jit, jacobian,
+               tuple(sorted((options or {}).items())))
         if cache and key in self._integrators:
             return self._integrators[key]
-        dae = {"x": self._x, "p": self.asm.p, "t": self.asm.t, "ode": self.ode}
-        opts = {"reltol": rtol, "abstol": atol, **(options or {})}
+        dae = self.dae(True, jacobian) if jit else \
+            {"x": self._x, "p": self.asm.p, "t": self.asm.t, "ode": self.ode}
+        opts = dict(options or {})
         integ = ca.integrator("simulate", plugin, dae, float(grid[0]),
                               [float(g) for g in grid[1:]], opts)
         if cache:
