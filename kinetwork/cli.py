@@ -1,4 +1,5 @@
-"""The ``kinetwork`` command: run, validate and derive the equations of a model file.
+"""The ``kinetwork`` command: run, validate and derive the equations of a model file; list
+the integration methods; run the benchmark studies.
 
 Exit codes: 0 success, 1 a refused model or an unwritable output, 2 a usage error (argparse),
 3 a failed integration (whatever was computed before the failure is still written).
@@ -69,6 +70,12 @@ def build_parser():
                      help=f"integrator: {', '.join(METHODS)}")
     run.add_argument("--rtol", type=float, metavar="R", help="relative tolerance")
     run.add_argument("--atol", type=float, metavar="A", help="absolute tolerance")
+    run.add_argument("--step", type=float, metavar="H",
+                     help="largest step [s] of the fixed-step methods (rk, collocation, "
+                          "midpoint; default: the output spacing)")
+    run.add_argument("--jit", action=argparse.BooleanOptionalAction,
+                     help="compile the equations to C with the system's compiler, cached on "
+                          "disk (default: when a compiler is found)")
     run.add_argument("--n-points", type=int, metavar="N", help="points on the output grid")
     run.add_argument("--param", type=_parameter, action="append", default=[],
                      metavar="NAME=VALUE",
@@ -82,6 +89,17 @@ def build_parser():
         description="Check MODEL.json and summarise it: components, degrees of freedom, "
                     "states, loops, equation size, parameters.")
     val.add_argument("model", metavar="MODEL.json", help="model file")
+
+    sub.add_parser("methods", help="list the integration methods",
+                   description="List the integration methods a model can be run with.")
+
+    bench = sub.add_parser(
+        "bench", help="run the speed-against-accuracy studies (from a source checkout)",
+        description="Run the benchmark studies of bench/ (work-precision against pinocchio, "
+                    "MuJoCo and sympy; stiffness; long runs; chaos; scaling), writing CSV, "
+                    "charts and bench/results/summary.md. Needs a source checkout and the "
+                    "'bench' extras.")
+    bench.add_argument("--quick", action="store_true", help="a smoke test of every study")
 
     eqs = sub.add_parser(
         "equations", help="print the mass matrix M and force vectors V, G",
@@ -100,7 +118,8 @@ def build_parser():
 def main(argv=None):
     """Run the ``kinetwork`` command; returns the exit code."""
     args = build_parser().parse_args(argv)
-    command = {"run": _run, "validate": _validate, "equations": _equations}[args.command]
+    command = {"run": _run, "validate": _validate, "equations": _equations,
+               "methods": _methods, "bench": _bench}[args.command]
     try:
         return command(args)
     except kn.ModelError as exc:
@@ -157,7 +176,7 @@ def _run(args):
     try:
         results = kn.simulate(system, t_end=args.t_end, n_points=args.n_points,
                               method=args.method, rtol=args.rtol, atol=args.atol,
-                              params=dict(args.param))
+                              step=args.step, jit=args.jit, params=dict(args.param))
     except kn.SimulationError as exc:
         _error(exc)
         if exc.results is not None and len(exc.results.t):
@@ -171,8 +190,15 @@ def _run(args):
     print(f"{model.name}: {system.n_states} states ({', '.join(system.state_names)})")
     if args.param:
         print("parameters set: " + ", ".join(f"{k} = {v:g}" for k, v in args.param))
-    print(f"simulated t = {t[0]:g} .. {t[-1]:g} s ({len(t)} points) with {results.method} in "
-          f"{done - compiled:.3g} s wall time (compile {compiled - start:.3g} s)")
+    stats = results.stats
+    code = ("C, cached" if stats.get("jit_cached") else
+            f"C, compiled in {stats['jit_seconds']:.2g} s" if "jit_seconds" in stats else
+            "C" if stats.get("jit") else "CasADi virtual machine")
+    work = ", ".join(f"{stats[k]} {k.replace('_', ' ')}" for k in ("steps", "rhs_evaluations")
+                     if k in stats)
+    print(f"simulated t = {t[0]:g} .. {t[-1]:g} s ({len(t)} points) with {results.method} "
+          f"({code}{'; ' + work if work else ''}) in {done - compiled:.3g} s wall time "
+          f"(build {compiled - start:.3g} s)")
     _outputs(args, results, model.name)
     return 0
 
@@ -185,6 +211,7 @@ def _validate(args):
     kinds = collections.Counter(c.type_name for c in comps)
     units = dict(zip(system.state_names, system.state_units))
     n_values = sum(system.signal_sizes.values())
+    size = system.size()
     lines = [
         f"model {model.name!r} ({args.model}): valid",
         *([textwrap.fill(f"description: {model.description}", 88, subsequent_indent="  ",
@@ -198,8 +225,9 @@ def _validate(args):
                             for s in system.state_names) + ")" if system.n_states else ""),
         f"loops: {len(topo.loops) or 'none'}"
         + "".join(f"\n  {' - '.join(loop)}" for loop in topo.loops),
-        f"equations: {system.n_states} states, {len(system.signal_names)} probe signals "
-        f"({n_values} values), right-hand side {system.f_rhs.n_instructions()} operations",
+        f"equations: {size['states']} states, {size['algebraic']} algebraic variables, "
+        f"{len(system.signal_names)} probe signals ({n_values} values); right-hand side "
+        f"{size['operations']} operations per evaluation (articulated-body algorithm, O(N))",
         f"parameters: {len(model.parameters)}"
         + (" (" + ", ".join(f"{k} = {v:g}" for k, v in model.parameters.items()) + ")"
            if model.parameters else ""),
@@ -209,6 +237,28 @@ def _validate(args):
                                                 for k, v in model.simulation.items()))
     print("\n".join(lines))
     return 0
+
+
+def _methods(args):
+    from .solver.integrate import DEFAULTS
+    width = max(map(len, METHODS))
+    print(f"default: {DEFAULTS['method']}, rtol {DEFAULTS['rtol']:g}, atol {DEFAULTS['atol']:g}")
+    for name, method in METHODS.items():
+        kind = "fixed step" if method.fixed else "variable step"
+        print(f"  {name:<{width}}  {kind:<13}  " + textwrap.fill(
+            method.doc, 88, initial_indent=" " * (width + 19),
+            subsequent_indent=" " * (width + 19)).lstrip())
+    return 0
+
+
+def _bench(args):
+    import pathlib
+    import subprocess
+    script = pathlib.Path(__file__).resolve().parents[1] / "bench" / "run.py"
+    if not script.exists():
+        raise kn.ModelError("bench: the studies live in the source checkout's bench/ folder, "
+                            "which this installation does not have")
+    return subprocess.call([sys.executable, str(script), *(["--quick"] if args.quick else [])])
 
 
 def _equations(args):

@@ -7,6 +7,7 @@ import sys
 import numpy as np
 import pytest
 from conftest import double_pendulum
+from reference import seed_reference
 
 import kinetwork as kn
 from kinetwork.cli import main
@@ -88,11 +89,32 @@ def test_validate_summarises(seed_file, capsys):
         "degrees of freedom: 2",
         "states: 4 (shoulder.q [rad], elbow.q [rad], shoulder.qd [rad/s], elbow.qd [rad/s])",
         "loops: none",
-        f"equations: 4 states, 8 probe signals (8 values), right-hand side "
-        f"{system.f_rhs.n_instructions()} operations",
+        f"equations: 4 states, 0 algebraic variables, 8 probe signals (8 values); "
+        f"right-hand side {system.size()['operations']} operations per evaluation "
+        f"(articulated-body algorithm, O(N))",
         "parameters: 7 (L1 = 1, L2 = 1, m1 = 1, m2 = 1, c = 1, d = 1, g = 9.8)",
     ]:
         assert line in out.splitlines()
+
+
+def test_methods_lists_every_method_and_the_default(capsys):
+    assert main(["methods"]) == 0
+    out = capsys.readouterr().out
+    assert out.startswith("default: auto, rtol 1e-06, atol 1e-08")
+    listed = [line.split()[0] for line in out.splitlines()[1:] if not line.startswith("    ")]
+    assert listed == list(kn.METHODS)
+
+
+@pytest.mark.parametrize("jit, code", [("--jit", "C"), ("--no-jit", "CasADi virtual machine")])
+def test_run_fixed_step_and_jit_options(seed_file, tmp_path, capsys, jit, code):
+    out = tmp_path / "out.csv"
+    assert main(["run", str(seed_file), "--method", "rk", "--step", "0.002", jit,
+                 "--t-end", "1", "--n-points", "101", "--out", str(out)]) == 0
+    text = capsys.readouterr().out
+    assert f"with rk ({code}" in text and "500 steps" in text
+    ref = seed_reference(np.linspace(0, 1, 101))
+    data = np.loadtxt(out, delimiter=",", skiprows=1)
+    np.testing.assert_allclose(data[:, 1], ref[:, 0], atol=1e-8)     # probe1.angle
 
 
 def test_equations_text_reads_like_the_paper(seed_file, capsys):
