@@ -25,13 +25,28 @@ def seed_mvg(q, qd, L1, L2, m1, m2, c, d, g, sin=np.sin, cos=np.cos, array=np.ar
     return M, V, G
 
 
-def seed_reference(t, x0=(0.05, 0.05, 0.0, 0.0), rtol=1e-13, atol=1e-14, **params):
-    """States on ``t`` from the closed form, integrated tightly with DOP853."""
+def seed_reference(t, x0=(0.05, 0.05, 0.0, 0.0), rtol=1e-13, atol=1e-14, method="DOP853",
+                   **params):
+    """States on ``t`` from the closed form, integrated tightly with DOP853 (or ``method``:
+    Radau for the stiff variants)."""
     p = {**PAPER, **params}
 
     def rhs(_, x):
         M, V, G = seed_mvg(x[:2], x[2:], **p)
         return np.concatenate([x[2:], np.linalg.solve(M, -(V + G))])
 
-    sol = solve_ivp(rhs, (t[0], t[-1]), x0, method="DOP853", t_eval=t, rtol=rtol, atol=atol)
+    sol = solve_ivp(rhs, (t[0], t[-1]), x0, method=method, t_eval=t, rtol=rtol, atol=atol)
     return sol.y.T
+
+
+def seed_energy(X, c=PAPER["c"], **params):
+    """Mechanical energy of the seed scene on states X (n, 4): kinetic from the closed-form M,
+    gravity of the point masses at mid-link (angles from the downward vertical), shoulder
+    spring c q1^2 / 2."""
+    p = {**PAPER, "c": c, **params}
+    q, qd = X[:, :2], X[:, 2:]
+    T = np.array([0.5 * w @ seed_mvg(a, w, **p)[0] @ w for a, w in zip(q, qd)])
+    m1, m2, L1, L2, g = p["m1"], p["m2"], p["L1"], p["L2"], p["g"]
+    height1 = -L1 / 2 * np.cos(q[:, 0])
+    height2 = -L1 * np.cos(q[:, 0]) - L2 / 2 * np.cos(q[:, 0] + q[:, 1])
+    return T + g * (m1 * height1 + m2 * height2) + 0.5 * c * q[:, 0] ** 2

@@ -46,6 +46,15 @@ def double_pendulum(q0=(0.05, 0.05), probes=True, qd0=None, inertia=None, **para
     return m
 
 
+@pytest.fixture(autouse=True, scope="session")
+def jit_cache(tmp_path_factory):
+    """Compiled models go to a folder of this test run, not to the user's cache."""
+    mp = pytest.MonkeyPatch()
+    mp.setenv("KINETWORK_CACHE", str(tmp_path_factory.mktemp("kinetwork-cache")))
+    yield
+    mp.undo()
+
+
 @pytest.fixture
 def seed_model():
     return double_pendulum()

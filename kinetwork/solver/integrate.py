@@ -38,7 +38,8 @@ def _casadi(plugin, newton, **options):
         opts = dict(options)
         if sundials:
             opts.update(reltol=settings["rtol"], abstol=settings["atol"])
-        else:       # fixed steps: CasADi counts them over the whole horizon
+        else:       # fixed steps: CasADi counts them over the whole horizon; a blow-up is
+            opts["show_eval_warnings"] = False           # reported once, below
             opts["number_of_finite_elements"] = \
                 _steps_per_interval(grid, settings["step"]) * (len(grid) - 1)
         jit = settings["jit"]
