@@ -293,10 +293,17 @@ def simulate(model, t_end=None, n_points=None, method=None, rtol=None, atol=None
 
 
 def _auto(system, grid, x0, p, settings):
-    """The default: Adams unless the stiffness test (or a failure of Adams) says BDF."""
-    stiff, sigma, omega = stiffness(system, x0, p, grid[0], grid[-1], settings["jit"])
-    why = {"stiff": bool(stiff), "decay_rate": sigma, "motion_rate": omega}
-    if not stiff:
+    """The default: Adams unless the stiffness test (or a failure of Adams) says BDF.
+
+    A model without damping (generalized forces independent of the speeds) is conservative
+    up to its time-dependent drives: its eigenvalues come in ±λ pairs and it is never stiff by
+    the test, so the test (an eigenvalue problem of 2n x 2n) is not run.
+    """
+    why = {"stiff": False, "damped": system.damped}
+    if system.damped:
+        stiff, sigma, omega = stiffness(system, x0, p, grid[0], grid[-1], settings["jit"])
+        why.update(stiff=bool(stiff), decay_rate=sigma, motion_rate=omega)
+    if not why["stiff"]:
         X, failure, stats = METHODS["cvodes-adams"].run(system, grid, x0, p, settings)
         if failure is None:
             return X, None, {**stats, **why}, "cvodes-adams"

@@ -121,6 +121,12 @@ class System:
         f = self.f_out.map(len(t))
         return np.asarray(f(t[None, :], X.T, p)).T
 
+    @property
+    def damped(self):
+        """Whether a generalized force depends on the speeds (dampers): only then can the
+        model be stiff in the sense of ``kinetwork.solver.integrate.stiffness``."""
+        return bool(ca.depends_on(self.asm.Q, self.asm.qd)) if self.n_states else False
+
     # -- size -----------------------------------------------------------------------------
     def size(self):
         """What the model costs: states, algebraic variables, right-hand-side operations.

@@ -60,6 +60,13 @@ def test_undamped_mechanisms_are_never_stiff(build):
     assert sigma <= omega * (1 + 1e-6)          # eigenvalues in +-lambda pairs
 
 
+def test_auto_skips_the_test_on_undamped_models(monkeypatch):
+    monkeypatch.setattr(integrate, "stiffness", None)     # calling it would fail
+    res = kn.simulate(chain(4), t_end=1.0)
+    assert res.method == "cvodes-adams"
+    assert res.stats["stiff"] is False and res.stats["damped"] is False
+
+
 def test_auto_solves_the_stiff_scene_with_bdf_untuned():
     k = 1e5
     system = seed(c=k, d=k)
