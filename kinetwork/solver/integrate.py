@@ -275,8 +275,8 @@ def simulate(model, t_end=None, n_points=None, method=None, rtol=None, atol=None
     stats.update(jit=settings["jit"], **system.jit_stats)
     t = grid[:len(X)]
     t_end = settings["t_end"]
-    results = Results(t, X, system.state_names, system.outputs_p(t, X, p) if len(t) else
-                      np.zeros((0, 0)), system.signal_names, system.signal_sizes,
+    outputs = system.outputs_p(t, X, p, settings["jit"]) if len(t) else np.zeros((0, 0))
+    results = Results(t, X, system.state_names, outputs, system.signal_names, system.signal_sizes,
                       system.signal_units, stats=stats,
                       state_units=system.state_units,
                       settings={"t_start": t_start, "t_end": t_end,

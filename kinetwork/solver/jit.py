@@ -11,6 +11,7 @@ The cache folder is ``$KINETWORK_CACHE``, else ``$XDG_CACHE_HOME/kinetwork``, el
 turns compilation off where ``jit`` is left to the default.
 """
 
+import functools
 import hashlib
 import os
 import pathlib
@@ -30,9 +31,14 @@ FLAGS = ("-O1", "-fPIC", "-shared")
 
 def compiler():
     """The C compiler's path, or None when the machine has none."""
-    for name in (os.environ.get("CC"), "gcc", "cc"):
-        if name and (path := shutil.which(name)):
-            return path
+    return _find_compiler(os.environ.get("CC"), os.environ.get("PATH"))
+
+
+@functools.lru_cache(maxsize=8)
+def _find_compiler(cc, path):
+    for name in (cc, "gcc", "cc"):
+        if name and (found := shutil.which(name, path=path)):
+            return found
     return None
 
 

@@ -114,12 +114,18 @@ class System:
         """Probe signals at the given times and states (x: (n_points, n_states))."""
         return self.outputs_p(t, x, self.param_vector(params))
 
-    def outputs_p(self, t, x, p):
-        """Probe signals for a parameter vector already checked by ``param_vector``."""
+    def outputs_p(self, t, x, p, jit=False):
+        """Probe signals for a parameter vector already checked by ``param_vector``; with
+        ``jit`` computed by compiled C."""
         t = np.atleast_1d(np.asarray(t, dtype=float))
         X = np.atleast_2d(np.asarray(x, dtype=float))
-        f = self.f_out.map(len(t))
-        return np.asarray(f(t[None, :], X.T, p)).T
+        jit = jit and bool(self.signal_names)
+        key = ("outputs", len(t), jit)
+        if key not in self._compiled:
+            if jit and "outputs" not in self._compiled:
+                self._compiled["outputs"] = _jit.external(self.f_out, False, self.jit_stats)
+            self._compiled[key] = (self._compiled["outputs"] if jit else self.f_out).map(len(t))
+        return np.asarray(self._compiled[key](t[None, :], X.T, p)).T
 
     @property
     def damped(self):
