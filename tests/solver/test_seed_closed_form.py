@@ -335,7 +335,7 @@ CASES = {
 # Every case is damped and only mildly sensitive: the reference itself moves by < 1e-8 from
 # rtol 1e-10 to 1e-13. (An undamped large swing is chaotic: 1e-12 perturbations grow to 1e-6
 # within 10 s, so it could not judge a solver at 1e-6.)
-METHODS = ["cvodes", "idas", "DOP853"]
+METHODS = ["auto", "cvodes", "idas", "DOP853"]
 TRAJECTORY_CASES = [pytest.param(case, method, id=f"{case}-{method}")
                     for case in CASES for method in METHODS]
 
