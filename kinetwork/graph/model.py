@@ -38,6 +38,7 @@ class Model:
         self.description = description
         self.components = {}
         self.connections = []
+        self._wired = set()            # the connections as unordered pairs, for O(1) checks
         self.parameters = {}
         self.simulation = dict(simulation or {})
         self.layout = {}
@@ -73,10 +74,12 @@ class Model:
         if da != db and ANY not in (da, db):
             raise ModelError(f"cannot connect {pa.path} ({da}) to {pb.path} ({db}): "
                              f"ports of different domains")
-        for c in self.connections:
-            if {c[0], c[1]} == {pa, pb}:
-                raise ModelError(f"{pa.path} and {pb.path} are already connected")
+        if len(self._wired) != len(self.connections):     # the list was edited by hand
+            self._wired = {frozenset(c) for c in self.connections}
+        if frozenset((pa, pb)) in self._wired:
+            raise ModelError(f"{pa.path} and {pb.path} are already connected")
         self.connections.append((pa, pb))
+        self._wired.add(frozenset((pa, pb)))
 
     def port(self, ref):
         """Resolve a PortRef or a ``"comp.port"`` string to a PortRef of this model."""

@@ -38,17 +38,23 @@ def _casadi(plugin, newton, **options):
         opts = dict(options)
         if sundials:
             opts.update(reltol=settings["rtol"], abstol=settings["atol"])
+            if plugin == "idas":
+                # an ODE's consistent initial rate is f(t0, x0): IDAS's own search for it
+                # (meant for algebraic variables) fails when it is large (a stiff spring)
+                xdot0 = system.numeric(system.rhs_function(settings["jit"]), p)(grid[0], x0)
+                opts.update(calc_ic=False, init_xdot=tuple(float(v) for v in xdot0))
         else:       # fixed steps: CasADi counts them over the whole horizon; a blow-up is
             opts["show_eval_warnings"] = False           # reported once, below
             opts["number_of_finite_elements"] = \
                 _steps_per_interval(grid, settings["step"]) * (len(grid) - 1)
         jit = settings["jit"]
-        integ = system.integrator(plugin, grid, opts, jit=jit, jacobian=newton)
+        integ = system.integrator(plugin, grid, opts, jit=jit, jacobian=newton,
+                                  cache=plugin != "idas")       # idas: options hold x0
         try:
             out = integ(x0=x0, p=p)
         except RuntimeError as exc:
             X, reason = _casadi_partial(system, plugin, grid, x0, p, opts, jit, newton, exc)
-            return X, reason, {}
+            return X, reason, {"restarted": "at every output time, after: " + _reason(str(exc))}
         X = np.vstack([x0, np.asarray(out["xf"]).T])
         stats = integ.stats()
         if not sundials:
@@ -75,18 +81,25 @@ def _finite(X):
 
 
 def _casadi_partial(system, plugin, grid, x0, p, options, jit, newton, exc):
-    """After a failure, step interval by interval to keep everything computed before it."""
+    """After a failure, step interval by interval to keep everything computed before it.
+
+    Returns (X, reason): reason is None when every interval went through after all (a fresh
+    start per output interval can pass where the continued run failed).
+    """
     X = [x0]
     quiet = {**options, "disable_internal_warnings": True} if plugin in ("cvodes", "idas") \
         else options
+    rate = system.numeric(system.rhs_function(jit), p) if plugin == "idas" else None
     for k in range(len(grid) - 1):
+        if rate is not None:           # idas starts each interval from its consistent rate
+            quiet["init_xdot"] = tuple(float(v) for v in rate(grid[k], X[-1]))
         integ = system.integrator(plugin, grid[k:k + 2], quiet, cache=False, jit=jit,
                                   jacobian=newton)
         try:
             X.append(np.asarray(integ(x0=X[-1], p=p)["xf"]).ravel())
         except RuntimeError as step_exc:
             return np.array(X), _reason(str(step_exc) or str(exc))
-    return np.array(X), _reason(str(exc))
+    return np.array(X), None
 
 
 #: SUNDIALS return flags, in plain words

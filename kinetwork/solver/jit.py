@@ -62,12 +62,14 @@ def cache_dir():
 def compile_functions(name, functions, stats=None):
     """Compile ``functions`` (CasADi Functions) into one shared library; return its path.
 
-    ``stats`` (a dict), if given, receives ``jit_seconds`` (0 on a cache hit) and ``jit_cached``.
+    ``stats`` (a dict), if given, receives ``jit_seconds`` (code generation, hashing and, on a
+    cache miss, the compiler) and ``jit_cached``.
     """
     cc = compiler()
     if cc is None:
         raise ModelError("jit: no C compiler found (set $CC, or install gcc); "
                          "run with jit=False to use CasADi's virtual machine")
+    start = time.perf_counter()
     gen = ca.CodeGenerator(f"{name}.c", {"with_header": False})
     for f in functions:
         gen.add(f)
@@ -75,7 +77,6 @@ def compile_functions(name, functions, stats=None):
     key = hashlib.sha256("\0".join([source, cc, *FLAGS, ca.__version__]).encode()).hexdigest()
     folder = cache_dir()
     lib = folder / f"{name}_{key[:20]}.so"
-    start = time.perf_counter()
     hit = lib.exists()
     if not hit:
         folder.mkdir(parents=True, exist_ok=True)

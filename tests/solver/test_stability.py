@@ -77,6 +77,16 @@ def test_auto_solves_the_stiff_scene_with_bdf_untuned():
     assert res.stats["steps"] < 2000
 
 
+@pytest.mark.parametrize("method, step", [("cvodes", None), ("idas", None), ("radau", None),
+                                          ("bdf", None), ("lsoda", None),
+                                          ("collocation", 0.01), ("midpoint", 0.001)])
+def test_implicit_methods_take_the_stiffest_scene_in_stride(method, step):
+    k = 1e6
+    res = kn.simulate(seed(c=k, d=k), t_end=1.0, n_points=101, method=method, step=step)
+    ref = seed_reference(res.t, c=k, d=k, method="Radau", rtol=1e-12, atol=1e-12)
+    np.testing.assert_allclose(res.states[:, :2], ref[:, :2], atol=1e-4)
+
+
 def test_adams_fails_on_the_stiffest_scene_and_auto_falls_back(monkeypatch):
     k = 1e6
     system = seed(c=k, d=k)
