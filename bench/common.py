@@ -71,6 +71,12 @@ def table(header, rows):
     return "\n".join(lines)
 
 
+def load():
+    """The machine's load while the study ran: other processes share its cores."""
+    one, five, _ = os.getloadavg()
+    return f"load average {one:.1f} (1 min), {five:.1f} (5 min) at the end"
+
+
 def machine():
     """One line on where the numbers come from."""
     import casadi

@@ -131,7 +131,8 @@ def _rotation(axis, angle):
 
 
 def chain_model(spec, name="chain"):
-    """A kinetwork model of ``spec``: Ground, then per link Revolute, RigidBody, FixedTranslation."""
+    """A kinetwork model of ``spec``: Ground, then per link Revolute, RigidBody and
+    FixedTranslation (and a rotational SpringDamper where the spec has one)."""
     m = kn.Model(name)
     mb = kn.multibody
     m.add(mb.Ground("ground", gravity=list(spec.gravity)))

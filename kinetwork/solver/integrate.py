@@ -199,10 +199,10 @@ def stiffness(system, x0, p, t_start, t_end, jit=False):
     """The stiffness test of the ``auto`` method, on the Jacobian at the initial state.
 
     With λ the eigenvalues of d(xdot)/dx at (t_start, x0), the fastest decay rate is
-    σ = max(-Re λ) and the fastest other motion is ω = max(max Re λ, max |Im λ|). The problem is
-    stiff when σ (t_end - t_start) > STIFF_HORIZON_STEPS (an explicit or Adams method would
-    need over ~10^3 steps for stability alone) and σ > STIFF_RATIO ω (that decay is much
-    faster than anything the solution must follow). An undamped mechanism is never stiff by
+    σ = max(-Re λ) and the fastest other motion is ω = max(max Re λ, max |Im λ|). The problem
+    is stiff when σ (t_end - t_start) > STIFF_HORIZON_STEPS (an explicit or Adams method
+    would need over ~10^3 steps for stability alone) and σ > STIFF_RATIO ω (that decay is
+    much faster than anything the solution must follow). An undamped mechanism is never stiff by
     this test (its eigenvalues come in ±λ pairs); a hard, heavily damped spring is.
 
     Returns (stiff, σ, ω).

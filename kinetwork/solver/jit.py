@@ -43,7 +43,7 @@ def _find_compiler(cc, path):
 
 
 def enabled(jit=None):
-    """Whether to compile: ``jit`` if given, else on when a compiler exists (KINETWORK_JIT=0: off)."""
+    """Whether to compile: ``jit`` if given, else when a compiler exists (KINETWORK_JIT=0: no)."""
     if jit is not None:
         return bool(jit)
     if os.environ.get("KINETWORK_JIT", "1").strip().lower() in ("0", "false", "no", "off"):
