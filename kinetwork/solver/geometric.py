@@ -19,6 +19,7 @@ import casadi as ca
 import numpy as np
 
 from .newton_euler import crba, rnea
+from .system import JACOBIAN_JIT_LIMIT
 
 
 class Midpoint:
@@ -49,7 +50,7 @@ class Midpoint:
         qm = q0 + h / 2 * v
         residual = ca.Function("midpoint_residual", [v, ca.vertcat(q0, p0, t0, h, par)],
                                [2 * f_Mqd(qm, v, par) - 2 * p0 - h * f_fp(t0 + h / 2, qm, v, par)])
-        if jit:
+        if jit and residual.jacobian().n_instructions() <= JACOBIAN_JIT_LIMIT:
             from . import jit as _jit
             residual = _jit.external(residual, jacobian=True, stats=system.jit_stats)
         solve = ca.rootfinder("midpoint", "newton", residual,

@@ -1,5 +1,7 @@
 """System: a compiled model, its states, parameters and CasADi Functions."""
 
+import functools
+
 import casadi as ca
 import numpy as np
 
@@ -127,7 +129,7 @@ class System:
             self._compiled[key] = (self._compiled["outputs"] if jit else self.f_out).map(len(t))
         return np.asarray(self._compiled[key](t[None, :], X.T, p)).T
 
-    @property
+    @functools.cached_property
     def damped(self):
         """Whether a generalized force depends on the speeds (dampers): only then can the
         model be stiff in the sense of ``kinetwork.solver.integrate.stiffness``."""
@@ -172,6 +174,9 @@ class System:
         return self._compiled["jac"]
 
     def _jacobian_small(self):
+        # a Jacobian costs about (operations x states): skip building one that cannot pass
+        if self.f_rhs.n_instructions() * self.n_states > 20 * JACOBIAN_JIT_LIMIT:
+            return False
         return self.jacobian_function().n_instructions() <= JACOBIAN_JIT_LIMIT
 
     def dae(self, jit=False, jacobian=False):
