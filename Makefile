@@ -22,7 +22,7 @@ test: $(VENV)/.installed
 	$(PY) -m pytest -q
 
 bench: $(VENV)/.installed
-	$(PY) bench/seed_scene.py
+	$(PY) bench/run.py
 
 clean:
 	rm -rf $(VENV) $(OUT) .pytest_cache
