@@ -18,7 +18,7 @@ Jacobian. Every piece is O(n) per evaluation (no mass matrix is formed in the st
 import casadi as ca
 import numpy as np
 
-from .newton_euler import crba, rnea
+from .newton_euler import aba, rnea
 from .system import JACOBIAN_JIT_LIMIT
 
 
@@ -43,47 +43,69 @@ class Midpoint:
         f_Mqd = ca.Function("Mqd", [a.q, a.qd, a.p], [Mqd])
         f_fp = ca.Function("fp", [a.t, a.q, a.qd, a.p], [fp])
         f_qdd = ca.Function("qdd", [a.t, a.q, a.qd, a.p], [a.qdd])
-        f_M = ca.Function("M", [a.q, a.p], [crba(a.bodies, n)])
+        # qd = M(q)^-1 p by the articulated-body algorithm (p as the joint forces, no speed,
+        # no gravity): O(n), no mass matrix
+        f_vel = ca.Function("velocity", [a.q, w, a.p],
+                            [ca.substitute(aba(a.bodies, zero, w, ca.SX.zeros(6)), a.qd, zero)])
 
         v, q0, p0 = ca.SX.sym("v", n), ca.SX.sym("q0", n), ca.SX.sym("p0", n)
         t0, h, par = ca.SX.sym("t0"), ca.SX.sym("h"), ca.SX.sym("par", a.p.shape[0])
+        args = ca.vertcat(q0, p0, t0, h, par)
         qm = q0 + h / 2 * v
-        residual = ca.Function("midpoint_residual", [v, ca.vertcat(q0, p0, t0, h, par)],
-                               [2 * f_Mqd(qm, v, par) - 2 * p0 - h * f_fp(t0 + h / 2, qm, v, par)])
-        if jit and residual.jacobian().n_instructions() <= JACOBIAN_JIT_LIMIT:
-            from . import jit as _jit
-            residual = _jit.external(residual, jacobian=True, stats=system.jit_stats)
-        solve = ca.rootfinder("midpoint", "newton", residual,
-                              {"abstol": 1e-12, "abstolStep": 1e-14, "max_iter": 30,
-                               "error_on_fail": False, "show_eval_warnings": False})
-
+        r = 2 * f_Mqd(qm, v, par) - 2 * p0 - h * f_fp(t0 + h / 2, qm, v, par)
+        residual = ca.Function("midpoint_residual", [v, args], [r])
+        qd0 = f_vel(q0, p0, par)
+        predict = ca.Function("midpoint_predict", [args], [qd0 + h / 2 * f_qdd(t0, q0, qd0, par)])
+        advance = ca.Function("midpoint_advance", [v, args],
+                              [ca.vertcat(q0 + h * v, 2 * f_Mqd(qm, v, par) - p0, t0 + h),
+                               ca.norm_inf(r) / (1 + ca.norm_inf(p0))])
         # one step on the state z = (q, p, t, worst relative residual so far)
-        z = ca.MX.sym("z", 2 * n + 2)
-        hh, pp = ca.MX.sym("h"), ca.MX.sym("p", a.p.shape[0])
-        q, p, t = z[:n], z[n:2 * n], z[2 * n]
-        qd = ca.solve(f_M(q, pp), p, "qr")
-        guess = qd + hh / 2 * f_qdd(t, q, qd, pp)
-        args = ca.vertcat(q, p, t, hh, pp)
-        v1 = solve(guess, args)
-        p1 = 2 * f_Mqd(q + hh / 2 * v1, v1, pp) - p
-        miss = ca.norm_inf(residual(v1, args)) / (1 + ca.norm_inf(p))
-        self._step = ca.Function("step", [z, hh, pp],
-                                 [ca.vertcat(q + hh * v1, p1, t + hh, ca.fmax(z[-1], miss))])
-        self._intervals = {}
+        if n <= UNROLLED:
+            # a few Newton iterations written out: one SX function per step, compiled whole
+            z, hh, pp = ca.SX.sym("z", 2 * n + 2), ca.SX.sym("h"), ca.SX.sym("p", a.p.shape[0])
+            here = ca.vertcat(z[:2 * n + 1], hh, pp)
+            jac = ca.Function("midpoint_jacobian", [v, args], [ca.jacobian(r, v)])
+            vk = predict(here)
+            for _ in range(NEWTON_ITERATIONS):
+                vk = vk - ca.solve(jac(vk, here), residual(vk, here))
+            nxt, miss = advance(vk, here)
+            self._step = ca.Function("step", [z, hh, pp],
+                                     [ca.vertcat(nxt, ca.fmax(z[-1], miss))])
+            if jit:
+                from . import jit as _jit
+                self._step = _jit.external(self._step, stats=system.jit_stats)
+        else:
+            # CasADi's Newton rootfinder, its residual compiled with its Jacobian if small
+            if jit:
+                from . import jit as _jit
+                if residual.jacobian().n_instructions() <= JACOBIAN_JIT_LIMIT:
+                    residual = _jit.external(residual, jacobian=True, stats=system.jit_stats)
+                predict, advance = (_jit.external(f, stats=system.jit_stats)
+                                    for f in (predict, advance))
+            solve = ca.rootfinder("midpoint", "newton", residual,
+                                  {"abstol": 1e-12, "abstolStep": 1e-14, "max_iter": 30,
+                                   "error_on_fail": False, "show_eval_warnings": False})
+            z = ca.MX.sym("z", 2 * n + 2)
+            hh, pp = ca.MX.sym("h"), ca.MX.sym("p", a.p.shape[0])
+            here = ca.vertcat(z[:2 * n + 1], hh, pp)
+            nxt, miss = advance(solve(predict(here), here), here)
+            self._step = ca.Function("step", [z, hh, pp],
+                                     [ca.vertcat(nxt, ca.fmax(z[-1], miss))])
+        self._runs = {}
         self.n = n
         self._momenta = f_Mqd
-        zz = ca.MX.sym("z", 2 * n)
-        self._velocity = ca.Function("velocity", [zz, pp],
-                                     [ca.solve(f_M(zz[:n], pp), zz[n:], "qr")])
+        self._velocity = f_vel
 
-    def interval(self, m):
-        """m steps at once, as one CasADi call."""
-        if m not in self._intervals:
+    def trajectory(self, m, n_out):
+        """``n_out`` output intervals of ``m`` steps each, as one CasADi call."""
+        key = (m, n_out)
+        if key not in self._runs:
             steps = self._step.mapaccum("steps", m)
             z, h = ca.MX.sym("z", 2 * self.n + 2), ca.MX.sym("h")
             p = ca.MX.sym("p", self._step.size1_in(2))
-            self._intervals[m] = ca.Function("interval", [z, h, p], [steps(z, h, p)[:, -1]])
-        return self._intervals[m]
+            interval = ca.Function("interval", [z, h, p], [steps(z, h, p)[:, -1]])
+            self._runs[key] = interval.mapaccum("outputs", n_out)
+        return self._runs[key]
 
     def run(self, grid, x0, p, step):
         """States (q, qd) on ``grid`` from ``x0``; steps of at most ``step`` seconds.
@@ -95,21 +117,18 @@ class Midpoint:
         dt = float(grid[1] - grid[0])
         m = max(1, int(np.ceil(dt / step * (1 - 1e-12))))
         h = dt / m
-        interval = self.interval(m)
         q0, qd0 = x0[:n], x0[n:]
-        z = np.concatenate([q0, np.asarray(self._momenta(q0, qd0, p)).ravel(), [grid[0], 0.0]])
-        Z = [z]
+        z0 = np.concatenate([q0, np.asarray(self._momenta(q0, qd0, p)).ravel(), [grid[0], 0.0]])
+        with np.errstate(invalid="ignore"):
+            Z = np.vstack([z0, np.asarray(self.trajectory(m, len(grid) - 1)(z0, h, p)).T])
+            bad = ~np.all(np.isfinite(Z), axis=1) | (Z[:, -1] > CONVERGED)
         failure = None
-        for _ in range(len(grid) - 1):
-            z = np.asarray(interval(z, h, p)).ravel()
-            if not np.all(np.isfinite(z)) or z[-1] > CONVERGED:
-                failure = (f"the midpoint rule's Newton iteration did not converge with steps "
-                           f"of {h:g} s (the motion changes too much within a step): take a "
-                           f"smaller step")
-                break
-            Z.append(z)
-        Z = np.array(Z)
-        qd = np.asarray(self._velocity.map(len(Z))(Z[:, :2 * n].T, p)).T
+        if bad.any():          # the worst residual only grows: keep what came before
+            Z = Z[:int(np.argmax(bad))]
+            failure = (f"the midpoint rule's Newton iteration did not converge with steps of "
+                       f"{h:g} s (the motion changes too much within a step): take a smaller "
+                       f"step")
+        qd = np.asarray(self._velocity.map(len(Z))(Z[:, :n].T, Z[:, n:2 * n].T, p)).T
         X = np.hstack([Z[:, :n], qd])
         return X, failure, {"steps": (len(Z) - 1) * m, "step": h,
                             "residual": float(Z[-1, -1])}
@@ -117,3 +136,10 @@ class Midpoint:
 
 #: largest residual of a step's equations, relative to the momenta, counted as converged
 CONVERGED = 1e-9
+#: up to this many coordinates the Newton iterations are written out in SX (a symbolic n x n
+#: solve per iteration); beyond, CasADi's rootfinder iterates numerically
+UNROLLED = 12
+#: Newton iterations from the explicit predictor (error O(h^3)): quadratic convergence takes
+#: it to round-off in two or three; a step that needs more than five is reported by the
+#: residual check
+NEWTON_ITERATIONS = 5
