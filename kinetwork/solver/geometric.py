@@ -18,6 +18,7 @@ Jacobian. Every piece is O(n) per evaluation (no mass matrix is formed in the st
 import casadi as ca
 import numpy as np
 
+from . import jit as _jit
 from .newton_euler import aba, rnea
 from .system import JACOBIAN_JIT_LIMIT
 
@@ -72,12 +73,10 @@ class Midpoint:
             self._step = ca.Function("step", [z, hh, pp],
                                      [ca.vertcat(nxt, ca.fmax(z[-1], miss))])
             if jit:
-                from . import jit as _jit
                 self._step = _jit.external(self._step, stats=system.jit_stats)
         else:
             # CasADi's Newton rootfinder, its residual compiled with its Jacobian if small
             if jit:
-                from . import jit as _jit
                 if residual.jacobian().n_instructions() <= JACOBIAN_JIT_LIMIT:
                     residual = _jit.external(residual, jacobian=True, stats=system.jit_stats)
                 predict, advance = (_jit.external(f, stats=system.jit_stats)
