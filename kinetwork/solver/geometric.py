@@ -106,16 +106,14 @@ class Midpoint:
             self._runs[key] = interval.mapaccum("outputs", n_out)
         return self._runs[key]
 
-    def run(self, grid, x0, p, step):
-        """States (q, qd) on ``grid`` from ``x0``; steps of at most ``step`` seconds.
+    def run(self, grid, x0, p, m):
+        """States (q, qd) on ``grid`` from ``x0``, in ``m`` equal steps per output interval.
 
         Returns (X, failure, stats): when a step's Newton iteration does not converge, the
         states up to the output time before it and the reason.
         """
         n = self.n
-        dt = float(grid[1] - grid[0])
-        m = max(1, int(np.ceil(dt / step * (1 - 1e-12))))
-        h = dt / m
+        h = float(grid[1] - grid[0]) / m
         q0, qd0 = x0[:n], x0[n:]
         z0 = np.concatenate([q0, np.asarray(self._momenta(q0, qd0, p)).ravel(), [grid[0], 0.0]])
         with np.errstate(invalid="ignore"):

@@ -68,6 +68,7 @@ def _casadi(plugin, newton, **options):
 
 
 def _steps_per_interval(grid, step):
+    """Equal steps per output interval, none longer than ``step`` (default: the spacing)."""
     dt = float(grid[1] - grid[0])
     return max(1, int(np.ceil(dt / (step or dt) * (1 - 1e-12))))
 
@@ -153,7 +154,7 @@ def _midpoint(system, grid, x0, p, settings):
     key = ("midpoint", settings["jit"])
     if key not in system._compiled:
         system._compiled[key] = Midpoint(system, settings["jit"])
-    return system._compiled[key].run(grid, x0, p, settings["step"] or grid[1] - grid[0])
+    return system._compiled[key].run(grid, x0, p, _steps_per_interval(grid, settings["step"]))
 
 
 #: method name (case-insensitive) -> Method

@@ -8,6 +8,7 @@ import numpy as np
 import pytest
 from conftest import double_pendulum
 from reference import PAPER, seed_energy, seed_mvg, seed_reference
+from scenes import chain  # the bench's chains of n uniform rods on revolute z joints
 
 import kinetwork as kn
 from kinetwork.solver import integrate
@@ -16,23 +17,6 @@ from kinetwork.solver.integrate import stiffness
 
 def seed(q0=(0.05, 0.05), **params):
     return double_pendulum(q0=q0, probes=False, **params).compile()
-
-
-def chain(n):
-    """n uniform rods hanging on revolute z joints, the first released at 0.5 rad."""
-    m = kn.Model(f"chain{n}")
-    mb = kn.multibody
-    m.add(mb.Ground("ground", gravity=[0, -9.81, 0]))
-    previous = "ground.frame"
-    for i in range(n):
-        m.add(mb.Revolute(f"j{i}", axis=[0, 0, 1], q0=0.5 if i == 0 else 0.0))
-        m.add(mb.RigidBody(f"b{i}", mass=1.0, r_cm=[0, -0.5, 0], inertia=[0.1, 0.001, 0.1]))
-        m.add(mb.FixedTranslation(f"l{i}", r=[0, -1, 0]))
-        m.connect(previous, f"j{i}.frame_a")
-        m.connect(f"j{i}.frame_b", f"b{i}.frame_a")
-        m.connect(f"j{i}.frame_b", f"l{i}.frame_a")
-        previous = f"l{i}.frame_b"
-    return m
 
 
 # ---------------------------------------------------------------------------------------------
