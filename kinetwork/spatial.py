@@ -35,3 +35,40 @@ def rotation(axis, angle):
     n = unit(axis)
     k = skew(n)
     return ca.SX.eye(3) + ca.sin(angle) * k + (1 - ca.cos(angle)) * (k @ k)
+
+
+# -- quaternions [w, x, y, z] (scalar first) ----------------------------------------------
+def quat_rotation(quat):
+    """Rotation matrix of ``quat`` divided by its norm: orthonormal for any non-zero quat,
+    so a drift of the norm during integration never distorts the motion."""
+    w, v = quat[0], quat[1:4]
+    k = skew(v)
+    return ca.SX.eye(3) + 2 / ca.sumsqr(quat) * (w * k + k @ k)
+
+
+#: rate [1/s] at which the quaternion kinematics pull the norm back to one
+QUATERNION_NORM_RATE = 1.0
+
+
+def quat_rate(quat, w_b):
+    """d(quat)/dt for the angular velocity ``w_b`` resolved in the rotated frame, plus a term
+    that pulls the norm back to one without touching the rotation it represents."""
+    w, v = quat[0], quat[1:4]
+    rate = ca.vertcat(-ca.dot(v, w_b), w * w_b + ca.cross(v, w_b)) / 2
+    return rate + QUATERNION_NORM_RATE * (1 - ca.sumsqr(quat)) * quat
+
+
+def cardan_quat(angles):
+    """Quaternion of the body-fixed x-y-z (Cardan) sequence: rotate about x by angles[0],
+    then about the new y by angles[1], then about the new z by angles[2]."""
+    def half(i, axis):
+        e = [0, 0, 0]
+        e[axis] = ca.sin(angles[i] / 2)
+        return ca.vertcat(ca.cos(angles[i] / 2), *e)
+    return quat_product(quat_product(half(0, 0), half(1, 1)), half(2, 2))
+
+
+def quat_product(a, b):
+    """Hamilton product a * b."""
+    aw, av, bw, bv = a[0], a[1:4], b[0], b[1:4]
+    return ca.vertcat(aw * bw - ca.dot(av, bv), aw * bv + bw * av + ca.cross(av, bv))

@@ -6,7 +6,7 @@ the solver's Newton-Euler passes derive everything else from it.
 
 import casadi as ca
 
-from ..spatial import mat3, rotation, unit, vec3
+from ..spatial import cardan_quat, mat3, quat_rate, quat_rotation, rotation, unit, vec3
 from .base import Component, Param, Port
 
 MB = "multibody"
@@ -50,13 +50,64 @@ class FixedRotation(PartialRigidTransform, library=MB):
 
 
 class PartialJoint(PartialRigidTransform):
-    """One degree of freedom between frame_a and frame_b, with its two 1-D flanges.
+    """Degrees of freedom between frame_a and frame_b.
+
+    A joint has ``nq`` coordinates q and ``dof`` speeds u. A *regular* joint's coordinates
+    are the integrals of its speeds (qdot = u): angles and distances, which can be driven
+    through 1-D flanges and solved from a kinematic loop. The motion subspace (the spatial
+    velocity of frame_b relative to frame_a per unit speed, in frame_b axes) is derived from
+    ``transform`` unless ``subspace`` gives it; ``rate`` gives qdot from (q, u).
+    """
+    dof = 1
+    nq = None                 # coordinates (None: as many as speeds)
+    regular = True
+    constant_subspace = True
+    frame_b = Port("frame", "Frame b, moved by the joint coordinates")
+    coordinate_ports = {}
+    zero_ports = ()
+    cut = Param(False, kind="bool", doc="Cut the kinematic loop at this joint")
+    #: unit of each coordinate
+    units = ()
+
+    @classmethod
+    def n_coordinates(cls):
+        return cls.nq or cls.dof
+
+    def coordinate_labels(self):
+        return ["q"] if self.dof == 1 else [f"q[{i}]" for i in range(self.dof)]
+
+    def speed_labels(self):
+        return ["qd"] if self.dof == 1 else [f"qd[{i}]" for i in range(self.dof)]
+
+    def subspace(self, q):
+        """Motion subspace (6 x dof, frame_b axes), or None to derive it from ``transform``."""
+        return None
+
+    def rate(self, q, u):
+        """d(q)/dt for the speeds u."""
+        return u
+
+    def initial(self):
+        """(q0, u0): lists of nq and dof values. None in q0 is solved from a loop (else 0);
+        None in u0 is 0, or follows from the loop's velocity constraint."""
+        q0, qd0 = self.q0, self.qd0
+        if self.dof == 1:
+            return [q0], [qd0]
+        return ([None] * self.dof if q0 is None else list(q0),
+                [None] * self.dof if qd0 is None else list(qd0))
+
+    def guesses(self):
+        """Where the search for coordinates solved from a loop starts."""
+        g = self.q0_guess
+        return [g] if self.dof == 1 else list(g)
+
+
+class PartialAxisJoint(PartialJoint):
+    """One degree of freedom along or about ``axis``, with its two 1-D flanges.
 
     ``axis`` (potential = q) drives the joint; ``support`` (potential 0) is its reaction side,
     taken, as in Modelica MultiBody, to rest in the world frame.
     """
-    dof = 1
-    frame_b = Port("frame", "Frame b, moved by the joint coordinate")
     coordinate_ports = {"axis": 0}
     zero_ports = ("support",)
     axis = Port("1d", "Flange driving the joint coordinate", optional=True)
@@ -66,27 +117,183 @@ class PartialJoint(PartialRigidTransform):
     q0 = Param(None, optional=True, doc="Initial coordinate (None: 0, or solved in a loop)")
     qd0 = Param(None, optional=True, doc="Initial coordinate speed (None: 0)")
     q0_guess = Param(0.0, doc="Start of the search for q0 when it is solved in a loop")
-    cut = Param(False, kind="bool", doc="Cut the kinematic loop at this joint")
 
 
-class Revolute(PartialJoint, library=MB):
+class Revolute(PartialAxisJoint, library=MB):
     """frame_b is frame_a rotated by q about ``axis`` (resolved in frame_a)."""
     domain = "rotational"
-    units = ("rad", "rad/s")
+    units = ("rad",)
 
     def transform(self, q):
         return rotation(vec3(self.direction), q[0]), ca.SX.zeros(3)
 
 
-class Prismatic(PartialJoint, library=MB):
+class Prismatic(PartialAxisJoint, library=MB):
     """frame_b is frame_a moved by q along ``axis`` (resolved in frame_a)."""
     domain = "translational"
-    units = ("m", "m/s")
+    units = ("m",)
     direction = Param([1.0, 0.0, 0.0], shape=(3,), nonzero=True, name="axis",
                       doc="Direction of motion, resolved in frame_a")
 
     def transform(self, q):
         return ca.SX.eye(3), unit(vec3(self.direction)) * q[0]
+
+
+def _pair(doc):
+    return Param(None, optional=True, shape=(2,), doc=doc)
+
+
+def _triple(doc, default=None, unit_=""):
+    return Param(default, optional=default is None, shape=(3,), unit=unit_, doc=doc)
+
+
+class Universal(PartialJoint, library=MB):
+    """Two revolutes in series: frame_b is frame_a rotated by q[0] about ``n_a``, then by
+    q[1] about ``n_b`` (resolved in the once-rotated frame); a Cardan joint."""
+    dof = 2
+    constant_subspace = False
+    units = ("rad", "rad")
+    coordinate_ports = {"axis_a": 0, "axis_b": 1}
+    zero_ports = ("support",)
+    axis_a = Port("rotational", "Flange driving q[0] (about n_a)", optional=True)
+    axis_b = Port("rotational", "Flange driving q[1] (about n_b)", optional=True)
+    support = Port("rotational", "Reaction flange of both drives", optional=True)
+    n_a = Param([1.0, 0.0, 0.0], shape=(3,), nonzero=True, doc="First axis, in frame_a")
+    n_b = Param([0.0, 1.0, 0.0], shape=(3,), nonzero=True,
+                doc="Second axis, in the frame rotated about n_a")
+    q0 = _pair("Initial angles (None: 0, or solved in a loop) [rad]")
+    qd0 = _pair("Initial angular speeds (None: 0) [rad/s]")
+    q0_guess = Param([0.0, 0.0], shape=(2,), doc="Start of the search for q0 in a loop")
+
+    def transform(self, q):
+        return rotation(vec3(self.n_a), q[0]) @ rotation(vec3(self.n_b), q[1]), ca.SX.zeros(3)
+
+
+class Cylindrical(PartialJoint, library=MB):
+    """frame_b is frame_a rotated by q[0] about ``axis`` and moved by q[1] along it."""
+    dof = 2
+    units = ("rad", "m")
+    coordinate_ports = {"axis_phi": 0, "axis_s": 1}
+    zero_ports = ("support_phi", "support_s")
+    axis_phi = Port("rotational", "Flange driving the angle q[0]", optional=True)
+    support_phi = Port("rotational", "Reaction flange of the rotation", optional=True)
+    axis_s = Port("translational", "Flange driving the distance q[1]", optional=True)
+    support_s = Port("translational", "Reaction flange of the translation", optional=True)
+    direction = Param([0.0, 0.0, 1.0], shape=(3,), nonzero=True, name="axis",
+                      doc="Axis of rotation and translation, resolved in frame_a")
+    q0 = _pair("Initial angle and distance (None: 0, or solved in a loop)")
+    qd0 = _pair("Initial angular and linear speed (None: 0)")
+    q0_guess = Param([0.0, 0.0], shape=(2,), doc="Start of the search for q0 in a loop")
+
+    def transform(self, q):
+        n = vec3(self.direction)
+        return rotation(n, q[0]), unit(n) * q[1]
+
+
+class Planar(PartialJoint, library=MB):
+    """frame_b moves in the plane normal to ``n``: by q[0] along ``n_x``, q[1] along
+    n x n_x, and is rotated by q[2] about ``n`` (all resolved in frame_a)."""
+    dof = 3
+    constant_subspace = False
+    units = ("m", "m", "rad")
+    coordinate_ports = {"axis_x": 0, "axis_y": 1, "axis_phi": 2}
+    zero_ports = ("support_s", "support_phi")
+    axis_x = Port("translational", "Flange driving q[0] (along n_x)", optional=True)
+    axis_y = Port("translational", "Flange driving q[1] (along n x n_x)", optional=True)
+    axis_phi = Port("rotational", "Flange driving the angle q[2]", optional=True)
+    support_s = Port("translational", "Reaction flange of the translations", optional=True)
+    support_phi = Port("rotational", "Reaction flange of the rotation", optional=True)
+    n = Param([0.0, 0.0, 1.0], shape=(3,), nonzero=True, doc="Plane normal, in frame_a")
+    n_x = Param([1.0, 0.0, 0.0], shape=(3,), nonzero=True,
+                doc="Direction of q[0] in the plane, in frame_a")
+    q0 = _triple("Initial x, y, angle (None: 0, or solved in a loop)")
+    qd0 = _triple("Initial speeds (None: 0)")
+    q0_guess = Param([0.0, 0.0, 0.0], shape=(3,), doc="Start of the search for q0 in a loop")
+
+    def transform(self, q):
+        n = unit(vec3(self.n))
+        ex = vec3(self.n_x)
+        ex = unit(ex - ca.dot(ex, n) * n)
+        ey = ca.cross(n, ex)
+        return rotation(n, q[2]), ex * q[0] + ey * q[1]
+
+
+class Spherical(PartialJoint, library=MB):
+    """A ball joint: frame_b turns freely about the common origin of the two frames.
+
+    Coordinates: a quaternion [w, x, y, z] of frame_b's orientation in frame_a (normalised,
+    so no orientation is singular); speeds: the angular velocity of frame_b relative to
+    frame_a, resolved in frame_b. In a kinematic loop a Spherical joint is best cut (three
+    position constraints).
+    """
+    dof = 3
+    nq = 4
+    regular = False
+    units = ("", "", "", "")
+    angles0 = Param([0.0, 0.0, 0.0], shape=(3,), unit="rad",
+                    doc="Initial orientation: body-fixed x-y-z (Cardan) angles")
+    w0 = Param([0.0, 0.0, 0.0], shape=(3,), unit="rad/s",
+               doc="Initial angular velocity of frame_b in frame_a, resolved in frame_b")
+
+    def coordinate_labels(self):
+        return [f"quat[{i}]" for i in range(4)]
+
+    def speed_labels(self):
+        return [f"w[{i}]" for i in range(3)]
+
+    def transform(self, q):
+        return quat_rotation(q), ca.SX.zeros(3)
+
+    def subspace(self, q):
+        return ca.vertcat(ca.SX.eye(3), ca.SX.zeros(3, 3))
+
+    def rate(self, q, u):
+        return quat_rate(q, u)
+
+    def initial(self):
+        return list(ca.vertsplit(cardan_quat(self.angles0))), list(self.w0)
+
+
+class FreeMotion(PartialJoint, library=MB):
+    """Six degrees of freedom: frame_b anywhere relative to frame_a (a free-flying body).
+
+    Coordinates: the position r of frame_b in frame_a (resolved in frame_a) and a normalised
+    quaternion [w, x, y, z] of its orientation; speeds: v = dr/dt (resolved in frame_a) and the
+    angular velocity w of frame_b relative to frame_a, resolved in frame_b (as Modelica's
+    FreeMotion). The quaternion has no singular orientation, so tumbling runs of any length
+    are fine.
+    """
+    dof = 6
+    nq = 7
+    regular = False
+    constant_subspace = False
+    units = ("m", "m", "m", "", "", "", "")
+    r0 = Param([0.0, 0.0, 0.0], shape=(3,), unit="m", doc="Initial position, in frame_a")
+    v0 = Param([0.0, 0.0, 0.0], shape=(3,), unit="m/s", doc="Initial velocity, in frame_a")
+    angles0 = Param([0.0, 0.0, 0.0], shape=(3,), unit="rad",
+                    doc="Initial orientation: body-fixed x-y-z (Cardan) angles")
+    w0 = Param([0.0, 0.0, 0.0], shape=(3,), unit="rad/s",
+               doc="Initial angular velocity, resolved in frame_b")
+
+    def coordinate_labels(self):
+        return [f"r[{i}]" for i in range(3)] + [f"quat[{i}]" for i in range(4)]
+
+    def speed_labels(self):
+        return [f"v[{i}]" for i in range(3)] + [f"w[{i}]" for i in range(3)]
+
+    def transform(self, q):
+        return quat_rotation(q[3:7]), q[0:3]
+
+    def subspace(self, q):
+        # spatial velocity of frame_b in its own axes: [w; R^T v]
+        Rt = quat_rotation(q[3:7]).T
+        return ca.blockcat([[ca.SX.zeros(3, 3), ca.SX.eye(3)], [Rt, ca.SX.zeros(3, 3)]])
+
+    def rate(self, q, u):
+        return ca.vertcat(u[0:3], quat_rate(q[3:7], u[3:6]))
+
+    def initial(self):
+        return [*self.r0, *ca.vertsplit(cardan_quat(self.angles0))], [*self.v0, *self.w0]
 
 
 class RigidBody(Component, library=MB):
@@ -102,3 +309,58 @@ class RigidBody(Component, library=MB):
     def mass_properties(self):
         """(mass, centre of mass, inertia about it) as CasADi values."""
         return self.mass, vec3(self.r_cm), mat3(self.inertia)
+
+
+class PartialLineForce(Component):
+    """A force along the line between the origins of frame_a and frame_b.
+
+    ``law(s, s_d)`` gives the tension f from the distance s and its rate: f > 0 pulls the
+    frames together (a stretched spring), as in Modelica's Forces.Spring.
+    """
+    role = "frame_force"
+    frame_a = Port("frame", "Frame a")
+    frame_b = Port("frame", "Frame b")
+
+    def law(self, s, s_d):
+        raise NotImplementedError
+
+
+class SpringDamper(PartialLineForce, library=MB):
+    """Linear spring and damper in parallel between two frame origins."""
+    c = Param(unit="N/m", min=0.0, doc="Spring constant")
+    d = Param(unit="N*s/m", min=0.0, doc="Damping constant")
+    s_unstretched = Param(0.0, unit="m", min=0.0, doc="Unstretched length")
+
+    def law(self, s, s_d):
+        return self.c * (s - self.s_unstretched) + self.d * s_d
+
+
+class Spring(PartialLineForce, library=MB):
+    """Linear spring between two frame origins."""
+    c = Param(unit="N/m", min=0.0, doc="Spring constant")
+    s_unstretched = Param(0.0, unit="m", min=0.0, doc="Unstretched length")
+
+    def law(self, s, s_d):
+        return self.c * (s - self.s_unstretched)
+
+
+class Damper(PartialLineForce, library=MB):
+    """Linear damper between two frame origins."""
+    d = Param(unit="N*s/m", min=0.0, doc="Damping constant")
+
+    def law(self, s, s_d):
+        return self.d * s_d
+
+
+class WorldForce(Component, library=MB):
+    """A force at the origin of frame_b, resolved in the world frame (time allowed)."""
+    role = "frame_force"
+    frame_b = Port("frame", "Frame the force acts on")
+    force = Param(unit="N", shape=(3,), time=True, doc="Force, resolved in the world frame")
+
+
+class WorldTorque(Component, library=MB):
+    """A torque on frame_b, resolved in the world frame (time allowed)."""
+    role = "frame_force"
+    frame_b = Port("frame", "Frame the torque acts on")
+    torque = Param(unit="N*m", shape=(3,), time=True, doc="Torque, resolved in the world frame")

@@ -142,10 +142,15 @@ class Model:
         from .topology import analyze
         return analyze(self)
 
-    def compile(self):
-        """Validate and build the equations: a ``kn.System``."""
+    def compile(self, loops="partition"):
+        """Validate and build the equations: a ``kn.System``.
+
+        ``loops`` chooses the formulation of kinematic loops (see ``kinetwork.solver.loops``):
+        "partition" (default; independent coordinates, dependent ones solved exactly at every
+        step) or "baumgarte" (an ODE in all coordinates, stabilised).
+        """
         from ..solver.system import System
-        return System(self)
+        return System(self, loops=loops)
 
     def save(self, path):
         """Write the model as JSON (atomically: a failed save leaves the old file whole)."""

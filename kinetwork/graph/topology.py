@@ -2,8 +2,10 @@
 
 Ports are nodes and connections edges of a networkx graph; a connection set is a connected
 component (potentials equal, flows summing to zero). Frame sets are the nodes of a second
-graph whose edges are joints and rigid parts; its BFS tree from the ground orders the
-Newton-Euler recursion.
+graph whose edges are joints and rigid parts. Its maximum spanning tree (weights prefer to
+keep rigid parts and regular joints, and to cut joints marked ``cut``, FreeMotion and
+Spherical joints) is walked breadth-first from the ground to order the Newton-Euler
+recursion; every edge left out is a cut joint that closes one independent kinematic loop.
 """
 
 from dataclasses import dataclass, field
@@ -26,6 +28,15 @@ class Edge:
 
 
 @dataclass
+class Cut:
+    """A joint or rigid part left out of the spanning tree: it closes a kinematic loop."""
+    component: object
+    set_a: int           # frame set of its frame_a
+    set_b: int           # frame set of its frame_b
+    loop: list           # names of the loop's parts, the tree path then the cut
+
+
+@dataclass
 class OneDSet:
     """A 1-D connection set: its ports and the port that sets its position."""
     index: int
@@ -42,11 +53,13 @@ class Topology:
     set_of: dict                        # PortRef -> set index
     root: int                           # frame set of the ground
     tree: list = field(default_factory=list)      # Edge, parents before children
-    joints: list = field(default_factory=list)    # tree joints with dof > 0, model order
+    joints: list = field(default_factory=list)    # joints with coordinates, model order
     bodies: list = field(default_factory=list)    # (RigidBody, frame set)
     oned: list = field(default_factory=list)      # OneDSet
     probes: list = field(default_factory=list)    # (Probe, target PortRef)
     loops: list = field(default_factory=list)     # lists of component names
+    cuts: list = field(default_factory=list)      # Cut, one per independent loop
+    forces: list = field(default_factory=list)    # frame force elements (line, world)
 
     @property
     def dof(self):
@@ -133,16 +146,25 @@ def _probes(model, graph, probes, problems):
                 problems.append(f"{model.place(probe, 'quantities')}: {q!r} is not a quantity "
                                 f"of a {target.domain} port ({target.path}); choose from "
                                 f"{', '.join(allowed)}")
-            elif target.domain == "frame" and q in ("force", "torque"):
-                problems.append(f"{model.place(probe, 'quantities')}: cut {q} on a frame "
-                                f"({target.path}) is not available yet; position, velocity, "
-                                f"acceleration, orientation and angular quantities are")
         out.append((probe, target))
     return out
 
 
+#: preference for keeping a part in the spanning tree (the rest are cut): rigid parts are
+#: never cut if a joint can be, a Spherical is cut before other joints (three position
+#: constraints, no coordinates) and a FreeMotion first of all (cutting it removes nothing)
+def _keep_weight(comp):
+    if comp.dof == 0:
+        return 4
+    if comp._values.get("cut", False):
+        return -1
+    if comp.type_name == "multibody.FreeMotion":
+        return 0
+    return 3 if comp.regular else 1
+
+
 def _tree(model, topo, roles, problems):
-    """Spanning tree of frame sets from the ground; loops and unreachable parts refused."""
+    """Spanning tree of frame sets from the ground; the joints left out cut the loops."""
     frames = nx.MultiGraph()
     frames.add_node(topo.root)
     for comp in roles.get("joint", []):
@@ -151,50 +173,52 @@ def _tree(model, topo, roles, problems):
             problems.append(f"{model.place(comp)}: frame_a and frame_b are connected to each "
                             f"other, which locks the part")
             continue
-        frames.add_edge(a, b, key=comp.name, component=comp)
-    for comp in roles.get("body", []):
-        frames.add_node(topo.set_of[comp.port_ref("frame_a")])
+        frames.add_edge(a, b, key=comp.name, component=comp, weight=_keep_weight(comp))
+    for comp in [*roles.get("body", []), *roles.get("frame_force", [])]:
+        for pname in comp.ports:
+            frames.add_node(topo.set_of[comp.port_ref(pname)])
 
     reached = nx.node_connected_component(frames, topo.root)
-    for comp in [*roles.get("joint", []), *roles.get("body", [])]:
-        if topo.set_of[comp.port_ref("frame_a")] not in reached:
-            problems.append(f"{model.place(comp)}: {comp.name} is not connected to the ground "
-                            f"{topo.world.name!r} through joints or rigid parts")
+    for comp in [*roles.get("joint", []), *roles.get("body", []),
+                 *roles.get("frame_force", [])]:
+        for pname in comp.ports:
+            if comp.ports[pname].domain == "frame" and \
+                    topo.set_of[comp.port_ref(pname)] not in reached:
+                problems.append(f"{model.place(comp)}: {comp.name} is not connected to the "
+                                f"ground {topo.world.name!r} through joints or rigid parts")
+                break
 
     sub = frames.subgraph(reached)
-    seen = set()
-    for parent, child in nx.bfs_edges(sub, topo.root):
-        data = next(iter(sub.get_edge_data(parent, child).values()))
-        comp = data["component"]
-        seen.add(comp.name)
+    tree = nx.Graph()
+    tree.add_node(topo.root)
+    for u, v, _, data in nx.maximum_spanning_edges(sub, keys=True, data=True):
+        tree.add_edge(u, v, component=data["component"])
+    for parent, child in nx.bfs_edges(tree, topo.root):
+        comp = tree.edges[parent, child]["component"]
         rev = topo.set_of[comp.port_ref("frame_a")] != parent
         topo.tree.append(Edge(comp, parent, child, rev))
-    extra = [d["component"] for _, _, d in sub.edges(data=True)
-             if d["component"].name not in seen]
-    if extra:
-        simple = nx.Graph(sub)
-        for cycle in nx.cycle_basis(simple):
-            names = _loop_names(sub, cycle)
-            topo.loops.append(names)
-        for u, v in {(u, v) for u, v, _ in sub.edges(keys=True)}:
-            comps = sub.get_edge_data(u, v)
-            if len(comps) > 1:
-                topo.loops.append(sorted(comps))
-        for names in topo.loops:
-            problems.append(f"kinematic loop through {', '.join(names)}: closed loops are not "
-                            f"supported yet; open the loop (remove one joint)")
+    in_tree = {e.component.name for e in topo.tree}
+    for u, v, data in sub.edges(data=True):
+        comp = data["component"]
+        if comp.name in in_tree:
+            if comp._values.get("cut", False):
+                problems.append(f"{model.place(comp, 'cut')}: {comp.name} is marked cut but "
+                                f"closes no kinematic loop")
+            continue
+        a, b = topo.set_of[comp.port_ref("frame_a")], topo.set_of[comp.port_ref("frame_b")]
+        path = nx.shortest_path(tree, a, b)
+        names = [tree.edges[x, y]["component"].name for x, y in zip(path, path[1:])]
+        topo.cuts.append(Cut(comp, a, b, [*names, comp.name]))
+        topo.loops.append([*names, comp.name])
     rank = {name: i for i, name in enumerate(model.components)}
-    topo.joints = sorted((e.component for e in topo.tree if e.component.dof > 0),
-                         key=lambda c: rank[c.name])
+    coordinated = [e.component for e in topo.tree if e.component.dof > 0]
+    coordinated += [c.component for c in topo.cuts
+                    if c.component.dof > 0 and c.component.regular]
+    topo.joints = sorted(coordinated, key=lambda c: rank[c.name])
     topo.bodies = [(b, topo.set_of[b.port_ref("frame_a")]) for b in roles.get("body", [])
                    if topo.set_of[b.port_ref("frame_a")] in reached]
-
-
-def _loop_names(graph, cycle):
-    names = []
-    for u, v in zip(cycle, cycle[1:] + cycle[:1]):
-        names.append(next(iter(graph.get_edge_data(u, v))))
-    return names
+    topo.forces = [f for f in roles.get("frame_force", [])
+                   if all(topo.set_of[f.port_ref(pn)] in reached for pn in f.ports)]
 
 
 def _oned(model, topo, values, problems):
@@ -223,8 +247,8 @@ def _oned(model, topo, values, problems):
                             f"defined {domain} position: wire it to a joint flange or a Fixed")
         for p in coords:
             if p.component.name not in tree_joints:
-                problems.append(f"{p.path}: joint {p.component.name!r} is not part of the "
-                                f"tree, so its flange cannot be used")
+                problems.append(f"{p.path}: joint {p.component.name!r} has no coordinates "
+                                f"here, so its flange cannot be used")
         oned.definer = definers[0] if definers else None
         topo.oned.append(oned)
 

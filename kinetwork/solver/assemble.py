@@ -1,8 +1,10 @@
 """From a validated model to CasADi SX equations: no integration, no I/O.
 
-States are the coordinates of the spanning tree's joints and their speeds (minimal
-coordinates). Rigid parts fold into the body of the joint before them; the 1-D network gives
-each joint coordinate its generalized force; probes become output expressions.
+The coordinates are those of the spanning tree's joints and of the regular joints that cut
+its loops, with their speeds. Rigid parts fold into the body of the joint before them; the
+1-D network and the frame forces give each speed its generalized force; each cut joint gives
+its loop-closure residual (reduced to independent coordinates in ``loops.py``); probes
+become output expressions.
 """
 
 from dataclasses import dataclass, field
@@ -11,13 +13,19 @@ import casadi as ca
 
 from ..components.probe import QUANTITIES
 from ..expr import Expression, casadi_functions
-from ..spatial import vee
+from ..spatial import vec3, vee
 from .newton_euler import Body, aba, crba, rnea, spatial_inertia
 
 
 @dataclass
 class Assembly:
-    """Symbols and expressions of a model (all CasADi SX)."""
+    """Symbols and expressions of a model (all CasADi SX).
+
+    ``q`` are the coordinates of every joint with coordinates (the tree's and those of
+    regular cut joints) and ``qd`` their speeds u; a quaternion joint has more coordinates
+    than speeds, so d(q)/dt is ``qdot`` (= u for angles and distances). ``qdd`` is the
+    tree's forward dynamics; a model with loops (``cuts``) is reduced by ``loops.py``.
+    """
     t: ca.SX
     q: ca.SX
     qd: ca.SX
@@ -25,25 +33,62 @@ class Assembly:
     param_names: list
     coordinate_names: list
     coordinate_units: list
+    speed_names: list
+    speed_units: list
     bodies: list
-    x0: ca.SX                  # initial state, in the parameters
-    Q: ca.SX                   # generalized forces of the 1-D network (t, q, qd, p)
-    qdd: ca.SX                 # forward dynamics (t, q, qd, p)
+    q_start: ca.SX             # initial coordinates (q0, or q0_guess where q0 is not given)
+    u_start: ca.SX             # initial speeds
+    given: list                # per coordinate: q0 was given (held in a loop's closure)
+    u_given: list              # per speed: qd0 was given
+    regular: list              # per coordinate: an angle or distance with qdot = its speed
+    speed_of: dict             # regular coordinate index -> speed index
+    Q: ca.SX                   # generalized forces of 1-D network and frame forces (t,q,qd,p)
+    qdd: ca.SX                 # forward dynamics of the tree (t, q, qd, p)
+    qdot: ca.SX                # d(q)/dt in (q, qd)
     gravity: ca.SX
+    place: dict = field(default_factory=dict)     # frame set -> (body, R, p) in the body
+    cuts: list = field(default_factory=list)      # (Cut, residual SX in q)
     signals: list = field(default_factory=list)   # (name, unit, SX expression in t,q,qd,qdd,p)
     qdd_sym: ca.SX = None      # placeholder for qdd inside signal expressions
+    lam_sym: ca.SX = None      # placeholder for the loops' multipliers (one per closure row)
+    qindex: dict = None        # joint name -> indices of its coordinates in q
+    uindex: dict = None        # joint name -> indices of its speeds in qd
+    Q_drive: ca.SX = None      # the part of Q that 1-D flanges apply (drives, springs)
+    _poses: dict = field(default_factory=dict)
 
     def mass_matrix(self):
-        return crba(self.bodies, self.q.shape[0])
+        return crba(self.bodies, self.qd.shape[0])
 
     def terms(self):
         """(M, V, G) with M qdd + V + G = 0: V holds Coriolis, centripetal and -Q."""
-        n = self.q.shape[0]
+        n = self.qd.shape[0]
         a_grav = ca.vertcat(ca.SX.zeros(3), -self.gravity)
         zero = ca.SX.zeros(n)
         C = rnea(self.bodies, self.qd, zero, ca.SX.zeros(6))
         G = rnea(self.bodies, zero, zero, a_grav)
         return self.mass_matrix(), C - self.Q, G
+
+    def pose(self, frame_set):
+        """World orientation R and position p of a frame set, in the coordinates q."""
+        if frame_set not in self._poses:
+            k, R, pos = self.place[frame_set]
+            while k >= 0:
+                b = self.bodies[k]
+                R, pos = b.R @ R, b.p + b.R @ pos
+                k = b.parent
+            self._poses[frame_set] = (R, pos)
+        return self._poses[frame_set]
+
+    def rate(self, expr):
+        """Time derivative of an expression in (q, qd), with qd's rate ``qdd_sym``."""
+        flat = ca.vec(expr)
+        return ca.reshape(ca.jtimes(flat, self.q, self.qdot)
+                          + ca.jtimes(flat, self.qd, self.qdd_sym), *expr.shape)
+
+    def twist(self, frame_set):
+        """World angular velocity and velocity of a frame set's origin, in (q, qd)."""
+        R, pos = self.pose(frame_set)
+        return vee(self.rate(R) @ R.T), self.rate(pos)
 
 
 def assemble(model, topo):
@@ -58,37 +103,72 @@ def assemble(model, topo):
                                else v for k, v in comp._values.items()})
              for name, comp in model.components.items()}
 
-    coord_names, coord_units, index = [], [], {}
+    coord_names, coord_units, speed_names, speed_units = [], [], [], []
+    qindex, uindex, regular, speed_of = {}, {}, [], {}
     for joint in topo.joints:
-        index[joint.name] = list(range(len(coord_names), len(coord_names) + joint.dof))
-        suffix = [""] if joint.dof == 1 else [f"[{i}]" for i in range(joint.dof)]
-        coord_names += [f"{joint.name}.q{s}" for s in suffix]
-        coord_units += [joint.units[0]] * joint.dof
-    n = len(coord_names)
-    q = ca.vertcat(*[ca.SX.sym(c.replace(".", "_")) for c in coord_names]) if n else ca.SX(0, 1)
-    qd = ca.vertcat(*[ca.SX.sym(c.replace(".", "_") + "d") for c in coord_names]) \
-        if n else ca.SX(0, 1)
+        nq = joint.n_coordinates()
+        qindex[joint.name] = list(range(len(coord_names), len(coord_names) + nq))
+        uindex[joint.name] = list(range(len(speed_names), len(speed_names) + joint.dof))
+        if joint.regular:
+            speed_of.update(zip(qindex[joint.name], uindex[joint.name]))
+        regular += [joint.regular] * nq
+        coord_names += [f"{joint.name}.{s}" for s in joint.coordinate_labels()]
+        coord_units += list(joint.units)
+        speed_names += [f"{joint.name}.{s}" for s in joint.speed_labels()]
+        speed_units += [f"{u}/s" if u else "rad/s" for u in joint.units[:joint.dof]] \
+            if joint.regular else _speed_units(joint)
+    q = _symbols(coord_names, "")
+    qd = _symbols(speed_names, "d")
+    n = len(speed_names)
     qdd_sym = ca.SX.sym("qdd", n)
+    qdot = ca.SX.zeros(len(coord_names))
+    for joint in topo.joints:
+        qdot[qindex[joint.name]] = bound[joint.name].rate(q[qindex[joint.name]],
+                                                          qd[uindex[joint.name]])
 
-    bodies, place = _bodies(topo, bound, q, qd, index)
-    pos, vel, acc, flow = _network(model, topo, bound, q, qd, qdd_sym, index, t)
+    bodies, place = _bodies(topo, bound, q, qd, qindex, uindex)
+    pos, vel, acc, flow = _network(model, topo, bound, q, qd, qdd_sym, qindex, uindex, t)
     Q = ca.SX.zeros(n)
     for joint in topo.joints:
         for pname, j in joint.coordinate_ports.items():
-            Q[index[joint.name][j]] = flow.get(joint.port_ref(pname), 0)
+            Q[uindex[joint.name][j]] = flow.get(joint.port_ref(pname), 0)
 
     world = bound[topo.world.name]
     gravity = ca.vertcat(*world.gravity)
-    qdd = aba(bodies, qd, Q, ca.vertcat(ca.SX.zeros(3), -gravity)) if n else ca.SX(0, 1)
-    x0 = ca.vertcat(*[_initial(bound[j.name].q0) for j in topo.joints],
-                    *[_initial(bound[j.name].qd0) for j in topo.joints])
-    asm = Assembly(t, q, qd, p, names, coord_names, coord_units, bodies, x0, Q, qdd, gravity,
-                   qdd_sym=qdd_sym)
-    _probes(asm, topo, place, pos, vel, acc, flow)
+    starts, given, u_start, u_given = [], [], [], []
+    for joint in topo.joints:
+        q0, u0 = bound[joint.name].initial()
+        guess = bound[joint.name].guesses() if joint.regular else [0] * len(q0)
+        starts += [g if v is None else v for v, g in zip(q0, guess)]
+        given += [v is not None for v in q0]
+        u_start += [0 if v is None else v for v in u0]
+        u_given += [v is not None for v in u0]
+    asm = Assembly(t, q, qd, p, names, coord_names, coord_units, speed_names, speed_units,
+                   bodies, ca.vertcat(*starts) if starts else ca.SX(0, 1),
+                   ca.vertcat(*u_start) if u_start else ca.SX(0, 1), given, u_given, regular,
+                   speed_of, Q, None, qdot, gravity, place=place, qdd_sym=qdd_sym)
+    asm.Q = Q + _frame_forces(asm, topo, bound, t)
+    asm.qdd = aba(bodies, qd, asm.Q, ca.vertcat(ca.SX.zeros(3), -gravity)) if n else ca.SX(0, 1)
+    asm.cuts = [(cut, _closure(asm, cut, bound[cut.component.name], qindex))
+                for cut in topo.cuts]
+    asm.lam_sym = ca.SX.sym("lambda", sum(r.shape[0] for _, r in asm.cuts))
+    asm.qindex, asm.uindex, asm.Q_drive = qindex, uindex, Q
+    _probes(asm, topo, pos, vel, acc, flow, bound)
     return asm
 
 
-def _bodies(topo, bound, q, qd, index):
+def _symbols(names, suffix):
+    if not names:
+        return ca.SX(0, 1)
+    clean = [n.replace(".", "_").replace("[", "_").replace("]", "") + suffix for n in names]
+    return ca.vertcat(*[ca.SX.sym(c) for c in clean])
+
+
+def _speed_units(joint):
+    return ["m/s"] * 3 + ["rad/s"] * 3 if joint.dof == 6 else ["rad/s"] * joint.dof
+
+
+def _bodies(topo, bound, q, qd, qindex, uindex):
     """Moving bodies along the tree; rigid parts fold into the body before them.
 
     Returns the bodies and, for each frame set, (body index, R, p): where the set sits in
@@ -98,7 +178,7 @@ def _bodies(topo, bound, q, qd, index):
     bodies = []
     for edge in topo.tree:
         comp = bound[edge.component.name]
-        qj = q[index[comp.name]] if comp.dof else ca.SX(0, 1)
+        qj = q[qindex[comp.name]] if comp.dof else ca.SX(0, 1)
         Re, re = comp.transform(qj)
         if edge.reversed:
             Re, re = Re.T, -Re.T @ re
@@ -107,17 +187,19 @@ def _bodies(topo, bound, q, qd, index):
         if comp.dof == 0:
             place[edge.child] = (k, R, pos)
             continue
-        # motion subspace in the child frame, from derivatives of the joint's transform
-        S = ca.horzcat(*[
-            ca.vertcat(vee(Re.T @ ca.reshape(ca.jacobian(ca.vec(Re), qj[j]), 3, 3)),
-                       Re.T @ ca.jacobian(re, qj[j]))
-            for j in range(comp.dof)])
-        if comp.constant_subspace:       # screw joints: exact constants, no S-dot term
-            S, cJ = ca.substitute(S, qj, ca.SX.zeros(comp.dof)), ca.SX.zeros(6)
+        uj = qd[uindex[comp.name]]
+        S = None if edge.reversed else comp.subspace(qj)
+        if S is None:
+            # motion subspace in the child frame, from the rate of the joint's transform
+            qdot = comp.rate(qj, uj)
+            w = vee(Re.T @ ca.reshape(ca.jtimes(ca.vec(Re), qj, qdot), 3, 3))
+            S = ca.jacobian(ca.vertcat(w, Re.T @ ca.jtimes(re, qj, qdot)), uj)
+        # screw joints: exact constants, no S-dot term (a reversed ball joint is not one)
+        if comp.constant_subspace and (comp.regular or not edge.reversed):
+            S, cJ = ca.substitute(S, qj, ca.DM(_zero_pose(comp))), ca.SX.zeros(6)
         else:
-            qdj = qd[index[comp.name]]
-            cJ = ca.jtimes(S @ qdj, qj, qdj)
-        bodies.append(Body(comp.name, k, R, pos, S, cJ, ca.SX.zeros(6, 6), index[comp.name]))
+            cJ = ca.jtimes(S @ uj, qj, comp.rate(qj, uj))
+        bodies.append(Body(comp.name, k, R, pos, S, cJ, ca.SX.zeros(6, 6), uindex[comp.name]))
         place[edge.child] = (len(bodies) - 1, ca.SX.eye(3), ca.SX.zeros(3))
     for body, frame_set in topo.bodies:
         k, Rs, ps = place[frame_set]
@@ -128,7 +210,65 @@ def _bodies(topo, bound, q, qd, index):
     return bodies, place
 
 
-def _network(model, topo, bound, q, qd, qdd_sym, index, t):
+def _zero_pose(comp):
+    """Coordinates of the joint's home pose (identity quaternion for quaternion joints)."""
+    labels = comp.coordinate_labels()
+    return [1.0 if label == "quat[0]" else 0.0 for label in labels]
+
+
+def _frame_forces(asm, topo, bound, t):
+    """Generalized forces of line forces and world forces/torques: the power they put in,
+    differentiated by the speeds (a force on a frame enters as J^T f)."""
+    Q = ca.SX.zeros(asm.qd.shape[0])
+    for comp in topo.forces:
+        c = bound[comp.name]
+        if "frame_a" in comp.ports:
+            _, pa = asm.pose(topo.set_of[comp.port_ref("frame_a")])
+            _, pb = asm.pose(topo.set_of[comp.port_ref("frame_b")])
+            s = ca.norm_2(pb - pa)
+            s_d = ca.jtimes(s, asm.q, asm.qdot)
+            power = -c.law(s, s_d) * s_d
+        else:
+            w, v = _twist_u(asm, topo.set_of[comp.port_ref("frame_b")])
+            power = ca.dot(vec3(c.force), v) if hasattr(c, "force") \
+                else ca.dot(vec3(c.torque), w)
+        Q += ca.gradient(power, asm.qd) if asm.qd.shape[0] else 0
+    return Q
+
+
+def _twist_u(asm, frame_set):
+    """World angular velocity and origin velocity of a frame set in (q, qd) (no qdd)."""
+    R, pos = asm.pose(frame_set)
+    rate = lambda e: ca.reshape(ca.jtimes(ca.vec(e), asm.q, asm.qdot), *e.shape)  # noqa: E731
+    return vee(rate(R) @ R.T), rate(pos)
+
+
+def _closure(asm, cut, comp, qindex):
+    """Loop-closure residual of a cut joint, zero when its frames meet as the joint allows."""
+    Ra, pa = asm.pose(cut.set_a)
+    Rb, pb = asm.pose(cut.set_b)
+    qj = asm.q[qindex[comp.name]] if comp.dof and comp.regular else ca.SX(0, 1)
+    return closure_rows(comp, Ra, pa, Rb, pb, qj)
+
+
+def closure_rows(comp, Ra, pa, Rb, pb, qj):
+    """Closure of a cut joint from the world poses of its two frames.
+
+    A regular cut joint keeps its coordinates: frame_a moved by its transform must be
+    frame_b (3 position rows, 9 rotation-matrix rows; only the independent ones are kept,
+    see ``loops.py``). A cut Spherical joint leaves the positions only; a cut FreeMotion
+    constrains nothing.
+    """
+    rel_p, rel_R = Ra.T @ (pb - pa), Ra.T @ Rb
+    if comp.dof and not comp.regular:
+        if comp.type_name == "multibody.FreeMotion":
+            return ca.SX(0, 1)
+        return rel_p                               # Spherical: the origins meet
+    Rc, pc = comp.transform(qj)
+    return ca.vertcat(rel_p - pc, ca.vec(Rc.T @ rel_R - ca.SX.eye(3)))
+
+
+def _network(model, topo, bound, q, qd, qdd_sym, qindex, uindex, t):
     """1-D network: position, speed, acceleration of every port, and the flow into it."""
     pos, vel, acc = {}, {}, {}
     for s in topo.oned:
@@ -136,8 +276,9 @@ def _network(model, topo, bound, q, qd, qdd_sym, index, t):
         if s.definer is not None:
             comp = bound[s.definer.component.name]
             if s.definer.name in comp.coordinate_ports:
-                i = index[comp.name][comp.coordinate_ports[s.definer.name]]
-                triple = (q[i], qd[i], qdd_sym[i])
+                j = comp.coordinate_ports[s.definer.name]
+                i, k = qindex[comp.name][j], uindex[comp.name][j]
+                triple = (q[i], qd[k], qdd_sym[k])
             elif comp.role == "fixed":
                 triple = (comp.position(), 0, 0)
         for ref in topo.sets[s.index]:
@@ -168,16 +309,12 @@ def _symbolic(value, env, funcs):
     return value
 
 
-def _initial(value):
-    return ca.SX.zeros(1) if value is None else value
-
-
-def _probes(asm, topo, place, pos, vel, acc, flow):
+def _probes(asm, topo, pos, vel, acc, flow, bound):
     for probe, target in topo.probes:
         units = QUANTITIES[target.domain]
         asked = probe.quantities if probe.quantities is not None else list(units)
         if target.domain == "frame":
-            values = _frame_kinematics(asm, place[topo.set_of[target]], asked)
+            values = _frame_quantities(asm, topo, target, asked, bound)
         else:
             potential = dict(zip(list(units)[:3], (pos[target], vel[target], acc[target])))
             values = {**potential, list(units)[3]: flow.get(target, 0)}
@@ -186,25 +323,19 @@ def _probes(asm, topo, place, pos, vel, acc, flow):
                                 ca.SX(values[quantity])))
 
 
-def _frame_kinematics(asm, where, asked):
-    """World-frame kinematics of a frame, differentiated exactly by CasADi."""
-    k, Rs, ps = where
-    R, pos = Rs, ps
-    while k >= 0:
-        b = asm.bodies[k]
-        R, pos = b.R @ R, b.p + b.R @ pos
-        k = b.parent
-    q, qd, qdd = asm.q, asm.qd, asm.qdd_sym
-
-    def rate(expr):          # time derivative of an expression in (q, qd)
-        flat = ca.vec(expr)
-        return ca.reshape(ca.jtimes(flat, q, qd) + ca.jtimes(flat, qd, qdd), *expr.shape)
-
+def _frame_quantities(asm, topo, target, asked, bound):
+    """World-frame kinematics of a frame, differentiated exactly by CasADi; the cut force and
+    torque through the port from the wrench balance of everything behind it."""
+    R, pos = asm.pose(topo.set_of[target])
     out = {"position": pos, "orientation": ca.reshape(R.T, 9, 1)}
     if {"velocity", "acceleration"} & set(asked):
-        out["velocity"] = rate(pos)
-        out["acceleration"] = rate(out["velocity"])
+        out["velocity"] = asm.rate(pos)
+        out["acceleration"] = asm.rate(out["velocity"])
     if {"angular_velocity", "angular_acceleration"} & set(asked):
-        out["angular_velocity"] = vee(rate(R) @ R.T)
-        out["angular_acceleration"] = rate(out["angular_velocity"])
+        out["angular_velocity"] = vee(asm.rate(R) @ R.T)
+        out["angular_acceleration"] = asm.rate(out["angular_velocity"])
+    if {"force", "torque"} & set(asked):
+        from .wrench import cut_wrench          # only models that ask for it pay for it
+        force, moment = cut_wrench(asm, topo, target, bound)
+        out["force"], out["torque"] = force, moment - ca.cross(pos, force)
     return out

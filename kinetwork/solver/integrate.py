@@ -28,6 +28,7 @@ class Method:
     doc: str
     fixed: bool = False
     newton: bool = False
+    dae: bool = False          # handles algebraic variables (the loops' dependent coordinates)
 
 
 def _casadi(plugin, newton, **options):
@@ -36,13 +37,13 @@ def _casadi(plugin, newton, **options):
 
     def run(system, grid, x0, p, settings):
         opts = dict(options)
+        nx = system.n_states
         if sundials:
             opts.update(reltol=settings["rtol"], abstol=settings["atol"])
             if plugin == "idas":
-                # an ODE's consistent initial rate is f(t0, x0): IDAS's own search for it
-                # (meant for algebraic variables) fails when it is large (a stiff spring)
-                xdot0 = system.numeric(system.rhs_function(settings["jit"]), p)(grid[0], x0)
-                opts.update(calc_ic=False, init_xdot=tuple(float(v) for v in xdot0))
+                # the consistent initial rate is f(t0, x0) (loops: z0 is consistent already):
+                # IDAS's own search for it fails when it is large (a stiff spring)
+                opts.update(calc_ic=False, init_xdot=_rate0(system, grid[0], x0, p))
         else:       # fixed steps: CasADi counts them over the whole horizon; a blow-up is
             opts["show_eval_warnings"] = False           # reported once, below
             opts["number_of_finite_elements"] = \
@@ -51,11 +52,11 @@ def _casadi(plugin, newton, **options):
         integ = system.integrator(plugin, grid, opts, jit=jit, jacobian=newton,
                                   cache=plugin != "idas")       # idas: options hold x0
         try:
-            out = integ(x0=x0, p=p)
+            out = integ(x0=x0[:nx], z0=x0[nx:], p=p)
         except RuntimeError as exc:
             X, reason = _casadi_partial(system, plugin, grid, x0, p, opts, jit, newton, exc)
             return X, reason, {"restarted": "at every output time, after: " + _reason(str(exc))}
-        X = np.vstack([x0, np.asarray(out["xf"]).T])
+        X = np.vstack([x0, np.vstack([np.asarray(out["xf"]), np.asarray(out["zf"])]).T])
         stats = integ.stats()
         if not sundials:
             X, failure = _finite(X)
@@ -88,19 +89,27 @@ def _casadi_partial(system, plugin, grid, x0, p, options, jit, newton, exc):
     start per output interval can pass where the continued run failed).
     """
     X = [x0]
+    nx = system.n_states
     quiet = {**options, "disable_internal_warnings": True} if plugin in ("cvodes", "idas") \
         else options
-    rate = system.numeric(system.rhs_function(jit), p) if plugin == "idas" else None
     for k in range(len(grid) - 1):
-        if rate is not None:           # idas starts each interval from its consistent rate
-            quiet["init_xdot"] = tuple(float(v) for v in rate(grid[k], X[-1]))
+        if plugin == "idas":           # idas starts each interval from its consistent rate
+            quiet["init_xdot"] = _rate0(system, grid[k], X[-1], p)
         integ = system.integrator(plugin, grid[k:k + 2], quiet, cache=False, jit=jit,
                                   jacobian=newton)
         try:
-            X.append(np.asarray(integ(x0=X[-1], p=p)["xf"]).ravel())
+            out = integ(x0=X[-1][:nx], z0=X[-1][nx:], p=p)
         except RuntimeError as step_exc:
             return np.array(X), _reason(str(step_exc) or str(exc))
+        X.append(np.concatenate([np.asarray(out["xf"]).ravel(), np.asarray(out["zf"]).ravel()]))
     return np.array(X), None
+
+
+def _rate0(system, t, X, p):
+    """d(x)/dt at a consistent full state X = (x, z), as IDAS's ``init_xdot``."""
+    nx = system.n_states
+    rate = system.f_dae(t, X[:nx], X[nx:], p)[0]
+    return tuple(float(v) for v in np.asarray(rate).ravel())
 
 
 #: SUNDIALS return flags, in plain words
@@ -151,6 +160,10 @@ def _scipy(name):
 
 def _midpoint(system, grid, x0, p, settings):
     from .geometric import Midpoint
+    if system.formulation != "tree" or not all(system.asm.regular):
+        raise ModelError("method 'midpoint' works in canonical coordinates of a tree of "
+                         "angles and distances; this model has kinematic loops or a "
+                         "quaternion joint (Spherical, FreeMotion): use 'auto' or 'idas'")
     key = ("midpoint", settings["jit"])
     if key not in system._compiled:
         system._compiled[key] = Midpoint(system, settings["jit"])
@@ -159,7 +172,8 @@ def _midpoint(system, grid, x0, p, settings):
 
 #: method name (case-insensitive) -> Method
 METHODS = {
-    "auto": Method(None, "cvodes-adams, or cvodes (BDF) when the stiffness test says so"),
+    "auto": Method(None, "cvodes-adams, or cvodes (BDF) when the stiffness test says so; "
+                   "idas for models with loops", dae=True),
     "cvodes-adams": Method(_casadi("cvodes", False, linear_multistep_method="adams",
                                    nonlinear_solver_iteration="functional"),
                            "SUNDIALS CVODES, variable-order Adams-Moulton with functional "
@@ -167,12 +181,12 @@ METHODS = {
     "cvodes": Method(_casadi("cvodes", True), "SUNDIALS CVODES, variable-order BDF with "
                      "Newton iteration: stiff", newton=True),
     "idas": Method(_casadi("idas", True), "SUNDIALS IDAS, variable-order BDF on the residual "
-                   "form: stiff", newton=True),
+                   "form: stiff, and the method of models with loops", newton=True, dae=True),
     "rk": Method(_casadi("rk", False), "CasADi's classical Runge-Kutta 4, fixed step",
                  fixed=True),
     "collocation": Method(_casadi("collocation", True),
                           "CasADi's Radau IIA collocation (order 5), fixed step: stiff",
-                          fixed=True, newton=True),
+                          fixed=True, newton=True, dae=True),
     "midpoint": Method(_midpoint, "implicit midpoint rule in canonical coordinates, fixed "
                        "step: symplectic, for long undamped runs", fixed=True, newton=True),
     **{m.lower(): Method(_scipy(m), f"scipy solve_ivp {m}", newton=m in ("Radau", "BDF", "LSODA"))
@@ -272,8 +286,14 @@ def simulate(model, t_end=None, n_points=None, method=None, rtol=None, atol=None
     if key not in METHODS:
         raise ModelError(f"method {settings['method']!r}: unknown{suggest(key, METHODS)}; "
                          f"methods are {', '.join(METHODS)}")
+    if system.n_algebraic and not METHODS[key].dae:
+        raise ModelError(
+            f"method {settings['method']!r} integrates ODEs only, and {system.model.name!r} "
+            f"has kinematic loops whose dependent coordinates are algebraic variables; use "
+            f"{', '.join(k for k, m in METHODS.items() if m.dae)}, or compile the model with "
+            f"loops='baumgarte' (an ODE in all coordinates)")
     p = system.param_vector(params)        # checks the overrides once for the whole run
-    x0 = system.initial_state_p(p)
+    x0 = np.concatenate(system.initial_full_p(p))
     grid = np.linspace(t_start, settings["t_end"], int(settings["n_points"]))
     settings.update(jit=_jit.enabled(jit) and system.n_states > 0, t_start=t_start,
                     n_points=int(settings["n_points"]),
@@ -281,7 +301,7 @@ def simulate(model, t_end=None, n_points=None, method=None, rtol=None, atol=None
     system.jit_stats.clear()
     stats = {}
     if not system.n_states:           # everything welded to the ground: nothing to integrate
-        X, failure, key = np.zeros((len(grid), 0)), None, "none"
+        X, failure, key = np.tile(x0, (len(grid), 1)), None, "none"
     elif key == "auto":
         X, failure, stats, key = _auto(system, grid, x0, p, settings)
     else:
@@ -290,9 +310,9 @@ def simulate(model, t_end=None, n_points=None, method=None, rtol=None, atol=None
     t = grid[:len(X)]
     t_end = settings["t_end"]
     outputs = system.outputs_p(t, X, p, settings["jit"]) if len(t) else np.zeros((0, 0))
-    results = Results(t, X, system.state_names, outputs, system.signal_names, system.signal_sizes,
-                      system.signal_units, stats=stats,
-                      state_units=system.state_units,
+    results = Results(t, X, system.state_names + system.algebraic_names, outputs,
+                      system.signal_names, system.signal_sizes, system.signal_units, stats=stats,
+                      state_units=system.state_units + system.algebraic_units,
                       settings={"t_start": t_start, "t_end": t_end,
                                 "n_points": settings["n_points"], "method": key,
                                 "rtol": settings["rtol"], "atol": settings["atol"],
@@ -313,6 +333,9 @@ def _auto(system, grid, x0, p, settings):
     up to its time-dependent drives: its eigenvalues come in ±λ pairs and it is never stiff by
     the test, so the test (an eigenvalue problem of 2n x 2n) is not run.
     """
+    if system.n_algebraic:
+        X, failure, stats = METHODS["idas"].run(system, grid, x0, p, settings)
+        return X, failure, {**stats, "loops": system.formulation_note}, "idas"
     why = {"stiff": False, "damped": system.damped}
     if system.damped:
         stiff, sigma, omega = stiffness(system, x0, p, grid[0], grid[-1], settings["jit"])

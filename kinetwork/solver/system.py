@@ -8,6 +8,7 @@ import numpy as np
 from ..errors import ModelError
 from . import jit as _jit
 from .assemble import assemble
+from .loops import formulate
 
 #: Jacobians larger than this (instructions) are not compiled to C: Newton iterations use
 #: finite differences of the compiled right-hand side instead (an N = 128 chain's exact
@@ -26,34 +27,73 @@ class System:
         Initial state for the model's parameter values.
     """
 
-    def __init__(self, model):
+    def __init__(self, model, loops="partition"):
         self.model = model
         self.topology = model.validate()
         self.asm = asm = assemble(model, self.topology)
+        self.eq = eq = formulate(asm, self.topology, self.parameter_values(), loops)
         self.param_names = asm.param_names
         self.coordinate_names = asm.coordinate_names
-        self.state_names = asm.coordinate_names + [c + "d" for c in asm.coordinate_names]
-        self.state_units = asm.coordinate_units + [u + "/s" for u in asm.coordinate_units]
-        x = ca.vertcat(asm.q, asm.qd)
-        self._x = x
-        self.ode = ca.vertcat(asm.qd, asm.qdd)
+        self.speed_names = asm.speed_names
+        self.state_names, self.state_units = eq.state_names, eq.state_units
+        #: dependent joint coordinates of a model with loops (solved, not integrated)
+        self.algebraic_names, self.algebraic_units = eq.algebraic_names, eq.algebraic_units
+        self._x, self._z = eq.x, eq.z
+        self.ode = eq.ode
         # dense outputs: Function.buffer callers read plain column-major arrays
-        self.f_rhs = ca.Function("rhs", [asm.t, x, asm.p], [ca.densify(self.ode)],
-                                 ["t", "x", "p"], ["xdot"])
-        self.f_x0 = ca.Function("x0", [asm.p], [asm.x0])
+        self.f_rhs = ca.Function("rhs", [asm.t, eq.x, asm.p], [ca.densify(self.ode)],
+                                 ["t", "x", "p"], ["xdot"]) if not self.n_algebraic else None
+        self.f_dae = ca.Function("dae", [asm.t, eq.x, eq.z, asm.p],
+                                 [ca.densify(eq.ode), ca.densify(eq.alg)],
+                                 ["t", "x", "z", "p"], ["ode", "alg"])
         self.probe_targets = {probe.name: target.path for probe, target in self.topology.probes}
         self.signal_names = [name for name, _, _ in asm.signals]
         self.signal_units = {name: unit for name, unit, _ in asm.signals}
         self.signal_sizes = {name: expr.numel() for name, _, expr in asm.signals}
-        outs = [ca.substitute(expr, asm.qdd_sym, asm.qdd) for _, _, expr in asm.signals]
-        self.f_out = ca.Function("outputs", [asm.t, x, asm.p],
+        outs = [ca.substitute(expr, ca.vertcat(asm.qd, asm.qdd_sym, asm.lam_sym),
+                              ca.vertcat(eq.u, eq.udot, eq.lam))
+                for _, _, expr in asm.signals]
+        # outputs read the whole state: differential, then algebraic
+        self.f_out = ca.Function("outputs", [asm.t, ca.vertcat(eq.x, eq.z), asm.p],
                                  [ca.vertcat(*outs) if outs else ca.SX(0, 1)])
         self._f_mass = None
         self._f_terms = None
         self._f_jac = None
+        self._f_residual = None
+        self._z_last = None
         self._integrators = {}
         self._compiled = {}
         self.jit_stats = {}
+
+    def parameter_values(self):
+        return self.model.parameter_values(None)
+
+    @property
+    def n_algebraic(self):
+        return len(self.algebraic_names)
+
+    @property
+    def formulation(self):
+        """"tree" (no loops), "partition" or "baumgarte"; ``formulation_note`` says why the
+        state count is what it is."""
+        return self.eq.formulation
+
+    @property
+    def formulation_note(self):
+        return self.eq.note
+
+    def constraint_residual(self, X, params=None):
+        """Largest |closure residual| of the kept loop equations at each row of full states
+        X (n_points, n_states + n_algebraic); zeros for a model without loops."""
+        X = np.atleast_2d(np.asarray(X, dtype=float))
+        if self.eq.residual is None:
+            return np.zeros(len(X))
+        if self._f_residual is None:
+            self._f_residual = ca.Function("residual", [ca.vertcat(self._x, self._z),
+                                                        self.asm.p],
+                                           [ca.norm_inf(self.eq.residual)])
+        p = self.param_vector(params)
+        return np.array([float(self._f_residual(row, p)) for row in X])
 
     # -- parameters -----------------------------------------------------------------------
     def param_vector(self, params=None):
@@ -73,7 +113,17 @@ class System:
 
     def initial_state_p(self, p):
         """Initial state for a parameter vector already checked by ``param_vector``."""
-        return np.asarray(self.f_x0(p)).ravel()
+        return self.initial_full_p(p)[0]
+
+    @property
+    def z0(self):
+        """Initial values of the algebraic variables (dependent coordinates of loops)."""
+        return self.initial_full_p(self.param_vector())[1]
+
+    def initial_full_p(self, p):
+        """(x0, z0): consistent initial states and algebraic variables (loops closed)."""
+        x0, z0 = self.eq.initial(np.asarray(p, dtype=float))
+        return np.asarray(x0, dtype=float), np.asarray(z0, dtype=float)
 
     @property
     def n_states(self):
@@ -81,9 +131,30 @@ class System:
 
     # -- numbers --------------------------------------------------------------------------
     def rhs(self, t, x, params=None):
-        """dx/dt of the ODE at (t, x), as numpy (n_states,)."""
+        """dx/dt of the ODE at (t, x), as numpy (n_states,).
+
+        With loops (algebraic variables z), z is first solved from the closure by Newton,
+        starting from the last z solved (at first the initial one).
+        """
         x = self._vector(x, self.n_states, "x")
-        return np.asarray(self.f_rhs(t, x, self.param_vector(params))).ravel()
+        p = self.param_vector(params)
+        if not self.n_algebraic:
+            return np.asarray(self.f_rhs(t, x, p)).ravel()
+        if "rootfinder" not in self._compiled:
+            z, xp = ca.SX.sym("z", self.n_algebraic), ca.SX.sym("xp", self.n_states + p.size)
+            alg = ca.Function("alg", [z, xp], [self.f_dae(0, xp[:self.n_states], z,
+                                                          xp[self.n_states:])[1]])
+            self._compiled["rootfinder"] = ca.rootfinder("closure", "newton", alg,
+                                                         {"abstol": 1e-13})
+        if self._z_last is None:
+            self._z_last = self.initial_full_p(p)[1]
+        try:
+            z = np.asarray(self._compiled["rootfinder"](self._z_last, np.concatenate([x, p])))
+        except RuntimeError:
+            raise ModelError("the loops cannot close at this state x (Newton on the "
+                             "dependent coordinates failed)") from None
+        self._z_last = z.ravel()
+        return np.asarray(self.f_dae(t, x, z, p)[0]).ravel()
 
     def mass_matrix(self, q, params=None):
         """Joint-space mass matrix M(q) of the tree, numpy (n, n)."""
@@ -100,8 +171,8 @@ class System:
         elements (so a shoulder spring-damper adds c*q + d*qd); G holds gravity.
         """
         f = self._terms_function()
-        n = len(self.coordinate_names)
-        M, V, G = f(t, self._vector(q, n, "q"), self._vector(qd, n, "qd"),
+        M, V, G = f(t, self._vector(q, len(self.coordinate_names), "q"),
+                    self._vector(qd, len(self.speed_names), "qd"),
                     self.param_vector(params))
         return np.asarray(M), np.asarray(V).ravel(), np.asarray(G).ravel()
 
@@ -113,7 +184,8 @@ class System:
                 "param_names": list(a.param_names)}
 
     def outputs(self, t, x, params=None):
-        """Probe signals at the given times and states (x: (n_points, n_states))."""
+        """Probe signals at the given times and states (x: (n_points, n_states +
+        n_algebraic)): differential states, then the algebraic variables of loops)."""
         return self.outputs_p(t, x, self.param_vector(params))
 
     def outputs_p(self, t, x, p, jit=False):
@@ -142,12 +214,14 @@ class System:
         ``operations`` counts the elementary operations of one right-hand-side evaluation
         (CasADi instructions that are not inputs, outputs or constants).
         """
-        f = self.f_rhs
+        f = self.f_rhs or self.f_dae
         ops = sum(1 for k in range(f.n_instructions())
                   if f.instruction_id(k) not in (ca.OP_INPUT, ca.OP_OUTPUT, ca.OP_CONST,
                                                  ca.OP_PARAMETER))
-        return {"states": self.n_states, "algebraic": 0, "parameters": len(self.param_names),
-                "operations": ops}
+        return {"states": self.n_states, "algebraic": self.n_algebraic,
+                "parameters": len(self.param_names), "operations": ops,
+                "formulation": self.formulation, "loop_equations": self.eq.loop_rows,
+                "redundant_equations": self.eq.loop_redundant}
 
     # -- compiled code ----------------------------------------------------------------------
     def rhs_function(self, jit=False, jacobian=False):
@@ -175,17 +249,31 @@ class System:
 
     def _jacobian_small(self):
         # a Jacobian costs about (operations x states): skip building one that cannot pass
-        if self.f_rhs.n_instructions() * self.n_states > 20 * JACOBIAN_JIT_LIMIT:
+        f = self.f_rhs or self.f_dae
+        if f.n_instructions() * (self.n_states + self.n_algebraic) > 20 * JACOBIAN_JIT_LIMIT:
             return False
+        if self.n_algebraic:
+            return True
         return self.jacobian_function().n_instructions() <= JACOBIAN_JIT_LIMIT
 
     def dae(self, jit=False, jacobian=False):
-        """The ODE as the DAE Function CasADi's integrators take (inputs t, x, z, p, u)."""
-        f = self.rhs_function(jit, jacobian)
+        """The equations as the DAE Function CasADi's integrators take (t, x, z, p, u)."""
         t, x = ca.MX.sym("t"), ca.MX.sym("x", self.n_states)
+        z = ca.MX.sym("z", self.n_algebraic)
         p, empty = ca.MX.sym("p", len(self.param_names)), ca.MX(0, 1)
-        return ca.Function("dae", [t, x, ca.MX.sym("z", 0), p, ca.MX.sym("u", 0)],
-                           [f(t, x, p), empty, empty, empty], ca.dyn_in(), ca.dyn_out())
+        if self.n_algebraic:
+            f = self.f_dae
+            if jit:
+                jacobian = jacobian and self._jacobian_small()
+                key = ("dae", jacobian)
+                if key not in self._compiled:
+                    self._compiled[key] = _jit.external(self.f_dae, jacobian, self.jit_stats)
+                f = self._compiled[key]
+            ode, alg = f(t, x, z, p)
+        else:
+            ode, alg = self.rhs_function(jit, jacobian)(t, x, p), empty
+        return ca.Function("dae", [t, x, z, p, ca.MX.sym("u", 0)],
+                           [ode, alg, empty, empty], ca.dyn_in(), ca.dyn_out())
 
     def integrator(self, plugin, grid, options=None, cache=True, jit=False, jacobian=True):
         """A CasADi integrator over ``grid`` (outputs at grid[1:]), cached per settings.
@@ -199,7 +287,8 @@ class System:
         if cache and key in self._integrators:
             return self._integrators[key]
         dae = self.dae(True, jacobian) if jit else \
-            {"x": self._x, "p": self.asm.p, "t": self.asm.t, "ode": self.ode}
+            {"x": self._x, "z": self._z, "p": self.asm.p, "t": self.asm.t, "ode": self.ode,
+             "alg": self.eq.alg}
         opts = dict(options or {})
         integ = ca.integrator("simulate", plugin, dae, float(grid[0]),
                               [float(g) for g in grid[1:]], opts)
@@ -252,5 +341,6 @@ class System:
         return arr
 
     def __repr__(self):
-        return (f"<System {self.model.name!r}: {self.n_states} states, "
+        alg = f", {self.n_algebraic} algebraic" if self.n_algebraic else ""
+        return (f"<System {self.model.name!r}: {self.n_states} states{alg}, "
                 f"{len(self.signal_names)} signals>")

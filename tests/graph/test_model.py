@@ -97,8 +97,6 @@ def drop(model, a, b):
                 m.add(mb.FixedTranslation("arm", r=[1, 0, 0])),
                 m.connect("floating.frame_a", "arm.frame_a")),
      "floating is not connected to the ground"),
-    (lambda m: (m.add(mb.Revolute("loop")), m.connect("loop.frame_a", "ground.frame"),
-                m.connect("loop.frame_b", "elbow.frame_b")), "kinematic loop through"),
     (lambda m: m.add(kn.Probe("lonely")), "lonely.port is wired to nothing"),
     (lambda m: (m.add(kn.Probe("wrong", quantities=["angle"])),
                 m.connect("wrong.port", "mass1.frame_a")), "'angle' is not a quantity of a frame"),

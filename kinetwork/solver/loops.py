@@ -1,0 +1,286 @@
+"""From the assembled tree (plus loop closures) to the equations that are integrated.
+
+A model without loops is an ODE in all its coordinates and speeds. A model with kinematic
+loops has more coordinates than degrees of freedom; two formulations are offered:
+
+``partition`` (the default): coordinate partitioning written as a semi-explicit index-1 DAE.
+    At the initial configuration the independent closure equations (rows of the loop
+    Jacobian, chosen by pivoted QR so that redundant ones, such as the out-of-plane rows of
+    a planar four-bar built from 3-D revolutes, drop out) split the speeds into dependent ones
+    u_D (as many as independent equations) and independent ones u_I, preferring to keep
+    independent the coordinates a user gave (a crank angle). The differential states are the
+    independent coordinates and speeds only (a four-bar: crank angle and speed, 2 states);
+    the dependent coordinates are algebraic variables fixed by the closure equations
+    Phi(q) = 0, which IDAS solves by Newton at every step: they never drift from the
+    constraint manifold. Dependent speeds and accelerations follow exactly from
+    J u = 0 and J udot + (dJ/dt) u = 0, and the dynamics are projected on the independent
+    speeds: (T^T M T) udot_I = -T^T (bias + M g), with u = T u_I, udot = T udot_I + g.
+
+``baumgarte``: an ODE in all coordinates and speeds, index-reduced to the acceleration
+    level with Baumgarte stabilisation J udot + (dJ/dt) u + 2 a J u + a^2 Phi = 0. Any ODE
+    method integrates it, but it has more states and the residual is only kept small, not
+    zero; it is there to compare with.
+"""
+
+from dataclasses import dataclass, field
+
+import casadi as ca
+import numpy as np
+import scipy.linalg
+
+from ..errors import ModelError
+from .newton_euler import crba, rnea
+
+FORMULATIONS = ("partition", "baumgarte")
+#: Baumgarte's stabilisation rate a [1/s] by default
+BAUMGARTE_RATE = 10.0
+#: a closure residual below this (m, and rotation-matrix entries) counts as closed
+CLOSED = 1e-10
+#: singular values below this fraction of the largest mark redundant closure equations
+RANK_TOL = 1e-8
+
+
+@dataclass
+class Equations:
+    """What is integrated: differential states x, algebraic variables z, and how the joint
+    coordinates q, speeds u and accelerations udot read from them (all SX in x, z, t, p)."""
+    x: ca.SX
+    z: ca.SX
+    ode: ca.SX
+    alg: ca.SX
+    state_names: list
+    state_units: list
+    algebraic_names: list
+    algebraic_units: list
+    u: ca.SX
+    udot: ca.SX
+    formulation: str
+    note: str = ""
+    loop_rows: int = 0              # independent closure equations kept
+    loop_redundant: int = 0         # closure equations dropped as redundant
+    initial: object = None          # p -> (x0, z0) numpy
+    residual: ca.SX = None          # kept closure equations, in q
+    lam: ca.SX = None               # multiplier of every closure row (0 for dropped ones)
+    extra: dict = field(default_factory=dict)
+
+
+def formulate(asm, topo, values, formulation="partition", rate=BAUMGARTE_RATE):
+    """The Equations of an assembled model; ``values`` are the model's parameter values,
+    at which loops are analysed (rows kept, speeds partitioned)."""
+    if formulation not in FORMULATIONS:
+        raise ModelError(f"loops={formulation!r}: unknown formulation; choose from "
+                         f"{', '.join(FORMULATIONS)}")
+    q, u = asm.q, asm.qd
+    names = asm.coordinate_names + asm.speed_names
+    units = asm.coordinate_units + asm.speed_units
+    given = np.array(asm.given, dtype=bool)
+    if not asm.cuts:
+        start = ca.Function("start", [asm.p], [asm.q_start, asm.u_start])
+
+        def initial(p):
+            q0, u0 = (np.asarray(v, dtype=float).ravel() for v in start(p))
+            return np.concatenate([np.where(given, q0, 0.0), u0]), np.zeros(0)
+        return Equations(ca.vertcat(q, u), ca.SX(0, 1), ca.vertcat(asm.qdot, asm.qdd),
+                         ca.SX(0, 1), names, units, [], [], u, asm.qdd, "tree",
+                         initial=initial, lam=ca.SX(0, 1))
+    return _Loops(asm, topo, values).equations(formulation, rate)
+
+
+class _Loops:
+    """Closure equations of every cut joint, their independent rows and the partition."""
+
+    def __init__(self, asm, topo, values):
+        self.asm, self.topo = asm, topo
+        p_nom = np.array([values[k] for k in asm.param_names], dtype=float)
+        self.phi = ca.vertcat(*[r for _, r in asm.cuts])
+        self.owner = [i for i, (_, r) in enumerate(asm.cuts) for _ in range(r.shape[0])]
+        q, u = asm.q, asm.qd
+        # velocity-level Jacobian: d(phi)/dt = J(q) u
+        self.J = ca.jacobian(ca.jtimes(self.phi, q, asm.qdot), u) if u.shape[0] \
+            else ca.SX(self.phi.shape[0], 0)
+        loop_coords = set(np.nonzero(np.asarray(
+            ca.DM(ca.jacobian(self.phi, q).sparsity(), 1)).any(axis=0))[0])
+        self.free = [i for i in sorted(loop_coords)
+                     if asm.regular[i] and not asm.given[i]]
+        self.f_phi = ca.Function("closure", [q, asm.p], [self.phi])
+        self.f_jac = ca.Function("closure_jacobian", [q, asm.p],
+                                 [ca.jacobian(self.phi, q)[:, self.free]])
+        self.f_start = ca.Function("start", [asm.p], [asm.q_start, asm.u_start])
+        q0 = self.close(p_nom)
+        Jn = np.asarray(ca.Function("J", [q, asm.p], [self.J])(q0, p_nom))
+        self.rows, self.dep = self._partition(Jn, loop_coords)
+
+    # -- consistent initial configuration ---------------------------------------------------
+    def close(self, p):
+        """Coordinates that close every loop, holding the given ones: Gauss-Newton with
+        least-squares steps from q0 (given) and q0_guess (not given)."""
+        q0, _ = self.f_start(p)
+        q = np.asarray(q0, dtype=float).ravel()
+        r = np.asarray(self.f_phi(q, p)).ravel()
+        for _ in range(100):
+            if np.max(np.abs(r), initial=0.0) < CLOSED * 1e-2:
+                break
+            J = np.asarray(self.f_jac(q, p))
+            step = np.linalg.lstsq(J, -r, rcond=None)[0] if self.free else np.zeros(0)
+            for scale in (1.0, 0.5, 0.25, 0.1, 0.01):        # backtrack on |residual|
+                trial = q.copy()
+                trial[self.free] += scale * step
+                r_trial = np.asarray(self.f_phi(trial, p)).ravel()
+                if np.linalg.norm(r_trial) < np.linalg.norm(r):
+                    q, r = trial, r_trial
+                    break
+            else:
+                break
+        worst = np.max(np.abs(r), initial=0.0)
+        if not np.isfinite(worst) or worst > CLOSED:
+            by_loop = {}
+            for i, v in zip(self.owner, np.abs(r)):
+                by_loop[i] = max(by_loop.get(i, 0.0), v)
+            bad = [i for i, v in by_loop.items() if v > CLOSED]
+            held = [n for n, g in zip(self.asm.coordinate_names, self.asm.given) if g]
+            msgs = [f"kinematic loop through {', '.join(self.asm.cuts[i][0].loop)} cannot "
+                    f"close: at the best fit found its closure is off by {by_loop[i]:.3g} "
+                    f"(m, or rotation-matrix entries); check the link lengths and axes"
+                    + (f", the given q0 ({', '.join(held)})" if held else "")
+                    + ", or start the search nearer an assembly with q0_guess"
+                    for i in bad]
+            raise ModelError(msgs)
+        return q
+
+    # -- independent equations and the speed partition ------------------------------------------
+    def _partition(self, J, loop_coords):
+        asm = self.asm
+        names = self.asm.coordinate_names
+        if J.size == 0:
+            return [], []
+        s = np.linalg.svd(J, compute_uv=False)
+        rank = int(np.sum(s > RANK_TOL * max(s[0], 1.0)))
+        _, _, piv = scipy.linalg.qr(J.T, pivoting=True)
+        rows = sorted(piv[:rank].tolist())
+        Jr = J[rows]
+        # speeds that may be dependent: of regular loop coordinates; preference tiers
+        cut_joints = {c.component.name for c, _ in asm.cuts}
+        tiers = [[], [], []]
+        for k in sorted(loop_coords):
+            if not asm.regular[k]:
+                continue
+            speed = asm.speed_of[k]
+            if asm.given[k] or asm.u_given[speed]:
+                tiers[2].append(speed)
+            elif names[k].split(".")[0] in cut_joints:
+                tiers[0].append(speed)
+            else:
+                tiers[1].append(speed)
+        dep = []
+        basis = np.zeros((rank, 0))
+        for tier in tiers:
+            if len(dep) == rank or not tier:
+                continue
+            cols = Jr[:, tier]
+            if basis.shape[1]:                 # what the chosen columns do not reach yet
+                Qb, _ = np.linalg.qr(basis)
+                cols = cols - Qb @ (Qb.T @ cols)
+            _, R, piv = scipy.linalg.qr(cols, pivoting=True, mode="economic")
+            diag = np.abs(np.diag(R)) if R.size else np.zeros(0)
+            for j, d in zip(piv, diag):
+                if len(dep) == rank or d <= RANK_TOL * max(np.abs(Jr).max(), 1.0):
+                    break
+                dep.append(tier[j])
+                basis = np.column_stack([basis, Jr[:, tier[j]]])
+        if len(dep) < rank:
+            quaternion = sorted({n.split(".")[0] for k, n in enumerate(names)
+                                 if k in loop_coords and not asm.regular[k]})
+            loops = "; ".join(", ".join(c.loop) for c, _ in asm.cuts)
+            raise ModelError(
+                f"kinematic loop through {loops}: its closure fixes {rank} speeds but only "
+                f"{len(dep)} joint angles or distances on the loop can follow it"
+                + (f"; the ball or free joint(s) {', '.join(quaternion)} on the loop must be "
+                   f"the cut joint (mark one cut=True), or be replaced by a Universal joint"
+                   if quaternion else ""))
+        return rows, sorted(dep)
+
+    # -- the equations --------------------------------------------------------------------------
+    def equations(self, formulation, rate):
+        asm = self.asm
+        q, u = asm.q, asm.qd
+        nv = u.shape[0]
+        dep = self.dep
+        ind = [k for k in range(nv) if k not in set(dep)]
+        phi = self.phi[self.rows]
+        J = self.J[self.rows, :]
+        JD, JI = J[:, dep], J[:, ind]
+        T = ca.SX.zeros(nv, len(ind))
+        T[ind, :] = ca.SX.eye(len(ind))
+        if dep:
+            T[dep, :] = -ca.solve(JD, JI)
+        c = ca.jtimes(J @ u, q, asm.qdot)             # (dJ/dt) u
+        if formulation == "baumgarte":
+            c = c + 2 * rate * (J @ u) + rate ** 2 * phi
+        g = ca.SX.zeros(nv)
+        if dep:
+            g[dep] = -ca.solve(JD, c)
+        a_grav = ca.vertcat(ca.SX.zeros(3), -asm.gravity)
+        M = crba(asm.bodies, nv)
+        bias = rnea(asm.bodies, u, ca.SX.zeros(nv), a_grav) - asm.Q
+        Mr = T.T @ M @ T
+        udot_i = ca.solve(Mr, -T.T @ (bias + M @ g))
+        udot = T @ udot_i + g
+        # multipliers: J^T lam = M udot + bias, exactly solvable as J has independent rows
+        lam = ca.SX.zeros(self.phi.shape[0])
+        if self.rows:
+            lam[self.rows] = ca.solve(J @ J.T, J @ (M @ udot + bias))
+        dep_q = [k for k, v in asm.speed_of.items() if v in set(dep)]
+        qnames, unames = asm.coordinate_names, asm.speed_names
+        qunits, uunits = asm.coordinate_units, asm.speed_units
+        note_rows = (f"{len(self.rows)} independent closure equations"
+                     + (f" ({self.phi.shape[0] - len(self.rows)} redundant dropped)"
+                        if self.phi.shape[0] > len(self.rows) else ""))
+        start = self.f_start
+        rows = self.rows
+        if formulation == "baumgarte":
+
+            f_T = ca.Function("T", [q, asm.p], [T])
+
+            def initial(p):
+                qc = self.close(p)
+                _, u0 = start(p)
+                un = np.asarray(f_T(qc, p)) @ np.asarray(u0, dtype=float).ravel()[ind]
+                return np.concatenate([qc, un]), np.zeros(0)
+            note = (f"kinematic loops, Baumgarte formulation: all {q.shape[0]} coordinates and "
+                    f"{nv} speeds are states ({nv - len(dep)} degrees of freedom; "
+                    f"{note_rows}, stabilised at rate {rate:g}/s)")
+            return Equations(ca.vertcat(q, u), ca.SX(0, 1), ca.vertcat(asm.qdot, udot),
+                             ca.SX(0, 1), qnames + unames, qunits + uunits, [], [], u, udot,
+                             "baumgarte", note, len(rows), self.phi.shape[0] - len(rows),
+                             initial, phi, lam)
+        keep_q = [k for k in range(q.shape[0]) if k not in set(dep_q)]
+        u_full = T @ u[ind]
+        sub = lambda e: ca.substitute(e, u, u_full)     # noqa: E731
+        x = ca.vertcat(q[keep_q], u[ind])
+        z = q[dep_q]
+        ode = ca.vertcat(sub(asm.qdot[keep_q]), sub(udot_i))
+
+        def initial(p):
+            qc = self.close(p)
+            _, u0 = start(p)
+            u0 = np.asarray(u0, dtype=float).ravel()
+            u_dep_given = [k for k in dep if asm.u_given[k] and u0[k] != 0]
+            if u_dep_given:
+                raise ModelError(
+                    f"qd0 of {', '.join(unames[k] for k in u_dep_given)}: this speed is "
+                    f"fixed by the loop closure (it is a dependent coordinate); give the "
+                    f"initial speed of an independent coordinate "
+                    f"({', '.join(unames[k] for k in ind)}) instead")
+            return np.concatenate([qc[keep_q], u0[ind]]), qc[dep_q]
+        note = (f"kinematic loops, coordinate partitioning: {len(keep_q) + len(ind)} "
+                f"differential states for {len(ind)} degrees of freedom"
+                + (f" (a quaternion has 4 coordinates for 3 speeds)"
+                   if len(keep_q) > len(ind) else "")
+                + f"; {len(dep_q)} dependent coordinates ({', '.join(qnames[k] for k in dep_q)})"
+                f" are algebraic variables solved from {note_rows} at every step")
+        return Equations(x, z, ode, phi, [qnames[k] for k in keep_q] + [unames[k] for k in ind],
+                         [qunits[k] for k in keep_q] + [uunits[k] for k in ind],
+                         [qnames[k] for k in dep_q], [qunits[k] for k in dep_q],
+                         u_full, sub(udot), "partition", note, len(rows),
+                         self.phi.shape[0] - len(rows), initial, phi, sub(lam))
+

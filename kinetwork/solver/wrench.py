@@ -1,0 +1,174 @@
+"""Cut force and torque through a frame connection, from the wrench balance of the motion.
+
+The flow into a component through one of its frame ports (Modelica's sign: positive into
+the component) is what the rest of the model exerts on it there:
+
+- a rigid body takes its inertial wrench, m (a_c - g) and I alpha + w x I w;
+- a force element (line force, world force) takes minus the force it applies;
+- a cut joint takes minus the constraint wrench it applies, from the loops' multipliers;
+- a joint or rigid part of the spanning tree passes on everything behind it: through its
+  port away from the ground flows minus the sum of the flows into every body, force element
+  and cut joint of the subtree beyond it, less the drives of the joints there (the inward
+  pass of Newton-Euler, per frame connection); through its port towards the ground, the
+  opposite less its own drive;
+- a joint's drive (the flow into its 1-D axis flanges) acts on its frame_b and reacts, through
+  the support flange, on the world (Modelica's convention), so a revolute's frames carry no
+  torque about its axis;
+- the ground takes minus everything else on its frame.
+
+All wrenches are resolved in the world frame, with moments about the world origin; the
+probe reports the torque about the frame's own origin.
+"""
+
+import casadi as ca
+
+from ..spatial import skew, vec3
+from ..spatial import vee as _vee
+from .assemble import closure_rows
+
+
+def cut_wrench(asm, topo, target, bound):
+    """(force, moment about the world origin) flowing into ``target``'s component there."""
+    return _Balance(asm, topo, bound).flow(target.component, target.name)
+
+
+class _Balance:
+    def __init__(self, asm, topo, bound):
+        self.asm, self.topo, self.bound = asm, topo, bound
+        self.children = {}
+        self.edge_of = {}
+        for e in topo.tree:
+            self.children.setdefault(e.parent, []).append(e.child)
+            self.edge_of[e.component.name] = e
+        self.cut_of = {c.component.name: (i, c) for i, c in enumerate(topo.cuts)}
+        self.rows = {}
+        start = 0
+        for i, (_, r) in enumerate(asm.cuts):
+            self.rows[i] = (start, start + r.shape[0])
+            start += r.shape[0]
+
+    def flow(self, comp, port):
+        name = comp.name
+        set_ = self.topo.set_of[comp.port_ref(port)]
+        if comp.role == "body":
+            return self._inertial(comp)
+        if comp.role == "frame_force":
+            f, m = self._applied(comp, port)
+            return -f, -m
+        if comp.role == "world":
+            return self._minus_rest(set_, comp)
+        if name in self.cut_of:
+            f, m = self._constraint(*self.cut_of[name], port)
+            return -f, -m
+        edge = self.edge_of[name]
+        f, m = self._subtree(edge.child, skip=name)
+        if set_ != edge.parent:
+            return -f, -m
+        if self.topo.set_of[comp.port_ref("frame_b")] == edge.child:
+            df, dm = self._drive(comp)
+            f, m = f - df, m - dm
+        return f, m
+
+    def _minus_rest(self, set_, comp):
+        f, m = ca.SX.zeros(3), ca.SX.zeros(3)
+        for ref in self.topo.sets[set_]:
+            if ref.component is comp or ref.component.role == "probe":
+                continue
+            df, dm = self.flow(ref.component, ref.name)
+            f, m = f + df, m + dm
+        return -f, -m
+
+    def _subtree(self, root, skip=None):
+        """What the subtree beyond ``root`` takes: the flows into its bodies, force elements
+        and cut joints, less the drives of its joints (but ``skip``'s)."""
+        f, m = ca.SX.zeros(3), ca.SX.zeros(3)
+        stack = [root]
+        while stack:
+            s = stack.pop()
+            stack.extend(self.children.get(s, []))
+            for ref in self.topo.sets[s]:
+                comp = ref.component
+                if comp.role in ("body", "frame_force") or comp.name in self.cut_of:
+                    df, dm = self.flow(comp, ref.name)
+                    f, m = f + df, m + dm
+                if comp.role == "joint" and ref.name == "frame_b" and comp.name != skip:
+                    df, dm = self._drive(comp)
+                    f, m = f - df, m - dm
+        return f, m
+
+    def _drive(self, comp):
+        """Wrench the 1-D flanges of a joint apply on its frame_b (force, moment about the
+        world origin): the generalized force times the motion subspace."""
+        asm = self.asm
+        if not comp.coordinate_ports or comp.name not in asm.uindex:
+            return ca.SX.zeros(3), ca.SX.zeros(3)
+        c = self.bound[comp.name]
+        qj = asm.q[asm.qindex[comp.name]]
+        uj = asm.qd[asm.uindex[comp.name]]
+        Re, re = c.transform(qj)
+        w = _vee(Re.T @ ca.reshape(ca.jtimes(ca.vec(Re), qj, uj), 3, 3))
+        S = ca.jacobian(ca.vertcat(w, Re.T @ ca.jtimes(re, qj, uj)), uj)
+        wrench = S @ asm.Q_drive[asm.uindex[comp.name]]
+        R, p = asm.pose(self.topo.set_of[comp.port_ref("frame_b")])
+        force = R @ wrench[3:]
+        return force, R @ wrench[:3] + ca.cross(p, force)
+
+    def _inertial(self, body):
+        asm = self.asm
+        R, p = asm.pose(self.topo.set_of[body.port_ref("frame_a")])
+        m, c, Ic = self.bound[body.name].mass_properties()
+        cw = p + R @ c
+        a = asm.rate(asm.rate(cw))
+        w = _omega(asm, R)
+        alpha = asm.rate(w)
+        Iw = R @ Ic @ R.T
+        force = m * (a - asm.gravity)
+        return force, ca.cross(cw, force) + Iw @ alpha + ca.cross(w, Iw @ w)
+
+    def _applied(self, comp, port):
+        """Force applied by a force element at ``port`` and its moment about the origin."""
+        asm, c = self.asm, self.bound[comp.name]
+        _, pb = asm.pose(self.topo.set_of[comp.port_ref(port)])
+        if "frame_a" in comp.ports:
+            _, pa = asm.pose(self.topo.set_of[comp.port_ref("frame_a")])
+            _, pb_ = asm.pose(self.topo.set_of[comp.port_ref("frame_b")])
+            d = pb_ - pa
+            s = ca.norm_2(d)
+            e = d / s
+            tension = c.law(s, ca.jtimes(s, asm.q, asm.qdot))
+            force = (-tension * e) if port == "frame_b" else tension * e
+            return force, ca.cross(pb, force)
+        if hasattr(c, "force"):
+            force = vec3(c.force)
+            return force, ca.cross(pb, force)
+        return ca.SX.zeros(3), vec3(c.torque)
+
+    def _constraint(self, i, cut, port):
+        """Constraint wrench a cut joint applies on the frame at ``port``: the dual of the
+        closure rows' rate under a twist of that frame, times the multipliers."""
+        asm = self.asm
+        comp = self.bound[cut.component.name]
+        Ra, pa = asm.pose(cut.set_a)
+        Rb, pb = asm.pose(cut.set_b)
+        qj = asm.q[asm.qindex[comp.name]] if comp.dof and comp.regular else ca.SX(0, 1)
+        R_s, p_s = ca.SX.sym("R", 3, 3), ca.SX.sym("p", 3)
+        w, v = ca.SX.sym("w", 3), ca.SX.sym("v", 3)
+        if port == "frame_a":
+            rows = closure_rows(comp, R_s, p_s, Rb, pb, qj)
+            pose = (Ra, pa)
+        else:
+            rows = closure_rows(comp, Ra, pa, R_s, p_s, qj)
+            pose = (Rb, pb)
+        rate = ca.jtimes(rows, ca.vertcat(ca.vec(R_s), p_s),
+                         ca.vertcat(ca.vec(skew(w) @ R_s), v + ca.cross(w, p_s)))
+        G = ca.substitute(ca.jacobian(rate, ca.vertcat(w, v)),
+                          ca.vertcat(ca.vec(R_s), p_s), ca.vertcat(ca.vec(pose[0]), pose[1]))
+        lo, hi = self.rows[i]
+        wrench = G.T @ asm.lam_sym[lo:hi]
+        # (w, v) is the world twist with v the velocity of the point at the world origin:
+        # its dual is (moment about the origin, force)
+        return wrench[3:], wrench[:3]
+
+
+def _omega(asm, R):
+    return _vee(asm.rate(R) @ R.T)
