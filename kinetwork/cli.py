@@ -219,15 +219,24 @@ def _validate(args):
         f"components: {len(model.components)} ("
         + ", ".join(f"{n} {kind}" for kind, n in kinds.most_common()) + ")",
         f"connections: {len(model.connections)}",
-        f"degrees of freedom: {topo.dof}",
+        f"degrees of freedom: {system.dof}",
         f"states: {system.n_states}"
         + (" (" + ", ".join(f"{s} [{units[s]}]" if units[s] else s
                             for s in system.state_names) + ")" if system.n_states else ""),
+        *([f"algebraic: {system.n_algebraic} ("
+           + ", ".join(f"{s} [{u}]" if u else s for s, u in
+                       zip(system.algebraic_names, system.algebraic_units)) + ")"]
+          if system.n_algebraic else []),
         f"loops: {len(topo.loops) or 'none'}"
-        + "".join(f"\n  {' - '.join(loop)}" for loop in topo.loops),
+        + "".join(f"\n  {' - '.join(cut.loop)} (cut at {cut.component.name})"
+                  for cut in topo.cuts),
+        *([textwrap.fill(f"why these states: {system.formulation_note}", 88,
+                         subsequent_indent="  ")] if system.formulation_note else []),
         f"equations: {size['states']} states, {size['algebraic']} algebraic variables, "
         f"{len(system.signal_names)} probe signals ({n_values} values); right-hand side "
-        f"{size['operations']} operations per evaluation (articulated-body algorithm, O(N))",
+        f"{size['operations']} operations per evaluation ("
+        + ("articulated-body algorithm, O(N)" if system.formulation == "tree" else
+           "mass matrix projected on the independent speeds") + ")",
         f"parameters: {len(model.parameters)}"
         + (" (" + ", ".join(f"{k} = {v:g}" for k, v in model.parameters.items()) + ")"
            if model.parameters else ""),

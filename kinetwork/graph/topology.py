@@ -167,13 +167,16 @@ def _tree(model, topo, roles, problems):
     """Spanning tree of frame sets from the ground; the joints left out cut the loops."""
     frames = nx.MultiGraph()
     frames.add_node(topo.root)
-    for comp in roles.get("joint", []):
+    joints = roles.get("joint", [])
+    for rank, comp in enumerate(joints):
         a, b = topo.set_of[comp.port_ref("frame_a")], topo.set_of[comp.port_ref("frame_b")]
         if a == b:
             problems.append(f"{model.place(comp)}: frame_a and frame_b are connected to each "
                             f"other, which locks the part")
             continue
-        frames.add_edge(a, b, key=comp.name, component=comp, weight=_keep_weight(comp))
+        # ties go to the part added first: the last joint of a loop closes it (is cut)
+        tie = 0.5 * (len(joints) - rank) / len(joints)
+        frames.add_edge(a, b, key=comp.name, component=comp, weight=_keep_weight(comp) + tie)
     for comp in [*roles.get("body", []), *roles.get("frame_force", [])]:
         for pname in comp.ports:
             frames.add_node(topo.set_of[comp.port_ref(pname)])

@@ -55,6 +55,7 @@ class Assembly:
     uindex: dict = None        # joint name -> indices of its speeds in qd
     Q_drive: ca.SX = None      # the part of Q that 1-D flanges apply (drives, springs)
     _poses: dict = field(default_factory=dict)
+    base: tuple = None         # world pose of the body of the last ``relative_poses``
 
     def mass_matrix(self):
         return crba(self.bodies, self.qd.shape[0])
@@ -78,6 +79,28 @@ class Assembly:
                 k = b.parent
             self._poses[frame_set] = (R, pos)
         return self._poses[frame_set]
+
+    def relative_poses(self, set_a, set_b):
+        """(Ra, pa, Rb, pb): two frame sets placed in the nearest body both hang from."""
+        def chain(k):
+            out = []
+            while k >= 0:
+                out.append(k)
+                k = self.bodies[k].parent
+            return out
+        ka, Ra, pa = self.place[set_a]
+        kb, Rb, pb = self.place[set_b]
+        common = set(chain(kb))
+        anc = next((k for k in chain(ka) if k in common), -1)
+
+        def up(k, R, pos, until):
+            while k != until:
+                b = self.bodies[k]
+                R, pos = b.R @ R, b.p + b.R @ pos
+                k = b.parent
+            return R, pos
+        self.base = up(anc, ca.SX.eye(3), ca.SX.zeros(3), -1)   # the shared body, in the world
+        return (*up(ka, Ra, pa, anc), *up(kb, Rb, pb, anc))
 
     def rate(self, expr):
         """Time derivative of an expression in (q, qd), with qd's rate ``qdd_sym``."""
@@ -220,6 +243,8 @@ def _frame_forces(asm, topo, bound, t):
     """Generalized forces of line forces and world forces/torques: the power they put in,
     differentiated by the speeds (a force on a frame enters as J^T f)."""
     Q = ca.SX.zeros(asm.qd.shape[0])
+    if not asm.qd.shape[0]:
+        return Q
     for comp in topo.forces:
         c = bound[comp.name]
         if "frame_a" in comp.ports:
@@ -227,12 +252,14 @@ def _frame_forces(asm, topo, bound, t):
             _, pb = asm.pose(topo.set_of[comp.port_ref("frame_b")])
             s = ca.norm_2(pb - pa)
             s_d = ca.jtimes(s, asm.q, asm.qdot)
-            power = -c.law(s, s_d) * s_d
+            # the tension times the rate of the length, differentiated by the speeds with
+            # the tension held (a damper's law depends on the speeds itself)
+            Q -= c.law(s, s_d) * ca.gradient(s_d, asm.qd)
         else:
             w, v = _twist_u(asm, topo.set_of[comp.port_ref("frame_b")])
-            power = ca.dot(vec3(c.force), v) if hasattr(c, "force") \
+            power = ca.dot(vec3(c.force), v) if "force" in comp.params \
                 else ca.dot(vec3(c.torque), w)
-        Q += ca.gradient(power, asm.qd) if asm.qd.shape[0] else 0
+            Q += ca.gradient(power, asm.qd)
     return Q
 
 
@@ -244,9 +271,12 @@ def _twist_u(asm, frame_set):
 
 
 def _closure(asm, cut, comp, qindex):
-    """Loop-closure residual of a cut joint, zero when its frames meet as the joint allows."""
-    Ra, pa = asm.pose(cut.set_a)
-    Rb, pb = asm.pose(cut.set_b)
+    """Loop-closure residual of a cut joint, zero when its frames meet as the joint allows.
+
+    Both frames are placed relative to the nearest body the two tree paths share, so a
+    loop's equations hold only the coordinates of the loop itself (sparse, cheap to solve).
+    """
+    Ra, pa, Rb, pb = asm.relative_poses(cut.set_a, cut.set_b)
     qj = asm.q[qindex[comp.name]] if comp.dof and comp.regular else ca.SX(0, 1)
     return closure_rows(comp, Ra, pa, Rb, pb, qj)
 

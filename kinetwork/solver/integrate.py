@@ -308,6 +308,7 @@ def simulate(model, t_end=None, n_points=None, method=None, rtol=None, atol=None
         X, failure, stats = METHODS[key].run(system, grid, x0, p, settings)
     stats.update(jit=settings["jit"], **system.jit_stats)
     t = grid[:len(X)]
+    X = system.polish(X, p)
     t_end = settings["t_end"]
     outputs = system.outputs_p(t, X, p, settings["jit"]) if len(t) else np.zeros((0, 0))
     results = Results(t, X, system.state_names + system.algebraic_names, outputs,

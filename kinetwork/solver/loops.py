@@ -100,6 +100,16 @@ class _Loops:
             else ca.SX(self.phi.shape[0], 0)
         loop_coords = set(np.nonzero(np.asarray(
             ca.DM(ca.jacobian(self.phi, q).sparsity(), 1)).any(axis=0))[0])
+        quaternion = sorted({asm.coordinate_names[i].split(".")[0] for i in loop_coords
+                             if not asm.regular[i]})
+        if quaternion:
+            loops = "; ".join(", ".join(c.loop) for c, _ in asm.cuts)
+            raise ModelError(
+                f"kinematic loop through {loops}: the ball or free joint(s) "
+                f"{', '.join(quaternion)} would stay in the loop's tree, where their "
+                f"quaternions cannot follow the closure; let one of them be the cut joint "
+                f"(mark it cut=True), or replace it by a Universal joint (a coupler between "
+                f"two ball joints spins freely about its own axis)")
         self.free = [i for i in sorted(loop_coords)
                      if asm.regular[i] and not asm.given[i]]
         self.f_phi = ca.Function("closure", [q, asm.p], [self.phi])

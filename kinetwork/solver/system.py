@@ -65,8 +65,34 @@ class System:
         self._compiled = {}
         self.jit_stats = {}
 
+    def polish(self, X, p):
+        """Full states X (n_points, n_states + n_algebraic) with the algebraic variables
+        (dependent coordinates) Newton-corrected onto the closure to machine precision: the
+        integrator solves them only to its tolerance."""
+        if not self.n_algebraic or not len(X):
+            return X
+        key = ("polish", len(X))
+        if key not in self._compiled:
+            x, z, a = self._x, self._z, self.asm
+            znew = z
+            for _ in range(3):
+                alg = ca.substitute(self.eq.alg, z, znew)
+                znew = znew - ca.solve(ca.substitute(ca.jacobian(self.eq.alg, z), z, znew), alg)
+            f = ca.Function("polish", [ca.vertcat(x, z), a.p], [znew])
+            self._compiled[key] = f.map(len(X))
+        Z = np.asarray(self._compiled[key](np.asarray(X).T, p)).T
+        out = np.array(X, dtype=float)
+        ok = np.all(np.isfinite(Z), axis=1)
+        out[ok, self.n_states:] = Z[ok]
+        return out
+
     def parameter_values(self):
         return self.model.parameter_values(None)
+
+    @property
+    def dof(self):
+        """Degrees of freedom: speeds less the independent loop-closure equations."""
+        return len(self.speed_names) - self.eq.loop_rows
 
     @property
     def n_algebraic(self):
@@ -252,8 +278,6 @@ class System:
         f = self.f_rhs or self.f_dae
         if f.n_instructions() * (self.n_states + self.n_algebraic) > 20 * JACOBIAN_JIT_LIMIT:
             return False
-        if self.n_algebraic:
-            return True
         return self.jacobian_function().n_instructions() <= JACOBIAN_JIT_LIMIT
 
     def dae(self, jit=False, jacobian=False):
@@ -297,11 +321,17 @@ class System:
         return integ
 
     def jacobian_function(self):
-        """d(xdot)/dx as a CasADi Function of (t, x, p), for implicit methods."""
+        """d(xdot)/dx as a CasADi Function of (t, x, p), for implicit methods (with loops:
+        d(xdot, alg)/d(x, z) of (t, x, z, p))."""
         if self._f_jac is None:
             a = self.asm
-            self._f_jac = ca.Function("jacobian", [a.t, self._x, a.p],
-                                      [ca.densify(ca.jacobian(self.ode, self._x))])
+            if self.n_algebraic:
+                v = ca.vertcat(self._x, self._z)
+                self._f_jac = ca.Function("jacobian", [a.t, self._x, self._z, a.p], [
+                    ca.densify(ca.jacobian(ca.vertcat(self.ode, self.eq.alg), v))])
+            else:
+                self._f_jac = ca.Function("jacobian", [a.t, self._x, a.p],
+                                          [ca.densify(ca.jacobian(self.ode, self._x))])
         return self._f_jac
 
     def numeric(self, f, p):

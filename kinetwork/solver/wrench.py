@@ -138,35 +138,36 @@ class _Balance:
             tension = c.law(s, ca.jtimes(s, asm.q, asm.qdot))
             force = (-tension * e) if port == "frame_b" else tension * e
             return force, ca.cross(pb, force)
-        if hasattr(c, "force"):
+        if "force" in comp.params:
             force = vec3(c.force)
             return force, ca.cross(pb, force)
         return ca.SX.zeros(3), vec3(c.torque)
 
     def _constraint(self, i, cut, port):
         """Constraint wrench a cut joint applies on the frame at ``port``: the dual of the
-        closure rows' rate under a twist of that frame, times the multipliers."""
+        closure rows' rate under a world twist of that frame, times the multipliers."""
         asm = self.asm
         comp = self.bound[cut.component.name]
-        Ra, pa = asm.pose(cut.set_a)
-        Rb, pb = asm.pose(cut.set_b)
+        Ra, pa, Rb, pb = asm.relative_poses(cut.set_a, cut.set_b)
+        R0, p0 = asm.base
         qj = asm.q[asm.qindex[comp.name]] if comp.dof and comp.regular else ca.SX(0, 1)
         R_s, p_s = ca.SX.sym("R", 3, 3), ca.SX.sym("p", 3)
         w, v = ca.SX.sym("w", 3), ca.SX.sym("v", 3)
         if port == "frame_a":
-            rows = closure_rows(comp, R_s, p_s, Rb, pb, qj)
-            pose = (Ra, pa)
+            rows, pose = closure_rows(comp, R_s, p_s, Rb, pb, qj), (Ra, pa)
         else:
-            rows = closure_rows(comp, Ra, pa, R_s, p_s, qj)
-            pose = (Rb, pb)
+            rows, pose = closure_rows(comp, Ra, pa, R_s, p_s, qj), (Rb, pb)
+        # (w, v): world twist, v the velocity of the point at the world origin; in the
+        # shared body's axes the frame turns at R0^T w and its origin moves at R0^T v_origin
+        origin_velocity = v + ca.cross(w, p0 + R0 @ p_s)
         rate = ca.jtimes(rows, ca.vertcat(ca.vec(R_s), p_s),
-                         ca.vertcat(ca.vec(skew(w) @ R_s), v + ca.cross(w, p_s)))
+                         ca.vertcat(ca.vec(skew(R0.T @ w) @ R_s), R0.T @ origin_velocity))
         G = ca.substitute(ca.jacobian(rate, ca.vertcat(w, v)),
-                          ca.vertcat(ca.vec(R_s), p_s), ca.vertcat(ca.vec(pose[0]), pose[1]))
+                          ca.vertcat(ca.vec(R_s), p_s),
+                          ca.densify(ca.vertcat(ca.vec(pose[0]), pose[1])))
         lo, hi = self.rows[i]
         wrench = G.T @ asm.lam_sym[lo:hi]
-        # (w, v) is the world twist with v the velocity of the point at the world origin:
-        # its dual is (moment about the origin, force)
+        # the dual of (w, v) is (moment about the world origin, force)
         return wrench[3:], wrench[:3]
 
 

@@ -1,0 +1,217 @@
+"""Kinematic loops against independent references: the closed-form closure and the
+one-degree-of-freedom Lagrange equation of ``bench/reference_loops.py``, energy, and the
+wrench balance of each link for the cut forces."""
+
+import json
+
+import numpy as np
+import pytest
+
+import kinetwork as kn
+import loop_scenes as scenes
+import reference_loops as ref
+
+mb = kn.multibody
+T = np.linspace(0.0, 10.0, 1001)
+
+
+@pytest.fixture(scope="module")
+def fourbar_run():
+    system = scenes.fourbar(theta0=1.0).compile()
+    return system, kn.simulate(system), ref.fourbar_simulate(1.0, 0.0, T)
+
+
+def test_fourbar_follows_the_one_dof_reference(fourbar_run):
+    system, res, r = fourbar_run
+    assert system.state_names == ["A.q", "A.qd"]               # crank angle and speed only
+    assert system.algebraic_names == ["B.q", "D.q", "C.q"]
+    assert np.max(np.abs(res["crank_probe.angle"] - r["theta"])) < 1e-6
+    assert np.max(np.abs(res["crank_probe.speed"] - r["thetad"])) < 1e-5
+    # dependent coordinates: B.q = phi - theta, D.q = psi (absolute angles of the reference)
+    assert np.max(np.abs(res["B.q"] - (r["phi"] - r["theta"]))) < 1e-6
+    assert np.max(np.abs(res["rocker_probe.angle"] - r["psi"])) < 1e-6
+    assert np.max(system.constraint_residual(res.states)) < 1e-8
+
+
+def test_fourbar_coupler_point_and_pivot_force(fourbar_run):
+    """The cut force through pivot D against each link's own Newton-Euler balance, written
+    from the reference's angles and their rates."""
+    system, res, r = fourbar_run
+    a, b, c, d, g = 0.3, 1.0, 0.8, 1.0, 9.81
+    m2, m3 = 2.0, 1.5
+    J2, J3 = m2 * b * b / 12, m3 * c * c / 12
+
+    def unit(x):
+        return np.stack([np.cos(x), np.sin(x)], -1)
+
+    def perp(x):
+        return np.stack([-np.sin(x), np.cos(x)], -1)
+
+    th, thd, thdd = r["theta"], r["thetad"], r["thetadd"]
+    ph, phd, phdd = r["phi"], r["phid"], r["phidd"]
+    ps, psd, psdd = r["psi"], r["psid"], r["psidd"]
+    aB = a * (thdd[:, None] * perp(th) - thd[:, None] ** 2 * unit(th))
+    a2 = aB + b / 2 * (phdd[:, None] * perp(ph) - phd[:, None] ** 2 * unit(ph))
+    a3 = c / 2 * (psdd[:, None] * perp(ps) - psd[:, None] ** 2 * unit(ps))
+    grav = np.array([0.0, -g])
+    cross = lambda u, v: u[..., 0] * v[..., 1] - u[..., 1] * v[..., 0]   # noqa: E731
+    # unknown pin force F on the rocker at C (the coupler feels -F): moments of the rocker
+    # about D and of the coupler about its centre of mass give two equations for F
+    rC_D = c * unit(ps)
+    F = np.empty((len(T), 2))
+    for k in range(len(T)):
+        # rocker about D: rC_D x F + r3 x m3 g = J3 psidd + r3 x m3 a3 (r3 = c/2 unit)
+        r3 = c / 2 * unit(ps[k])
+        rhs1 = J3 * psdd[k] + cross(r3, m3 * a3[k]) - cross(r3, m3 * grav)
+        # coupler about its centre: (C - c2) x (-F) + (B - c2) x F_B = J2 phidd, with
+        # F_B = m2 (a2 - g) + F, the force at B on the coupler
+        half = b / 2 * unit(ph[k])
+        rhs2 = J2 * phdd[k] - cross(-half, m2 * (a2[k] - grav))
+        A = np.array([[-rC_D[k][1], rC_D[k][0]],
+                      [-(-half[1] - half[1]), (-half[0] - half[0])]])
+        F[k] = np.linalg.solve(A, [rhs1, rhs2])
+    F_D = m3 * (a3 - grav) - F                # the ground's force on the rocker at D
+    # exact at t = 0; then as good as the trajectory (1e-7 rad): 1e-6 of the largest force
+    assert np.max(np.abs(res["pivot_D.force"][0, :2] - F_D[0])) < 1e-12 * np.max(np.abs(F_D))
+    assert np.max(np.abs(res["pivot_D.force"][:, :2] - F_D)) < 1e-6 * np.max(np.abs(F_D))
+    assert np.max(np.abs(res["pivot_D.force"][:, 2])) < 1e-9
+    C = d * np.array([1.0, 0.0]) + c * unit(ps)
+    assert np.max(np.abs(res["coupler_point.position"][:, :2] - C)) < 1e-6
+
+
+def test_slider_crank_follows_the_one_dof_reference():
+    system = scenes.slider_crank(theta0=0.5, thetad0=3.0).compile()
+    res = kn.simulate(system)
+    r = ref.slider_crank_simulate(0.5, 3.0, T)
+    assert system.n_states == 2
+    assert np.max(np.abs(res["crank_probe.angle"] - r["theta"])) < 1e-6
+    assert np.max(np.abs(res["piston.position"] - r["x"])) < 1e-6
+    assert np.max(np.abs(res["piston.velocity"] - r["xd"])) < 1e-5
+    assert np.max(system.constraint_residual(res.states)) < 1e-8
+
+
+def test_energy_of_undriven_planar_loops_is_conserved_over_100_s():
+    """Energy by the references' own formulas (closure and energy in the crank angle)."""
+    t = np.linspace(0.0, 100.0, 2001)
+    for build, energy_of, angle in ((scenes.fourbar, ref.fourbar_energy, "crank_probe"),
+                                    (scenes.slider_crank, ref.slider_crank_energy,
+                                     "crank_probe")):
+        system = build().compile()
+        res = kn.simulate(system, t_end=100.0, n_points=len(t))
+        E = energy_of(res[f"{angle}.angle"], res[f"{angle}.speed"])
+        assert np.max(np.abs(E - E[0])) / np.max(np.abs(E)) < 1e-7, build.__name__
+        assert np.max(system.constraint_residual(res.states)) < 1e-8
+
+
+def test_energy_of_the_spatial_loop_is_conserved_over_100_s():
+    """Kinetic energy 1/2 u^T M u (the tree's mass matrix at the full coordinates, speeds
+    from the loop's velocity constraint) plus the potential of every body's centre."""
+    import casadi as ca
+    system = scenes.spatial_fourbar().compile()
+    res = kn.simulate(system, t_end=100.0, n_points=2001)
+    a = system.asm
+    full = ca.vertcat(system._x, system._z)
+    values = system.model.numeric_values()
+    potential = 0
+    for body, frame_set in system.topology.bodies:
+        R, pos = a.pose(frame_set)
+        m, c, _ = body.bound(values[body.name]).mass_properties()
+        potential -= m * ca.dot(pos + R @ c, a.gravity)
+    u = system.eq.u
+    E = ca.Function("E", [full, a.p], [0.5 * u.T @ a.mass_matrix() @ u + potential])
+    p = system.param_vector()
+    values = np.array([float(E(row, p)) for row in res.states])
+    assert np.max(np.abs(values - values[0])) / np.max(np.abs(values)) < 1e-7
+    assert np.max(system.constraint_residual(res.states)) < 1e-8
+
+
+def test_baumgarte_formulation_agrees_and_drifts_little():
+    system = scenes.fourbar().compile(loops="baumgarte")
+    assert system.n_states == 8 and system.n_algebraic == 0
+    assert "Baumgarte" in system.formulation_note
+    res = kn.simulate(system, method="dop853", rtol=1e-12, atol=1e-12)
+    r = ref.fourbar_simulate(1.0, 0.0, T)
+    assert np.max(np.abs(res["A.q"] - r["theta"])) < 1e-6
+    assert np.max(system.constraint_residual(res.states)) < 1e-8
+
+
+def test_ode_methods_refuse_the_dae_with_a_way_out():
+    system = scenes.fourbar().compile()
+    with pytest.raises(kn.ModelError, match="loops='baumgarte'"):
+        kn.simulate(system, method="rk45")
+
+
+def test_collocation_integrates_the_dae():
+    system = scenes.fourbar(theta0=1.0).compile()
+    res = kn.simulate(system, method="collocation", t_end=2.0, n_points=201, step=2e-3)
+    r = ref.fourbar_simulate(1.0, 0.0, T[:201])
+    assert np.max(np.abs(res["A.q"] - r["theta"])) < 1e-6
+
+
+def test_user_chosen_cut_gives_the_same_motion():
+    model = scenes.fourbar(probes=False)
+    model.components["D"]._values["cut"] = True
+    system = model.compile()
+    assert "D.q" not in system.state_names
+    res = kn.simulate(system, t_end=2.0, n_points=201)
+    r = ref.fourbar_simulate(1.0, 0.0, T[:201])
+    assert np.max(np.abs(res["A.q"] - r["theta"])) < 1e-6
+    assert [c.component.name for c in system.topology.cuts] == ["D"]
+
+
+def test_a_loop_that_cannot_close_names_its_parts():
+    model = scenes.fourbar(d=2.5, probes=False, guesses=(0.0, 0.0, 0.0))   # d > a + b + c
+    with pytest.raises(kn.ModelError, match="kinematic loop through coupler, B, crank, A, "
+                                            "base, D, rocker, C cannot close"):
+        model.compile()
+
+
+def test_a_given_angle_that_cannot_be_reached_is_refused():
+    model = scenes.fourbar(probes=False)
+    model.components["D"]._values["q0"] = 3.0            # rocker pointing away: no assembly
+    with pytest.raises(kn.ModelError, match="cannot close.*given q0 \\(A.q, D.q\\)"):
+        model.compile()
+
+
+def test_assembly_branch_follows_the_guess():
+    up = scenes.fourbar(probes=False).compile()
+    down_guess = scenes.fourbar_guesses(1.0)
+    model = scenes.fourbar(probes=False, guesses=(-1.2, -1.0, 2.5))
+    down = model.compile()
+    zu, zd = up.z0, down.z0
+    assert zu[1] > 0 and zd[1] < 0                        # rocker above / below the ground
+    assert abs(zu[0] - down_guess[0]) < 1e-9
+
+
+def test_spatial_loop_with_ball_joint_cut():
+    system = scenes.spatial_fourbar().compile()
+    assert system.n_states == 2 and system.n_algebraic == 3
+    cut = system.topology.cuts[0].component.name
+    assert cut == "S"                                     # the ball joint is cut
+    res = kn.simulate(system, t_end=5.0, n_points=501)
+    # the ball joint's frame_b is the rocker tip; the loop holds it at the coupler's length
+    # from the crank tip (the Universal joint)
+    theta = res["crank_probe.angle"]
+    U = 0.3 * np.stack([np.cos(theta), np.sin(theta), 0 * theta], -1)
+    assert np.max(np.abs(np.linalg.norm(res["ball.position"] - U, axis=1) - 1.2083)) < 1e-10
+    assert np.ptp(theta) > 2 * np.pi                      # the crank turns round
+
+
+def test_two_ball_joints_in_one_loop_are_refused_with_advice():
+    data = json.loads(kn.dumps(scenes.spatial_fourbar(probes=False)))
+    for comp in data["components"]:
+        if comp["name"] == "U":
+            comp.update(type="multibody.Spherical", params={})
+    with pytest.raises(kn.ModelError, match="ball or free joint"):
+        kn.loads(json.dumps(data)).compile()
+
+
+def test_validate_states_the_reason_for_the_state_count(tmp_path, capsys):
+    from kinetwork import cli
+    path = tmp_path / "fourbar.json"
+    scenes.fourbar().save(path)
+    assert cli.main(["validate", str(path)]) == 0
+    out = capsys.readouterr().out
+    assert "states: 2 (A.q [rad], A.qd [rad/s])" in out and "algebraic: 3" in out
+    assert "degrees of freedom: 1" in out and "coordinate partitioning" in out
+    assert "loops: 1\n  coupler - B - crank - A - base - D - rocker - C (cut at C)" in out
