@@ -117,10 +117,12 @@ def slider_crank(theta0=0.5, thetad0=3.0, r=0.2, l=0.6, masses=(1.0, 0.5, 2.0), 
     return m
 
 
-def spatial_fourbar(theta0=0.0, thetad0=2.0, probes=True):
+def spatial_fourbar(theta0=0.0, thetad0=2.0, c=0.7, probes=True):
     """An RSUR spatial four-bar under gravity -z: crank about z at the origin (0.3 m),
-    rocker about x at (0.4, 0.9, 0.3) (0.5 m), coupler from a Universal joint at the crank tip
-    to a Spherical joint at the rocker tip; the Spherical is cut (three position equations)."""
+    rocker about x at (0.4, 0.9, 0.3) (length ``c``, upright at rest), coupler from a Universal
+    joint at the crank tip to a Spherical joint at the rocker tip, as long as the two tips are
+    apart at theta = 0 and an upright rocker; the Spherical is cut (three position equations)."""
+    b = float(np.sqrt(0.1 ** 2 + 0.9 ** 2 + (0.3 + c) ** 2))
     m = kn.Model("spatial_fourbar", parameters={"g": G},
                  description="A spatial RSUR four-bar: crank about z, rocker about x, coupler "
                              "on a Universal joint at the crank and a ball joint at the rocker "
@@ -133,12 +135,12 @@ def spatial_fourbar(theta0=0.0, thetad0=2.0, probes=True):
     tip = _rod(m, "crank", "A.frame_b", "0.3", 1.0, 0.3)
     m.add(mb.Universal("U", n_a=[0, 0, 1], n_b=[0, 1, 0], q0_guess=[1.4, -0.7]))
     m.connect(tip, "U.frame_a")
-    coupler_tip = _rod(m, "coupler", "U.frame_b", "1.2083", 1.5, 1.2083)
+    coupler_tip = _rod(m, "coupler", "U.frame_b", repr(round(b, 12)), 1.5, b)
     m.add(mb.FixedTranslation("base", r=[0.4, 0.9, 0.3]))
     m.connect("ground.frame", "base.frame_a")
     m.add(mb.Revolute("D", axis=[1, 0, 0], q0_guess=0.0))
     m.connect("base.frame_b", "D.frame_a")
-    rocker_tip = _rod(m, "rocker", "D.frame_b", "0.5", 1.0, 0.5, along=(0, 0, 1))
+    rocker_tip = _rod(m, "rocker", "D.frame_b", repr(c), 1.0, c, along=(0, 0, 1))
     m.add(mb.Spherical("S"))
     m.connect(coupler_tip, "S.frame_a")
     m.connect("S.frame_b", rocker_tip)

@@ -11,15 +11,16 @@ README = (pathlib.Path(__file__).resolve().parents[1] / "README.md").read_text()
 
 
 def test_every_component_is_listed():
+    """Each row's first cell names a type and its siblings: `lib.A` / `B` / `C`."""
+    table = README.split("## Components", 1)[1].split("\n## ", 1)[0]
     listed = set()
-    for row in re.findall(r"^\| `([^`]+)`(?: / `([^`]+)`)*(?: / `([^`]+)`)*", README, re.M):
-        first = row[0]
-        listed.add(first)
-        lib = first.rsplit(".", 1)[0] if "." in first else ""
-        listed.update(f"{lib}.{n}" for n in row[1:] if n)
-    table = README.split("## Components", 1)[1].split("##", 1)[0]
-    for extra in re.findall(r"/ `(\w+)`", table):
-        listed.update(f"{lib}.{extra}" for lib in ("rotational", "translational"))
+    for row in re.findall(r"^\| ([^|]+)\|", table, re.M):
+        names = re.findall(r"`([^`]+)`", row)
+        if not names:
+            continue
+        lib = names[0].rsplit(".", 1)[0] if "." in names[0] else ""
+        listed.add(names[0])
+        listed.update(f"{lib}.{n}" for n in names[1:])
     missing = sorted(set(REGISTRY) - listed)
     assert not missing, f"components missing from README: {missing}"
 

@@ -142,15 +142,16 @@ class Model:
         from .topology import analyze
         return analyze(self)
 
-    def compile(self, loops="partition"):
+    def compile(self, loops="partition", baumgarte_rate=None):
         """Validate and build the equations: a ``kn.System``.
 
         ``loops`` chooses the formulation of kinematic loops (see ``kinetwork.solver.loops``):
         "partition" (default; independent coordinates, dependent ones solved exactly at every
-        step) or "baumgarte" (an ODE in all coordinates, stabilised).
+        step) or "baumgarte" (an ODE in all coordinates, stabilised at ``baumgarte_rate``
+        [1/s], default 10; 0 leaves the drift unchecked).
         """
         from ..solver.system import System
-        return System(self, loops=loops)
+        return System(self, loops=loops, baumgarte_rate=baumgarte_rate)
 
     def save(self, path):
         """Write the model as JSON (atomically: a failed save leaves the old file whole)."""

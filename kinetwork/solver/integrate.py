@@ -124,6 +124,9 @@ FLAGS = {
     "RHSFUNC_FAIL": "the right-hand side became non-finite (Inf or NaN): a force or a "
                     "parameter expression blows up",
     "RES_FAIL": "the residual became non-finite (Inf or NaN)",
+    "REP_RES_ERR": "the equations became non-finite (Inf or NaN) again and again: with loops, "
+                   "the mechanism may have reached a dead point where the independent "
+                   "coordinates (those with a given q0) can no longer drive it",
     "LSETUP_FAIL": "the linear solver setup failed (singular iteration matrix)",
     "LSOLVE_FAIL": "the linear solver failed (singular iteration matrix)",
 }

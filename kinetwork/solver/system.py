@@ -8,7 +8,7 @@ import numpy as np
 from ..errors import ModelError
 from . import jit as _jit
 from .assemble import assemble
-from .loops import formulate
+from .loops import BAUMGARTE_RATE, formulate
 
 #: Jacobians larger than this (instructions) are not compiled to C: Newton iterations use
 #: finite differences of the compiled right-hand side instead (an N = 128 chain's exact
@@ -27,11 +27,12 @@ class System:
         Initial state for the model's parameter values.
     """
 
-    def __init__(self, model, loops="partition"):
+    def __init__(self, model, loops="partition", baumgarte_rate=None):
         self.model = model
         self.topology = model.validate()
         self.asm = asm = assemble(model, self.topology)
-        self.eq = eq = formulate(asm, self.topology, self.parameter_values(), loops)
+        self.eq = eq = formulate(asm, self.topology, self.parameter_values(), loops,
+                                 BAUMGARTE_RATE if baumgarte_rate is None else baumgarte_rate)
         self.param_names = asm.param_names
         self.coordinate_names = asm.coordinate_names
         self.speed_names = asm.speed_names

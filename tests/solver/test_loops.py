@@ -193,7 +193,8 @@ def test_spatial_loop_with_ball_joint_cut():
     # from the crank tip (the Universal joint)
     theta = res["crank_probe.angle"]
     U = 0.3 * np.stack([np.cos(theta), np.sin(theta), 0 * theta], -1)
-    assert np.max(np.abs(np.linalg.norm(res["ball.position"] - U, axis=1) - 1.2083)) < 1e-10
+    coupler = np.sqrt(0.1 ** 2 + 0.9 ** 2 + (0.3 + 0.7) ** 2)
+    assert np.max(np.abs(np.linalg.norm(res["ball.position"] - U, axis=1) - coupler)) < 1e-10
     assert np.ptp(theta) > 2 * np.pi                      # the crank turns round
 
 
