@@ -301,6 +301,10 @@ def _equations(args):
     print(f"coordinates: {coords}" if coords else "coordinates: none (no degrees of freedom)")
     print("speeds: " + (", ".join(str(s) for s in eq["qd"]) or "none"))
     print("parameters: " + (", ".join(eq["params"]) or "none"))
+    if system.topology.cuts:
+        print(f"loops: cut at {', '.join(c.component.name for c in system.topology.cuts)}; "
+              f"M, V, G are those of the open tree, and the {system.eq.loop_rows} independent "
+              f"closure equations phi(q) = 0 add J(q)^T lambda to the right-hand side")
     blocks = [[(str(w), expr) for w, expr in shared]] if shared else []
     comma = "," if len(eq["q"]) > 9 else ""       # M1011 would be ambiguous: M10,11
     for key, mat in mats.items():

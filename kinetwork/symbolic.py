@@ -231,11 +231,14 @@ def _uses(program):
 def coordinate_symbol(state_name, prefix="q"):
     """A readable symbol name for a joint coordinate: "shoulder.q" -> "q_shoulder".
 
-    Multi-DOF joints ("ball.q[1]") give "q_ball_1".
+    Multi-DOF joints ("ball.q[1]") give "q_ball_1"; named parts of a coordinate keep their
+    name ("free.quat[2]" -> "q_free_quat_2", "free.w[0]" with prefix qd -> "qd_free_w_0").
     """
     joint, _, coord = state_name.partition(".")
-    index = coord[coord.find("[") + 1:-1] if "[" in coord else ""
-    return f"{prefix}_{joint}" + (f"_{index}" if index else "")
+    label, _, rest = coord.partition("[")
+    index = rest[:-1]
+    named = f"_{label}" if label not in ("q", "qd") else ""
+    return f"{prefix}_{joint}{named}" + (f"_{index}" if index else "")
 
 
 def simplify(expr, floor=0.0):
@@ -276,8 +279,12 @@ def equations_sympy(system, simplified=None):
     params = {name: sp.Symbol(name, real=True) for name in eq["param_names"]}
     taken = set(params) | {"t"}
     q, qd = [], []
-    for coord in system.coordinate_names:
-        for prefix, out in (("q", q), ("qd", qd)):
+    # a speed of an angle or distance reads as its coordinate's rate (qd_shoulder); the
+    # speeds of quaternion joints have names of their own (qd_free_w_1)
+    coordinate_of = {u: system.coordinate_names[k] for k, u in system.asm.speed_of.items()}
+    rates = [coordinate_of.get(i, name) for i, name in enumerate(system.speed_names)]
+    for names, prefix, out in ((system.coordinate_names, "q", q), (rates, "qd", qd)):
+        for coord in names:
             name = coordinate_symbol(coord, prefix)
             while name in taken:          # a model parameter may already be called q_shoulder
                 name += "_"
