@@ -216,9 +216,9 @@ class _Loops:
         nv = u.shape[0]
         dep = self.dep
         ind = [k for k in range(nv) if k not in set(dep)]
-        phi = self.phi[self.rows]
-        J = self.J[self.rows, :]
-        JD, JI = J[:, dep], J[:, ind]
+        phi = _rows(self.phi, self.rows)
+        J = _rows(self.J, self.rows)
+        JD, JI = _cols(J, dep), _cols(J, ind)
         T = ca.SX.zeros(nv, len(ind))
         T[ind, :] = ca.SX.eye(len(ind))
         if dep:
@@ -264,11 +264,11 @@ class _Loops:
                              "baumgarte", note, len(rows), self.phi.shape[0] - len(rows),
                              initial, phi, lam)
         keep_q = [k for k in range(q.shape[0]) if k not in set(dep_q)]
-        u_full = T @ u[ind]
+        u_full = ca.densify(T @ _rows(u, ind))
         sub = lambda e: ca.substitute(e, u, u_full)     # noqa: E731
-        x = ca.vertcat(q[keep_q], u[ind])
-        z = q[dep_q]
-        ode = ca.vertcat(sub(asm.qdot[keep_q]), sub(udot_i))
+        x = ca.vertcat(_rows(q, keep_q), _rows(u, ind))
+        z = _rows(q, dep_q)
+        ode = ca.vertcat(sub(_rows(asm.qdot, keep_q)), sub(udot_i))
 
         def initial(p):
             qc = self.close(p)
@@ -282,7 +282,12 @@ class _Loops:
                     f"initial speed of an independent coordinate "
                     f"({', '.join(unames[k] for k in ind)}) instead")
             return np.concatenate([qc[keep_q], u0[ind]]), qc[dep_q]
-        note = (f"kinematic loops, coordinate partitioning: {len(keep_q) + len(ind)} "
+        if not dep:
+            note = ("kinematic loops closed by rigid parts or by a free joint: they fix no "
+                    "coordinate, so the states are those of the tree")
+        else:
+            note = ""
+        note = note or (f"kinematic loops, coordinate partitioning: {len(keep_q) + len(ind)} "
                 f"differential states for {len(ind)} degrees of freedom"
                 + (f" (a quaternion has 4 coordinates for 3 speeds)"
                    if len(keep_q) > len(ind) else "")
@@ -294,3 +299,13 @@ class _Loops:
                          u_full, sub(udot), "partition", note, len(rows),
                          self.phi.shape[0] - len(rows), initial, phi, sub(lam))
 
+
+
+def _rows(m, index):
+    """Rows ``index`` of an SX matrix: SX(0, columns) when there are none (CasADi's own
+    indexing of a 1 x 1 matrix by an empty list gives 1 x 0)."""
+    return m[index, :] if index else ca.SX(0, m.shape[1])
+
+
+def _cols(m, index):
+    return m[:, index] if index else ca.SX(m.shape[0], 0)

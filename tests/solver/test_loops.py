@@ -216,3 +216,75 @@ def test_validate_states_the_reason_for_the_state_count(tmp_path, capsys):
     assert "states: 2 (A.q [rad], A.qd [rad/s])" in out and "algebraic: 3" in out
     assert "degrees of freedom: 1" in out and "coordinate partitioning" in out
     assert "loops: 1\n  coupler - B - crank - A - base - D - rocker - C (cut at C)" in out
+
+
+def _wire(model, pairs):
+    for a, b in pairs:
+        model.connect(a, b)
+    return model
+
+
+def test_a_free_joint_in_a_loop_is_cut_and_constrains_nothing():
+    """A pendulum bob that is also on a FreeMotion from the ground: the free joint is cut
+    (it imposes nothing), so the pendulum swings as if it were not there."""
+    def pendulum(extra):
+        m = kn.Model("pendulum")
+        m.add(mb.Ground("ground", gravity=[0, -9.81, 0]))
+        m.add(mb.Revolute("hinge", q0=0.5))
+        m.add(mb.FixedTranslation("rod", r=[0, -1, 0]))
+        m.add(mb.RigidBody("bob", mass=1.0))
+        pairs = [("ground.frame", "hinge.frame_a"), ("hinge.frame_b", "rod.frame_a"),
+                 ("rod.frame_b", "bob.frame_a")]
+        if extra:
+            m.add(mb.FreeMotion("free"))
+            pairs += [("ground.frame", "free.frame_a"), ("free.frame_b", "rod.frame_b")]
+        return _wire(m, pairs).compile()
+    with_free, alone = pendulum(True), pendulum(False)
+    assert [c.component.name for c in with_free.topology.cuts] == ["free"]
+    assert with_free.state_names == alone.state_names and not with_free.n_algebraic
+    a = kn.simulate(with_free, t_end=2.0, n_points=11)["hinge.q"]
+    b = kn.simulate(alone, t_end=2.0, n_points=11)["hinge.q"]
+    assert np.max(np.abs(a - b)) < 1e-12
+
+
+@pytest.mark.parametrize("length, closes", [(1.0, True), (1.1, False)])
+def test_a_loop_of_rigid_parts(length, closes):
+    m = kn.Model("rigid_loop")
+    m.add(mb.Ground("ground"))
+    m.add(mb.FixedTranslation("a", r=[1, 0, 0]))
+    m.add(mb.FixedTranslation("b", r=[length, 0, 0]))
+    m.add(mb.Revolute("j", q0=0.3))
+    m.add(mb.RigidBody("body", mass=1, r_cm=[0, -1, 0]))
+    _wire(m, [("ground.frame", "a.frame_a"), ("ground.frame", "b.frame_a"),
+              ("a.frame_b", "b.frame_b"), ("a.frame_b", "j.frame_a"),
+              ("j.frame_b", "body.frame_a")])
+    if closes:
+        system = m.compile()
+        assert system.state_names == ["j.q", "j.qd"] and "fix no coordinate" in \
+            system.formulation_note
+    else:
+        with pytest.raises(kn.ModelError, match="loop through a, b cannot close.*off by 0.1"):
+            m.compile()
+
+
+def test_a_locked_loop_has_no_states_and_holds_its_shape():
+    """A triangle of three unit links on revolutes: zero degrees of freedom, every angle
+    solved from the closure (equilateral: 60 degrees inside)."""
+    m = kn.Model("triangle")
+    m.add(mb.Ground("ground"))
+    m.add(mb.Revolute("A", q0_guess=1.0))
+    m.add(mb.FixedTranslation("ab", r=[1, 0, 0]))
+    m.add(mb.Revolute("B", q0_guess=2.0))
+    m.add(mb.FixedTranslation("bc", r=[1, 0, 0]))
+    m.add(mb.FixedTranslation("base", r=[1, 0, 0]))
+    m.add(mb.Revolute("C", q0_guess=2.0))
+    m.add(mb.RigidBody("body", mass=1, r_cm=[0.5, 0, 0]))
+    _wire(m, [("ground.frame", "A.frame_a"), ("A.frame_b", "ab.frame_a"),
+              ("ab.frame_b", "B.frame_a"), ("B.frame_b", "bc.frame_a"),
+              ("ground.frame", "base.frame_a"), ("base.frame_b", "C.frame_a"),
+              ("C.frame_b", "bc.frame_b"), ("A.frame_b", "body.frame_a")])
+    system = m.compile()
+    assert system.dof == 0 and system.n_states == 0 and system.n_algebraic == 3
+    res = kn.simulate(system, t_end=1.0, n_points=5)
+    inner = np.mod(np.pi - np.abs(np.mod(res.states[:, 1] + np.pi, 2 * np.pi) - np.pi), np.pi)
+    assert np.allclose(inner, np.pi / 3, atol=1e-12)
