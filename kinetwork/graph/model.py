@@ -147,8 +147,10 @@ class Model:
 
         ``loops`` chooses the formulation of kinematic loops (see ``kinetwork.solver.loops``):
         "partition" (default; independent coordinates, dependent ones solved exactly at every
-        step) or "baumgarte" (an ODE in all coordinates, stabilised at ``baumgarte_rate``
-        [1/s], default 10; 0 leaves the drift unchecked).
+        step: a DAE for IDAS), "projected" (an ODE for any method, its dependent coordinates
+        Newton-projected onto the closure in every evaluation) or "baumgarte" (an ODE in all
+        coordinates, stabilised at ``baumgarte_rate`` [1/s], default 10; 0 leaves the drift
+        unchecked).
         """
         from ..solver.system import System
         return System(self, loops=loops, baumgarte_rate=baumgarte_rate)

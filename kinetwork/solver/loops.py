@@ -1,7 +1,7 @@
 """From the assembled tree (plus loop closures) to the equations that are integrated.
 
 A model without loops is an ODE in all its coordinates and speeds. A model with kinematic
-loops has more coordinates than degrees of freedom; two formulations are offered:
+loops has more coordinates than degrees of freedom; three formulations are offered:
 
 ``partition`` (the default): coordinate partitioning written as a semi-explicit index-1 DAE.
     At the initial configuration the independent closure equations (rows of the loop
@@ -15,6 +15,15 @@ loops has more coordinates than degrees of freedom; two formulations are offered
     constraint manifold. Dependent speeds and accelerations follow exactly from
     J u = 0 and J udot + (dJ/dt) u = 0, and the dynamics are projected on the independent
     speeds: (T^T M T) udot_I = -T^T (bias + M g), with u = T u_I, udot = T udot_I + g.
+    ``simulate`` Newton-polishes the algebraic variables at the output points (IDAS holds
+    them to its tolerance; the outputs hold them to round-off).
+
+``projected``: the same partition as an ODE that any method integrates. The dependent
+    coordinates are carried as states too, but only as the start of a Newton projection onto
+    the closure inside every evaluation (three steps from within the integrator's tolerance:
+    round-off); the dynamics and the probes see the projected values. More states (a
+    four-bar: 5), no drift, and Adams or DOP853 instead of BDF: on the four-bar 2-3x faster
+    than ``partition`` with IDAS for the same error.
 
 ``baumgarte``: an ODE in all coordinates and speeds, index-reduced to the acceleration
     level with Baumgarte stabilisation J udot + (dJ/dt) u + 2 a J u + a^2 Phi = 0. Any ODE
@@ -31,7 +40,12 @@ import scipy.linalg
 from ..errors import ModelError
 from .newton_euler import crba, rnea
 
-FORMULATIONS = ("partition", "baumgarte")
+FORMULATIONS = ("partition", "projected", "baumgarte")
+#: Newton steps of the projected formulation (from a start within the integrator's tolerance
+#: of the closure, two already reach round-off)
+PROJECTION_STEPS = 3
+#: rate [1/s] at which the projected formulation's carried starts follow the projection
+PROJECTION_PULL = 1.0
 #: Baumgarte's stabilisation rate a [1/s] by default
 BAUMGARTE_RATE = 10.0
 #: a closure residual below this (m, and rotation-matrix entries) counts as closed
@@ -61,6 +75,7 @@ class Equations:
     initial: object = None          # p -> (x0, z0) numpy
     residual: ca.SX = None          # kept closure equations, in q
     lam: ca.SX = None               # multiplier of every closure row (0 for dropped ones)
+    q: ca.SX = None                 # coordinates, where they are not the states themselves
     extra: dict = field(default_factory=dict)
 
 
@@ -80,8 +95,12 @@ def formulate(asm, topo, values, formulation="partition", rate=BAUMGARTE_RATE):
         def initial(p):
             q0, u0 = (np.asarray(v, dtype=float).ravel() for v in start(p))
             return np.concatenate([np.where(given, q0, 0.0), u0]), np.zeros(0)
+        quaternions = q.shape[0] - u.shape[0]
+        note = (f"{q.shape[0] + u.shape[0]} states for {u.shape[0]} degrees of freedom: the "
+                f"quaternion of each ball or free joint has 4 coordinates for 3 speeds, so "
+                f"that no orientation is singular" if quaternions else "")
         return Equations(ca.vertcat(q, u), ca.SX(0, 1), ca.vertcat(asm.qdot, asm.qdd),
-                         ca.SX(0, 1), names, units, [], [], u, asm.qdd, "tree",
+                         ca.SX(0, 1), names, units, [], [], u, asm.qdd, "tree", note,
                          initial=initial, lam=ca.SX(0, 1))
     return _Loops(asm, topo, values).equations(formulation, rate)
 
@@ -210,6 +229,38 @@ class _Loops:
         return rows, sorted(dep)
 
     # -- the equations --------------------------------------------------------------------------
+    def _projected(self, x, zg, ode, keep_q, dep_q, ind, sub, u_full, udot, udot_i, phi, lam,
+                   initial, note_rows):
+        """The ``projected`` formulation: an ODE whose dependent coordinates are carried as
+        states only as the start of a Newton projection onto the closure in every
+        evaluation; the dynamics see the projected values, so they hold the closure to
+        round-off, while any ODE method (Adams, DOP853, ...) can integrate them."""
+        asm = self.asm
+        q = asm.q
+        jac = ca.jacobian(phi, zg)
+        zs = zg
+        for _ in range(PROJECTION_STEPS):
+            zs = zs - ca.solve(ca.substitute(jac, zg, zs), ca.substitute(phi, zg, zs))
+        star = lambda e: ca.substitute(e, zg, zs)        # noqa: E731
+        rate_dep = star(sub(_rows(asm.qdot, dep_q))) + PROJECTION_PULL * (zs - zg)
+        x = ca.vertcat(_rows(q, keep_q), zg, _rows(asm.qd, ind))
+        ode = ca.vertcat(star(sub(_rows(asm.qdot, keep_q))), rate_dep, star(sub(udot_i)))
+        qn, un = asm.coordinate_names, asm.speed_names
+        qu, uu = asm.coordinate_units, asm.speed_units
+        names = [qn[k] for k in keep_q] + [qn[k] for k in dep_q] + [un[k] for k in ind]
+        units = [qu[k] for k in keep_q] + [qu[k] for k in dep_q] + [uu[k] for k in ind]
+        note = (f"kinematic loops, projected formulation: {x.shape[0]} states for {len(ind)} "
+                f"degrees of freedom; the {len(dep_q)} dependent coordinates are states only to "
+                f"start a Newton projection onto {note_rows} in every evaluation (an ODE that "
+                f"holds the closure to round-off)")
+        out = Equations(x, ca.SX(0, 1), ode, ca.SX(0, 1), names, units, [], [],
+                        star(u_full), star(sub(udot)), "projected", note, len(self.rows),
+                        self.phi.shape[0] - len(self.rows), initial, star(phi),
+                        star(sub(lam)))
+        out.q = ca.substitute(q, zg, zs)
+        return out
+
+
     def equations(self, formulation, rate):
         asm = self.asm
         q, u = asm.q, asm.qd
@@ -270,7 +321,7 @@ class _Loops:
         z = _rows(q, dep_q)
         ode = ca.vertcat(sub(_rows(asm.qdot, keep_q)), sub(udot_i))
 
-        def initial(p):
+        def initial(p, projected=False):
             qc = self.close(p)
             _, u0 = start(p)
             u0 = np.asarray(u0, dtype=float).ravel()
@@ -281,7 +332,12 @@ class _Loops:
                     f"fixed by the loop closure (it is a dependent coordinate); give the "
                     f"initial speed of an independent coordinate "
                     f"({', '.join(unames[k] for k in ind)}) instead")
+            if projected:
+                return np.concatenate([qc[keep_q], qc[dep_q], u0[ind]]), np.zeros(0)
             return np.concatenate([qc[keep_q], u0[ind]]), qc[dep_q]
+        if formulation == "projected" and dep:
+            return self._projected(x, z, ode, keep_q, dep_q, ind, sub, u_full, udot, udot_i,
+                                   phi, lam, lambda p: initial(p, True), note_rows)
         if not dep:
             note = ("kinematic loops closed by rigid parts or by a free joint: they fix no "
                     "coordinate, so the states are those of the tree")

@@ -51,8 +51,9 @@ class System:
         self.signal_names = [name for name, _, _ in asm.signals]
         self.signal_units = {name: unit for name, unit, _ in asm.signals}
         self.signal_sizes = {name: expr.numel() for name, _, expr in asm.signals}
-        outs = [ca.substitute(expr, ca.vertcat(asm.qd, asm.qdd_sym, asm.lam_sym),
-                              ca.vertcat(eq.u, eq.udot, eq.lam))
+        coords = asm.q if eq.q is None else eq.q
+        outs = [ca.substitute(expr, ca.vertcat(asm.q, asm.qd, asm.qdd_sym, asm.lam_sym),
+                              ca.vertcat(coords, eq.u, eq.udot, eq.lam))
                 for _, _, expr in asm.signals]
         # outputs read the whole state: differential, then algebraic
         self.f_out = ca.Function("outputs", [asm.t, ca.vertcat(eq.x, eq.z), asm.p],
