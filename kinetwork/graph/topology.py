@@ -201,7 +201,7 @@ def _tree(model, topo, roles, problems):
         rev = topo.set_of[comp.port_ref("frame_a")] != parent
         topo.tree.append(Edge(comp, parent, child, rev))
     in_tree = {e.component.name for e in topo.tree}
-    for u, v, data in sub.edges(data=True):
+    for _, _, data in sub.edges(data=True):
         comp = data["component"]
         if comp.name in in_tree:
             if comp._values.get("cut", False):

@@ -102,16 +102,18 @@ class Assembly:
         self.base = up(anc, ca.SX.eye(3), ca.SX.zeros(3), -1)   # the shared body, in the world
         return (*up(ka, Ra, pa, anc), *up(kb, Rb, pb, anc))
 
-    def rate(self, expr):
-        """Time derivative of an expression in (q, qd), with qd's rate ``qdd_sym``."""
+    def rate(self, expr, accelerations=True):
+        """Time derivative of an expression in (q, qd), with qd's rate ``qdd_sym`` (or, without
+        ``accelerations``, for an expression in q alone)."""
         flat = ca.vec(expr)
-        return ca.reshape(ca.jtimes(flat, self.q, self.qdot)
-                          + ca.jtimes(flat, self.qd, self.qdd_sym), *expr.shape)
+        out = ca.jtimes(flat, self.q, self.qdot)
+        if accelerations:
+            out += ca.jtimes(flat, self.qd, self.qdd_sym)
+        return ca.reshape(out, *expr.shape)
 
-    def twist(self, frame_set):
-        """World angular velocity and velocity of a frame set's origin, in (q, qd)."""
-        R, pos = self.pose(frame_set)
-        return vee(self.rate(R) @ R.T), self.rate(pos)
+    def angular_velocity(self, R, accelerations=True):
+        """World angular velocity of a frame of world orientation R(q)."""
+        return vee(self.rate(R, accelerations) @ R.T)
 
 
 def assemble(model, topo):
@@ -213,10 +215,7 @@ def _bodies(topo, bound, q, qd, qindex, uindex):
         uj = qd[uindex[comp.name]]
         S = None if edge.reversed else comp.subspace(qj)
         if S is None:
-            # motion subspace in the child frame, from the rate of the joint's transform
-            qdot = comp.rate(qj, uj)
-            w = vee(Re.T @ ca.reshape(ca.jtimes(ca.vec(Re), qj, qdot), 3, 3))
-            S = ca.jacobian(ca.vertcat(w, Re.T @ ca.jtimes(re, qj, qdot)), uj)
+            S = motion_subspace(comp, qj, uj, Re, re)
         # screw joints: exact constants, no S-dot term (a reversed ball joint is not one)
         if comp.constant_subspace and (comp.regular or not edge.reversed):
             S, cJ = ca.substitute(S, qj, ca.DM(_zero_pose(comp))), ca.SX.zeros(6)
@@ -231,6 +230,14 @@ def _bodies(topo, bound, q, qd, qindex, uindex):
         m, c, Ic = bound[body.name].mass_properties()
         bodies[k].inertia += spatial_inertia(m, ps + Rs @ c, Rs @ Ic @ Rs.T)
     return bodies, place
+
+
+def motion_subspace(comp, qj, uj, Re, re):
+    """Spatial velocity of the moved frame relative to the fixed one per unit joint speed,
+    in the moved frame's axes (6 x dof), from the rate of the joint's transform (Re, re)."""
+    qdot = comp.rate(qj, uj)
+    w = vee(Re.T @ ca.reshape(ca.jtimes(ca.vec(Re), qj, qdot), 3, 3))
+    return ca.jacobian(ca.vertcat(w, Re.T @ ca.jtimes(re, qj, qdot)), uj)
 
 
 def _zero_pose(comp):
@@ -256,18 +263,12 @@ def _frame_forces(asm, topo, bound, t):
             # the tension held (a damper's law depends on the speeds itself)
             Q -= c.law(s, s_d) * ca.gradient(s_d, asm.qd)
         else:
-            w, v = _twist_u(asm, topo.set_of[comp.port_ref("frame_b")])
+            R, pos = asm.pose(topo.set_of[comp.port_ref("frame_b")])
+            w, v = asm.angular_velocity(R, False), asm.rate(pos, False)
             power = ca.dot(vec3(c.force), v) if "force" in comp.params \
                 else ca.dot(vec3(c.torque), w)
             Q += ca.gradient(power, asm.qd)
     return Q
-
-
-def _twist_u(asm, frame_set):
-    """World angular velocity and origin velocity of a frame set in (q, qd) (no qdd)."""
-    R, pos = asm.pose(frame_set)
-    rate = lambda e: ca.reshape(ca.jtimes(ca.vec(e), asm.q, asm.qdot), *e.shape)  # noqa: E731
-    return vee(rate(R) @ R.T), rate(pos)
 
 
 def _closure(asm, cut, comp, qindex):
@@ -362,7 +363,7 @@ def _frame_quantities(asm, topo, target, asked, bound):
         out["velocity"] = asm.rate(pos)
         out["acceleration"] = asm.rate(out["velocity"])
     if {"angular_velocity", "angular_acceleration"} & set(asked):
-        out["angular_velocity"] = vee(asm.rate(R) @ R.T)
+        out["angular_velocity"] = asm.angular_velocity(R)
         out["angular_acceleration"] = asm.rate(out["angular_velocity"])
     if {"force", "torque"} & set(asked):
         from .wrench import cut_wrench          # only models that ask for it pay for it

@@ -345,7 +345,7 @@ class _Loops:
             note = ""
         note = note or (f"kinematic loops, coordinate partitioning: {len(keep_q) + len(ind)} "
                 f"differential states for {len(ind)} degrees of freedom"
-                + (f" (a quaternion has 4 coordinates for 3 speeds)"
+                + (" (a quaternion has 4 coordinates for 3 speeds)"
                    if len(keep_q) > len(ind) else "")
                 + f"; {len(dep_q)} dependent coordinates ({', '.join(qnames[k] for k in dep_q)})"
                 f" are algebraic variables solved from {note_rows} at every step")

@@ -23,8 +23,7 @@ probe reports the torque about the frame's own origin.
 import casadi as ca
 
 from ..spatial import skew, vec3
-from ..spatial import vee as _vee
-from .assemble import closure_rows
+from .assemble import closure_rows, motion_subspace
 
 
 def cut_wrench(asm, topo, target, bound):
@@ -105,9 +104,7 @@ class _Balance:
         c = self.bound[comp.name]
         qj = asm.q[asm.qindex[comp.name]]
         uj = asm.qd[asm.uindex[comp.name]]
-        Re, re = c.transform(qj)
-        w = _vee(Re.T @ ca.reshape(ca.jtimes(ca.vec(Re), qj, uj), 3, 3))
-        S = ca.jacobian(ca.vertcat(w, Re.T @ ca.jtimes(re, qj, uj)), uj)
+        S = motion_subspace(c, qj, uj, *c.transform(qj))
         wrench = S @ asm.Q_drive[asm.uindex[comp.name]]
         R, p = asm.pose(self.topo.set_of[comp.port_ref("frame_b")])
         force = R @ wrench[3:]
@@ -119,7 +116,7 @@ class _Balance:
         m, c, Ic = self.bound[body.name].mass_properties()
         cw = p + R @ c
         a = asm.rate(asm.rate(cw))
-        w = _omega(asm, R)
+        w = asm.angular_velocity(R)
         alpha = asm.rate(w)
         Iw = R @ Ic @ R.T
         force = m * (a - asm.gravity)
@@ -169,7 +166,3 @@ class _Balance:
         wrench = G.T @ asm.lam_sym[lo:hi]
         # the dual of (w, v) is (moment about the world origin, force)
         return wrench[3:], wrench[:3]
-
-
-def _omega(asm, R):
-    return _vee(asm.rate(R) @ R.T)
