@@ -9,8 +9,8 @@ the component) is what the rest of the model exerts on it there:
 - a joint or rigid part of the spanning tree passes on everything behind it: through its
   port away from the ground flows minus the sum of the flows into every body, force element
   and cut joint of the subtree beyond it, less the drives of the joints there (the inward
-  pass of Newton-Euler, per frame connection); through its port towards the ground, the
-  opposite less its own drive;
+  pass of Newton-Euler, per frame connection); through its port towards the ground, that
+  sum less its own drive;
 - a joint's drive (the flow into its 1-D axis flanges) acts on its frame_b and reacts, through
   the support flange, on the world (Modelica's convention), so a revolute's frames carry no
   torque about its axis;
@@ -58,15 +58,19 @@ class _Balance:
             return self._minus_rest(set_, comp)
         if name in self.cut_of:
             f, m = self._constraint(*self.cut_of[name], port)
+            if port == "frame_b":              # a cut joint's drive acts there too
+                df, dm = self._drive(comp)
+                f, m = f + df, m + dm
             return -f, -m
         edge = self.edge_of[name]
         f, m = self._subtree(edge.child, skip=name)
         if set_ != edge.parent:
             return -f, -m
-        if self.topo.set_of[comp.port_ref("frame_b")] == edge.child:
-            df, dm = self._drive(comp)
-            f, m = f - df, m - dm
-        return f, m
+        # towards the ground the joint passes on what it transmits, less its own drive:
+        # that acts on frame_b (beyond, or on this side when the joint is reversed) and
+        # reacts on the world
+        df, dm = self._drive(comp)
+        return f - df, m - dm
 
     def _minus_rest(self, set_, comp):
         f, m = ca.SX.zeros(3), ca.SX.zeros(3)
@@ -90,7 +94,8 @@ class _Balance:
                 if comp.role in ("body", "frame_force") or comp.name in self.cut_of:
                     df, dm = self.flow(comp, ref.name)
                     f, m = f + df, m + dm
-                if comp.role == "joint" and ref.name == "frame_b" and comp.name != skip:
+                if comp.role == "joint" and ref.name == "frame_b" and comp.name != skip \
+                        and comp.name not in self.cut_of:
                     df, dm = self._drive(comp)
                     f, m = f - df, m - dm
         return f, m

@@ -94,3 +94,47 @@ def test_bending_moment_of_a_spinning_arm():
     torque = m * g * L * np.stack([np.sin(th), 0 * th, np.cos(th)], -1)
     assert np.max(np.abs(res["cut.force"] - force)) < 1e-9
     assert np.max(np.abs(res["cut.torque"] - torque)) < 1e-9
+
+
+def test_flows_balance_at_every_frame_connection():
+    """Kirchhoff's law for frames: at every connection set the flows into the components
+    there sum to zero, forces and torques, in a four-bar driven at its cut joint, pulled by
+    a line spring and pushed by a world force (every kind of flow the wrench balance has)."""
+    import loop_scenes
+    model = loop_scenes.fourbar(probes=False)
+    mb = kn.multibody
+    model.add(kn.rotational.Torque("motor", tau="2*sin(3*t)"))
+    model.connect("motor.flange", "C.axis")
+    model.connect("motor.support", "C.support")
+    model.add(mb.Spring("spring", c=30.0, s_unstretched=0.5))
+    model.connect("spring.frame_a", "base.frame_b")
+    model.connect("spring.frame_b", "coupler.frame_b")
+    model.add(mb.WorldForce("push", force=[1.0, "cos(t)", 0.0]))
+    model.connect("push.frame_b", "crank.frame_b")
+    # a driven pendulum hung by its frame_b: a joint the tree walks in reverse
+    model.add(mb.Revolute("rev", q0=0.3))
+    model.add(mb.RigidBody("weight", mass=0.5, r_cm=[0.0, -0.2, 0.0], inertia=[0, 0, 0.01]))
+    model.add(kn.rotational.Torque("drive", tau="0.5 + t"))
+    for a, b in [("rev.frame_b", "crank.frame_b"), ("rev.frame_a", "weight.frame_a"),
+                 ("drive.flange", "rev.axis"), ("drive.support", "rev.support")]:
+        model.connect(a, b)
+    ports = [ref for comp in list(model.components.values()) for ref in
+             (comp.port_ref(p) for p in comp.ports) if ref.domain == "frame"]
+    for i, ref in enumerate(ports):
+        model.add(kn.Probe(f"f{i}", quantities=["force", "torque"]))
+        model.connect(f"f{i}.port", ref.path)
+    system = model.compile()
+    assert [c.component.name for c in system.topology.cuts] == ["C"]
+    assert [e.reversed for e in system.topology.tree if e.component.name == "rev"] == [True]
+    res = kn.simulate(system, t_end=2.0, n_points=41)
+    sets = {}
+    for i, ref in enumerate(ports):
+        sets.setdefault(system.topology.set_of[ref], []).append(i)
+    scale = max(np.max(np.abs(res[f"f{i}.force"])) for i in range(len(ports)))
+    for members in sets.values():
+        if len(members) < 2:
+            continue
+        force = sum(res[f"f{i}.force"] for i in members)
+        torque = sum(res[f"f{i}.torque"] for i in members)
+        assert np.max(np.abs(force)) < 1e-9 * scale, [ports[i].path for i in members]
+        assert np.max(np.abs(torque)) < 1e-9 * scale, [ports[i].path for i in members]

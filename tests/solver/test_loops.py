@@ -314,3 +314,30 @@ def test_rhs_of_the_dae_solves_the_closure_first():
             x = np.array([theta, thetad])
             assert np.allclose(system.rhs(0.0, x), ref.fourbar_rhs(0.0, x), rtol=1e-10,
                                atol=1e-10)
+
+
+def test_initial_speed_of_a_dependent_joint_is_refused_with_the_way_out():
+    model = scenes.fourbar(probes=False)
+    model.components["D"]._values["qd0"] = 1.0          # the rocker speed follows the crank
+    with pytest.raises(kn.ModelError, match=r"qd0 of D.qd: this speed is fixed by the loop"
+                                            r".*independent coordinate \(A.qd\)"):
+        model.compile().x0
+
+
+def test_dependent_speeds_follow_the_crank_speed():
+    """At the start the rocker turns at psi'(theta) theta' (the reference's closure rate)."""
+    system = scenes.fourbar(theta0=1.0, thetad0=2.0).compile()
+    res = kn.simulate(system, t_end=0.1, n_points=2)
+    r = ref.fourbar_simulate(1.0, 2.0, np.array([0.0, 0.1]))
+    assert abs(res["rocker_probe.speed"][0] - r["psid"][0]) < 1e-12
+
+
+def test_cut_flag_on_a_joint_outside_any_loop_is_refused():
+    model = scenes.fourbar(probes=False)
+    model.components["A"]._values["cut"] = True          # A is in the loop: fine
+    model.compile()
+    from conftest import double_pendulum
+    pendulum = double_pendulum()
+    pendulum.components["elbow"]._values["cut"] = True
+    with pytest.raises(kn.ModelError, match="elbow is marked cut but closes no kinematic loop"):
+        pendulum.compile()
