@@ -294,7 +294,7 @@ def simulate(model, t_end=None, n_points=None, method=None, rtol=None, atol=None
             f"method {settings['method']!r} integrates ODEs only, and {system.model.name!r} "
             f"has kinematic loops whose dependent coordinates are algebraic variables; use "
             f"{', '.join(k for k, m in METHODS.items() if m.dae)}, or compile the model with "
-            f"loops='baumgarte' (an ODE in all coordinates)")
+            f"loops='projected' or loops='baumgarte' (ODEs)")
     p = system.param_vector(params)        # checks the overrides once for the whole run
     x0 = np.concatenate(system.initial_full_p(p))
     grid = np.linspace(t_start, settings["t_end"], int(settings["n_points"]))

@@ -237,10 +237,7 @@ class _Loops:
         round-off, while any ODE method (Adams, DOP853, ...) can integrate them."""
         asm = self.asm
         q = asm.q
-        jac = ca.jacobian(phi, zg)
-        zs = zg
-        for _ in range(PROJECTION_STEPS):
-            zs = zs - ca.solve(ca.substitute(jac, zg, zs), ca.substitute(phi, zg, zs))
+        zs = newton(phi, zg)
         star = lambda e: ca.substitute(e, zg, zs)        # noqa: E731
         rate_dep = star(sub(_rows(asm.qdot, dep_q))) + PROJECTION_PULL * (zs - zg)
         x = ca.vertcat(_rows(q, keep_q), zg, _rows(asm.qd, ind))
@@ -355,6 +352,15 @@ class _Loops:
                          u_full, sub(udot), "partition", note, len(rows),
                          self.phi.shape[0] - len(rows), initial, phi, sub(lam))
 
+
+
+def newton(residual, z, steps=PROJECTION_STEPS):
+    """``z`` after ``steps`` Newton steps on ``residual(z) = 0``, written out in SX."""
+    jac = ca.jacobian(residual, z)
+    out = z
+    for _ in range(steps):
+        out = out - ca.solve(ca.substitute(jac, z, out), ca.substitute(residual, z, out))
+    return out
 
 
 def _rows(m, index):

@@ -8,7 +8,7 @@ import numpy as np
 from ..errors import ModelError
 from . import jit as _jit
 from .assemble import assemble
-from .loops import BAUMGARTE_RATE, formulate
+from .loops import BAUMGARTE_RATE, formulate, newton
 
 #: Jacobians larger than this (instructions) are not compiled to C: Newton iterations use
 #: finite differences of the compiled right-hand side instead (an N = 128 chain's exact
@@ -31,7 +31,7 @@ class System:
         self.model = model
         self.topology = model.validate()
         self.asm = asm = assemble(model, self.topology)
-        self.eq = eq = formulate(asm, self.topology, self.parameter_values(), loops,
+        self.eq = eq = formulate(asm, self.topology, model.parameter_values(), loops,
                                  BAUMGARTE_RATE if baumgarte_rate is None else baumgarte_rate)
         self.param_names = asm.param_names
         self.coordinate_names = asm.coordinate_names
@@ -75,21 +75,16 @@ class System:
             return X
         key = ("polish", len(X))
         if key not in self._compiled:
-            x, z, a = self._x, self._z, self.asm
-            znew = z
-            for _ in range(3):
-                alg = ca.substitute(self.eq.alg, z, znew)
-                znew = znew - ca.solve(ca.substitute(ca.jacobian(self.eq.alg, z), z, znew), alg)
-            f = ca.Function("polish", [ca.vertcat(x, z), a.p], [znew])
-            self._compiled[key] = f.map(len(X))
+            if "polish" not in self._compiled:
+                self._compiled["polish"] = ca.Function(
+                    "polish", [ca.vertcat(self._x, self._z), self.asm.p],
+                    [newton(self.eq.alg, self._z)])
+            self._compiled[key] = self._compiled["polish"].map(len(X))
         Z = np.asarray(self._compiled[key](np.asarray(X).T, p)).T
         out = np.array(X, dtype=float)
         ok = np.all(np.isfinite(Z), axis=1)
         out[ok, self.n_states:] = Z[ok]
         return out
-
-    def parameter_values(self):
-        return self.model.parameter_values(None)
 
     @property
     def dof(self):
@@ -102,8 +97,8 @@ class System:
 
     @property
     def formulation(self):
-        """"tree" (no loops), "partition" or "baumgarte"; ``formulation_note`` says why the
-        state count is what it is."""
+        """"tree" (no loops), "partition", "projected" or "baumgarte"; ``formulation_note``
+        says why the state count is what it is."""
         return self.eq.formulation
 
     @property
@@ -120,8 +115,8 @@ class System:
             self._f_residual = ca.Function("residual", [ca.vertcat(self._x, self._z),
                                                         self.asm.p],
                                            [ca.norm_inf(self.eq.residual)])
-        p = self.param_vector(params)
-        return np.array([float(self._f_residual(row, p)) for row in X])
+        out = self._f_residual.map(len(X))(X.T, self.param_vector(params))
+        return np.asarray(out).ravel()
 
     # -- parameters -----------------------------------------------------------------------
     def param_vector(self, params=None):
