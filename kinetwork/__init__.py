@@ -4,7 +4,7 @@ Wire components into a :class:`Model`, compile it to a :class:`System` of minima
 coordinates, :func:`simulate` it and read the probes from the :class:`Results`.
 """
 
-from .components import multibody, rotational, translational
+from .components import multibody, rotational, signals, translational
 from .components.probe import Probe
 from .errors import ModelError, SimulationError
 from .graph.io import dumps, load, loads
@@ -16,4 +16,5 @@ from .solver.system import System
 __version__ = "0.1.0"
 
 __all__ = ["METHODS", "Model", "ModelError", "Probe", "Results", "SimulationError", "System",
-           "dumps", "load", "loads", "multibody", "rotational", "simulate", "translational"]
+           "dumps", "load", "loads", "multibody", "rotational", "signals", "simulate",
+           "translational"]

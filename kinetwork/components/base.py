@@ -100,7 +100,7 @@ class Param:
 
     A value is a number, or a string expression in model parameters (and in time ``t`` where
     ``time=True``); ``shape`` (3,) takes three of those, (3, 3) a matrix or its diagonal.
-    ``kind`` "bool" and "names" take a flag and a list of strings.
+    ``kind`` "bool" and "names" take a flag and a list of strings, "table" rows [x, y].
     """
 
     def __init__(self, default=REQUIRED, *, unit="", min=None, max=None, shape=(), doc="",
@@ -140,6 +140,8 @@ class Param:
             if not isinstance(value, bool):
                 raise ModelError(f"{where}: must be true or false, got {value!r}")
             return value
+        if self.kind == "table":
+            return _table(value, where)
         if self.kind == "names":
             if not isinstance(value, (list, tuple)) or not all(isinstance(v, str) for v in value):
                 raise ModelError(f"{where}: must be a list of names, got {value!r}")
@@ -210,6 +212,24 @@ class Param:
             raise ModelError(f"{where} = {number}{unit}: must be >= {self.min}")
         if self.max is not None and number > self.max:
             raise ModelError(f"{where} = {number}{unit}: must be <= {self.max}")
+
+
+def _table(value, where):
+    """Rows [x, y] of numbers, x strictly increasing, at least two."""
+    if isinstance(value, np.ndarray):
+        value = value.tolist()
+    if not isinstance(value, (list, tuple)) or len(value) < 2:
+        raise ModelError(f"{where}: must be a table of at least two rows [x, y], got {value!r}")
+    rows = []
+    for i, row in enumerate(value):
+        if not isinstance(row, (list, tuple)) or len(row) != 2:
+            raise ModelError(f"{where}[{i}]: must be a row [x, y], got {row!r}")
+        rows.append([check_number(v, f"{where}[{i}][{j}]") for j, v in enumerate(row)])
+    for i in range(1, len(rows)):
+        if rows[i][0] <= rows[i - 1][0]:
+            raise ModelError(f"{where}[{i}]: x must increase, got {rows[i][0]} after "
+                             f"{rows[i - 1][0]}")
+    return rows
 
 
 class Component:

@@ -48,10 +48,12 @@ class PartialDamper(PartialCompliant):
 
 
 class PartialSource(Component):
-    """A flow source: applies ``amount`` to flange; its reaction goes to support, if wired."""
+    """A flow source: applies ``amount``, or the signal at ``u`` when it is wired, to flange;
+    its reaction goes to support, if wired."""
     role = "source"
     flange = Port(ONED, "Flange driven by the source")
     support = Port(ONED, "Reaction flange (unwired: the world)", optional=True)
+    u = Port("signal_in", "Signal giving the amount (instead of the parameter)", optional=True)
 
     def flows(self, pos, vel, t):
         return {"flange": -self.amount, "support": self.amount}
@@ -64,3 +66,54 @@ class PartialFixed(Component):
 
     def position(self):
         return self.position0
+
+
+class PartialRigid(Component):
+    """A rigid 1-D element: its two flanges move together, position(a) = ratio * position(b).
+
+    Rigid elements join connection sets into rigid groups that share one coordinate
+    (``kinetwork.graph.topology``); an inertia adds ``inertia()`` to its group.
+    """
+    role = "rigid"
+    flange_a = Port(ONED, "Flange a")
+    flange_b = Port(ONED, "Flange b")
+    has_inertia = False
+
+    def ratio(self):
+        return 1.0
+
+    def inertia(self):
+        return 0.0
+
+
+class PartialInertia(PartialRigid):
+    """A rigid 1-D inertia (rotor or sliding mass) between two flanges; either may stay
+    unwired."""
+    flange_a = Port(ONED, "Flange a", optional=True)
+    flange_b = Port(ONED, "Flange b", optional=True)
+    has_inertia = True
+
+    def inertia(self):
+        return self.amount
+
+
+class PartialSensor(Component):
+    """Turns a quantity of the flange it is wired to into a signal ``y``."""
+    role = "sensor"
+    flange = Port(ONED, "Flange measured")
+    y = Port("signal_out", "Measured quantity", optional=True)
+    quantity = None           # "position", "speed" or "acceleration"
+
+
+class PartialFlowSensor(PartialRigid):
+    """Measures the flow through it (into flange_a) as a signal ``y``; rigid, massless."""
+    y = Port("signal_out", "Flow through the sensor, into flange_a", optional=True)
+    quantity = "flow"
+
+
+class PartialMotion(Component):
+    """Prescribes the position of its flange as a function of time (the reaction, through
+    the optional support, rests in the world)."""
+    role = "prescribed"
+    flange = Port(ONED, "Flange moved")
+    support = Port(ONED, "Reaction flange (unwired: the world)", optional=True)

@@ -11,6 +11,8 @@ QUANTITIES = {
     "frame": {"position": "m", "velocity": "m/s", "acceleration": "m/s^2",
               "orientation": "", "angular_velocity": "rad/s",
               "angular_acceleration": "rad/s^2", "force": "N", "torque": "N*m"},
+    "signal_in": {"value": ""},
+    "signal_out": {"value": ""},
 }
 _ALL = sorted({q for qs in QUANTITIES.values() for q in qs})
 

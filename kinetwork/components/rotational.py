@@ -1,7 +1,8 @@
 """1-D rotational library: angle phi [rad] and torque tau [N*m] on flanges."""
 
-from .base import Param
-from .oned import (PartialDamper, PartialFixed, PartialSource, PartialSpring,
+from .base import Param, Port
+from .oned import (PartialDamper, PartialFixed, PartialFlowSensor, PartialInertia,
+                   PartialMotion, PartialRigid, PartialSensor, PartialSource, PartialSpring,
                    PartialSpringDamper)
 
 LIB = "rotational"
@@ -31,10 +32,74 @@ class Damper(PartialDamper, library=LIB):
 class Torque(PartialSource, library=LIB):
     """Torque source: a constant or an expression in time t and model parameters."""
     domain = LIB
-    amount = Param(unit="N*m", time=True, name="tau", doc="Torque applied to flange")
+    amount = Param(0.0, unit="N*m", time=True, name="tau",
+                   doc="Torque applied to flange (when u is not wired)")
 
 
 class Fixed(PartialFixed, library=LIB):
     """Flange fixed at an angle in the world."""
     domain = LIB
     position0 = Param(0.0, unit="rad", name="phi0", doc="Fixed angle")
+
+
+class Inertia(PartialInertia, library=LIB):
+    """A rigid rotor between flange_a and flange_b. Rigidly coupled to a joint axis
+    (directly or through gears) it adds to the joint's inertia and costs no state; free, it has
+    its own angle and speed."""
+    domain = LIB
+    amount = Param(unit="kg*m^2", min=0.0, name="J", doc="Moment of inertia")
+    position0 = Param(None, optional=True, unit="rad", name="phi0",
+                      doc="Initial angle when the inertia moves freely (None: 0)")
+    speed0 = Param(None, optional=True, unit="rad/s", name="w0",
+                   doc="Initial speed when the inertia moves freely (None: 0)")
+
+
+class AngleSensor(PartialSensor, library=LIB):
+    """The angle of the flange as a signal."""
+    domain = LIB
+    quantity = "position"
+
+
+class SpeedSensor(PartialSensor, library=LIB):
+    """The speed of the flange as a signal [rad/s]."""
+    domain = LIB
+    quantity = "speed"
+
+
+class AccSensor(PartialSensor, library=LIB):
+    """The acceleration of the flange as a signal [rad/s^2]."""
+    domain = LIB
+    quantity = "acceleration"
+
+
+class TorqueSensor(PartialFlowSensor, library=LIB):
+    """The torque through the sensor (into flange_a) as a signal; wire it in series."""
+    domain = LIB
+
+
+class Position(PartialMotion, library=LIB):
+    """Moves its flange to phi_ref(t), an expression in time and model parameters."""
+    domain = LIB
+    reference = Param(unit="rad", time=True, name="phi_ref", doc="Prescribed angle")
+
+    def motion(self, t):
+        return self.reference
+
+
+class Speed(PartialMotion, library=LIB):
+    """Moves its flange at w_ref(t) from phi0 (the angle is integrated)."""
+    domain = LIB
+    reference = Param(unit="rad/s", time=True, name="w_ref", doc="Prescribed speed")
+    position0 = Param(0.0, unit="rad", name="phi0", doc="Initial angle")
+
+
+class IdealGear(PartialRigid, library=LIB):
+    """A lossless gear: flange_a turns ``ratio`` times as far as flange_b (Modelica's
+    convention), and flange_b's torque is ``ratio`` times flange_a's; the reaction rests in the
+    world (or on the support, when wired)."""
+    domain = LIB
+    support = Port("1d", "Reaction flange (unwired: the world)", optional=True)
+    gear_ratio = Param(unit="", name="ratio", doc="flange_a angle / flange_b angle")
+
+    def ratio(self):
+        return self.gear_ratio

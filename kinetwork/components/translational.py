@@ -1,7 +1,8 @@
 """1-D translational library: position s [m] and force f [N] on flanges."""
 
 from .base import Param
-from .oned import (PartialDamper, PartialFixed, PartialSource, PartialSpring,
+from .oned import (PartialDamper, PartialFixed, PartialFlowSensor, PartialInertia,
+                   PartialMotion, PartialSensor, PartialSource, PartialSpring,
                    PartialSpringDamper)
 
 LIB = "translational"
@@ -31,10 +32,62 @@ class Damper(PartialDamper, library=LIB):
 class Force(PartialSource, library=LIB):
     """Force source: a constant or an expression in time t and model parameters."""
     domain = LIB
-    amount = Param(unit="N", time=True, name="f", doc="Force applied to flange")
+    amount = Param(0.0, unit="N", time=True, name="f",
+                   doc="Force applied to flange (when u is not wired)")
 
 
 class Fixed(PartialFixed, library=LIB):
     """Flange fixed at a position in the world."""
     domain = LIB
     position0 = Param(0.0, unit="m", name="s0", doc="Fixed position")
+
+
+class Mass(PartialInertia, library=LIB):
+    """A rigid sliding mass between flange_a and flange_b. Rigidly coupled to a joint axis
+    (directly or through gears) it adds to the joint's inertia and costs no state; free, it has
+    its own position and speed."""
+    domain = LIB
+    amount = Param(unit="kg", min=0.0, name="m", doc="Mass")
+    position0 = Param(None, optional=True, unit="m", name="s0",
+                      doc="Initial position when the inertia moves freely (None: 0)")
+    speed0 = Param(None, optional=True, unit="m/s", name="v0",
+                   doc="Initial speed when the inertia moves freely (None: 0)")
+
+
+class PositionSensor(PartialSensor, library=LIB):
+    """The position of the flange as a signal."""
+    domain = LIB
+    quantity = "position"
+
+
+class SpeedSensor(PartialSensor, library=LIB):
+    """The speed of the flange as a signal [m/s]."""
+    domain = LIB
+    quantity = "speed"
+
+
+class AccSensor(PartialSensor, library=LIB):
+    """The acceleration of the flange as a signal [m/s^2]."""
+    domain = LIB
+    quantity = "acceleration"
+
+
+class ForceSensor(PartialFlowSensor, library=LIB):
+    """The force through the sensor (into flange_a) as a signal; wire it in series."""
+    domain = LIB
+
+
+class Position(PartialMotion, library=LIB):
+    """Moves its flange to s_ref(t), an expression in time and model parameters."""
+    domain = LIB
+    reference = Param(unit="m", time=True, name="s_ref", doc="Prescribed position")
+
+    def motion(self, t):
+        return self.reference
+
+
+class Speed(PartialMotion, library=LIB):
+    """Moves its flange at v_ref(t) from s0 (the position is integrated)."""
+    domain = LIB
+    reference = Param(unit="m/s", time=True, name="v_ref", doc="Prescribed speed")
+    position0 = Param(0.0, unit="m", name="s0", doc="Initial position")

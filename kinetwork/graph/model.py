@@ -71,7 +71,8 @@ class Model:
         if pa == pb:
             raise ModelError(f"cannot connect {pa.path} to itself")
         da, db = pa.domain, pb.domain
-        if da != db and ANY not in (da, db):
+        signals = {da, db} <= {"signal_in", "signal_out"}
+        if da != db and ANY not in (da, db) and not signals:
             raise ModelError(f"cannot connect {pa.path} ({da}) to {pb.path} ({db}): "
                              f"ports of different domains")
         if len(self._wired) != len(self.connections):     # the list was edited by hand

@@ -16,6 +16,7 @@ from ..components.probe import QUANTITIES
 from ..errors import ModelError
 
 ONED_DOMAINS = ("rotational", "translational")
+SIGNAL_DOMAINS = ("signal_in", "signal_out")
 
 
 @dataclass
@@ -37,12 +38,22 @@ class Cut:
 
 
 @dataclass
-class OneDSet:
-    """A 1-D connection set: its ports and the port that sets its position."""
+class OneDGroup:
+    """1-D connection sets moving as one through rigid elements (inertias, gears).
+
+    ``sets`` lists (set, parent set, rigid element) breadth-first from the root, the set of
+    the ``definer`` when there is one. ``kind`` says what gives the group its position:
+    "joint" (a joint's coordinate), "fixed" (a Fixed or a support), "prescribed" (a motion
+    source), "free" (nothing: it has inertia, so its own coordinate and speed) or
+    "massless" (nothing, and no inertia: solved from the balance of its flows).
+    """
     index: int
     domain: str
+    sets: list
     ports: list
-    definer: object = None    # PortRef of a joint flange or Fixed, or None
+    definer: object = None
+    kind: str = "massless"
+    rigid: list = field(default_factory=list)
 
 
 @dataclass
@@ -55,11 +66,12 @@ class Topology:
     tree: list = field(default_factory=list)      # Edge, parents before children
     joints: list = field(default_factory=list)    # joints with coordinates, model order
     bodies: list = field(default_factory=list)    # (RigidBody, frame set)
-    oned: list = field(default_factory=list)      # OneDSet
+    oned: list = field(default_factory=list)      # OneDGroup
     probes: list = field(default_factory=list)    # (Probe, target PortRef)
     loops: list = field(default_factory=list)     # lists of component names
     cuts: list = field(default_factory=list)      # Cut, one per independent loop
     forces: list = field(default_factory=list)    # frame force elements (line, world)
+    signal_source: dict = field(default_factory=dict)   # signal set -> its output PortRef
 
     @property
     def dof(self):
@@ -111,6 +123,7 @@ def analyze(model):
                     root=set_of[world.port_ref("frame")], probes=probes)
     _tree(model, topo, roles, problems)
     _oned(model, topo, values, problems)
+    _signals(topo, problems)
     if problems:
         raise ModelError(problems)
     return topo
@@ -225,42 +238,113 @@ def _tree(model, topo, roles, problems):
 
 
 def _oned(model, topo, values, problems):
-    """Each 1-D set with force elements needs exactly one port that sets its position."""
+    """1-D connection sets joined by rigid elements (inertias, gears, flow sensors) into rigid
+    groups (networkx connected components); each group has at most one port that sets its
+    position: a joint flange, a support, a Fixed or a prescribed motion."""
     tree_joints = {j.name for j in topo.joints}
+    rigid = nx.MultiGraph()
     for index, ports in enumerate(topo.sets):
-        domain = ports[0].domain
-        if domain not in ONED_DOMAINS:
-            continue
-        physical = [p for p in ports if p.component.role != "probe"]
-        definers = [p for p in physical if _defines(p)]
-        oned = OneDSet(index, domain, physical)
+        if _domain(ports) in ONED_DOMAINS:
+            rigid.add_node(index)
+    for comp in model.components.values():
+        if comp.role == "rigid":
+            a = topo.set_of[comp.port_ref("flange_a")]
+            b = topo.set_of[comp.port_ref("flange_b")]
+            rigid.add_edge(a, b, key=comp.name, component=comp)
+    for members in sorted(nx.connected_components(rigid), key=min):
+        sub = rigid.subgraph(members)
+        ports = [p for s in sorted(members) for p in topo.sets[s]
+                 if p.component.role != "probe"]
+        domain = _domain(topo.sets[min(members)])
+        definers = [p for p in ports if _defines(p)]
+        where = "{" + ", ".join(p.path for p in ports) + "}"
+        elements = sorted({d["component"].name for _, _, d in sub.edges(data=True)})
         coords = [p for p in definers if p.name in p.component.coordinate_ports]
-        if coords and len(definers) > 1:
-            problems.append(f"connection set {{{', '.join(p.path for p in physical)}}} rigidly "
-                            f"ties joint flange {coords[0].path} to "
-                            f"{', '.join(p.path for p in definers if p != coords[0])}: this "
-                            f"locks or couples joints, which is not supported yet")
+        motions = [p for p in definers if p.component.role == "prescribed"]
+        if len(definers) > 1 and (coords or motions):
+            first = (coords or motions)[0]
+            what = "joint flange" if coords else "prescribed motion"
+            problems.append(f"connection set {where} rigidly ties {what} {first.path} to "
+                            f"{', '.join(p.path for p in definers if p != first)}"
+                            + (f" (through {', '.join(elements)})" if elements else "")
+                            + ": this locks or couples joints, which is not supported yet"
+                            if coords else f": two motions of one rigid group")
         elif len(definers) > 1 and values is not None:
-            positions = {p.path: _fixed_position(p, values) for p in definers}
-            if len(set(positions.values())) > 1:
-                problems.append(f"connection set {{{', '.join(p.path for p in physical)}}} "
-                                f"holds fixed flanges at different positions: {positions}")
-        if not definers and len(physical) > 1:
-            problems.append(f"connection set {{{', '.join(p.path for p in physical)}}} has no "
-                            f"defined {domain} position: wire it to a joint flange or a Fixed")
+            spots = {p.path: (topo.set_of[p], _fixed_position(p, values)) for p in definers}
+            if len(set(spots.values())) > 1:
+                problems.append(f"connection set {where} holds fixed flanges at different "
+                                f"positions: "
+                                + str({k: v[1] for k, v in spots.items()})
+                                + (f" (through {', '.join(elements)})" if elements else ""))
+        cycles = nx.cycle_basis(nx.Graph(sub)) if sub.number_of_edges() else []
+        parallel = [sorted(sub.get_edge_data(u, v)) for u, v in {(u, v) for u, v, _ in
+                                                                 sub.edges(keys=True)}
+                    if len(sub.get_edge_data(u, v)) > 1]
+        if cycles or parallel:
+            names = parallel[0] if parallel else sorted({
+                sub.get_edge_data(u, v)[next(iter(sub.get_edge_data(u, v)))]["component"].name
+                for cyc in cycles[:1] for u, v in zip(cyc, cyc[1:] + cyc[:1])})
+            problems.append(f"rigid 1-D elements {', '.join(names)} form a closed loop "
+                            f"(they tie flanges together twice): remove one")
         for p in coords:
             if p.component.name not in tree_joints:
                 problems.append(f"{p.path}: joint {p.component.name!r} has no coordinates "
                                 f"here, so its flange cannot be used")
-        oned.definer = definers[0] if definers else None
-        topo.oned.append(oned)
+        inertias = [d["component"] for _, _, d in sub.edges(data=True)
+                    if d["component"].has_inertia]
+        kind = ("joint" if coords else "prescribed" if motions else
+                "fixed" if definers else "free" if inertias else
+                "world" if len(ports) <= 1 else "massless")
+        if kind == "massless" and not any(p.component.role == "compliant" for p in ports):
+            problems.append(f"connection set {where} has no defined {domain} position: it "
+                            f"has no inertia, spring or damper, so the flows on it cannot "
+                            f"balance; wire it to a joint flange, a Fixed or an inertia")
+        topo.oned.append(OneDGroup(len(topo.oned), domain, _rooted(sub, members, definers,
+                                                                    topo), ports,
+                                   definers[0] if definers else None, kind,
+                                   [d["component"] for _, _, d in sub.edges(data=True)]))
+
+
+def _domain(ports):
+    """The domain of a connection set: that of its first port that is not a probe's."""
+    return next((p.domain for p in ports if p.component.role != "probe"), ports[0].domain)
+
+
+def _signals(topo, problems):
+    """Each signal connection set has one output and any number of inputs."""
+    for index, ports in enumerate(topo.sets):
+        physical = [p for p in ports if p.component.role != "probe"]
+        if _domain(ports) not in SIGNAL_DOMAINS or not physical:
+            continue
+        outs = [p for p in physical if p.domain == "signal_out"]
+        ins = [p for p in physical if p.domain == "signal_in"]
+        if len(outs) > 1:
+            problems.append(f"signal outputs {', '.join(p.path for p in outs)} are wired "
+                            f"together: a signal has exactly one source")
+        elif ins and not outs and len(physical) > 1:
+            problems.append(f"signal inputs {', '.join(p.path for p in ins)} are wired to "
+                            f"each other but to no output")
+        if outs:
+            topo.signal_source[index] = outs[0]
+
+
+def _rooted(sub, members, definers, topo):
+    """The group's sets, the definer's first, each with (parent set, rigid element) of the
+    breadth-first tree over the rigid elements."""
+    root = topo.set_of[definers[0]] if definers else min(members)
+    order = [(root, None, None)]
+    for parent, child in nx.bfs_edges(nx.Graph(sub), root):
+        data = next(iter(sub.get_edge_data(parent, child).values()))
+        order.append((child, parent, data["component"]))
+    return order
 
 
 def _defines(ref):
     comp = ref.component
     return (ref.name in comp.coordinate_ports
             or ref.name in comp.zero_ports
-            or comp.role == "fixed")
+            or comp.role == "fixed"
+            or (comp.role == "prescribed" and ref.name == "flange"))
 
 
 def _fixed_position(ref, values):

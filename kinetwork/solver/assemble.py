@@ -14,6 +14,7 @@ import casadi as ca
 from ..components.probe import QUANTITIES
 from ..expr import Expression, casadi_functions
 from ..spatial import vec3, vee
+from . import network
 from .newton_euler import Body, aba, crba, rnea, spatial_inertia
 
 
@@ -51,6 +52,8 @@ class Assembly:
     signals: list = field(default_factory=list)   # (name, unit, SX expression in t,q,qd,qdd,p)
     qdd_sym: ca.SX = None      # placeholder for qdd inside signal expressions
     lam_sym: ca.SX = None      # placeholder for the loops' multipliers (one per closure row)
+    armature: ca.SX = None     # 1-D inertia geared rigidly to each speed
+    net: object = None         # the 1-D network and signal blocks (network.Network)
     qindex: dict = None        # joint name -> indices of its coordinates in q
     uindex: dict = None        # joint name -> indices of its speeds in qd
     Q_drive: ca.SX = None      # the part of Q that 1-D flanges apply (drives, springs)
@@ -58,14 +61,14 @@ class Assembly:
     base: tuple = None         # world pose of the body of the last ``relative_poses``
 
     def mass_matrix(self):
-        return crba(self.bodies, self.qd.shape[0])
+        return crba(self.bodies, self.qd.shape[0], self.armature)
 
     def terms(self):
         """(M, V, G) with M qdd + V + G = 0: V holds Coriolis, centripetal and -Q."""
         n = self.qd.shape[0]
         a_grav = ca.vertcat(ca.SX.zeros(3), -self.gravity)
         zero = ca.SX.zeros(n)
-        C = rnea(self.bodies, self.qd, zero, ca.SX.zeros(6))
+        C = rnea(self.bodies, self.qd, zero, ca.SX.zeros(6))       # qdd = 0: no armature
         G = rnea(self.bodies, zero, zero, a_grav)
         return self.mass_matrix(), C - self.Q, G
 
@@ -152,11 +155,8 @@ def assemble(model, topo):
                                                           qd[uindex[joint.name]])
 
     bodies, place = _bodies(topo, bound, q, qd, qindex, uindex)
-    pos, vel, acc, flow = _network(model, topo, bound, q, qd, qdd_sym, qindex, uindex, t)
-    Q = ca.SX.zeros(n)
-    for joint in topo.joints:
-        for pname, j in joint.coordinate_ports.items():
-            Q[uindex[joint.name][j]] = flow.get(joint.port_ref(pname), 0)
+    net = network.build(model, topo, bound, q, qd, qdd_sym, qindex, uindex, t)
+    Q = net.Q
 
     world = bound[topo.world.name]
     gravity = ca.vertcat(*world.gravity)
@@ -172,13 +172,15 @@ def assemble(model, topo):
                    bodies, ca.vertcat(*starts) if starts else ca.SX(0, 1),
                    ca.vertcat(*u_start) if u_start else ca.SX(0, 1), given, u_given, regular,
                    speed_of, Q, None, qdot, gravity, place=place, qdd_sym=qdd_sym)
+    asm.armature, asm.net = net.armature, net
     asm.Q = Q + _frame_forces(asm, topo, bound, t)
-    asm.qdd = aba(bodies, qd, asm.Q, ca.vertcat(ca.SX.zeros(3), -gravity)) if n else ca.SX(0, 1)
+    asm.qdd = aba(bodies, qd, asm.Q, ca.vertcat(ca.SX.zeros(3), -gravity), net.armature) \
+        if n else ca.SX(0, 1)
     asm.cuts = [(cut, _closure(asm, cut, bound[cut.component.name], qindex))
                 for cut in topo.cuts]
     asm.lam_sym = ca.SX.sym("lambda", sum(r.shape[0] for _, r in asm.cuts))
-    asm.qindex, asm.uindex, asm.Q_drive = qindex, uindex, Q
-    _probes(asm, topo, pos, vel, acc, flow, bound)
+    asm.qindex, asm.uindex, asm.Q_drive = qindex, uindex, net.axis_flow
+    _probes(asm, topo, net, bound)
     return asm
 
 
@@ -299,36 +301,6 @@ def closure_rows(comp, Ra, pa, Rb, pb, qj):
     return ca.vertcat(rel_p - pc, ca.vec(Rc.T @ rel_R - ca.SX.eye(3)))
 
 
-def _network(model, topo, bound, q, qd, qdd_sym, qindex, uindex, t):
-    """1-D network: position, speed, acceleration of every port, and the flow into it."""
-    pos, vel, acc = {}, {}, {}
-    for s in topo.oned:
-        triple = (0, 0, 0)                     # an optional flange wired to nothing: world
-        if s.definer is not None:
-            comp = bound[s.definer.component.name]
-            if s.definer.name in comp.coordinate_ports:
-                j = comp.coordinate_ports[s.definer.name]
-                i, k = qindex[comp.name][j], uindex[comp.name][j]
-                triple = (q[i], qd[k], qdd_sym[k])
-            elif comp.role == "fixed":
-                triple = (comp.position(), 0, 0)
-        for ref in topo.sets[s.index]:
-            pos[ref], vel[ref], acc[ref] = triple
-    flow = {}
-    for comp in model.components.values():
-        if comp.role in ("compliant", "source"):
-            refs = {pn: comp.port_ref(pn) for pn in comp.ports}
-            out = bound[comp.name].flows({pn: pos.get(r, 0) for pn, r in refs.items()},
-                                         {pn: vel.get(r, 0) for pn, r in refs.items()}, t)
-            for pn, f in out.items():
-                flow[refs[pn]] = f
-    for s in topo.oned:        # the defining port takes what the rest sends (sum is zero)
-        if s.definer is not None:
-            flow[s.definer] = -sum((flow.get(r, 0) for r in s.ports if r != s.definer),
-                                   ca.SX(0))
-    return pos, vel, acc, flow
-
-
 def _symbolic(value, env, funcs):
     """A normalized parameter value as CasADi SX (lists stay lists of SX)."""
     if isinstance(value, list):
@@ -340,15 +312,18 @@ def _symbolic(value, env, funcs):
     return value
 
 
-def _probes(asm, topo, pos, vel, acc, flow, bound):
+def _probes(asm, topo, net, bound):
     for probe, target in topo.probes:
         units = QUANTITIES[target.domain]
         asked = probe.quantities if probe.quantities is not None else list(units)
         if target.domain == "frame":
             values = _frame_quantities(asm, topo, target, asked, bound)
+        elif target.domain in ("signal_in", "signal_out"):
+            values = {"value": net.signal.get(topo.set_of[target], ca.SX.nan())}
         else:
-            potential = dict(zip(list(units)[:3], (pos[target], vel[target], acc[target])))
-            values = {**potential, list(units)[3]: flow.get(target, 0)}
+            potential = dict(zip(list(units)[:3], (net.pos[target], net.vel[target],
+                                                   net.acc[target])))
+            values = {**potential, list(units)[3]: net.flow.get(target, 0)}
         for quantity in asked:
             asm.signals.append((f"{probe.name}.{quantity}", units[quantity],
                                 ca.SX(values[quantity])))

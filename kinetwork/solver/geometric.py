@@ -37,7 +37,7 @@ class Midpoint:
         zero, w = ca.SX.zeros(n), ca.SX.sym("w", n)
         a_grav = ca.vertcat(ca.SX.zeros(3), -a.gravity)
         # M(q) w by RNEA with no speed and no gravity; M(q) qd and its rate by differentiation
-        Mw = ca.substitute(rnea(a.bodies, zero, w, ca.SX.zeros(6)), a.qd, zero)
+        Mw = ca.substitute(rnea(a.bodies, zero, w, ca.SX.zeros(6), a.armature), a.qd, zero)
         Mqd = ca.substitute(Mw, w, a.qd)
         Mdot_qd = ca.substitute(ca.jtimes(Mw, a.q, a.qd), w, a.qd)
         fp = Mdot_qd - rnea(a.bodies, a.qd, zero, a_grav) + a.Q
@@ -47,7 +47,8 @@ class Midpoint:
         # qd = M(q)^-1 p by the articulated-body algorithm (p as the joint forces, no speed,
         # no gravity): O(n), no mass matrix
         f_vel = ca.Function("velocity", [a.q, w, a.p],
-                            [ca.substitute(aba(a.bodies, zero, w, ca.SX.zeros(6)), a.qd, zero)])
+                            [ca.substitute(aba(a.bodies, zero, w, ca.SX.zeros(6), a.armature),
+                                           a.qd, zero)])
 
         v, q0, p0 = ca.SX.sym("v", n), ca.SX.sym("q0", n), ca.SX.sym("p0", n)
         t0, h, par = ca.SX.sym("t0"), ca.SX.sym("h"), ca.SX.sym("par", a.p.shape[0])

@@ -81,7 +81,30 @@ class Equations:
 
 def formulate(asm, topo, values, formulation="partition", rate=BAUMGARTE_RATE):
     """The Equations of an assembled model; ``values`` are the model's parameter values,
-    at which loops are analysed (rows kept, speeds partitioned)."""
+    at which loops are analysed (rows kept, speeds partitioned). The states of the 1-D
+    network and the signal blocks (free rotors, controller integrals) follow the mechanism's.
+    """
+    eq = _mechanism(asm, topo, values, formulation, rate)
+    net = asm.net
+    if net is None or not net.x:
+        return eq
+    q = asm.q if eq.q is None else eq.q
+    rates = ca.substitute(ca.vertcat(*net.rate), ca.vertcat(asm.q, asm.qd, asm.qdd_sym),
+                          ca.vertcat(q, eq.u, eq.udot))
+    eq.x, eq.ode = ca.vertcat(eq.x, *net.x), ca.vertcat(eq.ode, rates)
+    eq.state_names = eq.state_names + net.names
+    eq.state_units = eq.state_units + net.units
+    start = ca.Function("start_network", [asm.p], [ca.vertcat(*[ca.SX(s) for s in net.start])])
+    mechanism = eq.initial
+
+    def initial(p):
+        x0, z0 = mechanism(p)
+        return np.concatenate([x0, np.asarray(start(p), dtype=float).ravel()]), z0
+    eq.initial = initial
+    return eq
+
+
+def _mechanism(asm, topo, values, formulation, rate):
     if formulation not in FORMULATIONS:
         raise ModelError(f"loops={formulation!r}: unknown formulation; choose from "
                          f"{', '.join(FORMULATIONS)}")
@@ -278,7 +301,7 @@ class _Loops:
         if dep:
             g[dep] = -ca.solve(JD, c)
         a_grav = ca.vertcat(ca.SX.zeros(3), -asm.gravity)
-        M = crba(asm.bodies, nv)
+        M = crba(asm.bodies, nv, asm.armature)
         bias = rnea(asm.bodies, u, ca.SX.zeros(nv), a_grav) - asm.Q
         Mr = T.T @ M @ T
         udot_i = ca.solve(Mr, -T.T @ (bias + M @ g))

@@ -62,8 +62,12 @@ def _solve(D, b):
     return b / D if D.shape == (1, 1) else ca.solve(D, b)
 
 
-def aba(bodies, qd, tau, a0):
-    """Articulated-body algorithm: joint accelerations qdd, O(n) in the number of bodies."""
+def aba(bodies, qd, tau, a0, armature=None):
+    """Articulated-body algorithm: joint accelerations qdd, O(n) in the number of bodies.
+
+    ``armature`` (one per speed) is 1-D inertia rigidly geared to a joint coordinate (a
+    motor's rotor): it adds to D, the joint-space inertia of its joint, and nowhere else.
+    """
     n = len(bodies)
     X = [b.X for b in bodies]
     v, c, IA, pA = [None] * n, [None] * n, [None] * n, [None] * n
@@ -78,6 +82,8 @@ def aba(bodies, qd, tau, a0):
         b = bodies[k]
         U[k] = IA[k] @ b.S
         D[k] = b.S.T @ U[k]
+        if armature is not None:
+            D[k] = D[k] + ca.diag(armature[b.index])
         u[k] = tau[b.index] - b.S.T @ pA[k]
         if b.parent >= 0:
             Ia = IA[k] - U[k] @ _solve(D[k], U[k].T)
@@ -94,8 +100,9 @@ def aba(bodies, qd, tau, a0):
     return qdd
 
 
-def crba(bodies, n_q):
-    """Composite-rigid-body algorithm: the joint-space mass matrix M(q)."""
+def crba(bodies, n_q, armature=None):
+    """Composite-rigid-body algorithm: the joint-space mass matrix M(q) (plus ``armature``
+    on the diagonal)."""
     X = [b.X for b in bodies]
     IC = [b.inertia for b in bodies]
     for k in reversed(range(len(bodies))):
@@ -113,11 +120,12 @@ def crba(bodies, n_q):
             block = F.T @ bodies[j].S
             M[b.index, bodies[j].index] = block
             M[bodies[j].index, b.index] = block.T
-    return M
+    return M if armature is None else M + ca.diag(armature)
 
 
-def rnea(bodies, qd, qdd, a0):
-    """Inverse dynamics: generalized forces that produce qdd at (q, qd) (outward, inward)."""
+def rnea(bodies, qd, qdd, a0, armature=None):
+    """Inverse dynamics: generalized forces that produce qdd at (q, qd) (outward, inward),
+    with ``armature`` times qdd on each speed."""
     n = len(bodies)
     X = [b.X for b in bodies]
     v, a, f = [None] * n, [None] * n, [None] * n
@@ -133,4 +141,4 @@ def rnea(bodies, qd, qdd, a0):
         tau[b.index] = b.S.T @ f[k]
         if b.parent >= 0:
             f[b.parent] = f[b.parent] + X[k].T @ f[k]
-    return tau
+    return tau if armature is None else tau + armature * qdd

@@ -1,0 +1,373 @@
+"""The 1-D mechanical networks and the signal blocks, as SX expressions.
+
+Structure first (the rigid groups of ``kinetwork.graph.topology``): every rigid group shares
+one coordinate theta, and each of its connection sets sits at k * theta, k the product of
+the gear ratios on the way from the group's root (alias elimination: one variable for all the
+flanges a rigid chain ties together). What the group's coordinate is follows from its kind:
+
+- "joint": the joint coordinate; the group's inertia sum(J k^2) is added to the joint's
+  diagonal of the mass matrix (its armature): exact, and no state;
+- "fixed" / "world": a constant; "prescribed": a function of time (Position), or its
+  integral (Speed, one state);
+- "free": a coordinate and a speed of its own (a rotor behind a flexible coupling):
+  J theta'' = the generalized force of the elements on it;
+- "massless": no inertia, so the flows on it balance at every instant: solved symbolically
+  for the speed (a damper on it: one first-order state) or for the position (springs only:
+  no state), the balance being linear in them.
+
+Signals are causal: each block's output is an expression of its inputs, states and time. The
+dependency graph (networkx) of blocks, sensors and the mechanics (sources drive it,
+acceleration and flow sensors read it) is sorted topologically; a strongly connected
+component (Tarjan) of direct-feedthrough dependencies is an algebraic loop, refused with the
+components named.
+"""
+
+from dataclasses import dataclass, field
+
+import casadi as ca
+import networkx as nx
+
+from ..errors import ModelError
+
+MECHANICS = "the mechanics"
+
+
+@dataclass
+class Network:
+    """What the 1-D network and the blocks give the Assembly."""
+    pos: dict
+    vel: dict
+    acc: dict
+    flow: dict                      # PortRef -> flow into its component
+    Q: ca.SX                        # generalized forces on the joint speeds
+    armature: ca.SX                 # inertia added to each joint speed
+    axis_flow: ca.SX                # flow into the joint axes (drive torques, with inertia)
+    x: list = field(default_factory=list)        # extra states (SX scalars)
+    rate: list = field(default_factory=list)     # their rates
+    start: list = field(default_factory=list)    # their initial values
+    names: list = field(default_factory=list)
+    units: list = field(default_factory=list)
+    signal: dict = field(default_factory=dict)   # signal set -> value
+
+
+def build(model, topo, bound, q, qd, qdd_sym, qindex, uindex, t):
+    """The Network of a validated model, in the symbols of the Assembly."""
+    return _Builder(model, topo, bound, q, qd, qdd_sym, qindex, uindex, t).run()
+
+
+class _Builder:
+    def __init__(self, model, topo, bound, q, qd, qdd_sym, qindex, uindex, t):
+        self.model, self.topo, self.bound = model, topo, bound
+        self.q, self.qd, self.qdd, self.t = q, qd, qdd_sym, t
+        self.qindex, self.uindex = qindex, uindex
+        n = qd.shape[0]
+        self.net = Network({}, {}, {}, {}, ca.SX.zeros(n), ca.SX.zeros(n), ca.SX.zeros(n))
+        self.k = {}                  # connection set -> ratio to its group's coordinate
+        self.group_of = {}           # connection set -> group
+        self.coord = {}              # group index -> (theta, theta', theta'')
+        self.pending = {}            # placeholder symbol -> expression, substituted at the end
+        self.block_x = {}
+
+    # -- the steps ------------------------------------------------------------------------
+    def run(self):
+        for group in self.topo.oned:
+            self._ratios(group)
+        for group in self.topo.oned:
+            self._coordinate(group)
+        for s, group in self.group_of.items():
+            theta, w, a = self.coord[group.index]
+            k = self.k[s]
+            for ref in self.topo.sets[s]:
+                self.net.pos[ref], self.net.vel[ref], self.net.acc[ref] = k * theta, k * w, k * a
+        self._block_states()
+        for node in self._order():
+            if node == MECHANICS:
+                self._mechanics()
+            else:
+                self._output(self.model.components[node])
+        self._block_rates()
+        self._finish()
+        return self.net
+
+    def _ratios(self, group):
+        for s, parent, element in group.sets:
+            self.group_of[s] = group
+            if parent is None:
+                self.k[s] = ca.SX(1)
+                continue
+            r = self.bound[element.name].ratio()
+            a_here = self.topo.set_of[element.port_ref("flange_a")] == s
+            # position(flange_a) = r * position(flange_b)
+            self.k[s] = self.k[parent] * r if a_here else self.k[parent] / r
+
+    def _coordinate(self, group):
+        kind, t = group.kind, self.t
+        zero = (ca.SX(0), ca.SX(0), ca.SX(0))
+        if kind == "joint":
+            joint = group.definer.component
+            j = joint.coordinate_ports[group.definer.name]
+            i, u = self.qindex[joint.name][j], self.uindex[joint.name][j]
+            self.coord[group.index] = (self.q[i], self.qd[u], self.qdd[u])
+        elif kind == "fixed":
+            comp = self.bound[group.definer.component.name]
+            position = comp.position() if comp.role == "fixed" else 0
+            self.coord[group.index] = (ca.SX(position), ca.SX(0), ca.SX(0))
+        elif kind == "prescribed":
+            comp = self.bound[group.definer.component.name]
+            ref = ca.SX(comp.reference)
+            if comp.type_name.endswith(".Speed"):
+                theta = self._state(f"{comp.name}.{_pos(group)}", _units(group)[0],
+                                    comp.position0, ref)
+                self.coord[group.index] = (theta, ref, ca.jacobian(ref, t))
+            else:
+                w = ca.jacobian(ref, t)
+                self.coord[group.index] = (ref, w, ca.jacobian(w, t))
+        elif kind == "free":
+            self._free(group)
+        elif kind == "massless":
+            theta, w = ca.SX.sym(f"g{group.index}_pos"), ca.SX.sym(f"g{group.index}_vel")
+            a = ca.SX.sym(f"g{group.index}_acc")
+            self.coord[group.index] = (theta, w, a)
+        else:
+            self.coord[group.index] = zero
+
+    def _free(self, group):
+        inertias = [e for e in group.rigid if e.has_inertia]
+        first = self.bound[inertias[0].name]
+        pos_unit, vel_unit = _units(group)
+        k = self.k[self.topo.set_of[inertias[0].port_ref("flange_a")]]
+        p0 = 0 if first.position0 is None else first.position0 / k
+        w0 = 0 if first.speed0 is None else first.speed0 / k
+        a = ca.SX.sym(f"g{group.index}_acc")
+        w = self._state(f"{first.name}.{_vel(group)}", vel_unit, w0, a)
+        theta = self._state(f"{first.name}.{_pos(group)}", pos_unit, p0, w,
+                            at=len(self.net.x) - 1)
+        self.coord[group.index] = (theta, w, a)
+
+    def _state(self, name, unit, start, rate, at=None):
+        x = ca.SX.sym(name.replace(".", "_"))
+        at = len(self.net.x) if at is None else at
+        self.net.x.insert(at, x)
+        self.net.rate.insert(at, rate)
+        self.net.start.insert(at, start)
+        self.net.names.insert(at, name)
+        self.net.units.insert(at, unit)
+        return x
+
+    # -- signals ----------------------------------------------------------------------------
+    def _block_states(self):
+        for comp in self.model.components.values():
+            if comp.role == "block" and comp.n_states:
+                b = self.bound[comp.name]
+                labels = ["x"] if comp.n_states == 1 else [f"x[{i}]" for i in
+                                                          range(comp.n_states)]
+                xs = [self._state(f"{comp.name}.{lab}", "", 0, 0) for lab in labels]
+                starts = b.initial()
+                for x, s in zip(xs, starts):
+                    self.net.start[self.net.x.index(x)] = s
+                self.block_x[comp.name] = xs
+
+    def _inputs(self, comp):
+        """Input port name -> signal value (None: an unwired optional input)."""
+        out = {}
+        for pname, port in comp.ports.items():
+            if port.domain == "signal_in":
+                s = self.topo.set_of[comp.port_ref(pname)]
+                out[pname] = self.net.signal.get(s) if s in self.topo.signal_source else None
+        return out
+
+    def _output(self, comp):
+        """Evaluate a block's or a sensor's output into its signal set."""
+        s = self.topo.set_of[comp.port_ref("y")]
+        b = self.bound[comp.name]
+        if comp.role == "block":
+            value = b.output(self._inputs(comp), self.block_x.get(comp.name, []), self.t)
+        elif comp.quantity == "flow":
+            value = self.net.flow[comp.port_ref("flange_a")]
+        else:
+            ref = comp.port_ref("flange")
+            value = {"position": self.net.pos, "speed": self.net.vel,
+                     "acceleration": self.net.acc}[comp.quantity][ref]
+        self.net.signal[s] = ca.SX(value)
+
+    def _block_rates(self):
+        for name, xs in self.block_x.items():
+            comp = self.model.components[name]
+            rates = self.bound[name].rates(self._inputs(comp), xs, self.t)
+            for x, r in zip(xs, rates):
+                self.net.rate[self.net.x.index(x)] = r
+
+    def _order(self):
+        """Blocks, sensors and the mechanics in an order where everything an output needs at
+        the same instant comes first; algebraic loops refused."""
+        g = nx.DiGraph()
+        g.add_node(MECHANICS)
+        for comp in self.model.components.values():
+            if comp.role == "block" or _measures(comp):
+                g.add_node(comp.name)
+        for comp in self.model.components.values():
+            if _measures(comp) in ("acceleration", "flow"):
+                g.add_edge(MECHANICS, comp.name)
+            if comp.role == "sensor":
+                group = self.group_of.get(self.topo.set_of[comp.port_ref("flange")])
+                if group is not None and group.kind == "massless":
+                    g.add_edge(MECHANICS, comp.name)   # flows set its position at once
+            for pname, port in comp.ports.items():
+                if port.domain != "signal_in":
+                    continue
+                s = self.topo.set_of[comp.port_ref(pname)]
+                if s not in self.topo.signal_source:
+                    continue
+                source = self.topo.signal_source[s].component.name
+                if comp.role == "block" and comp.feedthrough:
+                    g.add_edge(source, comp.name)
+                elif comp.role == "source":
+                    g.add_edge(source, MECHANICS)
+        loops = [sorted(c) for c in nx.strongly_connected_components(g)
+                 if len(c) > 1 or g.has_edge(next(iter(c)), next(iter(c)))]
+        if loops:
+            raise ModelError([
+                f"algebraic loop through {', '.join(n for n in c if n != MECHANICS)}"
+                + (" and the mechanics (an acceleration or force measured and fed back "
+                   "without delay to a source)" if MECHANICS in c else
+                   " (outputs that depend on each other at the same instant)")
+                + ": break it with a state (an Integrator, a FirstOrder or a filtered "
+                  "Derivative)" for c in loops])
+        return list(nx.lexicographical_topological_sort(g))
+
+    # -- the mechanics ------------------------------------------------------------------
+    def _mechanics(self):
+        net = self.net
+        flow = net.flow
+        for comp in self.model.components.values():
+            if comp.role not in ("compliant", "source"):
+                continue
+            b = self.bound[comp.name]
+            if comp.role == "source":
+                u = self._inputs(comp).get("u")
+                if u is not None:             # the signal replaces the amount parameter
+                    b = b.bound({**b._values, type(comp).amount.name: u})
+            refs = {pn: comp.port_ref(pn) for pn in comp.ports if comp.ports[pn].domain
+                    in ("rotational", "translational")}
+            out = b.flows({pn: net.pos.get(r, 0) for pn, r in refs.items()},
+                          {pn: net.vel.get(r, 0) for pn, r in refs.items()}, self.t)
+            for pn, f in out.items():
+                flow[refs[pn]] = f
+        for group in self.topo.oned:
+            self._balance(group)
+
+    def _applied(self, s):
+        """Flows into the non-rigid elements at a connection set (compliant, sources)."""
+        return sum((self.net.flow.get(r, 0) for r in self.topo.sets[s]
+                    if r.component.role in ("compliant", "source")), ca.SX(0))
+
+    def _balance(self, group):
+        """The generalized force on the group's coordinate, what it does with it, and the
+        flow through every rigid element and into the defining port."""
+        gen = sum((-self.k[s] * self._applied(s) for s, _, _ in group.sets), ca.SX(0))
+        inertia = sum((self.bound[e.name].inertia() * self.k[self.topo.set_of[
+            e.port_ref("flange_a")]] ** 2 for e in group.rigid if e.has_inertia), ca.SX(0))
+        theta, w, a = self.coord[group.index]
+        if group.kind == "joint":
+            joint = group.definer.component
+            u = self.uindex[joint.name][joint.coordinate_ports[group.definer.name]]
+            self.net.Q[u] += gen
+            self.net.armature[u] += inertia
+        elif group.kind == "free":
+            self.pending[a] = gen / inertia
+        elif group.kind == "massless":
+            self._massless(group, gen)
+        self._rigid_flows(group)
+
+    def _massless(self, group, gen):
+        theta, w, a = self.coord[group.index]
+        where = ", ".join(r.path for s, _, _ in group.sets for r in self.topo.sets[s])
+        dw = ca.jacobian(gen, w)
+        if ca.depends_on(gen, w):
+            if ca.depends_on(dw, w) or ca.depends_on(dw, theta):
+                raise ModelError(f"connection set {{{where}}}: its balance is not linear "
+                                 f"in its speed, which kinetwork solves only when it is")
+            speed = -ca.substitute(gen, w, ca.SX(0)) / dw
+            x = self._state(f"{group.ports[0].path}.{_pos(group)}", _units(group)[0], 0, speed)
+            self.pending[theta] = x
+            self.pending[w] = speed
+            self.pending[a] = ca.SX.nan()
+            return
+        dp = ca.jacobian(gen, theta)
+        if not ca.depends_on(gen, theta) or ca.depends_on(dp, theta):
+            raise ModelError(f"connection set {{{where}}} has no defined position: nothing "
+                             f"on it depends on where it is (or not linearly)")
+        position = -ca.substitute(gen, theta, ca.SX(0)) / dp
+        self.pending[theta] = position
+        self.pending[w] = ca.jtimes(position, self.q, self.qd) + ca.jacobian(position, self.t)
+        self.pending[a] = ca.SX.nan()
+
+    def _rigid_flows(self, group):
+        """Kirchhoff at every set of the group, leaves first: the flow into a rigid element at
+        its far side balances what is beyond; its law gives the near side."""
+        flow, k = self.net.flow, self.k
+        theta, w, a = self.coord[group.index]
+        beyond = {s: self._applied(s) for s, _, _ in group.sets}
+        for s, parent, element in reversed(group.sets):
+            if parent is None:
+                if group.definer is not None:
+                    flow[group.definer] = -beyond[s]
+                continue
+            far = element.port_ref("flange_a" if self.topo.set_of[element.port_ref(
+                "flange_a")] == s else "flange_b")
+            near = element.port_ref("flange_b" if far.name == "flange_a" else "flange_a")
+            flow[far] = -beyond[s]
+            b = self.bound[element.name]
+            if element.has_inertia:
+                flow[near] = b.inertia() * k[s] * a - flow[far]
+            elif far.name == "flange_a":          # torque_b = -ratio * torque_a
+                flow[near] = -b.ratio() * flow[far]
+            else:
+                flow[near] = -flow[far] / b.ratio()
+            beyond[parent] = beyond[parent] + flow[near]
+
+    def _finish(self):
+        net = self.net
+        for joint_ports in self._axis_ports():
+            ref, u = joint_ports
+            net.axis_flow[u] += net.flow.get(ref, 0)
+        if not self.pending:
+            return
+        keys = list(self.pending)
+        old, new = ca.vertcat(*keys), ca.vertcat(*[ca.SX(self.pending[k]) for k in keys])
+        # placeholders may refer to each other (a free rotor's acceleration to a massless
+        # node's position): substitute until none is left
+        for _ in range(len(keys) + 1):
+            if not ca.depends_on(new, old):
+                break
+            new = ca.substitute(new, old, new)
+
+        def sub(e):
+            return ca.substitute(ca.SX(e), old, new)
+        for d in (net.pos, net.vel, net.acc, net.flow, net.signal):
+            for key in d:
+                d[key] = sub(d[key])
+        net.Q, net.armature, net.axis_flow = sub(net.Q), sub(net.armature), sub(net.axis_flow)
+        net.rate = [sub(r) for r in net.rate]
+
+    def _axis_ports(self):
+        for joint in self.topo.joints:
+            for pname, j in joint.coordinate_ports.items():
+                yield joint.port_ref(pname), self.uindex[joint.name][j]
+
+
+def _measures(comp):
+    """What a sensor measures ("position", "speed", "acceleration", "flow"), or None."""
+    return getattr(type(comp), "quantity", None)
+
+
+def _pos(group):
+    return "phi" if group.domain == "rotational" else "s"
+
+
+def _vel(group):
+    return "w" if group.domain == "rotational" else "v"
+
+
+def _units(group):
+    return ("rad", "rad/s") if group.domain == "rotational" else ("m", "m/s")
