@@ -15,7 +15,7 @@ MB = "multibody"
 class Ground(Component, library=MB):
     """The inertial world frame, with the gravity field of the model."""
     role = "world"
-    frame = Port("frame", "World frame")
+    frame = Port("frame", "World frame", optional=True)
     gravity = Param([0.0, -9.81, 0.0], unit="m/s^2", shape=(3,),
                     doc="Gravity acceleration, resolved in the world frame")
 

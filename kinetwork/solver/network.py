@@ -154,6 +154,10 @@ class _Builder:
         self.net.units.insert(at, unit)
         return x
 
+    def _at(self, x):
+        """Position of the state symbol ``x`` (by identity: SX == builds an expression)."""
+        return next(i for i, v in enumerate(self.net.x) if v is x)
+
     # -- signals ----------------------------------------------------------------------------
     def _block_states(self):
         for comp in self.model.components.values():
@@ -164,7 +168,7 @@ class _Builder:
                 xs = [self._state(f"{comp.name}.{lab}", "", 0, 0) for lab in labels]
                 starts = b.initial()
                 for x, s in zip(xs, starts):
-                    self.net.start[self.net.x.index(x)] = s
+                    self.net.start[self._at(x)] = s
                 self.block_x[comp.name] = xs
 
     def _inputs(self, comp):
@@ -195,7 +199,7 @@ class _Builder:
             comp = self.model.components[name]
             rates = self.bound[name].rates(self._inputs(comp), xs, self.t)
             for x, r in zip(xs, rates):
-                self.net.rate[self.net.x.index(x)] = r
+                self.net.rate[self._at(x)] = r
 
     def _order(self):
         """Blocks, sensors and the mechanics in an order where everything an output needs at
