@@ -1,7 +1,7 @@
 """The scenes of issue 5 (drives, gears, sensors, feedback) as kinetwork models.
 
-``python bench/drive_scenes.py`` writes ``models/arm_pid.json`` and ``models/drive_train.json``
-from these builders; the tests compare them with closed-loop simulations written directly
+``python bench/drive_scenes.py`` writes ``models/arm_pid.json``, ``models/drive_train.json``
+and ``models/arm_computed_torque.json`` from these builders; the tests compare them with closed-loop simulations written directly
 from the seed's closed-form M, V, G.
 
 arm_pid      the seed's arm, each joint driven by a motor (rotor inertia J_m) through a gearbox
@@ -9,6 +9,8 @@ arm_pid      the seed's arm, each joint driven by a motor (rotor inertia J_m) th
              elbow a sine
 drive_train  a motor torque drives a rotor, which drives a pendulum through a flexible coupling
              (a rotational spring-damper) and a gearbox: the rotor has a state of its own
+arm_computed_torque  the seed's arm under computed-torque control built from its own
+             dynamics (InverseDynamics blocks)
 """
 
 import json
@@ -99,7 +101,61 @@ def drive_train(c=200.0, d=0.5, J_rotor=0.01, n=10.0, tau=0.5):
     return model
 
 
-FILES = {"arm_pid": arm_pid, "drive_train": drive_train}
+#: the computed-torque references: per joint (amplitude, phase) of a 0.5 Hz sine
+SINES = {"shoulder": (0.4, 0.0), "elbow": (0.3, 0.5)}
+
+
+def arm_computed_torque(kp=100.0, kd=20.0, f=0.5):
+    """The seed's arm under computed-torque control built from its own dynamics: per joint,
+    the commanded acceleration r'' + kd (r' - q') + kp (r - q) goes into InverseDynamics
+    blocks (the model's M, V, G at the measured state), whose outputs drive the joints."""
+    data = json.loads(SEED_FILE.read_text())
+    model = kn.loads(json.dumps(data))
+    model.name = "arm_computed_torque"
+    model.description = (
+        "The seed's arm under computed-torque control: each joint's commanded acceleration "
+        "r'' + kd (r' - q') + kp (r - q) feeds InverseDynamics blocks, which evaluate the "
+        "model's own M(q) a + V(q, q') + G(q) (the shoulder spring-damper included). With "
+        "the model exact, each tracking error obeys e'' + kd e' + kp e = 0: critically "
+        "damped at kp = 100, kd = 20.")
+    model.simulation = {"t_end": 4.0, "n_points": 401, "method": "auto", "rtol": 1e-9,
+                        "atol": 1e-11}
+    model.set_parameter("kp", kp)
+    model.set_parameter("kd", kd)
+    rot, sig = kn.rotational, kn.signals
+    w = 2 * 3.141592653589793 * f
+    for i, (joint, (amp, phase)) in enumerate(SINES.items()):
+        for name, a, shift in (("r", amp, 0.0), ("rd", amp * w, 1.5707963267948966),
+                               ("rdd", amp * w * w, 3.141592653589793)):
+            model.add(sig.Sine(f"{name}_{joint}", amplitude=a, f=f, phase=phase + shift))
+        model.add(rot.AngleSensor(f"q_{joint}"))
+        model.add(rot.SpeedSensor(f"qd_{joint}"))
+        model.add(sig.Add(f"e_{joint}", k2=-1.0))
+        model.add(sig.Add(f"ed_{joint}", k2=-1.0))
+        model.add(sig.Gain(f"kp_{joint}", k="kp"))
+        model.add(sig.Gain(f"kd_{joint}", k="kd"))
+        model.add(sig.Sum(f"a_{joint}"))
+        model.add(sig.InverseDynamics(f"inverse_{joint}", joint=joint))
+        model.add(rot.Torque(f"motor_{joint}"))
+        for a, b in [(f"q_{joint}.flange", f"{joint}.axis"), (f"qd_{joint}.flange", f"{joint}.axis"),
+                     (f"r_{joint}.y", f"e_{joint}.u1"), (f"q_{joint}.y", f"e_{joint}.u2"),
+                     (f"rd_{joint}.y", f"ed_{joint}.u1"), (f"qd_{joint}.y", f"ed_{joint}.u2"),
+                     (f"e_{joint}.y", f"kp_{joint}.u"), (f"ed_{joint}.y", f"kd_{joint}.u"),
+                     (f"rdd_{joint}.y", f"a_{joint}.u1"), (f"kp_{joint}.y", f"a_{joint}.u2"),
+                     (f"kd_{joint}.y", f"a_{joint}.u3"),
+                     (f"inverse_{joint}.y", f"motor_{joint}.u"),
+                     (f"motor_{joint}.flange", f"{joint}.axis")]:
+            model.connect(a, b)
+        model.add(kn.Probe(f"error_{joint}", quantities=["value"]))
+        model.connect(f"error_{joint}.port", f"e_{joint}.y")
+    for joint in SINES:
+        for i, other in enumerate(SINES):
+            model.connect(f"a_{other}.y", f"inverse_{joint}.a{i + 1}")
+    return model
+
+
+FILES = {"arm_pid": arm_pid, "drive_train": drive_train,
+         "arm_computed_torque": arm_computed_torque}
 
 
 if __name__ == "__main__":

@@ -43,6 +43,7 @@ def rotor_arm():
 
 
 MODELS = {"seed": seed, "seed + geared rotors": rotor_arm, "arm_pid": drive_scenes.arm_pid,
+          "arm_computed_torque": drive_scenes.arm_computed_torque,
           "drive_train": drive_scenes.drive_train}
 
 

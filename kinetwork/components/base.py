@@ -100,7 +100,8 @@ class Param:
 
     A value is a number, or a string expression in model parameters (and in time ``t`` where
     ``time=True``); ``shape`` (3,) takes three of those, (3, 3) a matrix or its diagonal.
-    ``kind`` "bool" and "names" take a flag and a list of strings, "table" rows [x, y].
+    ``kind`` "bool", "name" and "names" take a flag, a component name and a list of strings,
+    "table" rows [x, y].
     """
 
     def __init__(self, default=REQUIRED, *, unit="", min=None, max=None, shape=(), doc="",
@@ -142,6 +143,10 @@ class Param:
             return value
         if self.kind == "table":
             return _table(value, where)
+        if self.kind == "name":
+            if not isinstance(value, str) or not _NAME.match(value):
+                raise ModelError(f"{where}: must be a component name, got {value!r}")
+            return value
         if self.kind == "names":
             if not isinstance(value, (list, tuple)) or not all(isinstance(v, str) for v in value):
                 raise ModelError(f"{where}: must be a list of names, got {value!r}")

@@ -236,3 +236,17 @@ class PID(PartialBlock, library=LIB):
 
     def initial(self):
         return [self.xi_start, 0.0]
+
+
+class InverseDynamics(PartialBlock, library=LIB):
+    """The model's own inverse dynamics, the heart of a computed-torque controller: the
+    generalized force joint ``joint`` needs for the joint accelerations a1, a2, ... (one per
+    joint coordinate, in model order; unwired: 0) at the present joint angles and speeds,
+    y = [M(q) a + C(q, qd) qd + G(q) - Q(q, qd)]_joint, with M including geared rotors and Q
+    the springs and dampers of the 1-D network (sources and line forces are not in it)."""
+    a1 = Port("signal_in", "Acceleration of the first joint coordinate")
+    a2 = Port("signal_in", "Acceleration of the second", optional=True)
+    a3 = Port("signal_in", "Acceleration of the third", optional=True)
+    a4 = Port("signal_in", "Acceleration of the fourth", optional=True)
+    optional_inputs = ("a2", "a3", "a4")
+    joint = Param(kind="name", doc="Joint (one degree of freedom) whose force is the output")

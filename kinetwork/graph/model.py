@@ -186,7 +186,7 @@ def check_setting(key, value):
 
 def evaluate(value, spec, env, where):
     """A normalized parameter value evaluated with numbers; bounds checked."""
-    if value is None or spec.kind in ("bool", "names", "table"):
+    if value is None or spec.kind in ("bool", "name", "names", "table"):
         return value
     if spec.shape == ():
         return _scalar(value, spec, env, where)

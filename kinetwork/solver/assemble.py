@@ -155,7 +155,12 @@ def assemble(model, topo):
                                                           qd[uindex[joint.name]])
 
     bodies, place = _bodies(topo, bound, q, qd, qindex, uindex)
-    net = network.build(model, topo, bound, q, qd, qdd_sym, qindex, uindex, t)
+    world = bound[topo.world.name]
+    a_grav = ca.vertcat(ca.SX.zeros(3), -ca.vertcat(*world.gravity))
+
+    def inverse(a, armature, passive):     # M(q) a + C(q, qd) qd + G(q) - Q_passive
+        return rnea(bodies, qd, a, a_grav, armature) - passive
+    net = network.build(model, topo, bound, q, qd, qdd_sym, qindex, uindex, t, inverse)
     Q = net.Q
 
     world = bound[topo.world.name]

@@ -50,14 +50,19 @@ class Network:
     signal: dict = field(default_factory=dict)   # signal set -> value
 
 
-def build(model, topo, bound, q, qd, qdd_sym, qindex, uindex, t):
-    """The Network of a validated model, in the symbols of the Assembly."""
-    return _Builder(model, topo, bound, q, qd, qdd_sym, qindex, uindex, t).run()
+def build(model, topo, bound, q, qd, qdd_sym, qindex, uindex, t, inverse=None):
+    """The Network of a validated model, in the symbols of the Assembly.
+
+    ``inverse(a, armature, Q)`` is the tree's inverse dynamics (for InverseDynamics blocks):
+    the generalized forces for speeds' rates ``a`` with the given armature, less ``Q``.
+    """
+    return _Builder(model, topo, bound, q, qd, qdd_sym, qindex, uindex, t, inverse).run()
 
 
 class _Builder:
-    def __init__(self, model, topo, bound, q, qd, qdd_sym, qindex, uindex, t):
+    def __init__(self, model, topo, bound, q, qd, qdd_sym, qindex, uindex, t, inverse):
         self.model, self.topo, self.bound = model, topo, bound
+        self.inverse = inverse
         self.q, self.qd, self.qdd, self.t = q, qd, qdd_sym, t
         self.qindex, self.uindex = qindex, uindex
         n = qd.shape[0]
@@ -80,6 +85,10 @@ class _Builder:
             for ref in self.topo.sets[s]:
                 self.net.pos[ref], self.net.vel[ref], self.net.acc[ref] = k * theta, k * w, k * a
         self._block_states()
+        self._flows("compliant")               # springs and dampers need no signal
+        self._passive = ca.SX.zeros(self.qd.shape[0])
+        for group in self.topo.oned:
+            self._inertia(group)
         for node in self._order():
             if node == MECHANICS:
                 self._mechanics()
@@ -184,7 +193,9 @@ class _Builder:
         """Evaluate a block's or a sensor's output into its signal set."""
         s = self.topo.set_of[comp.port_ref("y")]
         b = self.bound[comp.name]
-        if comp.role == "block":
+        if comp.type_name == "signals.InverseDynamics":
+            value = self._inverse_dynamics(comp)
+        elif comp.role == "block":
             value = b.output(self._inputs(comp), self.block_x.get(comp.name, []), self.t)
         elif comp.quantity == "flow":
             value = self.net.flow[comp.port_ref("flange_a")]
@@ -193,6 +204,21 @@ class _Builder:
             value = {"position": self.net.pos, "speed": self.net.vel,
                      "acceleration": self.net.acc}[comp.quantity][ref]
         self.net.signal[s] = ca.SX(value)
+
+    def _inverse_dynamics(self, comp):
+        joint = self.model.components.get(comp.joint)
+        if joint is None or joint.name not in self.uindex or joint.dof != 1:
+            raise ModelError(f"{self.model.place(comp, 'joint')}: {comp.joint!r} is not a "
+                             f"joint with one degree of freedom of this model")
+        n = self.qd.shape[0]
+        inputs = self._inputs(comp)
+        a = ca.vertcat(*[inputs.get(f"a{i + 1}") if inputs.get(f"a{i + 1}") is not None
+                         else ca.SX(0) for i in range(n)]) if n <= 4 else None
+        if a is None:
+            raise ModelError(f"{self.model.place(comp)}: InverseDynamics takes at most 4 "
+                             f"joint coordinates; this model has {n}")
+        tau = self.inverse(a, self.net.armature, self._passive)
+        return tau[self.uindex[joint.name][0]]
 
     def _block_rates(self):
         for name, xs in self.block_x.items():
@@ -241,10 +267,15 @@ class _Builder:
 
     # -- the mechanics ------------------------------------------------------------------
     def _mechanics(self):
+        self._flows("source")
+        for group in self.topo.oned:
+            self._balance(group)
+
+    def _flows(self, role):
         net = self.net
         flow = net.flow
         for comp in self.model.components.values():
-            if comp.role not in ("compliant", "source"):
+            if comp.role != role:
                 continue
             b = self.bound[comp.name]
             if comp.role == "source":
@@ -257,28 +288,38 @@ class _Builder:
                           {pn: net.vel.get(r, 0) for pn, r in refs.items()}, self.t)
             for pn, f in out.items():
                 flow[refs[pn]] = f
-        for group in self.topo.oned:
-            self._balance(group)
 
-    def _applied(self, s):
+    def _applied(self, s, roles=("compliant", "source")):
         """Flows into the non-rigid elements at a connection set (compliant, sources)."""
         return sum((self.net.flow.get(r, 0) for r in self.topo.sets[s]
-                    if r.component.role in ("compliant", "source")), ca.SX(0))
+                    if r.component.role in roles), ca.SX(0))
+
+    def _generalized(self, group, roles=("compliant", "source")):
+        return sum((-self.k[s] * self._applied(s, roles) for s, _, _ in group.sets), ca.SX(0))
+
+    def _inertia(self, group):
+        """The group's inertia; on a joint, its armature, and the passive generalized force
+        (springs and dampers) that an InverseDynamics block compensates."""
+        group.inertia = sum((self.bound[e.name].inertia() * self.k[self.topo.set_of[
+            e.port_ref("flange_a")]] ** 2 for e in group.rigid if e.has_inertia), ca.SX(0))
+        if group.kind == "joint":
+            u = self._speed(group)
+            self.net.armature[u] += group.inertia
+            self._passive[u] += self._generalized(group, ("compliant",))
+
+    def _speed(self, group):
+        joint = group.definer.component
+        return self.uindex[joint.name][joint.coordinate_ports[group.definer.name]]
 
     def _balance(self, group):
         """The generalized force on the group's coordinate, what it does with it, and the
         flow through every rigid element and into the defining port."""
-        gen = sum((-self.k[s] * self._applied(s) for s, _, _ in group.sets), ca.SX(0))
-        inertia = sum((self.bound[e.name].inertia() * self.k[self.topo.set_of[
-            e.port_ref("flange_a")]] ** 2 for e in group.rigid if e.has_inertia), ca.SX(0))
+        gen = self._generalized(group)
         theta, w, a = self.coord[group.index]
         if group.kind == "joint":
-            joint = group.definer.component
-            u = self.uindex[joint.name][joint.coordinate_ports[group.definer.name]]
-            self.net.Q[u] += gen
-            self.net.armature[u] += inertia
+            self.net.Q[self._speed(group)] += gen
         elif group.kind == "free":
-            self.pending[a] = gen / inertia
+            self.pending[a] = gen / group.inertia
         elif group.kind == "massless":
             self._massless(group, gen)
         self._rigid_flows(group)

@@ -277,3 +277,29 @@ def test_prescribed_motion_drives_a_rotor_through_a_spring():
     x = np.array([0.2, -0.1, 0.3, 0.4])
     tau = 5.0 * (np.sin(0.7) - x[1])
     assert np.allclose(system.rhs(0.7, x)[2:], _seed(x, tau=(0.0, tau)), atol=1e-10)
+
+
+def test_computed_torque_from_the_models_own_dynamics_leaves_a_linear_error():
+    """arm_computed_torque: InverseDynamics blocks evaluate the model's M, V, G (spring-damper
+    included) at the measured state, so each error e = r - q obeys e'' + kd e' + kp e = 0
+    exactly: at kp = 100, kd = 20 it is (e0 + (e0' + 10 e0) t) exp(-10 t)."""
+    system = drive_scenes.arm_computed_torque().compile()
+    assert system.n_states == 4                    # the controller has no state of its own
+    res = kn.simulate(system)
+    t, w = res.t, np.pi
+    for joint, probe in (("shoulder", "probe1"), ("elbow", "probe2")):
+        amp, phase = drive_scenes.SINES[joint]
+        e0, ed0 = amp * np.sin(phase) - 0.05, amp * w * np.cos(phase)
+        expected = (e0 + (ed0 + 10 * e0) * t) * np.exp(-10 * t)
+        assert np.max(np.abs(amp * np.sin(w * t + phase) - res[f"{probe}.angle"]
+                             - expected)) < 1e-8, joint
+        assert np.allclose(res[f"error_{joint}.value"], expected, atol=1e-8)
+
+
+def test_inverse_dynamics_needs_a_joint_of_the_model():
+    model = double_pendulum()
+    model.add(sig.Constant("a", k=1.0))
+    model.add(sig.InverseDynamics("inv", joint="link1"))
+    model.connect("a.y", "inv.a1")
+    with pytest.raises(kn.ModelError, match="'link1' is not a joint with one degree"):
+        model.compile()
