@@ -160,7 +160,9 @@ def assemble(model, topo):
 
     def inverse(a, armature, passive):     # M(q) a + C(q, qd) qd + G(q) - Q_passive
         return rnea(bodies, qd, a, a_grav, armature) - passive
-    net = network.build(model, topo, bound, q, qd, qdd_sym, qindex, uindex, t, inverse)
+    values = model.parameter_values()
+    net = network.build(model, topo, bound, q, qd, qdd_sym, qindex, uindex, t, inverse, p,
+                        [values[k] for k in names])
     Q = net.Q
 
     world = bound[topo.world.name]

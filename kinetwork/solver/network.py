@@ -17,9 +17,10 @@ flanges a rigid chain ties together). What the group's coordinate is follows fro
 
 Signals are causal: each block's output is an expression of its inputs, states and time. The
 dependency graph (networkx) of blocks, sensors and the mechanics (sources drive it,
-acceleration and flow sensors read it) is sorted topologically; a strongly connected
-component (Tarjan) of direct-feedthrough dependencies is an algebraic loop, refused with the
-components named.
+acceleration and flow sensors read it) is cut into its strongly connected components
+(Tarjan) and those are taken in topological order: a block-lower-triangular sort. A component
+of several blocks is an algebraic loop: solved symbolically when it is linear and regular,
+refused with its blocks named otherwise, and always when it runs through the mechanics.
 """
 
 from dataclasses import dataclass, field
@@ -50,13 +51,16 @@ class Network:
     signal: dict = field(default_factory=dict)   # signal set -> value
 
 
-def build(model, topo, bound, q, qd, qdd_sym, qindex, uindex, t, inverse=None):
+def build(model, topo, bound, q, qd, qdd_sym, qindex, uindex, t, inverse=None, p=None,
+          p_values=None):
     """The Network of a validated model, in the symbols of the Assembly.
 
     ``inverse(a, armature, Q)`` is the tree's inverse dynamics (for InverseDynamics blocks):
     the generalized forces for speeds' rates ``a`` with the given armature, less ``Q``.
     """
-    return _Builder(model, topo, bound, q, qd, qdd_sym, qindex, uindex, t, inverse).run()
+    builder = _Builder(model, topo, bound, q, qd, qdd_sym, qindex, uindex, t, inverse)
+    builder.p, builder.p_values = p, p_values
+    return builder.run()
 
 
 class _Builder:
@@ -92,6 +96,8 @@ class _Builder:
         for node in self._order():
             if node == MECHANICS:
                 self._mechanics()
+            elif isinstance(node, list):
+                self._algebraic_loop(node)
             else:
                 self._output(self.model.components[node])
         self._block_rates()
@@ -205,6 +211,33 @@ class _Builder:
                      "acceleration": self.net.acc}[comp.quantity][ref]
         self.net.signal[s] = ca.SX(value)
 
+    def _algebraic_loop(self, names):
+        """Blocks whose outputs depend on each other at the same instant: with their outputs
+        z as unknowns, z = f(z) is solved symbolically when it is linear and regular (gains
+        and sums in a ring); otherwise it is refused."""
+        comps = [self.model.components[n] for n in names]
+        sets = [self.topo.set_of[c.port_ref("y")] for c in comps]
+        z = ca.SX.sym("loop", len(comps))
+        for i, s in enumerate(sets):
+            self.net.signal[s] = z[i]
+        for c in comps:
+            self._output(c)
+        residual = z - ca.vertcat(*[self.net.signal[s] for s in sets])
+        jac = ca.jacobian(residual, z)
+        what = f"algebraic loop through {', '.join(names)}"
+        if ca.depends_on(jac, z):
+            raise ModelError(f"{what}: it is not linear (a Limiter, a Product or a Table in "
+                             f"it), which kinetwork does not solve; break it with a state (an "
+                             f"Integrator, a FirstOrder or a filtered Derivative)")
+        det = ca.Function("det", [self.p], [ca.det(jac)])(self.p_values)
+        if ca.sprank(jac) < len(comps) or abs(float(det)) < 1e-12:
+            raise ModelError(f"{what}: its outputs are not determined (the loop gain is 1, "
+                             f"det = {float(det):g}); break it with a state (an Integrator, a "
+                             f"FirstOrder or a filtered Derivative)")
+        solved = -ca.solve(jac, ca.substitute(residual, z, ca.SX.zeros(len(comps))))
+        for i, s in enumerate(sets):
+            self.net.signal[s] = solved[i]
+
     def _inverse_dynamics(self, comp):
         joint = self.model.components.get(comp.joint)
         if joint is None or joint.name not in self.uindex or joint.dof != 1:
@@ -253,17 +286,20 @@ class _Builder:
                     g.add_edge(source, comp.name)
                 elif comp.role == "source":
                     g.add_edge(source, MECHANICS)
-        loops = [sorted(c) for c in nx.strongly_connected_components(g)
-                 if len(c) > 1 or g.has_edge(next(iter(c)), next(iter(c)))]
+        # block-lower-triangular order: the strongly connected components (Tarjan) of the
+        # graph, each solved as one block, in topological order of the condensation
+        dag = nx.condensation(g)
+        blocks = [sorted(dag.nodes[c]["members"]) for c in
+                  nx.lexicographical_topological_sort(dag, key=lambda c: min(
+                      dag.nodes[c]["members"]))]
+        loops = [c for c in blocks if MECHANICS in c and len(c) > 1]
         if loops:
             raise ModelError([
-                f"algebraic loop through {', '.join(n for n in c if n != MECHANICS)}"
-                + (" and the mechanics (an acceleration or force measured and fed back "
-                   "without delay to a source)" if MECHANICS in c else
-                   " (outputs that depend on each other at the same instant)")
-                + ": break it with a state (an Integrator, a FirstOrder or a filtered "
-                  "Derivative)" for c in loops])
-        return list(nx.lexicographical_topological_sort(g))
+                f"algebraic loop through {', '.join(n for n in c if n != MECHANICS)} and "
+                f"the mechanics (an acceleration or force measured and fed back without delay "
+                f"to a source): break it with a state (an Integrator, a FirstOrder or a "
+                f"filtered Derivative)" for c in loops])
+        return [c[0] if len(c) == 1 else c for c in blocks]
 
     # -- the mechanics ------------------------------------------------------------------
     def _mechanics(self):

@@ -211,9 +211,16 @@ def test_signal_blocks_against_their_formulas():
 
 
 ILL_POSED = [
-    ("feedthrough loop", lambda m: (m.add(sig.Gain("g1", k=1.0)), m.add(sig.Gain("g2", k=0.5)),
-                                    m.connect("g1.y", "g2.u"), m.connect("g2.y", "g1.u")),
-     r"algebraic loop through g1, g2 \(outputs that depend on each other"),
+    ("singular signal loop", lambda m: (m.add(sig.Gain("g1", k=1.0)),
+                                        m.add(sig.Gain("g2", k=1.0)),
+                                        m.connect("g1.y", "g2.u"), m.connect("g2.y", "g1.u")),
+     r"algebraic loop through g1, g2: its outputs are not determined"),
+    ("nonlinear signal loop", lambda m: (m.add(sig.Limiter("lim", u_max=1.0)),
+                                         m.add(sig.Add("add", k2=-0.5)),
+                                         m.add(sig.Constant("c", k=3.0)),
+                                         m.connect("c.y", "add.u1"), m.connect("lim.y", "add.u2"),
+                                         m.connect("add.y", "lim.u")),
+     r"algebraic loop through add, lim: it is not linear"),
     ("loop through the mechanics", lambda m: (
         m.add(rot.AccSensor("acc")), m.add(sig.Gain("fb", k=0.1)), m.add(rot.Torque("push")),
         m.connect("acc.flange", "elbow.axis"), m.connect("acc.y", "fb.u"),
@@ -303,3 +310,19 @@ def test_inverse_dynamics_needs_a_joint_of_the_model():
     model.connect("a.y", "inv.a1")
     with pytest.raises(kn.ModelError, match="'link1' is not a joint with one degree"):
         model.compile()
+
+
+def test_linear_algebraic_loop_of_signals_is_solved():
+    """y = 3 - 0.5 y through an Add and a Gain: solved symbolically, y = 2, no state."""
+    model = double_pendulum()
+    model.add(sig.Constant("c", k=3.0))
+    model.add(sig.Add("add", k2=-0.5))
+    model.add(sig.Gain("same", k=1.0))
+    for a, b in [("c.y", "add.u1"), ("add.y", "same.u"), ("same.y", "add.u2")]:
+        model.connect(a, b)
+    model.add(kn.Probe("p", quantities=["value"]))
+    model.connect("p.port", "add.y")
+    system = model.compile()
+    assert system.n_states == 4
+    res = kn.simulate(system, t_end=0.1, n_points=3)
+    assert np.allclose(res["p.value"], 2.0, atol=1e-14)
