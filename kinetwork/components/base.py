@@ -106,10 +106,11 @@ class Param:
 
     def __init__(self, default=REQUIRED, *, unit="", min=None, max=None, shape=(), doc="",
                  time=False, optional=False, nonzero=False, kind="real", choices=None,
-                 name=None):
+                 name=None, positive=False):
         self.default, self.unit, self.min, self.max = default, unit, min, max
         self.shape, self.doc, self.time, self.optional = tuple(shape), doc, time, optional
         self.nonzero, self.kind, self.choices = nonzero, kind, choices
+        self.positive = positive
         # ``name`` lets a parameter share its file name with a port (a joint's "axis")
         self.name = name
 
@@ -213,6 +214,10 @@ class Param:
         unit = f" {self.unit}" if self.unit else ""
         if not math.isfinite(number):
             raise ModelError(f"{where} = {number}{unit}: must be finite")
+        if self.positive and number <= 0:
+            raise ModelError(f"{where} = {number}{unit}: must be > 0")
+        if self.nonzero and not self.shape and number == 0:
+            raise ModelError(f"{where} = {number}{unit}: must not be 0")
         if self.min is not None and number < self.min:
             raise ModelError(f"{where} = {number}{unit}: must be >= {self.min}")
         if self.max is not None and number > self.max:

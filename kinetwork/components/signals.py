@@ -164,7 +164,7 @@ class FirstOrder(PartialSISO, library=LIB):
     n_states = 1
     feedthrough = False
     k = Param(1.0, doc="Gain")
-    T = Param(unit="s", min=0.0, doc="Time constant (> 0)")
+    T = Param(unit="s", positive=True, doc="Time constant")
     y_start = Param(0.0, doc="Initial output")
 
     def output(self, u, x, t):
@@ -181,7 +181,7 @@ class Derivative(PartialSISO, library=LIB):
     """A filtered derivative: y = k s / (T s + 1) u."""
     n_states = 1
     k = Param(1.0, doc="Gain")
-    T = Param(0.01, unit="s", min=0.0, doc="Filter time constant (> 0)")
+    T = Param(0.01, unit="s", positive=True, doc="Filter time constant")
     x_start = Param(0.0, doc="Initial filter state (the input it starts from)")
 
     def output(self, u, x, t):
@@ -202,11 +202,11 @@ class PID(PartialBlock, library=LIB):
     u_s = Port("signal_in", "Set point")
     u_m = Port("signal_in", "Measurement")
     n_states = 2
-    k = Param(1.0, doc="Gain")
-    Ti = Param(None, optional=True, unit="s", min=0.0, doc="Integral time (None: no I)")
+    k = Param(1.0, nonzero=True, doc="Gain")
+    Ti = Param(None, optional=True, unit="s", positive=True, doc="Integral time (None: no I)")
     Td = Param(0.0, unit="s", min=0.0, doc="Derivative time (0: no D)")
-    Nd = Param(10.0, min=0.0, doc="Derivative filter: gain at high frequency")
-    Ni = Param(0.9, min=0.0, doc="Anti-windup: Ni Ti is the back-calculation time")
+    Nd = Param(10.0, positive=True, doc="Derivative filter: gain at high frequency")
+    Ni = Param(0.9, positive=True, doc="Anti-windup: Ni Ti is the back-calculation time")
     y_max = Param(None, optional=True, doc="Upper output limit (None: none)")
     y_min = Param(None, optional=True, doc="Lower output limit (None: -y_max)")
     xi_start = Param(0.0, doc="Initial integral state")

@@ -296,6 +296,11 @@ def _oned(model, topo, values, problems):
         kind = ("joint" if coords else "prescribed" if motions else
                 "fixed" if definers else "free" if inertias else
                 "world" if len(ports) <= 1 else "massless")
+        if kind == "free" and values is not None and all(
+                values[e.name][type(e).amount.name] == 0 for e in inertias):
+            problems.append(f"connection set {where}: the inertia of "
+                            f"{', '.join(e.name for e in inertias)} is zero and nothing "
+                            f"holds the flange, so its motion is not determined")
         if kind == "massless" and not any(p.component.role == "compliant" for p in ports):
             problems.append(f"connection set {where} has no defined {domain} position: it "
                             f"has no inertia, spring or damper, so the flows on it cannot "

@@ -250,6 +250,15 @@ ILL_POSED = [
                                             m.add(rot.Torque("t2", tau=1.0)),
                                             m.connect("t1.flange", "t2.flange")),
      r"\{t1.flange, t2.flange\} has no defined rotational position"),
+    ("a free rotor without inertia", lambda m: (m.add(rot.Inertia("rotor", J=0.0)),
+                                                m.add(rot.Spring("shaft", c=1.0)),
+                                                m.connect("rotor.flange_b", "shaft.flange_a"),
+                                                m.connect("shaft.flange_b", "elbow.axis")),
+     r"the inertia of rotor is zero and nothing holds the flange"),
+    ("a gear of ratio 0", lambda m: (m.add(rot.IdealGear("gear", ratio=0.0)),
+                                     m.connect("gear.flange_b", "elbow.axis")),
+     r"gear.ratio = 0.0: must not be 0"),
+    ("a PID with Ti = 0", lambda m: m.add(sig.PID("pid", Ti=0.0)), r"pid.Ti = 0.0 s: must be > 0"),
     ("motion on a joint", lambda m: (m.add(rot.Position("drive", phi_ref="sin(t)")),
                                      m.connect("drive.flange", "elbow.axis")),
      r"rigidly ties joint flange elbow.axis to drive.flange"),
@@ -259,8 +268,8 @@ ILL_POSED = [
 @pytest.mark.parametrize("what, edit, message", ILL_POSED, ids=[w for w, _, _ in ILL_POSED])
 def test_ill_posed_networks_are_refused_by_name(what, edit, message):
     model = double_pendulum()
-    edit(model)
-    with pytest.raises(kn.ModelError, match=message):
+    with pytest.raises(kn.ModelError, match=message):     # when built, or when compiled
+        edit(model)
         model.compile()
 
 
