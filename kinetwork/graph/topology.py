@@ -113,16 +113,19 @@ def analyze(model):
                                 f"is not connected")
 
     worlds = roles.get("world", [])
-    if len(worlds) != 1:
+    frames = any(p.domain == "frame" for c in model.components.values() for p in
+                 c.ports.values())
+    if len(worlds) > 1 or (not worlds and frames):
         names = ", ".join(w.name for w in worlds)
         problems.append("the model needs exactly one multibody.Ground, found "
                         f"{len(worlds)}{': ' + names if names else ''}")
         if not worlds:
             raise ModelError(problems)
-    world = worlds[0]
+    world = worlds[0] if worlds else None          # a 1-D and signal model needs none
     topo = Topology(world=world, sets=sets, set_of=set_of,
-                    root=set_of[world.port_ref("frame")], probes=probes)
-    _tree(model, topo, roles, problems)
+                    root=set_of[world.port_ref("frame")] if world else None, probes=probes)
+    if world is not None:
+        _tree(model, topo, roles, problems)
     _oned(model, topo, values, problems)
     _signals(topo, problems)
     if problems:

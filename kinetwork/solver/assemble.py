@@ -155,8 +155,8 @@ def assemble(model, topo):
                                                           qd[uindex[joint.name]])
 
     bodies, place = _bodies(topo, bound, q, qd, qindex, uindex)
-    world = bound[topo.world.name]
-    a_grav = ca.vertcat(ca.SX.zeros(3), -ca.vertcat(*world.gravity))
+    gravity = ca.vertcat(*bound[topo.world.name].gravity) if topo.world else ca.SX.zeros(3)
+    a_grav = ca.vertcat(ca.SX.zeros(3), -gravity)
 
     def inverse(a, armature, passive):     # M(q) a + C(q, qd) qd + G(q) - Q_passive
         return rnea(bodies, qd, a, a_grav, armature) - passive
@@ -165,8 +165,6 @@ def assemble(model, topo):
                         [values[k] for k in names])
     Q = net.Q
 
-    world = bound[topo.world.name]
-    gravity = ca.vertcat(*world.gravity)
     starts, given, u_start, u_given = [], [], [], []
     for joint in topo.joints:
         q0, u0 = bound[joint.name].initial()
