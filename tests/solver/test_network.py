@@ -151,13 +151,14 @@ def _pid_reference(t_eval, drive, step, sine):
         qdd = _seed(np.concatenate([q, qd]), (J * n * n, J * n * n), n * out)
         return np.concatenate([qd, qdd, rates])
     x0 = np.array([0.05, 0.05, 0, 0, 0, 0, 0, 0])
-    pieces = [t_eval[t_eval < step["start_time"]], t_eval[t_eval >= step["start_time"]]]
-    out, t0 = [], 0.0
-    for piece in pieces:                 # restart at the step: no error across it
-        sol = solve_ivp(rhs, (t0, piece[-1]), x0, t_eval=piece, rtol=1e-12, atol=1e-12,
-                        method="DOP853")
+    ts = step["start_time"]
+    out = []
+    for span, piece in (((0.0, ts), t_eval[t_eval < ts]),       # restart at the step: no
+                        ((ts, t_eval[-1]), t_eval[t_eval >= ts])):  # error across it
+        sol = solve_ivp(rhs, span, x0, t_eval=piece, rtol=1e-12, atol=1e-12,
+                        method="DOP853", dense_output=True)
         out.append(sol.y.T)
-        x0, t0 = sol.y[:, -1], piece[-1]
+        x0 = sol.sol(span[1])
     return np.vstack(out)
 
 
