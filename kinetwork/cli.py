@@ -232,6 +232,8 @@ def _validate(args):
                   for cut in topo.cuts),
         *([textwrap.fill(f"why these states: {system.formulation_note}", 88,
                          subsequent_indent="  ")] if system.formulation_note else []),
+        *([textwrap.fill(network, 88, subsequent_indent="  ")]
+          if (network := system.asm.net.summary(topo)) else []),
         f"equations: {size['states']} states, {size['algebraic']} algebraic variables, "
         f"{len(system.signal_names)} probe signals ({n_values} values); right-hand side "
         f"{size['operations']} operations per evaluation ("

@@ -49,6 +49,26 @@ class Network:
     names: list = field(default_factory=list)
     units: list = field(default_factory=list)
     signal: dict = field(default_factory=dict)   # signal set -> value
+    loops_solved: list = field(default_factory=list)   # algebraic loops solved symbolically
+    block_states: int = 0
+
+    def summary(self, topo):
+        """A line on what structural analysis made of the 1-D network and the blocks."""
+        kinds = {}
+        for g in topo.oned:
+            kinds[g.kind] = kinds.get(g.kind, 0) + 1
+        blocks = self.block_states
+        parts = [f"{kinds[k]} {what}" for k, what in (
+            ("joint", "on joint axes (no state: any inertia adds to the joint's)"),
+            ("free", "free (an angle and a speed each)"),
+            ("massless", "massless (solved from their balance)"),
+            ("prescribed", "prescribed"), ("fixed", "fixed")) if kinds.get(k)]
+        out = f"1-D rigid groups: {', '.join(parts)}" if parts else ""
+        if blocks or self.loops_solved:
+            out += ("; " if out else "") + f"signal block states: {blocks}" + (
+                f"; algebraic loops solved symbolically: {len(self.loops_solved)}"
+                if self.loops_solved else "")
+        return out
 
 
 def build(model, topo, bound, q, qd, qdd_sym, qindex, uindex, t, inverse=None, p=None,
@@ -185,6 +205,7 @@ class _Builder:
                 for x, s in zip(xs, starts):
                     self.net.start[self._at(x)] = s
                 self.block_x[comp.name] = xs
+                self.net.block_states += len(xs)
 
     def _inputs(self, comp):
         """Input port name -> signal value (None: an unwired optional input)."""
@@ -235,6 +256,7 @@ class _Builder:
                              f"det = {float(det):g}); break it with a state (an Integrator, a "
                              f"FirstOrder or a filtered Derivative)")
         solved = -ca.solve(jac, ca.substitute(residual, z, ca.SX.zeros(len(comps))))
+        self.net.loops_solved.append(names)
         for i, s in enumerate(sets):
             self.net.signal[s] = solved[i]
 

@@ -88,8 +88,10 @@ class System:
 
     @property
     def dof(self):
-        """Degrees of freedom: speeds less the independent loop-closure equations."""
-        return len(self.speed_names) - self.eq.loop_rows
+        """Degrees of freedom: speeds less the independent loop-closure equations, plus the
+        free rotors and sliding masses of the 1-D network."""
+        free = sum(1 for g in self.topology.oned if g.kind == "free")
+        return len(self.speed_names) - self.eq.loop_rows + free
 
     @property
     def n_algebraic(self):
