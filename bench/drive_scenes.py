@@ -13,7 +13,6 @@ arm_computed_torque  the seed's arm under computed-torque control built from its
              dynamics (InverseDynamics blocks)
 """
 
-import json
 import pathlib
 
 import kinetwork as kn
@@ -28,21 +27,25 @@ STEP = {"height": 0.5, "start_time": 0.5}
 SINE = {"amplitude": 0.3, "f": 0.5}
 
 
+def _seed_copy(name, simulation, description):
+    """The seed model of ``models/double_pendulum.json``, renamed, to build on."""
+    model = kn.loads(SEED_FILE.read_text())
+    model.name, model.description = name, description
+    model.simulation = {**simulation, "method": "auto"}
+    return model
+
+
 def arm_pid(drive=None, step=None, sine=None):
     """The seed model with two PID-controlled geared motors (parameters of ``DRIVE``)."""
     d = {**DRIVE, **(drive or {})}
-    data = json.loads(SEED_FILE.read_text())
-    model = kn.loads(json.dumps(data))
-    model.name = "arm_pid"
-    model.description = (
+    model = _seed_copy("arm_pid", {"t_end": 6.0, "n_points": 601, "rtol": 1e-8,
+                                   "atol": 1e-10}, (
         "The seed's 2-DOF arm, each joint driven by a motor (rotor inertia J_m) through a "
         "gearbox of ratio n, under PID control of the joint angle (motor torque limited to "
         "y_max, back-calculation anti-windup): the shoulder follows a step of 0.5 rad at "
         "t = 0.5 s, the elbow a sine of 0.3 rad at 0.5 Hz. The rotors cost no state: each "
         "adds J_m n^2 to its joint's inertia. The shoulder settles within 1e-3 rad of the "
-        "step by t = 2 s.")
-    model.simulation = {"t_end": 6.0, "n_points": 601, "method": "auto", "rtol": 1e-8,
-                        "atol": 1e-10}
+        "step by t = 2 s."))
     for name, value in d.items():
         model.set_parameter(name, value)
     rot, sig = kn.rotational, kn.signals
@@ -109,17 +112,13 @@ def arm_computed_torque(kp=100.0, kd=20.0, f=0.5):
     """The seed's arm under computed-torque control built from its own dynamics: per joint,
     the commanded acceleration r'' + kd (r' - q') + kp (r - q) goes into InverseDynamics
     blocks (the model's M, V, G at the measured state), whose outputs drive the joints."""
-    data = json.loads(SEED_FILE.read_text())
-    model = kn.loads(json.dumps(data))
-    model.name = "arm_computed_torque"
-    model.description = (
+    model = _seed_copy("arm_computed_torque", {"t_end": 4.0, "n_points": 401, "rtol": 1e-9,
+                                               "atol": 1e-11}, (
         "The seed's arm under computed-torque control: each joint's commanded acceleration "
         "r'' + kd (r' - q') + kp (r - q) feeds InverseDynamics blocks, which evaluate the "
         "model's own M(q) a + V(q, q') + G(q) (the shoulder spring-damper included). With "
         "the model exact, each tracking error obeys e'' + kd e' + kp e = 0: critically "
-        "damped at kp = 100, kd = 20.")
-    model.simulation = {"t_end": 4.0, "n_points": 401, "method": "auto", "rtol": 1e-9,
-                        "atol": 1e-11}
+        "damped at kp = 100, kd = 20."))
     model.set_parameter("kp", kp)
     model.set_parameter("kd", kd)
     rot, sig = kn.rotational, kn.signals
