@@ -54,7 +54,6 @@ class OneDGroup:
     definer: object = None
     kind: str = "massless"
     rigid: list = field(default_factory=list)
-    inertia: object = None        # sum of J k^2, set by the solver
 
 
 @dataclass

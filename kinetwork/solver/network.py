@@ -78,15 +78,15 @@ def build(model, topo, bound, q, qd, qdd_sym, qindex, uindex, t, inverse=None, p
     ``inverse(a, armature, Q)`` is the tree's inverse dynamics (for InverseDynamics blocks):
     the generalized forces for speeds' rates ``a`` with the given armature, less ``Q``.
     """
-    builder = _Builder(model, topo, bound, q, qd, qdd_sym, qindex, uindex, t, inverse)
-    builder.p, builder.p_values = p, p_values
-    return builder.run()
+    return _Builder(model, topo, bound, q, qd, qdd_sym, qindex, uindex, t, inverse, p,
+                    p_values).run()
 
 
 class _Builder:
-    def __init__(self, model, topo, bound, q, qd, qdd_sym, qindex, uindex, t, inverse):
+    def __init__(self, model, topo, bound, q, qd, qdd_sym, qindex, uindex, t, inverse, p,
+                 p_values):
         self.model, self.topo, self.bound = model, topo, bound
-        self.inverse = inverse
+        self.inverse, self.p, self.p_values = inverse, p, p_values
         self.q, self.qd, self.qdd, self.t = q, qd, qdd_sym, t
         self.qindex, self.uindex = qindex, uindex
         n = qd.shape[0]
@@ -96,6 +96,7 @@ class _Builder:
         self.coord = {}              # group index -> (theta, theta', theta'')
         self.pending = {}            # placeholder symbol -> expression, substituted at the end
         self.block_x = {}
+        self.inertia = {}            # group index -> sum of J k^2
 
     # -- the steps ------------------------------------------------------------------------
     def run(self):
@@ -358,11 +359,12 @@ class _Builder:
     def _inertia(self, group):
         """The group's inertia; on a joint, its armature, and the passive generalized force
         (springs and dampers) that an InverseDynamics block compensates."""
-        group.inertia = sum((self.bound[e.name].inertia() * self.k[self.topo.set_of[
+        inertia = sum((self.bound[e.name].inertia() * self.k[self.topo.set_of[
             e.port_ref("flange_a")]] ** 2 for e in group.rigid if e.has_inertia), ca.SX(0))
+        self.inertia[group.index] = inertia
         if group.kind == "joint":
             u = self._speed(group)
-            self.net.armature[u] += group.inertia
+            self.net.armature[u] += inertia
             self._passive[u] += self._generalized(group, ("compliant",))
 
     def _speed(self, group):
@@ -377,7 +379,7 @@ class _Builder:
         if group.kind == "joint":
             self.net.Q[self._speed(group)] += gen
         elif group.kind == "free":
-            self.pending[a] = gen / group.inertia
+            self.pending[a] = gen / self.inertia[group.index]
         elif group.kind == "massless":
             self._massless(group, gen)
         self._rigid_flows(group)
