@@ -1,8 +1,8 @@
 """The scenes of issue 5 (drives, gears, sensors, feedback) as kinetwork models.
 
 ``python bench/drive_scenes.py`` writes ``models/arm_pid.json``, ``models/drive_train.json``
-and ``models/arm_computed_torque.json`` from these builders; the tests compare them with closed-loop simulations written directly
-from the seed's closed-form M, V, G.
+and ``models/arm_computed_torque.json`` from these builders; the tests compare them with
+closed-loop simulations written directly from the seed's closed-form M, V, G.
 
 arm_pid      the seed's arm, each joint driven by a motor (rotor inertia J_m) through a gearbox
              (ratio n), under PID control of the joint angle: the shoulder follows a step, the
@@ -136,7 +136,8 @@ def arm_computed_torque(kp=100.0, kd=20.0, f=0.5):
         model.add(sig.Sum(f"a_{joint}"))
         model.add(sig.InverseDynamics(f"inverse_{joint}", joint=joint))
         model.add(rot.Torque(f"motor_{joint}"))
-        for a, b in [(f"q_{joint}.flange", f"{joint}.axis"), (f"qd_{joint}.flange", f"{joint}.axis"),
+        for a, b in [(f"q_{joint}.flange", f"{joint}.axis"),
+                     (f"qd_{joint}.flange", f"{joint}.axis"),
                      (f"r_{joint}.y", f"e_{joint}.u1"), (f"q_{joint}.y", f"e_{joint}.u2"),
                      (f"rd_{joint}.y", f"ed_{joint}.u1"), (f"qd_{joint}.y", f"ed_{joint}.u2"),
                      (f"e_{joint}.y", f"kp_{joint}.u"), (f"ed_{joint}.y", f"kd_{joint}.u"),

@@ -86,20 +86,45 @@ def formulate(asm, topo, values, formulation="partition", rate=BAUMGARTE_RATE):
     """
     eq = _mechanism(asm, topo, values, formulation, rate)
     net = asm.net
-    if net is None or not net.x:
+    if net is None or not (net.x or net.alg_z):
         return eq
     q = asm.q if eq.q is None else eq.q
-    rates = ca.substitute(ca.vertcat(*net.rate), ca.vertcat(asm.q, asm.qd, asm.qdd_sym),
-                          ca.vertcat(q, eq.u, eq.udot))
-    eq.x, eq.ode = ca.vertcat(eq.x, *net.x), ca.vertcat(eq.ode, rates)
+
+    def in_states(exprs):
+        return ca.substitute(ca.vertcat(*exprs), ca.vertcat(asm.q, asm.qd, asm.qdd_sym),
+                             ca.vertcat(q, eq.u, eq.udot))
+    z_mech = eq.z
+    eq.x, eq.ode = ca.vertcat(eq.x, *net.x), ca.vertcat(eq.ode, in_states(net.rate))
     eq.state_names = eq.state_names + net.names
     eq.state_units = eq.state_units + net.units
     start = ca.Function("start_network", [asm.p], [ca.vertcat(*[ca.SX(s) for s in net.start])])
     mechanism = eq.initial
+    solve_z = None
+    if net.alg_z:
+        # a nonlinear algebraic loop of signals: its outputs join the algebraic variables,
+        # started by Newton from 0 at the initial state (t = 0)
+        z_sig = ca.vertcat(*net.alg_z)
+        res = ca.substitute(in_states(net.alg_res), asm.t, ca.SX(0))
+        eq.z, eq.alg = ca.vertcat(eq.z, z_sig), ca.vertcat(eq.alg, in_states(net.alg_res))
+        eq.algebraic_names = eq.algebraic_names + net.alg_names
+        eq.algebraic_units = eq.algebraic_units + [""] * len(net.alg_names)
+        known = ca.vertcat(eq.x, z_mech, asm.p)
+        solve_z = ca.rootfinder("signal_loops", "newton",
+                                ca.Function("res", [z_sig, known], [res]), {"abstol": 1e-13})
 
     def initial(p):
         x0, z0 = mechanism(p)
-        return np.concatenate([x0, np.asarray(start(p), dtype=float).ravel()]), z0
+        x0 = np.concatenate([x0, np.asarray(start(p), dtype=float).ravel()])
+        if solve_z is None:
+            return x0, z0
+        try:
+            zs = solve_z(np.zeros(len(net.alg_z)), np.concatenate([x0, z0, p]))
+        except RuntimeError:
+            raise ModelError("the nonlinear algebraic loop(s) through "
+                             + "; ".join(", ".join(n) for n in net.loops_kept)
+                             + " have no solution at the initial state (Newton from 0 "
+                               "failed)") from None
+        return x0, np.concatenate([z0, np.asarray(zs, dtype=float).ravel()])
     eq.initial = initial
     return eq
 

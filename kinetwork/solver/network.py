@@ -20,7 +20,8 @@ dependency graph (networkx) of blocks, sensors and the mechanics (sources drive 
 acceleration and flow sensors read it) is cut into its strongly connected components
 (Tarjan) and those are taken in topological order: a block-lower-triangular sort. A component
 of several blocks is an algebraic loop: solved symbolically when it is linear and regular,
-refused with its blocks named otherwise, and always when it runs through the mechanics.
+kept as algebraic variables (IDAS solves them with the rest) when it is nonlinear, refused
+with its blocks named when it is singular, and always when it runs through the mechanics.
 """
 
 from dataclasses import dataclass, field
@@ -50,6 +51,10 @@ class Network:
     units: list = field(default_factory=list)
     signal: dict = field(default_factory=dict)   # signal set -> value
     loops_solved: list = field(default_factory=list)   # algebraic loops solved symbolically
+    loops_kept: list = field(default_factory=list)     # nonlinear ones: algebraic variables
+    alg_z: list = field(default_factory=list)          # their outputs, unknowns ...
+    alg_res: list = field(default_factory=list)        # ... and their equations z - f(z)
+    alg_names: list = field(default_factory=list)
     block_states: int = 0
 
     def summary(self, topo):
@@ -64,10 +69,13 @@ class Network:
             ("massless", "massless (solved from their balance)"),
             ("prescribed", "prescribed"), ("fixed", "fixed")) if kinds.get(k)]
         out = f"1-D rigid groups: {', '.join(parts)}" if parts else ""
-        if blocks or self.loops_solved:
+        if blocks or self.loops_solved or self.loops_kept:
             out += ("; " if out else "") + f"signal block states: {blocks}" + (
                 f"; algebraic loops solved symbolically: {len(self.loops_solved)}"
-                if self.loops_solved else "")
+                if self.loops_solved else "") + (
+                f"; nonlinear algebraic loops kept as algebraic variables: "
+                f"{len(self.loops_kept)} ({len(self.alg_z)} variables)" if self.loops_kept
+                else "")
         return out
 
 
@@ -247,10 +255,20 @@ class _Builder:
         residual = z - ca.vertcat(*[self.net.signal[s] for s in sets])
         jac = ca.jacobian(residual, z)
         what = f"algebraic loop through {', '.join(names)}"
+        if ca.sprank(jac) < len(comps):
+            raise ModelError(f"{what}: its outputs are not determined (structurally "
+                             f"singular); break it with a state (an Integrator, a FirstOrder "
+                             f"or a filtered Derivative)")
         if ca.depends_on(jac, z):
-            raise ModelError(f"{what}: it is not linear (a Limiter, a Product or a Table in "
-                             f"it), which kinetwork does not solve; break it with a state (an "
-                             f"Integrator, a FirstOrder or a filtered Derivative)")
+            # nonlinear (a Limiter, a Product, a Table in it): the outputs stay unknowns,
+            # algebraic variables that IDAS solves with the rest at every step
+            for i, (c, s) in enumerate(zip(comps, sets)):
+                self.net.alg_z.append(z[i])
+                self.net.alg_res.append(residual[i])
+                self.net.alg_names.append(f"{c.name}.y")
+                self.net.signal[s] = z[i]
+            self.net.loops_kept.append(names)
+            return
         det = ca.Function("det", [self.p], [ca.det(jac)])(self.p_values)
         if ca.sprank(jac) < len(comps) or abs(float(det)) < 1e-12:
             raise ModelError(f"{what}: its outputs are not determined (the loop gain is 1, "
@@ -454,6 +472,7 @@ class _Builder:
                 d[key] = sub(d[key])
         net.Q, net.armature, net.axis_flow = sub(net.Q), sub(net.armature), sub(net.axis_flow)
         net.rate = [sub(r) for r in net.rate]
+        net.alg_res = [sub(r) for r in net.alg_res]
 
     def _axis_ports(self):
         for joint in self.topo.joints:
