@@ -12,6 +12,7 @@ from dataclasses import dataclass, field
 import casadi as ca
 
 from ..components.probe import QUANTITIES
+from ..errors import ModelError
 from ..expr import Expression, casadi_functions
 from ..spatial import vec3, vee
 from . import network
@@ -185,7 +186,7 @@ def assemble(model, topo):
                 for cut in topo.cuts]
     asm.lam_sym = ca.SX.sym("lambda", sum(r.shape[0] for _, r in asm.cuts))
     asm.qindex, asm.uindex, asm.Q_drive = qindex, uindex, net.axis_flow
-    _probes(asm, topo, net, bound)
+    _probes(asm, topo, net, bound, model)
     return asm
 
 
@@ -317,7 +318,7 @@ def _symbolic(value, env, funcs):
     return value
 
 
-def _probes(asm, topo, net, bound):
+def _probes(asm, topo, net, bound, model):
     for probe, target in topo.probes:
         units = QUANTITIES[target.domain]
         asked = probe.quantities if probe.quantities is not None else list(units)
@@ -325,6 +326,8 @@ def _probes(asm, topo, net, bound):
             values = _frame_quantities(asm, topo, target, asked, bound)
         elif target.domain in ("signal_in", "signal_out"):
             values = {"value": net.signal.get(topo.set_of[target], ca.SX.nan())}
+        elif "acceleration" in asked and topo.set_of[target] in net.no_acceleration:
+            raise ModelError(network.acceleration_unavailable(model.place(probe), target))
         else:
             potential = dict(zip(list(units)[:3], (net.pos[target], net.vel[target],
                                                    net.acc[target])))

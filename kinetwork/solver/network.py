@@ -56,6 +56,7 @@ class Network:
     alg_res: list = field(default_factory=list)        # ... and their equations z - f(z)
     alg_names: list = field(default_factory=list)
     block_states: int = 0
+    no_acceleration: set = field(default_factory=set)  # sets of massless groups
 
     def summary(self, topo):
         """A line on what structural analysis made of the 1-D network and the blocks."""
@@ -237,6 +238,8 @@ class _Builder:
             value = self.net.flow[comp.port_ref("flange_a")]
         else:
             ref = comp.port_ref("flange")
+            if comp.quantity == "acceleration" and self._massless_at(ref):
+                raise ModelError(acceleration_unavailable(self.model.place(comp), ref))
             value = {"position": self.net.pos, "speed": self.net.vel,
                      "acceleration": self.net.acc}[comp.quantity][ref]
         self.net.signal[s] = ca.SX(value)
@@ -278,6 +281,10 @@ class _Builder:
         self.net.loops_solved.append(names)
         for i, s in enumerate(sets):
             self.net.signal[s] = solved[i]
+
+    def _massless_at(self, ref):
+        group = self.group_of.get(self.topo.set_of[ref])
+        return group is not None and group.kind == "massless"
 
     def _inverse_dynamics(self, comp):
         joint = self.model.components.get(comp.joint)
@@ -404,6 +411,7 @@ class _Builder:
 
     def _massless(self, group, gen):
         theta, w, a = self.coord[group.index]
+        self.net.no_acceleration.update(s for s, _, _ in group.sets)
         where = ", ".join(r.path for s, _, _ in group.sets for r in self.topo.sets[s])
         dw = ca.jacobian(gen, w)
         if ca.depends_on(gen, w):
@@ -478,6 +486,11 @@ class _Builder:
         for joint in self.topo.joints:
             for pname, j in joint.coordinate_ports.items():
                 yield joint.port_ref(pname), self.uindex[joint.name][j]
+
+
+def acceleration_unavailable(where, ref):
+    return (f"{where}: the acceleration of {ref.path} is not available: that flange has no "
+            f"inertia (a damper sets its speed); measure its speed or position instead")
 
 
 def _measures(comp):

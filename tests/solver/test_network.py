@@ -253,6 +253,12 @@ ILL_POSED = [
                                      m.connect("gear.flange_b", "elbow.axis")),
      r"gear.ratio = 0.0: must not be 0"),
     ("a PID with Ti = 0", lambda m: m.add(sig.PID("pid", Ti=0.0)), r"pid.Ti = 0.0 s: must be > 0"),
+    ("acceleration of a massless flange", lambda m: (
+        m.add(rot.Spring("s", c=1.0)), m.add(rot.Damper("d", d=1.0)),
+        m.add(kn.Probe("pa", quantities=["acceleration"])),
+        m.connect("s.flange_a", "shoulder.axis"), m.connect("s.flange_b", "d.flange_a"),
+        m.connect("d.flange_b", "elbow.axis"), m.connect("pa.port", "s.flange_b")),
+     r"the acceleration of s.flange_b is not available"),
     ("motion on a joint", lambda m: (m.add(rot.Position("drive", phi_ref="sin(t)")),
                                      m.connect("drive.flange", "elbow.axis")),
      r"rigidly ties joint flange elbow.axis to drive.flange"),
