@@ -7,6 +7,7 @@ Exit codes: 0 success, 1 a refused model or an unwritable output, 2 a usage erro
 
 import argparse
 import collections
+import contextlib
 import os
 import sys
 import textwrap
@@ -14,7 +15,7 @@ import time
 
 import kinetwork as kn
 
-from .solver.integrate import METHODS
+from .solver.integrate import DEFAULTS, METHODS
 
 EXIT_MODEL, EXIT_SIMULATION = 1, 3         # usage errors exit with argparse's 2
 
@@ -80,6 +81,15 @@ def build_parser():
     run.add_argument("--param", type=_parameter, action="append", default=[],
                      metavar="NAME=VALUE",
                      help="set a model parameter for this run (repeat for several)")
+    run.add_argument("--max-steps", type=int, metavar="N",
+                     help="step budget per output interval of the variable-step methods")
+    run.add_argument("--time-limit", type=float, metavar="S",
+                     help="wall-clock limit of the integration [s]")
+    run.add_argument("--quiet", "-q", action="store_true",
+                     help="print nothing but errors (on stderr)")
+    run.add_argument("--progress", action=argparse.BooleanOptionalAction, default=None,
+                     help="a progress bar on stderr (default: when stderr is a terminal and "
+                          "not --quiet)")
     run.add_argument("--out", metavar="FILE.csv", help="write t and the probe signals as CSV")
     run.add_argument("--plot", metavar="FILE.png",
                      help="write the probe plots (format from the extension: png, pdf, svg)")
@@ -146,23 +156,47 @@ def _load(path):
         raise kn.ModelError(f"cannot read {path}: {exc.strerror or exc}") from None
 
 
-def _write(path, write, what):
+def _write(path, write, what, quiet=False):
     """Write one output, making its folder; an OSError becomes a message naming the file."""
     try:
         os.makedirs(os.path.dirname(os.path.abspath(path)), exist_ok=True)
         write(path)
     except OSError as exc:
         raise kn.ModelError(f"cannot write {path}: {exc.strerror or exc}") from None
-    print(f"wrote {what} {path}")
+    if not quiet:
+        print(f"wrote {what} {path}")
 
 
 def _outputs(args, results, title):
+    quiet = getattr(args, "quiet", False)
     if args.out:
         _write(args.out, results.to_csv,
-               f"{len(results.t)} points x {len(results.columns()[0])} columns to")
+               f"{len(results.t)} points x {len(results.columns()[0])} columns to", quiet)
     if args.plot:
         from .plot import save_plot
-        _write(args.plot, lambda path: save_plot(results, path, title=title), "probe plots to")
+        _write(args.plot, lambda path: save_plot(results, path, title=title), "probe plots to",
+               quiet)
+
+
+@contextlib.contextmanager
+def _progress_bar(args, model, t_end):
+    """A tqdm bar on stderr while the run goes, or None. It writes to a duplicate of the
+    terminal's descriptor: the integrators' own output is captured meanwhile."""
+    show = args.progress if args.progress is not None else \
+        (not args.quiet and sys.stderr.isatty())
+    if not show:
+        yield None
+        return
+    from tqdm import tqdm
+    terminal = os.fdopen(os.dup(sys.stderr.fileno()), "w")
+    bar = tqdm(total=round(t_end, 9), file=terminal, unit="s", desc=f"{model.name}",
+               bar_format="{desc}: {percentage:3.0f}%|{bar}| t = {n:.3g} of {total:g} s "
+                          "[{elapsed}<{remaining}]", leave=False)
+    try:
+        yield lambda t: bar.update(max(0.0, t - bar.n))
+    finally:
+        bar.close()
+        terminal.close()
 
 
 def _run(args):
@@ -173,10 +207,15 @@ def _run(args):
     start = time.perf_counter()
     system = model.compile()
     compiled = time.perf_counter()
+    t_end = args.t_end if args.t_end is not None else \
+        model.simulation.get("t_end", DEFAULTS["t_end"])
     try:
-        results = kn.simulate(system, t_end=args.t_end, n_points=args.n_points,
-                              method=args.method, rtol=args.rtol, atol=args.atol,
-                              step=args.step, jit=args.jit, params=dict(args.param))
+        with _progress_bar(args, model, t_end) as progress:
+            results = kn.simulate(system, t_end=args.t_end, n_points=args.n_points,
+                                  method=args.method, rtol=args.rtol, atol=args.atol,
+                                  step=args.step, jit=args.jit, params=dict(args.param),
+                                  max_steps=args.max_steps, time_limit=args.time_limit,
+                                  progress=progress)
     except kn.SimulationError as exc:
         _error(exc)
         if exc.results is not None and len(exc.results.t):
@@ -186,6 +225,9 @@ def _run(args):
                 _error(write_exc)
         return EXIT_SIMULATION
     done = time.perf_counter()
+    if args.quiet:
+        _outputs(args, results, model.name)
+        return 0
     t = results.t
     print(f"{model.name}: {system.n_states} states ({', '.join(system.state_names)})")
     if args.param:

@@ -233,3 +233,46 @@ def test_console_entry_point(seed_file):
                          capture_output=True, text=True)
     assert bad.returncode == 1 and "nowhere.json" in bad.stderr
     assert "Traceback" not in bad.stderr
+
+
+def test_quiet_run_prints_nothing(seed_file, tmp_path, capsys):
+    out = tmp_path / "quiet.csv"
+    assert main(["run", str(seed_file), "--quiet", "--out", str(out)]) == 0
+    captured = capsys.readouterr()
+    assert captured.out == "" and captured.err == ""
+    assert out.exists()
+
+
+def test_step_budget_and_time_limit_end_in_exit_3_with_the_partial_csv(blowup_file, tmp_path,
+                                                                         capsys):
+    out = tmp_path / "budget.csv"
+    code = main(["run", str(blowup_file), "--t-end", "2", "--n-points", "201", "--method",
+                 "rk45", "--max-steps", "40", "-q", "--out", str(out)])
+    assert code == 3
+    err = capsys.readouterr().err
+    assert "rk45 failed after t = " in err and "step budget of 40 steps" in err
+    assert no_traceback(capsys.readouterr())
+    _, data = read_csv(out)
+    assert 0.5 < data[-1, 0] < 1.0
+    code = main(["run", str(seed_file_long(tmp_path)), "--time-limit", "0.2", "-q",
+                 "--out", str(out)])
+    assert code == 3
+    assert "time limit" in capsys.readouterr().err
+    _, data = read_csv(out)
+    assert 0 < data[-1, 0] < 1e5
+
+
+def seed_file_long(tmp_path):
+    """The seed over 1e5 s with a million output points: far more than 0.2 s of work."""
+    model = double_pendulum()
+    model.simulation = {"t_end": 1e5, "n_points": 1000001}
+    path = tmp_path / "long.json"
+    model.save(path)
+    return path
+
+
+def test_progress_bar_goes_to_stderr(seed_file, capfd):
+    assert main(["run", str(seed_file), "--progress", "--t-end", "5"]) == 0
+    captured = capfd.readouterr()
+    assert "t = " in captured.err and "%" in captured.err      # the bar
+    assert "simulated t = 0 .. 5 s" in captured.out

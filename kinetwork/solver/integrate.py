@@ -1,5 +1,12 @@
 """simulate(): integrate a model with CasADi's integrators or scipy's, looked up in METHODS."""
 
+import contextlib
+import ctypes
+import io
+import os
+import sys
+import tempfile
+import time
 from dataclasses import dataclass
 from typing import Callable
 
@@ -49,18 +56,36 @@ def _casadi(plugin, newton, **options):
             opts["number_of_finite_elements"] = \
                 _steps_per_interval(grid, settings["step"]) * (len(grid) - 1)
         jit = settings["jit"]
+        m = None if sundials else opts["number_of_finite_elements"] // (len(grid) - 1)
+        if settings.get("max_steps"):
+            if sundials:
+                opts["max_num_steps"] = int(settings["max_steps"])
+            elif m > settings["max_steps"]:
+                return x0[None, :], (f"the step budget of {settings['max_steps']} steps per "
+                                     f"output interval is smaller than the {m} steps of "
+                                     f"{settings['step'] or float(grid[1] - grid[0]):g} s that "
+                                     f"the fixed-step method takes"), {}
+        if settings.get("time_limit") or settings.get("progress"):
+            # in chunks: the clock is read and the progress told between them
+            chunk = max(1, (len(grid) - 1) // CHUNKS)
+            limit = settings.get("time_limit")
+            X, failure = _chunks(system, plugin, grid, x0, p, opts, jit, newton, chunk, m,
+                                 deadline=settings["started"] + limit if limit else None,
+                                 progress=settings.get("progress"))
+            X, bad = _finite(X)
+            return X, bad or failure, {"chunks": -(-(len(grid) - 1) // chunk)}
         integ = system.integrator(plugin, grid, opts, jit=jit, jacobian=newton,
                                   cache=plugin != "idas")       # idas: options hold x0
         try:
             out = integ(x0=x0[:nx], z0=x0[nx:], p=p)
         except RuntimeError as exc:
-            X, reason = _casadi_partial(system, plugin, grid, x0, p, opts, jit, newton, exc)
+            X, reason = _chunks(system, plugin, grid, x0, p, opts, jit, newton, 1, m,
+                                first_error=str(exc))
             return X, reason, {"restarted": "at every output time, after: " + _reason(str(exc))}
         X = np.vstack([x0, np.vstack([np.asarray(out["xf"]), np.asarray(out["zf"])]).T])
         stats = integ.stats()
         if not sundials:
             X, failure = _finite(X)
-            m = opts["number_of_finite_elements"] // (len(grid) - 1)
             return X, failure, {"steps": m * (len(X) - 1),
                                 "step": float(grid[1] - grid[0]) / m}
         return X, None, {"steps": int(stats["nsteps"]), "rhs_evaluations": int(stats["nfevals"]),
@@ -82,26 +107,46 @@ def _finite(X):
     return X[:int(np.argmin(good))], "the state became non-finite (Inf or NaN)"
 
 
-def _casadi_partial(system, plugin, grid, x0, p, options, jit, newton, exc):
-    """After a failure, step interval by interval to keep everything computed before it.
+#: a run under a time limit or with a progress report goes in about this many chunks
+CHUNKS = 50
 
-    Returns (X, reason): reason is None when every interval went through after all (a fresh
-    start per output interval can pass where the continued run failed).
-    """
-    X = [x0]
+
+def _chunks(system, plugin, grid, x0, p, options, jit, newton, chunk, m, deadline=None,
+            first_error="", progress=None):
+    """Integrate ``chunk`` output intervals at a time, each from where the last one ended:
+    after a failure (``chunk`` = 1 keeps everything computed before it: a fresh start per
+    output interval can even pass where the continued run failed), or to read the clock
+    against ``deadline``. Returns (X, reason): reason is None when every interval went
+    through."""
+    X = [np.asarray(x0, dtype=float)]
     nx = system.n_states
-    quiet = {**options, "disable_internal_warnings": True} if plugin in ("cvodes", "idas") \
-        else options
-    for k in range(len(grid) - 1):
-        if plugin == "idas":           # idas starts each interval from its consistent rate
-            quiet["init_xdot"] = _rate0(system, grid[k], X[-1], p)
-        integ = system.integrator(plugin, grid[k:k + 2], quiet, cache=False, jit=jit,
-                                  jacobian=newton)
+    opts = {**options, "disable_internal_warnings": True} if plugin in ("cvodes", "idas") \
+        else dict(options)
+    k = 0
+    while k < len(grid) - 1:
+        sub = grid[k:k + chunk + 1]
+        if m is not None:                      # fixed steps: counted over the chunk
+            opts["number_of_finite_elements"] = m * (len(sub) - 1)
+        if plugin == "idas":                   # idas starts from its consistent rate
+            opts["init_xdot"] = _rate0(system, sub[0], X[-1], p)
+        integ = system.integrator(plugin, sub, opts, cache=False, jit=jit, jacobian=newton)
         try:
             out = integ(x0=X[-1][:nx], z0=X[-1][nx:], p=p)
-        except RuntimeError as step_exc:
-            return np.array(X), _reason(str(step_exc) or str(exc))
-        X.append(np.concatenate([np.asarray(out["xf"]).ravel(), np.asarray(out["zf"]).ravel()]))
+        except RuntimeError as exc:
+            if len(sub) <= 2:
+                return np.array(X), _reason(str(exc) or first_error)
+            part, reason = _chunks(system, plugin, sub, X[-1], p, options, jit, newton, 1, m,
+                                   first_error=str(exc))
+            X.extend(part[1:])
+            if reason is not None:
+                return np.array(X), reason
+        else:
+            X.extend(np.vstack([np.asarray(out["xf"]), np.asarray(out["zf"])]).T)
+        k += len(sub) - 1
+        if progress is not None:
+            progress(float(grid[k]))
+        if deadline is not None and time.perf_counter() > deadline and k < len(grid) - 1:
+            return np.array(X), "the time limit set for the run was reached"
     return np.array(X), None
 
 
@@ -141,23 +186,51 @@ def _reason(message):
 
 
 def _scipy(name):
-    """A scipy solve_ivp method fed by the compiled CasADi right-hand side and Jacobian."""
+    """A scipy ODE solver (the stepper class solve_ivp uses) fed by the compiled CasADi
+    right-hand side and Jacobian, stepped here so that a step budget or a time limit stops
+    it with everything up to that point kept."""
     implicit = name in ("Radau", "BDF", "LSODA")
 
     def run(system, grid, x0, p, settings):
-        from scipy.integrate import solve_ivp    # 0.4 s to import: only when asked for
+        import scipy.integrate                 # 0.4 s to import: only when asked for
         jit = settings["jit"]
         kwargs = {"jac": system.numeric(system.jacobian_numeric_function(jit), p)} \
             if implicit else {}
         fun = system.numeric(system.rhs_function(jit), p)
+        budget, limit = settings.get("max_steps"), settings.get("time_limit")
+        X, k, steps, in_interval, failure = [np.asarray(x0, dtype=float)], 1, 0, 0, None
         with np.errstate(all="ignore"):      # a blow-up is reported below, not warned
-            sol = solve_ivp(fun, (grid[0], grid[-1]), x0, method=name, t_eval=grid,
-                            rtol=settings["rtol"], atol=settings["atol"], **kwargs)
-        stats = {"rhs_evaluations": int(sol.nfev), "jacobian_evaluations": int(sol.njev)}
-        X, failure = _finite(sol.y.T)
-        if failure is None and sol.status < 0:
-            failure = sol.message
-        return X, failure, stats
+            solver = getattr(scipy.integrate, name)(
+                fun, grid[0], x0, grid[-1], rtol=settings["rtol"], atol=settings["atol"],
+                **kwargs)
+            while k < len(grid):
+                message = solver.step()
+                steps, in_interval = steps + 1, in_interval + 1
+                if solver.status == "failed":
+                    failure = message
+                    break
+                if grid[k] <= solver.t:
+                    dense = solver.dense_output()
+                    while k < len(grid) and grid[k] <= solver.t:
+                        X.append(dense(grid[k]))
+                        k, in_interval = k + 1, 0
+                    if settings.get("progress"):
+                        settings["progress"](float(grid[k - 1]))
+                if not np.all(np.isfinite(solver.y)):
+                    failure = "the state became non-finite (Inf or NaN)"
+                    break
+                if budget and in_interval >= budget and k < len(grid):
+                    failure = (f"the step budget of {budget} steps per output interval ran "
+                               f"out at t = {solver.t:g} s: the problem may be stiff for "
+                               f"this method, or the solution blows up")
+                    break
+                if limit and time.perf_counter() - settings["started"] > limit:
+                    failure = "the time limit set for the run was reached"
+                    break
+        stats = {"steps": steps, "rhs_evaluations": int(solver.nfev),
+                 "jacobian_evaluations": int(solver.njev)}
+        X, bad = _finite(np.array(X))
+        return X, bad or failure, stats
     return run
 
 
@@ -235,8 +308,51 @@ def stiffness(system, x0, p, t_start, t_end, jit=False):
     return stiff, sigma, omega
 
 
+@contextlib.contextmanager
+def _solver_output():
+    """What the integrators print (SUNDIALS' failure chatter, CasADi's warnings) captured
+    instead of reaching the user's terminal: CasADi writes through Python's sys.stdout and
+    sys.stderr, plain C code to file descriptors 1 and 2; both are caught. The text is in the
+    yielded dict's "text" afterwards."""
+    box = {"text": ""}
+    python_level = io.StringIO()
+    for stream in (sys.stdout, sys.stderr):
+        stream.flush()
+    try:
+        saved = [os.dup(1), os.dup(2)]
+    except OSError:                            # no file descriptors to redirect
+        saved = None
+    with tempfile.TemporaryFile() as sink, contextlib.redirect_stdout(python_level), \
+            contextlib.redirect_stderr(python_level):
+        if saved:
+            os.dup2(sink.fileno(), 1)
+            os.dup2(sink.fileno(), 2)
+        try:
+            yield box
+        finally:
+            if saved:
+                ctypes.CDLL(None).fflush(None)
+                os.dup2(saved[0], 1)
+                os.dup2(saved[1], 2)
+                for fd in saved:
+                    os.close(fd)
+                sink.seek(0)
+            box["text"] = python_level.getvalue() + (
+                sink.read().decode("utf-8", "replace") if saved else "")
+
+
+def _last_words(text):
+    """The solver's own last line (what it said when it failed), shortened."""
+    lines = [ln.strip() for ln in text.splitlines() if ln.strip()]
+    if not lines:
+        return ""
+    line = lines[-1]
+    return line if len(line) <= 200 else line[:197] + "..."
+
+
 def simulate(model, t_end=None, n_points=None, method=None, rtol=None, atol=None,
-             params=None, t_start=0.0, step=None, jit=None):
+             params=None, t_start=0.0, step=None, jit=None, max_steps=None,
+             time_limit=None, progress=None):
     """Integrate ``model`` (a Model or a compiled System) and record its probes.
 
     Settings not given come from the model's ``simulation`` block, then from DEFAULTS.
@@ -260,6 +376,16 @@ def simulate(model, t_end=None, n_points=None, method=None, rtol=None, atol=None
     jit : bool, optional
         Compile the right-hand side to C (cached on disk, see ``kinetwork.solver.jit``).
         Default: when a C compiler is found and ``KINETWORK_JIT`` is not 0.
+    max_steps : int, optional
+        Step budget per output interval of the variable-step methods (SUNDIALS' mxstep;
+        counted here for scipy's): when it runs out the run stops with a SimulationError.
+    time_limit : float, optional
+        Wall-clock limit [s] of the integration; the run stops with a SimulationError
+        holding what it computed (CasADi methods read the clock between chunks of output
+        intervals, scipy's at every step; the midpoint rule ignores it).
+    progress : callable, optional
+        Called with the simulated time reached, now and then (CasADi methods then run in
+        chunks of output intervals); ``kinetwork run`` draws a progress bar with it.
 
     Returns
     -------
@@ -283,6 +409,11 @@ def simulate(model, t_end=None, n_points=None, method=None, rtol=None, atol=None
     if not problems and settings["t_end"] <= t_start:
         problems.append(f"simulation.t_end: must be > t_start = {t_start}, "
                         f"got {settings['t_end']}")
+    for name, value, kind in (("max_steps", max_steps, int), ("time_limit", time_limit, float)):
+        if value is not None and (isinstance(value, bool) or not isinstance(value, (int, float))
+                                  or value <= 0 or (kind is int and int(value) != value)):
+            problems.append(f"{name}: must be a positive {'integer' if kind is int else 'number'}"
+                            f", got {value!r}")
     if problems:
         raise ModelError(problems)
     key = settings["method"].lower()
@@ -298,17 +429,22 @@ def simulate(model, t_end=None, n_points=None, method=None, rtol=None, atol=None
     p = system.param_vector(params)        # checks the overrides once for the whole run
     x0 = np.concatenate(system.initial_full_p(p))
     grid = np.linspace(t_start, settings["t_end"], int(settings["n_points"]))
+    settings.update(max_steps=max_steps, time_limit=time_limit, progress=progress,
+                    started=time.perf_counter())
     settings.update(jit=_jit.enabled(jit) and system.n_states > 0, t_start=t_start,
                     n_points=int(settings["n_points"]),
                     rtol=float(settings["rtol"]), atol=float(settings["atol"]))
     system.jit_stats.clear()
     stats = {}
-    if not system.n_states:           # everything welded to the ground: nothing to integrate
-        X, failure, key = np.tile(x0, (len(grid), 1)), None, "none"
-    elif key == "auto":
-        X, failure, stats, key = _auto(system, grid, x0, p, settings)
-    else:
-        X, failure, stats = METHODS[key].run(system, grid, x0, p, settings)
+    with _solver_output() as said:
+        if not system.n_states:       # everything welded to the ground: nothing to integrate
+            X, failure, key = np.tile(x0, (len(grid), 1)), None, "none"
+        elif key == "auto":
+            X, failure, stats, key = _auto(system, grid, x0, p, settings)
+        else:
+            X, failure, stats = METHODS[key].run(system, grid, x0, p, settings)
+    if said["text"].strip():
+        stats["solver_output"] = said["text"]
     stats.update(jit=settings["jit"], **system.jit_stats)
     t = grid[:len(X)]
     X = system.polish(X, p)
@@ -321,12 +457,15 @@ def simulate(model, t_end=None, n_points=None, method=None, rtol=None, atol=None
                                 "n_points": settings["n_points"], "method": key,
                                 "rtol": settings["rtol"], "atol": settings["atol"],
                                 "step": settings["step"], "jit": settings["jit"],
+                                "max_steps": max_steps, "time_limit": time_limit,
                                 "params": dict(params or {})},
                       probe_targets=system.probe_targets)
     if failure is not None:
         reached = float(t[-1]) if len(t) else float(t_start)
+        said = _last_words(stats.get("solver_output", ""))
         raise SimulationError(f"{key} failed after t = {reached:g} s (of {t_end:g} s): "
-                              f"{failure}", results=results, t_reached=reached)
+                              f"{failure}" + (f" (the solver said: {said})" if said else ""),
+                              results=results, t_reached=reached, reason=failure)
     return results
 
 

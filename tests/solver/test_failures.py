@@ -1,0 +1,75 @@
+"""Integration failures end in a SimulationError that says when and why in plain words and
+keeps everything computed up to then, which matches a correct run; the solvers' own chatter
+is captured, not printed."""
+
+import numpy as np
+import pytest
+
+import kinetwork as kn
+from scenes import stiff
+
+
+@pytest.fixture(scope="module")
+def stiff_reference():
+    """The stiff seed (c = d = 1e5) by Radau at tight tolerances: a correct run."""
+    return kn.simulate(stiff(1e5), t_end=1.0, n_points=101, method="radau", rtol=1e-10,
+                       atol=1e-12)
+
+
+@pytest.mark.parametrize("method", ["rk45", "dop853", "cvodes-adams"])
+def test_a_stiff_model_under_an_explicit_method_runs_out_of_steps(method, stiff_reference,
+                                                                    capfd):
+    with pytest.raises(kn.SimulationError) as info:
+        kn.simulate(stiff(1e5), t_end=1.0, n_points=101, method=method, max_steps=50,
+                    rtol=1e-8, atol=1e-10)
+    err = info.value
+    assert err.t_reached < 1.0 and f"failed after t = {err.t_reached:g} s" in str(err)
+    assert "step" in err.reason
+    res = err.results
+    assert len(res.t) >= 1 and res.t[-1] == pytest.approx(err.t_reached)
+    ref = stiff_reference.states[:len(res.t)]
+    assert np.max(np.abs(res.states - ref)) < 1e-5
+    out, errout = capfd.readouterr()
+    assert out == "" and errout == ""          # nothing printed by the solvers
+
+
+def test_the_step_budget_is_generous_enough_for_a_well_posed_run():
+    res = kn.simulate(stiff(1e5), t_end=1.0, n_points=11, method="auto", max_steps=500)
+    assert res.method == "cvodes" and res.t[-1] == 1.0
+
+
+@pytest.mark.parametrize("method", ["cvodes-adams", "rk45"])
+def test_a_time_limit_stops_the_run_and_keeps_what_it_computed(method):
+    from scenes import chain
+    model = chain(32)
+    full = kn.simulate(model, t_end=2.0, n_points=201, method=method)
+    with pytest.raises(kn.SimulationError, match="time limit") as info:
+        kn.simulate(model, t_end=2000.0, n_points=200001, method=method, time_limit=0.3)
+    res = info.value.results
+    assert 0 < res.t[-1] < 2000.0
+    n = min(len(res.t), len(full.t))
+    assert np.max(np.abs(res.states[:n] - full.states[:n])) < 1e-4
+
+
+def test_the_solvers_own_words_join_the_message(capfd):
+    """IDAS on the spatial four-bar with a rocker too short to go round: a dead point."""
+    import loop_scenes
+    with pytest.raises(kn.SimulationError) as info:
+        kn.simulate(loop_scenes.spatial_fourbar(c=0.3), t_end=2.0, n_points=201,
+                    rtol=1e-8, atol=1e-10)
+    err = info.value
+    assert "dead point" in err.reason and "the solver said" in str(err)
+    assert 0.2 < err.t_reached < 0.5
+    out, errout = capfd.readouterr()
+    assert out == "" and errout == ""
+    assert "corrector convergence failed" in err.results.stats["solver_output"] or \
+        "residual" in err.results.stats["solver_output"]
+
+
+@pytest.mark.parametrize("bad", [0, -3, 2.5, True, "10"])
+def test_bad_budgets_are_refused(bad):
+    with pytest.raises(kn.ModelError, match="max_steps: must be a positive integer"):
+        kn.simulate(stiff(1e5), t_end=0.1, max_steps=bad)
+    if bad not in (2.5,):
+        with pytest.raises(kn.ModelError, match="time_limit: must be a positive number"):
+            kn.simulate(stiff(1e5), t_end=0.1, time_limit=bad if bad != 2.5 else -1)
