@@ -8,6 +8,7 @@ from .components import multibody, rotational, signals, translational
 from .components.probe import Probe
 from .errors import ModelError, SimulationError
 from .graph.io import dumps, load, loads
+from .schema import schema
 from .graph.model import Model
 from .solver.integrate import METHODS, simulate
 from .solver.results import Results
@@ -16,5 +17,6 @@ from .solver.system import System
 __version__ = "0.1.0"
 
 __all__ = ["METHODS", "Model", "ModelError", "Probe", "Results", "SimulationError", "System",
-           "dumps", "load", "loads", "multibody", "rotational", "signals", "simulate",
+           "dumps", "load", "loads", "multibody", "rotational", "schema", "signals",
+           "simulate",
            "translational"]

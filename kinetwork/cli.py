@@ -100,6 +100,10 @@ def build_parser():
                     "states, loops, equation size, parameters.")
     val.add_argument("model", metavar="MODEL.json", help="model file")
 
+    sub.add_parser("schema", help="print the JSON Schema of model files",
+                   description="Print the JSON Schema (draft 2020-12) of the model format, "
+                               "generated from the component declarations: point an editor "
+                               "at it for completion and checks.")
     sub.add_parser("methods", help="list the integration methods",
                    description="List the integration methods a model can be run with.")
 
@@ -129,7 +133,7 @@ def main(argv=None):
     """Run the ``kinetwork`` command; returns the exit code."""
     args = build_parser().parse_args(argv)
     command = {"run": _run, "validate": _validate, "equations": _equations,
-               "methods": _methods, "bench": _bench}[args.command]
+               "methods": _methods, "bench": _bench, "schema": _schema}[args.command]
     try:
         return command(args)
     except kn.ModelError as exc:
@@ -289,6 +293,12 @@ def _validate(args):
         lines.append("simulation: " + ", ".join(f"{k} = {v}"
                                                 for k, v in model.simulation.items()))
     print("\n".join(lines))
+    return 0
+
+
+def _schema(args):
+    import json
+    print(json.dumps(kn.schema(), indent=2))
     return 0
 
 

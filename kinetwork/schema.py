@@ -1,0 +1,119 @@
+"""The JSON Schema of the model format, generated from the component declarations (it sits
+on top of the layers, as the command line does: it lists the solver's methods too).
+
+Every component type of the ``REGISTRY`` becomes one branch of ``components.items`` (its
+``type`` a constant, its parameters with their shapes, units and docs, the required ones
+required, no others allowed), so the schema never drifts from the code. Editors use it for
+completion and first checks; ``kinetwork.load`` remains the judge (it also checks what a
+schema cannot: wiring, units of expressions, physical sense).
+"""
+
+from .components.base import REGISTRY
+from .graph.io import FORMAT, KEYS, VERSION
+from .graph.model import SIMULATION_KEYS
+from .solver.integrate import METHODS
+
+IDENT = "^[A-Za-z_][A-Za-z0-9_]*$"
+NUMBER = {"type": "number"}
+EXPRESSION = {"type": "string", "minLength": 1,
+              "description": "arithmetic in model parameters (and t where allowed)"}
+SCALAR = {"anyOf": [NUMBER, EXPRESSION]}
+
+
+def schema():
+    """The JSON Schema (draft 2020-12) of a kinetwork model file, as a dict."""
+    types = sorted(REGISTRY)
+    return {
+        "$schema": "https://json-schema.org/draft/2020-12/schema",
+        "$id": "https://kinetwork.dev/schema/model-v1.json",
+        "title": "kinetwork model",
+        "description": "A wiring diagram of multibody, 1-D and signal components "
+                       f"(format {FORMAT!r}, version {VERSION}).",
+        "type": "object",
+        "required": ["format", "version", "name", "components"],
+        "additionalProperties": False,
+        "properties": {
+            "format": {"const": FORMAT},
+            "version": {"const": VERSION},
+            "name": {"type": "string", "minLength": 1},
+            "description": {"type": "string"},
+            "parameters": {"type": "object", "propertyNames": {"pattern": IDENT},
+                           "additionalProperties": NUMBER},
+            "components": {"type": "array",
+                           "items": {"oneOf": [_component(t) for t in types]}},
+            "connections": {"type": "array", "items": {
+                "type": "array", "minItems": 2, "maxItems": 2,
+                "items": {"type": "string", "pattern": IDENT[:-1] + r"\.[A-Za-z_][A-Za-z0-9_]*$"}}},
+            "simulation": {"type": "object", "additionalProperties": False,
+                           "properties": _simulation()},
+            "layout": {"type": "object"},
+        },
+        "propertyNames": {"enum": list(KEYS)},
+    }
+
+
+def _component(type_name):
+    cls = REGISTRY[type_name]
+    params = {name: _param(spec) for name, spec in cls.params.items()}
+    required = [name for name, spec in cls.params.items() if spec.required]
+    doc = (cls.__doc__ or "").strip().split("\n\n")[0].replace("\n", " ")
+    ports = ", ".join(f"{p} ({port.domain})" for p, port in cls.ports.items())
+    return {
+        "type": "object", "title": type_name,
+        "description": f"{doc} Ports: {ports}.",
+        "required": ["name", "type"], "additionalProperties": False,
+        "properties": {
+            "name": {"type": "string", "pattern": IDENT},
+            "type": {"const": type_name},
+            "params": {"type": "object", "additionalProperties": False,
+                       "properties": params, "required": required},
+        },
+    }
+
+
+def _param(spec):
+    doc = spec.describe()
+    if spec.kind == "bool":
+        out = {"type": "boolean"}
+    elif spec.kind == "name":
+        out = {"type": "string", "pattern": IDENT}
+    elif spec.kind == "names":
+        items = {"enum": list(spec.choices)} if spec.choices else {"type": "string"}
+        out = {"type": "array", "items": items, "uniqueItems": True}
+    elif spec.kind == "table":
+        out = {"type": "array", "minItems": 2, "items": {
+            "type": "array", "minItems": 2, "maxItems": 2, "items": NUMBER}}
+    elif spec.shape == ():
+        out = _bounded(spec)
+    elif len(spec.shape) == 1:
+        n = spec.shape[0]
+        out = {"type": "array", "minItems": n, "maxItems": n, "items": SCALAR}
+    else:                                     # (3, 3), or its diagonal
+        row = {"type": "array", "minItems": 3, "maxItems": 3, "items": SCALAR}
+        out = {"anyOf": [{"type": "array", "minItems": 3, "maxItems": 3, "items": row}, row]}
+    if spec.optional:
+        out = {"anyOf": [out, {"type": "null"}]}
+    if not spec.required and spec.default is not None:
+        out["default"] = spec.default
+    out["description"] = doc
+    return out
+
+
+def _bounded(spec):
+    number = dict(NUMBER)
+    if spec.min is not None:
+        number["minimum"] = spec.min
+    if spec.max is not None:
+        number["maximum"] = spec.max
+    if spec.positive:
+        number["exclusiveMinimum"] = 0
+    if spec.nonzero:
+        number["not"] = {"const": 0}
+    return {"anyOf": [number, EXPRESSION]}
+
+
+def _simulation():
+    out = {key: {"type": "number", "exclusiveMinimum": 0} for key in SIMULATION_KEYS}
+    out["n_points"] = {"type": "integer", "minimum": 2}
+    out["method"] = {"type": "string", "enum": sorted(METHODS)}
+    return out
