@@ -11,6 +11,7 @@ recursion; every edge left out is a cut joint that closes one independent kinema
 from dataclasses import dataclass, field
 
 import networkx as nx
+import numpy as np
 
 from ..components.probe import QUANTITIES
 from ..errors import ModelError
@@ -127,6 +128,8 @@ def analyze(model):
         _tree(model, topo, roles, problems)
     _oned(model, topo, values, problems)
     _signals(topo, problems)
+    if values is not None:
+        _inertias(model, roles.get("body", []), values, problems)
     if problems:
         raise ModelError(problems)
     return topo
@@ -311,6 +314,30 @@ def _oned(model, topo, values, problems):
                                                                     topo), ports,
                                    definers[0] if definers else None, kind,
                                    [d["component"] for _, _, d in sub.edges(data=True)]))
+
+
+def _inertias(model, bodies, values, problems):
+    """A body's inertia about its centre of mass must be a physical one: symmetric, positive
+    semi-definite, and its principal moments must satisfy the triangle inequality (no moment
+    exceeds the sum of the other two). A tensor with a zero principal moment is taken as an
+    idealisation (planar models often give a link only its moment about the joint axis) and
+    is not held to the inequality."""
+    for body in bodies:
+        inertia = np.asarray(values[body.name]["inertia"], dtype=float)
+        where = model.place(body, "inertia")
+        scale = max(np.max(np.abs(inertia)), 1e-300)
+        if np.max(np.abs(inertia - inertia.T)) > 1e-9 * scale:
+            problems.append(f"{where}: must be symmetric, got {inertia.tolist()}")
+            continue
+        moments = np.linalg.eigvalsh(inertia)
+        listed = ", ".join(f"{m:.6g}" for m in moments)
+        if moments[0] < -1e-9 * scale:
+            problems.append(f"{where}: must be positive semi-definite; its principal moments "
+                            f"are {listed}")
+        elif moments[0] > 1e-12 * scale and moments[0] + moments[1] < moments[2] - 1e-9 * scale:
+            problems.append(f"{where}: its principal moments {listed} break the triangle "
+                            f"inequality (the largest exceeds the sum of the other two): no "
+                            f"rigid body has them")
 
 
 def _domain(ports):

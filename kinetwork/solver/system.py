@@ -59,6 +59,8 @@ class System:
         self.f_out = ca.Function("outputs", [asm.t, ca.vertcat(eq.x, eq.z), asm.p],
                                  [ca.vertcat(*outs) if outs else ca.SX(0, 1)])
         self._f_mass = None
+        if self.formulation == "tree" and self.speed_names:
+            self._check_mass_matrix()
         self._f_terms = None
         self._f_jac = None
         self._f_residual = None
@@ -66,6 +68,30 @@ class System:
         self._integrators = {}
         self._compiled = {}
         self.jit_stats = {}
+
+    def _check_mass_matrix(self):
+        """Refuse a mass matrix that is singular at the initial state (a joint that moves no
+        mass or inertia: a chain of bodies with zero mass, a slider carrying nothing), naming
+        the joints it cannot accelerate, rather than integrating NaNs."""
+        p = self.param_vector()
+        x0 = self.initial_full_p(p)[0]
+        with np.errstate(all="ignore"):
+            rate = np.asarray(self.f_rhs(0.0, x0, p)).ravel()
+        if np.all(np.isfinite(rate)):          # the articulated-body algorithm went through
+            return
+        M = self.mass_matrix(x0[:len(self.coordinate_names)])
+        values, vectors = np.linalg.eigh((M + M.T) / 2)
+        scale = max(np.max(np.abs(M)), 1.0)
+        if values[0] > 1e-12 * scale:
+            return                               # non-finite for another reason: run, see
+        null = vectors[:, values <= 1e-12 * scale]
+        involved = [self.speed_names[i] for i in range(len(self.speed_names))
+                    if np.max(np.abs(null[i])) > 1e-3]
+        joints = list(dict.fromkeys(n.split(".")[0] for n in involved))
+        raise ModelError(f"the mass matrix is singular at the initial state: "
+                         f"{', '.join(joints)} move(s) no mass or inertia in the direction of "
+                         f"{', '.join(involved)} (give the bodies they carry mass or inertia, "
+                         f"or lock the joint)")
 
     def polish(self, X, p):
         """Full states X (n_points, n_states + n_algebraic) with the algebraic variables

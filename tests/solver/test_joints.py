@@ -732,7 +732,8 @@ def spring_pendulum(variant, mass, inertia_z, c, s0, g):
     Planar joint, or on a Revolute (about z) carrying a Prismatic along its -y."""
     model = kn.Model("spring_pendulum")
     ground = model.add(mb.Ground("ground", gravity=[0, -g, 0]))
-    body = model.add(mb.RigidBody("body", mass=mass, inertia=[0.01, 0.02, inertia_z]))
+    body = model.add(mb.RigidBody("body", mass=mass, inertia=[inertia_z - 0.02, 0.02,
+                                                              inertia_z]))
     spring = model.add(mb.Spring("spring", c=c, s_unstretched=s0))
     probe = model.add(kn.Probe("probe", quantities=["position", "velocity",
                                                     "angular_velocity"]))

@@ -22,7 +22,8 @@ def chain_with_probes(n_links, damped=False, seed=0):
                                     qd0=float(rng.uniform(-1, 1))))
         m.add(kn.multibody.FixedTranslation(f"to_cm{i}", r=rng.uniform(-0.5, 0.5, 3).tolist()))
         A = rng.normal(size=(3, 3))
-        inertia = (A @ A.T + 0.1 * np.eye(3)) * 0.1
+        S = (A @ A.T + 0.1 * np.eye(3)) * 0.05     # second moments of a mass distribution:
+        inertia = np.trace(S) * np.eye(3) - S       # a physical tensor (triangle inequality)
         mass = float(rng.uniform(0.5, 2.0))
         m.add(kn.multibody.RigidBody(f"b{i}", mass=mass, inertia=inertia.tolist()))
         m.add(kn.Probe(f"p{i}", quantities=["position", "velocity", "orientation",
@@ -143,7 +144,7 @@ def test_torque_source_in_time_exact():
     m = kn.Model("rotor", parameters={"A": 2.0, "w": 3.0})
     m.add(kn.multibody.Ground("ground", gravity=[0, -9.81, 0]))
     m.add(kn.multibody.Revolute("hub", axis=[0, 1, 0]))
-    m.add(kn.multibody.RigidBody("disc", mass=3.0, inertia=[0.1, 0.4, 0.1]))
+    m.add(kn.multibody.RigidBody("disc", mass=3.0, inertia=[0.2, 0.4, 0.2]))   # a disc
     m.add(kn.rotational.Torque("drive", tau="A*sin(w*t)"))
     m.add(kn.Probe("probe", quantities=["angle", "torque"]))
     m.connect("ground.frame", "hub.frame_a")

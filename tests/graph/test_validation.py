@@ -1,0 +1,46 @@
+"""Physical validation: bodies that no rigid body can be, and mass matrices that cannot be
+inverted, refused with the place named."""
+
+import pytest
+
+import kinetwork as kn
+from conftest import double_pendulum
+
+mb = kn.multibody
+
+
+@pytest.mark.parametrize("inertia, message", [
+    ([[1, 0.5, 0], [0, 1, 0], [0, 0, 1]], "mass1.inertia: must be symmetric"),
+    ([1, -1, 1], "mass1.inertia: must be positive semi-definite; its principal moments are "
+                 "-1, 1, 1"),
+    ([1, 1, 3], "mass1.inertia: its principal moments 1, 1, 3 break the triangle inequality"),
+    ([[2, 0.9, 0], [0.9, 2, 0], [0, 0, 4.5]], "break the triangle inequality"),
+])
+def test_impossible_inertias_are_refused(inertia, message):
+    model = double_pendulum()
+    model.components["mass1"]._values["inertia"] = kn.multibody.RigidBody(
+        "x", mass=1.0, inertia=inertia).inertia
+    with pytest.raises(kn.ModelError, match=message.replace("(", r"\(")):
+        model.compile()
+
+
+@pytest.mark.parametrize("inertia", [[0, 0, 0.2], [0.1, 0.1, 0.2], [0.3, 0.2, 0.5]])
+def test_idealised_and_limiting_inertias_are_accepted(inertia):
+    """A planar link given only its moment about the joint axis, and bodies on the edge of the
+    inequality (a thin disc: I_z = I_x + I_y), are fine."""
+    model = double_pendulum(inertia=(0.1, 0.2))
+    model.components["mass1"]._values["inertia"] = kn.multibody.RigidBody(
+        "x", mass=1.0, inertia=inertia).inertia
+    model.compile()
+
+
+def test_a_joint_that_moves_nothing_is_refused_by_name():
+    """A slider carrying a body of zero mass: the mass matrix is singular at the start."""
+    model = double_pendulum()
+    model.add(mb.Prismatic("slide", axis=[1, 0, 0]))
+    model.add(mb.RigidBody("ghost", mass=0.0))
+    model.connect("mass2.frame_a", "slide.frame_a")
+    model.connect("slide.frame_b", "ghost.frame_a")
+    with pytest.raises(kn.ModelError, match=r"mass matrix is singular at the initial state: "
+                                            r"slide move\(s\) no mass"):
+        model.compile()
