@@ -59,7 +59,7 @@ class System:
         self.f_out = ca.Function("outputs", [asm.t, ca.vertcat(eq.x, eq.z), asm.p],
                                  [ca.vertcat(*outs) if outs else ca.SX(0, 1)])
         self._f_mass = None
-        if self.formulation == "tree" and self.speed_names:
+        if self.formulation == "tree" and self.speed_names and not self.n_algebraic:
             self._check_mass_matrix()
         self._f_terms = None
         self._f_jac = None
