@@ -61,6 +61,8 @@ class System:
         self._f_mass = None
         if self.formulation == "tree" and self.speed_names and not self.n_algebraic:
             self._check_mass_matrix()
+        else:                  # initial values that contradict the loops: refused now
+            self.initial_full_p(self.param_vector())
         self._f_terms = None
         self._f_jac = None
         self._f_residual = None
