@@ -92,7 +92,7 @@ def formulate(asm, topo, values, formulation="partition", rate=BAUMGARTE_RATE):
 
     def in_states(exprs):
         return ca.substitute(ca.vertcat(*exprs), ca.vertcat(asm.q, asm.qd, asm.qdd_sym),
-                             ca.vertcat(q, eq.u, eq.udot))
+                             ca.densify(ca.vertcat(q, eq.u, eq.udot)))
     z_mech = eq.z
     eq.x, eq.ode = ca.vertcat(eq.x, *net.x), ca.vertcat(eq.ode, in_states(net.rate))
     eq.state_names = eq.state_names + net.names

@@ -9,6 +9,7 @@ from ..errors import ModelError
 from . import jit as _jit
 from .assemble import assemble
 from .loops import BAUMGARTE_RATE, formulate, newton
+from .newton_euler import rnea
 
 #: Jacobians larger than this (instructions) are not compiled to C: Newton iterations use
 #: finite differences of the compiled right-hand side instead (an N = 128 chain's exact
@@ -52,8 +53,10 @@ class System:
         self.signal_units = {name: unit for name, unit, _ in asm.signals}
         self.signal_sizes = {name: expr.numel() for name, _, expr in asm.signals}
         coords = asm.q if eq.q is None else eq.q
-        outs = [ca.substitute(expr, ca.vertcat(asm.q, asm.qd, asm.qdd_sym, asm.lam_sym),
-                              ca.vertcat(coords, eq.u, eq.udot, eq.lam))
+        # dense: a structurally zero acceleration (a body with no inertia about an axis)
+        # must still replace its symbol
+        values = ca.densify(ca.vertcat(coords, eq.u, eq.udot, eq.lam))
+        outs = [ca.substitute(expr, ca.vertcat(asm.q, asm.qd, asm.qdd_sym, asm.lam_sym), values)
                 for _, _, expr in asm.signals]
         # outputs read the whole state: differential, then algebraic
         self.f_out = ca.Function("outputs", [asm.t, ca.vertcat(eq.x, eq.z), asm.p],
@@ -73,19 +76,22 @@ class System:
 
     def _check_mass_matrix(self):
         """Refuse a mass matrix that is singular at the initial state (a joint that moves no
-        mass or inertia: a chain of bodies with zero mass, a slider carrying nothing), naming
-        the joints it cannot accelerate, rather than integrating NaNs."""
+        mass or inertia: a chain of bodies with zero mass, a slider carrying nothing, a free
+        body with no inertia about an axis), naming the joints it cannot accelerate, rather
+        than integrating NaNs or, worse, zeros."""
         p = self.param_vector()
         x0 = self.initial_full_p(p)[0]
-        with np.errstate(all="ignore"):
-            rate = np.asarray(self.f_rhs(0.0, x0, p)).ravel()
-        if np.all(np.isfinite(rate)):          # the articulated-body algorithm went through
-            return
-        M = self.mass_matrix(x0[:len(self.coordinate_names)])
+        # M column by column as inverse dynamics of unit accelerations (no speed, no
+        # gravity): an O(n) expression, where CRBA's would be O(n^2) to build
+        a, n = self.asm, len(self.speed_names)
+        acc = ca.SX.sym("acc", n)
+        Ma = rnea(a.bodies, ca.SX.zeros(n), acc, ca.SX.zeros(6), a.armature)
+        f = ca.Function("M_columns", [a.q, acc, a.p], [ca.substitute(Ma, a.qd, ca.SX.zeros(n))])
+        M = np.asarray(f.map(n)(x0[:len(self.coordinate_names)], np.eye(n), p))
         values, vectors = np.linalg.eigh((M + M.T) / 2)
         scale = max(np.max(np.abs(M)), 1.0)
         if values[0] > 1e-12 * scale:
-            return                               # non-finite for another reason: run, see
+            return
         null = vectors[:, values <= 1e-12 * scale]
         involved = [self.speed_names[i] for i in range(len(self.speed_names))
                     if np.max(np.abs(null[i])) > 1e-3]
