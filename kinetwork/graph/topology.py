@@ -93,8 +93,9 @@ def analyze(model):
         for pname in comp.ports:
             graph.add_node(comp.port_ref(pname))
     graph.add_edges_from(model.connections)
-    sets = [sorted(s, key=_order(model)) for s in nx.connected_components(graph)]
-    sets.sort(key=lambda s: _order(model)(s[0]))
+    order = _order(model)                      # once: it ranks every component
+    sets = [sorted(s, key=order) for s in nx.connected_components(graph)]
+    sets.sort(key=lambda s: order(s[0]))
     set_of = {p: i for i, s in enumerate(sets) for p in s}
 
     roles = {}
@@ -137,7 +138,14 @@ def analyze(model):
 
 def _order(model):
     rank = {name: i for i, name in enumerate(model.components)}
-    return lambda ref: (rank[ref.component.name], list(ref.component.ports).index(ref.name))
+    port_rank = {}
+
+    def key(ref):
+        comp = ref.component
+        if comp.name not in port_rank:
+            port_rank[comp.name] = {p: i for i, p in enumerate(comp.ports)}
+        return rank[comp.name], port_rank[comp.name][ref.name]
+    return key
 
 
 def _probes(model, graph, probes, problems):
