@@ -2,6 +2,7 @@
 
 import json
 import os
+import pathlib
 
 import pytest
 
@@ -415,3 +416,37 @@ def test_save_through_a_symlink_keeps_the_link(saved, tmp_path):
     model.description = "through the link"
     model.save(link)
     assert link.is_symlink() and kn.load(saved).description == "through the link"
+
+
+def test_killing_a_save_halfway_leaves_the_old_file_whole(tmp_path):
+    """A child process saves a large model over and over onto the same file and is killed
+    with SIGKILL mid-way, several times: the file always loads, whole, as one of the two."""
+    import signal
+    import subprocess
+    import sys
+    import time
+
+    from scenes import chain
+    path = tmp_path / "model.json"
+    small = chain(2)
+    small.save(path)
+    script = (
+        "import sys; sys.path.insert(0, %r)\n"
+        "from scenes import chain\n"
+        "m = chain(400)\n"
+        "print('ready', flush=True)\n"
+        "while True:\n"
+        "    m.save(%r)\n") % (str(pathlib.Path(__file__).resolve().parents[2] / "bench"),
+                            str(path))
+    names = set()
+    for delay in (0.05, 0.13, 0.21, 0.34):
+        child = subprocess.Popen([sys.executable, "-c", script], stdout=subprocess.PIPE,
+                                 text=True)
+        assert child.stdout.readline().strip() == "ready"
+        time.sleep(delay)
+        child.send_signal(signal.SIGKILL)
+        child.wait()
+        child.stdout.close()
+        model = kn.load(path)                    # whole: it parses and validates
+        names.add(len(model.components))
+    assert names <= {len(small.components), 1201}
