@@ -64,6 +64,17 @@ class Assembly:
     def mass_matrix(self):
         return crba(self.bodies, self.qd.shape[0], self.armature)
 
+    def mass_times(self, w):
+        """M(q) w, by inverse dynamics with no speed and no gravity: an O(n) expression in
+        (q, w), where the mass matrix itself is O(n^2)."""
+        zero = ca.SX.zeros(self.qd.shape[0])
+        return ca.substitute(rnea(self.bodies, zero, w, ca.SX.zeros(6), self.armature),
+                             self.qd, zero)
+
+    def start_function(self):
+        """Function p -> (q_start, u_start): the initial coordinates and speeds as given."""
+        return ca.Function("start", [self.p], [self.q_start, self.u_start])
+
     def terms(self):
         """(M, V, G) with M qdd + V + G = 0: V holds Coriolis, centripetal and -Q."""
         n = self.qd.shape[0]

@@ -37,7 +37,7 @@ class Midpoint:
         zero, w = ca.SX.zeros(n), ca.SX.sym("w", n)
         a_grav = ca.vertcat(ca.SX.zeros(3), -a.gravity)
         # M(q) w by RNEA with no speed and no gravity; M(q) qd and its rate by differentiation
-        Mw = ca.substitute(rnea(a.bodies, zero, w, ca.SX.zeros(6), a.armature), a.qd, zero)
+        Mw = a.mass_times(w)
         Mqd = ca.substitute(Mw, w, a.qd)
         Mdot_qd = ca.substitute(ca.jtimes(Mw, a.q, a.qd), w, a.qd)
         fp = Mdot_qd - rnea(a.bodies, a.qd, zero, a_grav) + a.Q

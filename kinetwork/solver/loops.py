@@ -138,7 +138,7 @@ def _mechanism(asm, topo, values, formulation, rate):
     units = asm.coordinate_units + asm.speed_units
     given = np.array(asm.given, dtype=bool)
     if not asm.cuts:
-        start = ca.Function("start", [asm.p], [asm.q_start, asm.u_start])
+        start = asm.start_function()
 
         def initial(p):
             q0, u0 = (np.asarray(v, dtype=float).ravel() for v in start(p))
@@ -182,7 +182,7 @@ class _Loops:
         self.f_phi = ca.Function("closure", [q, asm.p], [self.phi])
         self.f_jac = ca.Function("closure_jacobian", [q, asm.p],
                                  [ca.jacobian(self.phi, q)[:, self.free]])
-        self.f_start = ca.Function("start", [asm.p], [asm.q_start, asm.u_start])
+        self.f_start = asm.start_function()
         q0 = self.close(p_nom)
         Jn = np.asarray(ca.Function("J", [q, asm.p], [self.J])(q0, p_nom))
         self.rows, self.dep = self._partition(Jn, loop_coords)

@@ -9,7 +9,6 @@ from ..errors import ModelError
 from . import jit as _jit
 from .assemble import assemble
 from .loops import BAUMGARTE_RATE, formulate, newton
-from .newton_euler import rnea
 
 #: Jacobians larger than this (instructions) are not compiled to C: Newton iterations use
 #: finite differences of the compiled right-hand side instead (an N = 128 chain's exact
@@ -85,8 +84,7 @@ class System:
         # gravity): an O(n) expression, where CRBA's would be O(n^2) to build
         a, n = self.asm, len(self.speed_names)
         acc = ca.SX.sym("acc", n)
-        Ma = rnea(a.bodies, ca.SX.zeros(n), acc, ca.SX.zeros(6), a.armature)
-        f = ca.Function("M_columns", [a.q, acc, a.p], [ca.substitute(Ma, a.qd, ca.SX.zeros(n))])
+        f = ca.Function("M_columns", [a.q, acc, a.p], [a.mass_times(acc)])
         M = np.asarray(f.map(n)(x0[:len(self.coordinate_names)], np.eye(n), p))
         values, vectors = np.linalg.eigh((M + M.T) / 2)
         scale = max(np.max(np.abs(M)), 1.0)
