@@ -278,11 +278,12 @@ def _oned(model, topo, values, problems):
         if len(definers) > 1 and (coords or motions):
             first = (coords or motions)[0]
             what = "joint flange" if coords else "prescribed motion"
+            why = ("this locks or couples joints, which is not supported yet" if coords else
+                   "one rigid group cannot follow two prescribed motions")
             problems.append(f"connection set {where} rigidly ties {what} {first.path} to "
                             f"{', '.join(p.path for p in definers if p != first)}"
                             + (f" (through {', '.join(elements)})" if elements else "")
-                            + ": this locks or couples joints, which is not supported yet"
-                            if coords else f": two motions of one rigid group")
+                            + f": {why}")
         elif len(definers) > 1 and values is not None:
             spots = {p.path: (topo.set_of[p], _fixed_position(p, values)) for p in definers}
             if len(set(spots.values())) > 1:
