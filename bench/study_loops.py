@@ -43,6 +43,7 @@ import statistics
 import tempfile
 import time
 
+import casadi as ca
 import numpy as np
 
 from common import RESULTS, load, machine, table, timed, write_csv, write_markdown
@@ -50,7 +51,7 @@ from common import RESULTS, load, machine, table, timed, write_csv, write_markdo
 import kinetwork as kn
 import loop_scenes as ls
 import reference_loops as rl
-from kinetwork.solver.system import JACOBIAN_JIT_LIMIT
+from kinetwork.simulation.compiled import JACOBIAN_JIT_LIMIT, compiled
 
 THETA0 = 1.0
 SPACING = 0.05
@@ -218,13 +219,14 @@ def part_formulations(quick, systems):
 # -- part 3: drift over a long run --------------------------------------------------------------
 def raw_idas(system, t_end, n_points, rtol, atol):
     """The partition's full states as IDAS returns them, before ``simulate``'s polish: the
-    same integrator and options (``system.integrator``) that ``simulate`` builds for idas."""
+    same compiled equations and options that ``simulate`` hands IDAS."""
     p = system.param_vector()
     x0, z0 = system.initial_full_p(p)
     rate0 = tuple(float(v) for v in np.asarray(system.f_dae(0.0, x0, z0, p)[0]).ravel())
     grid = np.linspace(0.0, t_end, n_points)
-    integ = system.integrator("idas", grid, dict(reltol=rtol, abstol=atol, calc_ic=False,
-                                                 init_xdot=rate0), cache=False, jit=True)
+    integ = ca.integrator("raw_idas", "idas", compiled(system).dae({"stats": {}}, True), 0.0,
+                          [float(g) for g in grid[1:]],
+                          dict(reltol=rtol, abstol=atol, calc_ic=False, init_xdot=rate0))
     out = integ(x0=x0, z0=z0, p=p)
     return np.vstack([np.concatenate([x0, z0]),
                       np.vstack([np.asarray(out["xf"]), np.asarray(out["zf"])]).T])

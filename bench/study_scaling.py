@@ -4,10 +4,10 @@ For each chain (``scenes.chain(n)``: N uniform rods on revolute joints): states 
 right-hand-side operations (``system.size()``); model construction and build time (model ->
 compiled System, no C compilation) as medians of repeated builds; JIT compilation of the
 right-hand side cold (an empty cache folder) and warm (a new System of the same model, the
-library found in the cache): the cold one timed once around ``rhs_function(jit=True)``, the
+library found in the cache): the cold one timed once around ``compiled(system).rhs(jit)``, the
 warm one as the median of repeated ``jit.external`` calls (what that call does on a hit); and
 the cost of one right-hand-side evaluation from Python: kinetwork compiled C and CasADi's
-virtual machine, both through ``system.numeric`` (~0.5 us of call overhead included),
+virtual machine, both through ``kinetwork.simulation.compiled.numeric`` (~0.5 us of call overhead included),
 pinocchio's ``aba`` and MuJoCo's ``mj_forward`` on the peers' models of the same chain. Each
 per-evaluation time is the median over batches of repeated calls on one state.
 
@@ -29,7 +29,10 @@ import numpy as np
 from common import RESULTS, STYLE, chart, load, machine, table, timed, write_csv, write_markdown
 
 import scenes
-from kinetwork.solver import jit
+import kinetwork as kn
+from kinetwork.graph.topology import analyze
+from kinetwork.simulation import jit
+from kinetwork.simulation.compiled import compiled as compiled_of, numeric
 
 SIZES = (2, 4, 8, 16, 32, 64, 128)
 FIT_FROM = 8
@@ -117,28 +120,30 @@ def _key(tool):
 
 def measure(n, tools):
     model_s, model = timed(lambda: scenes.chain(n), budget=0.3, max_repeats=7)
-    build_s, system = timed(model.compile, budget=1.0, max_repeats=7)
+    # validate and assemble afresh each time: model.compile() would hand back its System
+    build_s, system = timed(lambda: kn.System(model, topology=analyze(model)), budget=1.0,
+                            max_repeats=7)
     size = system.size()
     with tempfile.TemporaryDirectory() as folder:
         os.environ["KINETWORK_CACHE"] = folder       # jit.cache_dir() reads it on each call
-        start = time.perf_counter()
-        compiled = system.rhs_function(jit=True)
+        start, stats = time.perf_counter(), {}
+        compiled = compiled_of(system).rhs({"stats": stats})
         cold = time.perf_counter() - start
-        gcc = system.jit_stats.get("jit_seconds", float("nan"))
-        again = model.compile()
-        again.rhs_function(jit=True)
-        assert again.jit_stats.get("jit_cached"), "a new System missed the cache"
+        gcc = stats.get("jit_seconds", float("nan"))
+        again, stats = scenes.chain(n).compile(), {}       # a new model: a new System
+        compiled_of(again).rhs({"stats": stats})
+        assert stats.get("jit_cached"), "a new System missed the cache"
         # what that call did, repeated for a median: generate and hash the C, load the library
         warm, _ = timed(lambda: jit.external(again.f_rhs, False, {}), budget=0.3)
         p = system.param_vector()
         x = np.random.default_rng(0).uniform(-0.5, 0.5, 2 * n)
-        c_rhs = system.numeric(compiled, p)
-        vm_rhs = system.numeric(system.f_rhs, p)
+        c_rhs = numeric(compiled, p, system.n_states)
+        vm_rhs = numeric(system.f_rhs, p, system.n_states)
         assert np.allclose(c_rhs(0.0, x), vm_rhs(0.0, x), rtol=1e-10, atol=1e-10)
         # the same call path around a Function that does nothing but copy x: the overhead
         t_, x_, p_ = (ca.SX.sym(name, system.f_rhs.size1_in(i))
                       for i, name in enumerate("txp"))
-        empty = system.numeric(ca.Function("copy", [t_, x_, p_], [x_]), p)
+        empty = numeric(ca.Function("copy", [t_, x_, p_], [x_]), p, system.n_states)
         row = {"N": n, "states": size["states"], "operations": size["operations"],
                "model_s": model_s, "build_s": build_s, "jit_cold_s": cold,
                "jit_cold_compiler_s": gcc, "jit_warm_s": warm,
@@ -210,7 +215,7 @@ def report(rows, fits, tools, total, quick):
     lines = [f"## Scaling: chains of N rods{' (quick smoke run)' if quick else ''}", "",
              f"{machine()}; {load()}. Build: median of repeated `model.compile()` "
              f"(validate, assemble, "
-             f"CasADi Functions; no C). JIT cold: `rhs_function(jit=True)` with an empty "
+             f"CasADi Functions; no C). JIT cold: `compiled(system).rhs(jit)` with an empty "
              f"cache folder (code generation + gcc -O1); JIT hit: what the same call does "
              f"for a new System of the same model (code generation and hashing, then loading "
              f"the cached library), median of repeats. Per-evaluation times from Python, "

@@ -38,7 +38,7 @@ from reference import PAPER, seed_mvg
 
 import kinetwork as kn
 import scenes
-from kinetwork.solver.integrate import STIFF_HORIZON_STEPS, STIFF_RATIO
+from kinetwork.simulation.methods import STIFF_HORIZON_STEPS, STIFF_RATIO
 
 RTOL, ATOL = 1e-6, 1e-8
 SPACING = 0.01

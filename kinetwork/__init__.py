@@ -2,21 +2,27 @@
 
 Wire components into a :class:`Model`, compile it to a :class:`System` of minimal
 coordinates, :func:`simulate` it and read the probes from the :class:`Results`.
+
+Layers, each importing only those before it: ``errors``, ``util``, ``expr``, ``spatial``
+(helpers) -> ``components`` (what a user places) -> ``graph`` (model, topology, files) ->
+``equations`` (the System) -> ``simulation`` (driver, methods, JIT cache, Results) -> the
+faces: ``plot``, ``schema``, ``symbolic``, ``cli``.
 """
 
+from . import plot as _plot  # noqa: F401  (installs Results.plot)
 from .components import multibody, rotational, signals, translational
 from .components.probe import Probe
+from .equations.system import System
 from .errors import ModelError, SimulationError
 from .graph.io import dumps, load, loads
-from .schema import schema
 from .graph.model import Model
-from .solver.integrate import METHODS, simulate
-from .solver.results import Results
-from .solver.system import System
+from .schema import schema
+from .simulation.driver import simulate
+from .simulation.methods import METHODS
+from .simulation.results import Results
 
 __version__ = "0.1.0"
 
 __all__ = ["METHODS", "Model", "ModelError", "Probe", "Results", "SimulationError", "System",
            "dumps", "load", "loads", "multibody", "rotational", "schema", "signals",
-           "simulate",
-           "translational"]
+           "simulate", "translational"]

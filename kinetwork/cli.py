@@ -15,7 +15,7 @@ import time
 
 import kinetwork as kn
 
-from .solver.integrate import DEFAULTS, METHODS
+from .simulation.driver import DEFAULTS, METHODS
 
 EXIT_MODEL, EXIT_SIMULATION = 1, 3         # usage errors exit with argparse's 2
 
@@ -256,7 +256,7 @@ def _validate(args):
     comps = model.components.values()
     kinds = collections.Counter(c.type_name for c in comps)
     units = dict(zip(system.state_names, system.state_units))
-    n_values = sum(system.signal_sizes.values())
+    n_values = sum(sig.size for sig in system.signals)
     size = system.size()
     lines = [
         f"model {model.name!r} ({args.model}): valid",
@@ -303,7 +303,7 @@ def _schema(args):
 
 
 def _methods(args):
-    from .solver.integrate import DEFAULTS
+    from .simulation.driver import DEFAULTS
     width = max(map(len, METHODS))
     print(f"default: {DEFAULTS['method']}, rtol {DEFAULTS['rtol']:g}, atol {DEFAULTS['atol']:g}")
     for name, method in METHODS.items():

@@ -23,9 +23,11 @@ class ModelError(ValueError):
 class SimulationError(RuntimeError):
     """A failed integration; ``results`` holds what was computed up to ``t_reached``."""
 
-    def __init__(self, message, results=None, t_reached=None, reason=None):
+    def __init__(self, message, results=None, t_reached=None, reason=None, signal=None):
         super().__init__(message)
         self.results = results
         self.t_reached = t_reached
         #: why, in plain words (without the time and the solver's own message)
         self.reason = reason
+        #: the signal (SIGINT, SIGTERM) that stopped the run, or None
+        self.signal = signal

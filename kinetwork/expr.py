@@ -7,10 +7,11 @@ parsed tree serves validation with numbers and compilation with symbols.
 """
 
 import ast
-import difflib
+import functools
 import math
 
 from .errors import ModelError
+from .util import quote, suggest
 
 # name -> (function over floats, name of the CasADi/numpy method it maps to)
 FUNCTIONS = {
@@ -21,6 +22,8 @@ FUNCTIONS = {
     "min": min, "max": max, "sign": lambda x: math.copysign(1.0, x) if x else 0.0,
 }
 CONSTANTS = {"pi": math.pi, "e": math.e}
+#: how many arguments each function takes (CasADi's fmin/fmax take two, as does atan2)
+ARITY = {**{name: 1 for name in FUNCTIONS}, "atan2": 2, "min": 2, "max": 2}
 
 _BINARY = {ast.Add: lambda a, b: a + b, ast.Sub: lambda a, b: a - b,
            ast.Mult: lambda a, b: a * b, ast.Div: lambda a, b: a / b,
@@ -33,24 +36,37 @@ class Expression:
     """A parsed, checked arithmetic expression; ``names`` are the free symbols it uses."""
 
     def __init__(self, text):
+        if not isinstance(text, str):
+            raise ModelError(f"expression must be a string, got {quote(text)}")
         self.text = text
         if len(text) > _MAX_LENGTH:
-            raise ModelError(f"expression longer than {_MAX_LENGTH} characters")
+            raise ModelError(f"expression longer than {_MAX_LENGTH} characters "
+                             f"({len(text)}): {quote(text)}")
+        try:
+            text.encode("utf-8")
+        except UnicodeEncodeError as exc:     # a lone surrogate, from JSON's "\ud800"
+            raise ModelError(f"expression {quote(text)}: not valid text (a lone surrogate "
+                             f"at character {exc.start})") from None
         try:
             tree = ast.parse(text.strip(), mode="eval")
             self.names = set()
             self._check(tree.body)
+        except ModelError:
+            raise
         except SyntaxError as exc:
-            raise ModelError(f"cannot parse expression {text!r}: {exc.msg}") from None
+            raise ModelError(f"cannot parse expression {quote(text)}: {exc.msg}") from None
+        except ValueError as exc:            # a NUL character
+            raise ModelError(f"cannot parse expression {quote(text)}: {exc}") from None
         except (RecursionError, MemoryError):
             raise ModelError(f"expression nested too deeply ({len(text)} characters)") from None
         self._tree = tree.body
 
     def _check(self, node):
+        text = quote(self.text)
         if isinstance(node, ast.Constant):
             if isinstance(node.value, bool) or not isinstance(node.value, (int, float)):
-                raise ModelError(f"expression {self.text!r}: only numbers are allowed as "
-                                 f"constants, got {node.value!r}")
+                raise ModelError(f"expression {text}: only numbers are allowed as "
+                                 f"constants, got {quote(node.value)}")
         elif isinstance(node, ast.Name):
             if node.id not in CONSTANTS:
                 self.names.add(node.id)
@@ -61,19 +77,25 @@ class Expression:
             self._check(node.operand)
         elif (isinstance(node, ast.Call) and isinstance(node.func, ast.Name)
               and node.func.id in FUNCTIONS and not node.keywords):
+            name, given = node.func.id, len(node.args)
+            if given != ARITY[name]:
+                takes = f"{ARITY[name]} argument{'s' if ARITY[name] > 1 else ''}"
+                raise ModelError(f"expression {text}: {name}() takes {takes}, got {given}")
             for arg in node.args:
                 self._check(arg)
         else:
             if isinstance(node, ast.Call):
                 name = getattr(node.func, "id", None)
                 if name is None:
-                    raise ModelError(f"expression {self.text!r}: calling anything but a named "
+                    raise ModelError(f"expression {text}: calling anything but a named "
                                      f"function is not allowed")
-                close = difflib.get_close_matches(name, FUNCTIONS, n=1)
-                hint = f" (did you mean {close[0]!r}?)" if close else ""
-                raise ModelError(f"expression {self.text!r}: call of {name!r} is not allowed"
-                                 f"{hint}; functions are {', '.join(sorted(FUNCTIONS))}")
-            raise ModelError(f"expression {self.text!r}: {type(node).__name__} is not allowed "
+                if name in FUNCTIONS:                         # with keyword arguments
+                    raise ModelError(f"expression {text}: {name}() takes no keyword "
+                                     f"arguments")
+                raise ModelError(f"expression {text}: call of {quote(name)} is not allowed"
+                                 f"{suggest(name, FUNCTIONS)}; functions are "
+                                 f"{', '.join(sorted(FUNCTIONS))}")
+            raise ModelError(f"expression {text}: {type(node).__name__} is not allowed "
                              f"(only numbers, names, + - * / ** and functions)")
 
     def evaluate(self, env, functions=None):
@@ -111,3 +133,11 @@ def casadi_functions():
         "exp": ca.exp, "log": ca.log, "sqrt": ca.sqrt, "abs": ca.fabs, "min": ca.fmin,
         "max": ca.fmax, "sign": ca.sign,
     }
+
+
+@functools.lru_cache(maxsize=4096)
+def parse(text):
+    """The Expression of ``text``, parsed once per process however often it is asked for:
+    a parameter is checked at construction, evaluated at validation and bound to symbols at
+    compilation from the same parsed tree."""
+    return Expression(text)

@@ -8,8 +8,9 @@ kinetwork`` stays fast and never touches a display.
 import os
 import sys
 
-from .components.base import suggest
+from .util import atomic_write, suggest
 from .errors import ModelError
+from .simulation.results import install_plotter
 
 #: a probe with more quantities than this wraps onto further rows (a frame probe has eight)
 MAX_COLUMNS = 4
@@ -172,7 +173,12 @@ def save_plot(results, path, probes=None, title=None, dpi=150, **kwargs):
     check_plot_path(path)
     plt = _pyplot()
     fig = plot_results(results, probes=probes, title=title, **kwargs)
+    fmt = os.path.splitext(str(path))[1].lstrip(".").lower()
     try:
-        fig.savefig(path, dpi=dpi)
+        # atomically: a full disk or a signal leaves an old image whole
+        atomic_write(path, lambda tmp: fig.savefig(tmp, dpi=dpi, format=fmt))
     finally:
         plt.close(fig)
+
+
+install_plotter(plot_results)

@@ -10,8 +10,8 @@ schema cannot: wiring, units of expressions, physical sense).
 
 from .components.base import REGISTRY
 from .graph.io import FORMAT, KEYS, VERSION
-from .graph.model import SIMULATION_KEYS
-from .solver.integrate import METHODS
+from .graph.settings import SIMULATION_KEYS
+from .simulation.methods import METHODS
 
 IDENT = "^[A-Za-z_][A-Za-z0-9_]*$"
 NUMBER = {"type": "number"}

@@ -33,9 +33,15 @@ def blowup_file(tmp_path):
     return path
 
 
-def read_csv(path):
+def read_csv(path, partial=None):
+    """(header, data) of a results CSV; ``partial`` says whether it must end with the
+    ``# partial:`` line of a run that stopped early (None: either)."""
     with open(path, newline="") as fh:
-        rows = list(csv.reader(fh))
+        lines = fh.read().splitlines()
+    notes = [ln for ln in lines if ln.startswith("#")]
+    rows = list(csv.reader(ln for ln in lines if not ln.startswith("#")))
+    if partial is not None:
+        assert bool(notes) == partial and (not notes or lines[-1].startswith("# partial: "))
     return rows[0], np.array(rows[1:], dtype=float)
 
 
@@ -219,7 +225,7 @@ def test_failed_integration_exits_3_with_partial_results(blowup_file, tmp_path, 
     assert code == 3
     err = capsys.readouterr()
     assert "cvodes failed after t = " in err.err and no_traceback(err)
-    _, data = read_csv(out)
+    _, data = read_csv(out, partial=True)
     assert 0.9 <= data[-1, 0] <= 1.0
     assert png.exists()
 
@@ -252,13 +258,13 @@ def test_step_budget_and_time_limit_end_in_exit_3_with_the_partial_csv(blowup_fi
     err = capsys.readouterr().err
     assert "rk45 failed after t = " in err and "step budget of 40 steps" in err
     assert no_traceback(capsys.readouterr())
-    _, data = read_csv(out)
+    _, data = read_csv(out, partial=True)
     assert 0.5 < data[-1, 0] < 1.0
     code = main(["run", str(seed_file_long(tmp_path)), "--time-limit", "0.2", "-q",
                  "--out", str(out)])
     assert code == 3
     assert "time limit" in capsys.readouterr().err
-    _, data = read_csv(out)
+    _, data = read_csv(out, partial=True)
     assert 0 < data[-1, 0] < 1e5
 
 

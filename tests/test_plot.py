@@ -149,7 +149,7 @@ def test_single_point_results_plot_without_warnings():
     system = double_pendulum().compile()
     res = kn.simulate(system, t_end=0.1, n_points=2)
     one = kn.Results(res.t[:1], res.states[:1], res.state_names, res.columns()[1][:1, 1:],
-                     system.signal_names, system.signal_sizes, system.signal_units)
+                     system.signals)
     fig = one.plot()
     fig.canvas.draw()
     assert len(visible(fig)) == 8

@@ -5,51 +5,29 @@ format and validation are all generated from the same declarations and never dri
 """
 
 import copy
-import difflib
 import math
 import re
 
 import numpy as np
 
 from ..errors import ModelError
-from ..expr import Expression
+from ..expr import parse
+from ..util import check_number, quote, suggest
 
 REQUIRED = object()
 DOMAINS = ("frame", "rotational", "translational", "signal_in", "signal_out")
 #: placeholder domains: ONED is the class's ``domain`` (rotational or translational); ANY
 #: connects to every domain (a probe)
 ONED, ANY = "1d", "any"
-_NAME = re.compile(r"^[A-Za-z_][A-Za-z0-9_]*$")
+#: a name: an ASCII identifier of at most NAME_LIMIT characters, matched whole (fullmatch:
+#: "mass1\n" is refused, not matched up to its newline)
+NAME_LIMIT = 200
+_NAME = re.compile(rf"[A-Za-z_][A-Za-z0-9_]{{0,{NAME_LIMIT - 1}}}")
+#: rows a signals.Table may have: a table is data for interpolation, not a data set
+TABLE_ROWS_LIMIT = 100_000
 
 #: type name ("multibody.Revolute") -> class; files resolve types only through this table.
 REGISTRY = {}
-
-
-def finite(value):
-    """math.isfinite that says False, not OverflowError, for a huge int."""
-    try:
-        return math.isfinite(value)
-    except OverflowError:
-        return False
-
-
-def check_number(value, where, what="a number"):
-    """A finite real number, or a ModelError naming ``where``."""
-    if isinstance(value, np.generic):
-        value = value.item()
-    if isinstance(value, bool) or not isinstance(value, (int, float)):
-        raise ModelError(f"{where}: must be {what}, got {value!r}")
-    if not finite(value):
-        got = (f"an integer of {len(str(value))} digits" if isinstance(value, int)
-               else repr(value))
-        raise ModelError(f"{where}: must be finite, got {got}")
-    return value
-
-
-def suggest(name, choices):
-    """' (did you mean 'x'?)' for the closest of ``choices``, or ''."""
-    close = difflib.get_close_matches(str(name), list(choices), n=1)
-    return f" (did you mean {close[0]!r}?)" if close else ""
 
 
 class Port:
@@ -66,6 +44,10 @@ class Port:
 
     def __get__(self, instance, owner):
         return self if instance is None else PortRef(instance, self.name)
+
+    def __set__(self, instance, value):
+        raise ModelError(f"{instance.name}.{self.name} is a port, not a parameter: wire it with "
+                         f"model.connect")
 
 
 class PortRef:
@@ -120,6 +102,11 @@ class Param:
     def __get__(self, instance, owner):
         return self if instance is None else instance._values[self.name]
 
+    def __set__(self, instance, value):
+        # ``comp.mass = 2`` goes through the same checks as the constructor and lands in what
+        # is saved and simulated: one truth for a parameter's value
+        instance.set_param(self.name, value)
+
     @property
     def required(self):
         return self.default is REQUIRED
@@ -140,30 +127,31 @@ class Param:
             raise ModelError(f"{where}: a value is required")
         if self.kind == "bool":
             if not isinstance(value, bool):
-                raise ModelError(f"{where}: must be true or false, got {value!r}")
+                raise ModelError(f"{where}: must be true or false, got {quote(value)}")
             return value
         if self.kind == "table":
             return _table(value, where)
         if self.kind == "name":
-            if not isinstance(value, str) or not _NAME.match(value):
-                raise ModelError(f"{where}: must be a component name, got {value!r}")
+            if not isinstance(value, str) or not _NAME.fullmatch(value):
+                raise ModelError(f"{where}: must be a component name, got {quote(value)}")
             return value
         if self.kind == "names":
             if not isinstance(value, (list, tuple)) or not all(isinstance(v, str) for v in value):
-                raise ModelError(f"{where}: must be a list of names, got {value!r}")
+                raise ModelError(f"{where}: must be a list of names, got {quote(value)}")
             for v in value:
                 if self.choices is not None and v not in self.choices:
-                    raise ModelError(f"{where}: unknown {v!r}{suggest(v, self.choices)}; "
+                    raise ModelError(f"{where}: unknown {quote(v)}{suggest(v, self.choices)}; "
                                      f"choose from {', '.join(self.choices)}")
             if len(set(value)) != len(value):
-                raise ModelError(f"{where}: names repeated in {list(value)!r}")
+                raise ModelError(f"{where}: names repeated in {quote(list(value))}")
             return list(value)
         if self.shape == ():
             return self._scalar(value, where)
         if isinstance(value, np.ndarray):
             value = value.tolist()
         if not isinstance(value, (list, tuple)):
-            raise ModelError(f"{where}: must be a list of shape {self.shape}, got {value!r}")
+            raise ModelError(f"{where}: must be a list of shape {self.shape}, "
+                             f"got {quote(value)}")
         if self.shape == (3, 3) and len(value) == 3 and not any(
                 isinstance(v, (list, tuple)) for v in value):
             value = [[value[0], 0, 0], [0, value[1], 0], [0, 0, value[2]]]
@@ -197,11 +185,11 @@ class Param:
             if not value.strip():
                 raise ModelError(f"{where}: empty expression")
             try:
-                expr = Expression(value)
+                expr = parse(value)
             except ModelError as exc:
                 raise ModelError(f"{where}: {exc}") from None
             if "t" in expr.names and not self.time:
-                raise ModelError(f"{where}: time 't' is not allowed in {value!r}; "
+                raise ModelError(f"{where}: time 't' is not allowed in {quote(value)}; "
                                  f"this parameter is constant")
             return value
         value = check_number(value, where, "a number or an expression")
@@ -225,21 +213,33 @@ class Param:
 
 
 def _table(value, where):
-    """Rows [x, y] of numbers, x strictly increasing, at least two."""
+    """Rows [x, y] of numbers, x strictly increasing, at least two and at most
+    TABLE_ROWS_LIMIT."""
     if isinstance(value, np.ndarray):
         value = value.tolist()
     if not isinstance(value, (list, tuple)) or len(value) < 2:
-        raise ModelError(f"{where}: must be a table of at least two rows [x, y], got {value!r}")
+        raise ModelError(f"{where}: must be a table of at least two rows [x, y], "
+                         f"got {quote(value)}")
+    if len(value) > TABLE_ROWS_LIMIT:
+        # refused before any row is read: the cost of a table grows with its rows all the
+        # way to the compiled code
+        raise ModelError(f"{where}: {len(value)} rows, more than the {TABLE_ROWS_LIMIT} a "
+                         f"table may have; resample it")
     rows = []
     for i, row in enumerate(value):
         if not isinstance(row, (list, tuple)) or len(row) != 2:
-            raise ModelError(f"{where}[{i}]: must be a row [x, y], got {row!r}")
+            raise ModelError(f"{where}[{i}]: must be a row [x, y], got {quote(row)}")
         rows.append([check_number(v, f"{where}[{i}][{j}]") for j, v in enumerate(row)])
     for i in range(1, len(rows)):
         if rows[i][0] <= rows[i - 1][0]:
             raise ModelError(f"{where}[{i}]: x must increase, got {rows[i][0]} after "
                              f"{rows[i - 1][0]}")
     return rows
+
+
+def _cut(key):
+    """A parameter key as given, cut for messages (a file may hold any text as a key)."""
+    return key if isinstance(key, str) and len(key) <= NAME_LIMIT else quote(key, NAME_LIMIT)
 
 
 class Component:
@@ -288,17 +288,19 @@ class Component:
         return comp
 
     def _declare(self, name, params, place):
-        place = place or (lambda key: f"{name}.{key}")
-        if not isinstance(name, str) or not _NAME.match(name):
-            raise ModelError(f"{type(self).__name__} name {name!r}: must be an identifier "
-                             f"(letters, digits, underscore; not starting with a digit)")
-        self.name = name
+        place = place or (lambda key: f"{name}.{_cut(key)}")
+        if not isinstance(name, str) or not _NAME.fullmatch(name):
+            size = (f"; at most {NAME_LIMIT} characters, got {len(name)}"
+                    if isinstance(name, str) and len(name) > NAME_LIMIT else "")
+            raise ModelError(f"{type(self).__name__} name {quote(name)}: must be an identifier "
+                             f"(letters, digits, underscore; not starting with a digit{size})")
+        object.__setattr__(self, "name", name)
         kind = self.type_name or type(self).__name__
         problems = [f"{place(key)}: unknown parameter{suggest(key, self.params)}; "
                     f"{kind} has {', '.join(self.params) or 'none'}"
                     for key in params if key not in self.params]
-        self.given = {}
-        self._values = {}
+        object.__setattr__(self, "given", {})
+        object.__setattr__(self, "_values", {})
         for key, spec in self.params.items():
             try:
                 if key in params:
@@ -313,6 +315,43 @@ class Component:
         if problems:
             raise ModelError(problems)
 
+    def set_param(self, key, value):
+        """Change parameter ``key`` (its file name) to ``value``, checked as at construction.
+
+        The new value is what ``Model.save``, ``numeric_values`` and ``simulate`` see; a
+        compiled System of a model holding this component is rebuilt on its next use.
+        """
+        if key not in self.params:
+            raise ModelError(f"{type(self).__name__} {self.name!r} has no parameter "
+                             f"{quote(key)}{suggest(key, self.params)}; parameters: "
+                             f"{', '.join(self.params) or 'none'}")
+        spec = self.params[key]
+        value = spec.normalize(value, f"{self.name}.{key}")
+        if value is None and not spec.optional:
+            raise ModelError(f"{self.name}.{key}: a value is required")
+        self.given[key] = value
+        self._values[key] = value
+
+    def __setattr__(self, key, value):
+        declared = getattr(type(self), key, None)
+        if isinstance(declared, (Param, Port)) or key.startswith("_"):
+            object.__setattr__(self, key, value)
+            return
+        if key == "name":
+            raise ModelError(f"{self.name!r}: a component cannot be renamed; build a new one "
+                             f"(a model refers to its components by name)")
+        by_file_name = {spec.name: spec for spec in self.params.values()}
+        if key in by_file_name:        # a parameter whose attribute has another name
+            self.set_param(key, value)
+            return
+        raise ModelError(f"{type(self).__name__} {self.name!r} has no parameter "
+                         f"{quote(key)}{suggest(key, [*self.params, *self.ports])}; change a "
+                         f"parameter with comp.<parameter> = value or comp.set_param(name, "
+                         f"value); parameters: {', '.join(self.params) or 'none'}")
+
+    def __delattr__(self, key):
+        raise ModelError(f"{self.name}.{key}: parameters and ports cannot be deleted")
+
     def __getattr__(self, key):
         # reached only when normal lookup fails: a misspelt port or parameter
         if key.startswith("_"):
@@ -324,14 +363,14 @@ class Component:
     def port_ref(self, name):
         """The ``PortRef`` called ``name``; a ModelError suggesting close names otherwise."""
         if name not in self.ports:
-            raise ModelError(f"{type(self).__name__} {self.name!r} has no port {name!r}"
+            raise ModelError(f"{type(self).__name__} {self.name!r} has no port {quote(name)}"
                              f"{suggest(name, self.ports)}; ports: {', '.join(self.ports)}")
         return PortRef(self, name)
 
     def bound(self, values):
         """A copy whose parameters read as ``values`` (numbers or CasADi symbols)."""
         twin = copy.copy(self)
-        twin._values = dict(values)
+        object.__setattr__(twin, "_values", dict(values))
         return twin
 
     def __repr__(self):

@@ -21,13 +21,26 @@ class Ground(Component, library=MB):
 
 
 class PartialRigidTransform(Component):
-    """Two frames at a transform fixed by parameters: costs no state."""
-    role = "joint"
+    """Two frames at a transform fixed by parameters: costs no state.
+
+    It and the joints are the edges of the frame graph; ``cut_preference`` ranks how
+    willingly the spanning tree leaves one out to cut a kinematic loop (lowest first).
+    """
+    role = "part"
     dof = 0
     constant_subspace = True
+    regular = True
+    cut_preference = 4          # a rigid part is never cut while a joint of the loop can be
     frame_a = Port("frame", "Frame a")
     # a dangling end of a rigid part is a marker frame (for probes), as in Modelica
     frame_b = Port("frame", "Frame b, at the fixed transform from frame_a", optional=True)
+
+    def closure(self, rel_R, rel_p, q):
+        """Loop-closure residual when this part or joint is cut: zero when frame_b, at
+        ``rel_R, rel_p`` in frame_a, sits where the transform at coordinates ``q`` puts it
+        (3 position rows, 9 rotation-matrix rows; the redundant ones are dropped later)."""
+        Rc, pc = self.transform(q)
+        return ca.vertcat(rel_p - pc, ca.vec(Rc.T @ rel_R - ca.SX.eye(3)))
 
 
 class FixedTranslation(PartialRigidTransform, library=MB):
@@ -58,10 +71,12 @@ class PartialJoint(PartialRigidTransform):
     velocity of frame_b relative to frame_a per unit speed, in frame_b axes) is derived from
     ``transform`` unless ``subspace`` gives it; ``rate`` gives qdot from (q, u).
     """
+    role = "joint"
     dof = 1
     nq = None                 # coordinates (None: as many as speeds)
     regular = True
     constant_subspace = True
+    cut_preference = 3
     frame_b = Port("frame", "Frame b, moved by the joint coordinates")
     coordinate_ports = {}
     zero_ports = ()
@@ -229,6 +244,7 @@ class Spherical(PartialJoint, library=MB):
     dof = 3
     nq = 4
     regular = False
+    cut_preference = 1        # three position rows, and no quaternion left in a loop
     units = ("", "", "", "")
     angles0 = Param([0.0, 0.0, 0.0], shape=(3,), unit="rad",
                     doc="Initial orientation: body-fixed x-y-z (Cardan) angles")
@@ -250,6 +266,9 @@ class Spherical(PartialJoint, library=MB):
     def rate(self, q, u):
         return quat_rate(q, u)
 
+    def closure(self, rel_R, rel_p, q):
+        return rel_p                               # cut: the origins meet
+
     def initial(self):
         return list(ca.vertsplit(cardan_quat(self.angles0))), list(self.w0)
 
@@ -267,6 +286,7 @@ class FreeMotion(PartialJoint, library=MB):
     nq = 7
     regular = False
     constant_subspace = False
+    cut_preference = 0        # cutting it removes nothing: the first choice
     units = ("m", "m", "m", "", "", "", "")
     r0 = Param([0.0, 0.0, 0.0], shape=(3,), unit="m", doc="Initial position, in frame_a")
     v0 = Param([0.0, 0.0, 0.0], shape=(3,), unit="m/s", doc="Initial velocity, in frame_a")
@@ -291,6 +311,9 @@ class FreeMotion(PartialJoint, library=MB):
 
     def rate(self, q, u):
         return ca.vertcat(u[0:3], quat_rate(q[3:7], u[3:6]))
+
+    def closure(self, rel_R, rel_p, q):
+        return ca.SX(0, 1)                         # cut: it constrains nothing
 
     def initial(self):
         return [*self.r0, *ca.vertsplit(cardan_quat(self.angles0))], [*self.v0, *self.w0]

@@ -21,7 +21,7 @@ class PartialCompliant(Component):
     def law(self, rel, rel_d):
         raise NotImplementedError
 
-    def flows(self, pos, vel, t):
+    def flows(self, pos, vel, t, u=None):
         f = self.law(pos["flange_b"] - pos["flange_a"], vel["flange_b"] - vel["flange_a"])
         return {"flange_a": -f, "flange_b": f}
 
@@ -48,15 +48,20 @@ class PartialDamper(PartialCompliant):
 
 
 class PartialSource(Component):
-    """A flow source: applies ``amount``, or the signal at ``u`` when it is wired, to flange;
-    its reaction goes to support, if wired."""
+    """A flow source: applies ``applied()`` (its torque or force parameter), or the signal at
+    ``u`` when it is wired, to flange; its reaction goes to support, if wired."""
     role = "source"
     flange = Port(ONED, "Flange driven by the source")
     support = Port(ONED, "Reaction flange (unwired: the world)", optional=True)
-    u = Port("signal_in", "Signal giving the amount (instead of the parameter)", optional=True)
+    u = Port("signal_in", "Signal giving the torque or force (instead of the parameter)",
+             optional=True)
 
-    def flows(self, pos, vel, t):
-        return {"flange": -self.amount, "support": self.amount}
+    def applied(self):
+        raise NotImplementedError
+
+    def flows(self, pos, vel, t, u=None):
+        f = self.applied() if u is None else u
+        return {"flange": -f, "support": f}
 
 
 class PartialFixed(Component):
@@ -94,7 +99,7 @@ class PartialInertia(PartialRigid):
     has_inertia = True
 
     def inertia(self):
-        return self.amount
+        raise NotImplementedError
 
 
 class PartialSensor(Component):
@@ -112,8 +117,11 @@ class PartialFlowSensor(PartialRigid):
 
 
 class PartialMotion(Component):
-    """Prescribes the position of its flange as a function of time (the reaction, through
-    the optional support, rests in the world)."""
+    """Prescribes the motion of its flange as a function of time (the reaction, through
+    the optional support, rests in the world): ``reference`` is the ``derivative``-th time
+    derivative of the flange's position (0: the position, 1: the speed, integrated from
+    ``position0``)."""
     role = "prescribed"
+    derivative = 0
     flange = Port(ONED, "Flange moved")
     support = Port(ONED, "Reaction flange (unwired: the world)", optional=True)

@@ -32,8 +32,10 @@ class Damper(PartialDamper, library=LIB):
 class Torque(PartialSource, library=LIB):
     """Torque source: a constant or an expression in time t and model parameters."""
     domain = LIB
-    amount = Param(0.0, unit="N*m", time=True, name="tau",
-                   doc="Torque applied to flange (when u is not wired)")
+    tau = Param(0.0, unit="N*m", time=True, doc="Torque applied to flange (when u is not wired)")
+
+    def applied(self):
+        return self.tau
 
 
 class Fixed(PartialFixed, library=LIB):
@@ -47,11 +49,14 @@ class Inertia(PartialInertia, library=LIB):
     (directly or through gears) it adds to the joint's inertia and costs no state; free, it has
     its own angle and speed."""
     domain = LIB
-    amount = Param(unit="kg*m^2", min=0.0, name="J", doc="Moment of inertia")
+    J = Param(unit="kg*m^2", min=0.0, doc="Moment of inertia")
     position0 = Param(None, optional=True, unit="rad", name="phi0",
                       doc="Initial angle when the inertia moves freely (None: 0)")
     speed0 = Param(None, optional=True, unit="rad/s", name="w0",
                    doc="Initial speed when the inertia moves freely (None: 0)")
+
+    def inertia(self):
+        return self.J
 
 
 class AngleSensor(PartialSensor, library=LIB):
@@ -82,13 +87,11 @@ class Position(PartialMotion, library=LIB):
     domain = LIB
     reference = Param(unit="rad", time=True, name="phi_ref", doc="Prescribed angle")
 
-    def motion(self, t):
-        return self.reference
-
 
 class Speed(PartialMotion, library=LIB):
     """Moves its flange at w_ref(t) from phi0 (the angle is integrated)."""
     domain = LIB
+    derivative = 1
     reference = Param(unit="rad/s", time=True, name="w_ref", doc="Prescribed speed")
     position0 = Param(0.0, unit="rad", name="phi0", doc="Initial angle")
 

@@ -4,6 +4,8 @@
 A block gives its output from its inputs, its states x and time (``output``), and the rates
 of its states (``rates``). ``feedthrough`` says whether the output depends on the inputs at
 the same instant: a loop of signals through feedthrough blocks only is an algebraic loop.
+Unwired optional inputs read as None. A block that needs the model's own dynamics (a
+computed-torque controller) overrides ``evaluate``, which is handed them.
 """
 
 import casadi as ca
@@ -19,11 +21,14 @@ class PartialBlock(Component):
     y = Port("signal_out", "Output", optional=True)
     n_states = 0
     feedthrough = True
-    #: inputs that may stay unwired (they read as None)
-    optional_inputs = ()
 
     def output(self, u, x, t):
         raise NotImplementedError
+
+    def evaluate(self, u, x, t, mechanics):
+        """The output, for blocks that may use ``mechanics`` (the model's inverse dynamics,
+        see ``kinetwork.equations.network``); most ignore it."""
+        return self.output(u, x, t)
 
     def rates(self, u, x, t):
         return []
@@ -104,7 +109,6 @@ class Sum(PartialBlock, library=LIB):
     u2 = Port("signal_in", "Input 2", optional=True)
     u3 = Port("signal_in", "Input 3", optional=True)
     u4 = Port("signal_in", "Input 4", optional=True)
-    optional_inputs = ("u2", "u3", "u4")
 
     def output(self, u, x, t):
         return sum((u[k] for k in ("u1", "u2", "u3", "u4") if u[k] is not None), ca.SX(0))
@@ -134,7 +138,6 @@ class Table(PartialBlock, library=LIB):
     wired), extrapolated linearly from the end rows."""
     u = Port("signal_in", "Abscissa (unwired: time)", optional=True)
     table = Param(kind="table", doc="Rows [x, y], x increasing")
-    optional_inputs = ("u",)
 
     def output(self, u, x, t):
         xs = ca.DM([row[0] for row in self.table])
@@ -214,7 +217,7 @@ class PID(PartialBlock, library=LIB):
     def _parts(self, u, x):
         e = u["u_s"] - u["u_m"]
         integral = x[0] if self.Ti is not None else 0
-        deriv = self.Nd * (e - x[1]) if self._has_d() else 0
+        deriv = self._when_d(self.Nd * (e - x[1]))
         unlimited = self.k * (e + integral + deriv)
         y = unlimited
         if self.y_max is not None:
@@ -222,8 +225,14 @@ class PID(PartialBlock, library=LIB):
             y = ca.fmin(ca.fmax(unlimited, low), self.y_max)
         return e, y, unlimited
 
-    def _has_d(self):
-        return not (isinstance(self.Td, (int, float)) and self.Td == 0)
+    def _when_d(self, value):
+        """``value`` where the derivative part is on (Td > 0), else 0. Td may be a symbol (a
+        model parameter set per run): then the choice is made at run time, and the division
+        by Td = 0 in the branch not taken is discarded, not propagated."""
+        td = ca.SX(self.Td)
+        if td.is_constant():
+            return value if float(td) > 0 else 0
+        return ca.if_else(td > 0, value, 0)
 
     def output(self, u, x, t):
         return self._parts(u, x)[1]
@@ -231,7 +240,7 @@ class PID(PartialBlock, library=LIB):
     def rates(self, u, x, t):
         e, y, unlimited = self._parts(u, x)
         di = (e + (y - unlimited) / (self.k * self.Ni)) / self.Ti if self.Ti is not None else 0
-        dd = (e - x[1]) * self.Nd / self.Td if self._has_d() else 0
+        dd = self._when_d((e - x[1]) * self.Nd / self.Td)
         return [di, dd]
 
     def initial(self):
@@ -248,5 +257,16 @@ class InverseDynamics(PartialBlock, library=LIB):
     a2 = Port("signal_in", "Acceleration of the second", optional=True)
     a3 = Port("signal_in", "Acceleration of the third", optional=True)
     a4 = Port("signal_in", "Acceleration of the fourth", optional=True)
-    optional_inputs = ("a2", "a3", "a4")
     joint = Param(kind="name", doc="Joint (one degree of freedom) whose force is the output")
+
+    def evaluate(self, u, x, t, mechanics):
+        n = mechanics.n_speeds
+        if n > 4:
+            raise mechanics.refuse(self, None, f"InverseDynamics takes at most 4 joint "
+                                               f"coordinates; this model has {n}")
+        speed = mechanics.speed_of(self.joint)
+        if speed is None:
+            raise mechanics.refuse(self, "joint", f"{self.joint!r} is not a joint with one "
+                                                  f"degree of freedom of this model")
+        a = [u[f"a{i + 1}"] if u[f"a{i + 1}"] is not None else 0 for i in range(n)]
+        return mechanics.inverse(a)[speed]

@@ -32,8 +32,10 @@ class Damper(PartialDamper, library=LIB):
 class Force(PartialSource, library=LIB):
     """Force source: a constant or an expression in time t and model parameters."""
     domain = LIB
-    amount = Param(0.0, unit="N", time=True, name="f",
-                   doc="Force applied to flange (when u is not wired)")
+    f = Param(0.0, unit="N", time=True, doc="Force applied to flange (when u is not wired)")
+
+    def applied(self):
+        return self.f
 
 
 class Fixed(PartialFixed, library=LIB):
@@ -47,11 +49,14 @@ class Mass(PartialInertia, library=LIB):
     (directly or through gears) it adds to the joint's inertia and costs no state; free, it has
     its own position and speed."""
     domain = LIB
-    amount = Param(unit="kg", min=0.0, name="m", doc="Mass")
+    m = Param(unit="kg", min=0.0, doc="Mass")
     position0 = Param(None, optional=True, unit="m", name="s0",
                       doc="Initial position when the inertia moves freely (None: 0)")
     speed0 = Param(None, optional=True, unit="m/s", name="v0",
                    doc="Initial speed when the inertia moves freely (None: 0)")
+
+    def inertia(self):
+        return self.m
 
 
 class PositionSensor(PartialSensor, library=LIB):
@@ -82,12 +87,10 @@ class Position(PartialMotion, library=LIB):
     domain = LIB
     reference = Param(unit="m", time=True, name="s_ref", doc="Prescribed position")
 
-    def motion(self, t):
-        return self.reference
-
 
 class Speed(PartialMotion, library=LIB):
     """Moves its flange at v_ref(t) from s0 (the position is integrated)."""
     domain = LIB
+    derivative = 1
     reference = Param(unit="m/s", time=True, name="v_ref", doc="Prescribed speed")
     position0 = Param(0.0, unit="m", name="s0", doc="Initial position")

@@ -11,12 +11,11 @@ from dataclasses import dataclass, field
 
 import casadi as ca
 
-from ..components.probe import QUANTITIES
-from ..errors import ModelError
-from ..expr import Expression, casadi_functions
+from ..expr import casadi_functions, parse
 from ..spatial import vec3, vee
 from . import network
-from .newton_euler import Body, aba, crba, rnea, spatial_inertia
+from .newton_euler import Body, aba, crba, motion_subspace, rnea, spatial_inertia
+from .signals import probe_signals
 
 
 @dataclass
@@ -24,13 +23,15 @@ class Assembly:
     """Symbols and expressions of a model (all CasADi SX).
 
     ``q`` are the coordinates of every joint with coordinates (the tree's and those of
-    regular cut joints) and ``qd`` their speeds u; a quaternion joint has more coordinates
-    than speeds, so d(q)/dt is ``qdot`` (= u for angles and distances). ``qdd`` is the
-    tree's forward dynamics; a model with loops (``cuts``) is reduced by ``loops.py``.
+    regular cut joints) and ``u`` their speeds; a quaternion joint has more coordinates than
+    speeds, so d(q)/dt is ``qdot`` (= u for angles and distances). ``udot`` is the symbol of
+    the speeds' rates in expressions that need them (probe signals, sensors, inverse
+    dynamics): the formulation of ``loops.py`` says what it equals, ``udot_tree`` for a model
+    without loops. ``lam`` likewise stands for the loops' multipliers.
     """
     t: ca.SX
     q: ca.SX
-    qd: ca.SX
+    u: ca.SX
     p: ca.SX
     param_names: list
     coordinate_names: list
@@ -44,32 +45,32 @@ class Assembly:
     u_given: list              # per speed: qd0 was given
     regular: list              # per coordinate: an angle or distance with qdot = its speed
     speed_of: dict             # regular coordinate index -> speed index
-    Q: ca.SX                   # generalized forces of 1-D network and frame forces (t,q,qd,p)
-    qdd: ca.SX                 # forward dynamics of the tree (t, q, qd, p)
-    qdot: ca.SX                # d(q)/dt in (q, qd)
+    Q: ca.SX                   # generalized forces of 1-D network and frame forces (t,q,u,p)
+    udot_tree: ca.SX           # forward dynamics of the tree (t, q, u, p)
+    qdot: ca.SX                # d(q)/dt in (q, u)
     gravity: ca.SX
+    udot: ca.SX                # symbol: the speeds' rates, bound by the formulation
     place: dict = field(default_factory=dict)     # frame set -> (body, R, p) in the body
     cuts: list = field(default_factory=list)      # (Cut, residual SX in q)
-    signals: list = field(default_factory=list)   # (name, unit, SX expression in t,q,qd,qdd,p)
-    qdd_sym: ca.SX = None      # placeholder for qdd inside signal expressions
-    lam_sym: ca.SX = None      # placeholder for the loops' multipliers (one per closure row)
+    signals: list = field(default_factory=list)   # Signal descriptors, in (t, q, u, udot, lam, p)
+    lam: ca.SX = None          # symbol: the loops' multipliers (one per closure row)
     armature: ca.SX = None     # 1-D inertia geared rigidly to each speed
     net: object = None         # the 1-D network and signal blocks (network.Network)
     qindex: dict = None        # joint name -> indices of its coordinates in q
-    uindex: dict = None        # joint name -> indices of its speeds in qd
+    uindex: dict = None        # joint name -> indices of its speeds in u
     Q_drive: ca.SX = None      # the part of Q that 1-D flanges apply (drives, springs)
     _poses: dict = field(default_factory=dict)
     base: tuple = None         # world pose of the body of the last ``relative_poses``
 
     def mass_matrix(self):
-        return crba(self.bodies, self.qd.shape[0], self.armature)
+        return crba(self.bodies, self.u.shape[0], self.armature)
 
     def mass_times(self, w):
         """M(q) w, by inverse dynamics with no speed and no gravity: an O(n) expression in
         (q, w), where the mass matrix itself is O(n^2)."""
-        zero = ca.SX.zeros(self.qd.shape[0])
+        zero = ca.SX.zeros(self.u.shape[0])
         return ca.substitute(rnea(self.bodies, zero, w, ca.SX.zeros(6), self.armature),
-                             self.qd, zero)
+                             self.u, zero)
 
     def start_function(self):
         """Function p -> (q_start, u_start): the initial coordinates and speeds as given."""
@@ -77,10 +78,10 @@ class Assembly:
 
     def terms(self):
         """(M, V, G) with M qdd + V + G = 0: V holds Coriolis, centripetal and -Q."""
-        n = self.qd.shape[0]
+        n = self.u.shape[0]
         a_grav = ca.vertcat(ca.SX.zeros(3), -self.gravity)
         zero = ca.SX.zeros(n)
-        C = rnea(self.bodies, self.qd, zero, ca.SX.zeros(6))       # qdd = 0: no armature
+        C = rnea(self.bodies, self.u, zero, ca.SX.zeros(6))       # udot = 0: no armature
         G = rnea(self.bodies, zero, zero, a_grav)
         return self.mass_matrix(), C - self.Q, G
 
@@ -118,12 +119,12 @@ class Assembly:
         return (*up(ka, Ra, pa, anc), *up(kb, Rb, pb, anc))
 
     def rate(self, expr, accelerations=True):
-        """Time derivative of an expression in (q, qd), with qd's rate ``qdd_sym`` (or, without
+        """Time derivative of an expression in (q, u), with u's rate ``udot`` (or, without
         ``accelerations``, for an expression in q alone)."""
         flat = ca.vec(expr)
         out = ca.jtimes(flat, self.q, self.qdot)
         if accelerations:
-            out += ca.jtimes(flat, self.qd, self.qdd_sym)
+            out += ca.jtimes(flat, self.u, self.udot)
         return ca.reshape(out, *expr.shape)
 
     def angular_velocity(self, R, accelerations=True):
@@ -131,8 +132,10 @@ class Assembly:
         return vee(self.rate(R, accelerations) @ R.T)
 
 
-def assemble(model, topo):
-    """Build the Assembly of a validated model (``topo`` from ``model.validate()``)."""
+def assemble(model, topo, values):
+    """Build the Assembly of a validated model (``topo`` from ``model.validate()``);
+    ``values`` are the model parameters' values, at which structural choices that depend on
+    numbers (a singular algebraic loop) are checked. Every model parameter stays a symbol."""
     names = list(model.parameters)
     p = ca.SX.sym("p", len(names))
     t = ca.SX.sym("t")
@@ -158,22 +161,21 @@ def assemble(model, topo):
         speed_units += [f"{u}/s" if u else "rad/s" for u in joint.units[:joint.dof]] \
             if joint.regular else _speed_units(joint)
     q = _symbols(coord_names, "")
-    qd = _symbols(speed_names, "d")
+    u = _symbols(speed_names, "d")
     n = len(speed_names)
-    qdd_sym = ca.SX.sym("qdd", n)
+    udot = ca.SX.sym("udot", n)
     qdot = ca.SX.zeros(len(coord_names))
     for joint in topo.joints:
         qdot[qindex[joint.name]] = bound[joint.name].rate(q[qindex[joint.name]],
-                                                          qd[uindex[joint.name]])
+                                                          u[uindex[joint.name]])
 
-    bodies, place = _bodies(topo, bound, q, qd, qindex, uindex)
+    bodies, place = _bodies(topo, bound, q, u, qindex, uindex)
     gravity = ca.vertcat(*bound[topo.world.name].gravity) if topo.world else ca.SX.zeros(3)
     a_grav = ca.vertcat(ca.SX.zeros(3), -gravity)
 
-    def inverse(a, armature, passive):     # M(q) a + C(q, qd) qd + G(q) - Q_passive
-        return rnea(bodies, qd, a, a_grav, armature) - passive
-    values = model.parameter_values()
-    net = network.build(model, topo, bound, q, qd, qdd_sym, qindex, uindex, t, inverse, p,
+    def inverse(a, armature, passive):     # M(q) a + C(q, u) u + G(q) - Q_passive
+        return rnea(bodies, u, a, a_grav, armature) - passive
+    net = network.build(model, topo, bound, q, u, udot, qindex, uindex, t, inverse, p,
                         [values[k] for k in names])
     Q = net.Q
 
@@ -185,19 +187,19 @@ def assemble(model, topo):
         given += [v is not None for v in q0]
         u_start += [0 if v is None else v for v in u0]
         u_given += [v is not None for v in u0]
-    asm = Assembly(t, q, qd, p, names, coord_names, coord_units, speed_names, speed_units,
+    asm = Assembly(t, q, u, p, names, coord_names, coord_units, speed_names, speed_units,
                    bodies, ca.vertcat(*starts) if starts else ca.SX(0, 1),
                    ca.vertcat(*u_start) if u_start else ca.SX(0, 1), given, u_given, regular,
-                   speed_of, Q, None, qdot, gravity, place=place, qdd_sym=qdd_sym)
+                   speed_of, Q, None, qdot, gravity, udot, place=place)
     asm.armature, asm.net = net.armature, net
     asm.Q = Q + _frame_forces(asm, topo, bound, t)
-    asm.qdd = aba(bodies, qd, asm.Q, ca.vertcat(ca.SX.zeros(3), -gravity), net.armature) \
+    asm.udot_tree = aba(bodies, u, asm.Q, ca.vertcat(ca.SX.zeros(3), -gravity), net.armature) \
         if n else ca.SX(0, 1)
     asm.cuts = [(cut, _closure(asm, cut, bound[cut.component.name], qindex))
                 for cut in topo.cuts]
-    asm.lam_sym = ca.SX.sym("lambda", sum(r.shape[0] for _, r in asm.cuts))
+    asm.lam = ca.SX.sym("lambda", sum(r.shape[0] for _, r in asm.cuts))
     asm.qindex, asm.uindex, asm.Q_drive = qindex, uindex, net.axis_flow
-    _probes(asm, topo, net, bound, model)
+    asm.signals = probe_signals(asm, topo, net, bound, model)
     return asm
 
 
@@ -212,7 +214,7 @@ def _speed_units(joint):
     return ["m/s"] * 3 + ["rad/s"] * 3 if joint.dof == 6 else ["rad/s"] * joint.dof
 
 
-def _bodies(topo, bound, q, qd, qindex, uindex):
+def _bodies(topo, bound, q, u, qindex, uindex):
     """Moving bodies along the tree; rigid parts fold into the body before them.
 
     Returns the bodies and, for each frame set, (body index, R, p): where the set sits in
@@ -231,7 +233,7 @@ def _bodies(topo, bound, q, qd, qindex, uindex):
         if comp.dof == 0:
             place[edge.child] = (k, R, pos)
             continue
-        uj = qd[uindex[comp.name]]
+        uj = u[uindex[comp.name]]
         S = None if edge.reversed else comp.subspace(qj)
         if S is None:
             S = motion_subspace(comp, qj, uj, Re, re)
@@ -251,14 +253,6 @@ def _bodies(topo, bound, q, qd, qindex, uindex):
     return bodies, place
 
 
-def motion_subspace(comp, qj, uj, Re, re):
-    """Spatial velocity of the moved frame relative to the fixed one per unit joint speed,
-    in the moved frame's axes (6 x dof), from the rate of the joint's transform (Re, re)."""
-    qdot = comp.rate(qj, uj)
-    w = vee(Re.T @ ca.reshape(ca.jtimes(ca.vec(Re), qj, qdot), 3, 3))
-    return ca.jacobian(ca.vertcat(w, Re.T @ ca.jtimes(re, qj, qdot)), uj)
-
-
 def _zero_pose(comp):
     """Coordinates of the joint's home pose (identity quaternion for quaternion joints)."""
     labels = comp.coordinate_labels()
@@ -268,8 +262,8 @@ def _zero_pose(comp):
 def _frame_forces(asm, topo, bound, t):
     """Generalized forces of line forces and world forces/torques: the power they put in,
     differentiated by the speeds (a force on a frame enters as J^T f)."""
-    Q = ca.SX.zeros(asm.qd.shape[0])
-    if not asm.qd.shape[0]:
+    Q = ca.SX.zeros(asm.u.shape[0])
+    if not asm.u.shape[0]:
         return Q
     for comp in topo.forces:
         c = bound[comp.name]
@@ -280,13 +274,13 @@ def _frame_forces(asm, topo, bound, t):
             s_d = ca.jtimes(s, asm.q, asm.qdot)
             # the tension times the rate of the length, differentiated by the speeds with
             # the tension held (a damper's law depends on the speeds itself)
-            Q -= c.law(s, s_d) * ca.gradient(s_d, asm.qd)
+            Q -= c.law(s, s_d) * ca.gradient(s_d, asm.u)
         else:
             R, pos = asm.pose(topo.set_of[comp.port_ref("frame_b")])
             w, v = asm.angular_velocity(R, False), asm.rate(pos, False)
             power = ca.dot(vec3(c.force), v) if "force" in comp.params \
                 else ca.dot(vec3(c.torque), w)
-            Q += ca.gradient(power, asm.qd)
+            Q += ca.gradient(power, asm.u)
     return Q
 
 
@@ -298,24 +292,7 @@ def _closure(asm, cut, comp, qindex):
     """
     Ra, pa, Rb, pb = asm.relative_poses(cut.set_a, cut.set_b)
     qj = asm.q[qindex[comp.name]] if comp.dof and comp.regular else ca.SX(0, 1)
-    return closure_rows(comp, Ra, pa, Rb, pb, qj)
-
-
-def closure_rows(comp, Ra, pa, Rb, pb, qj):
-    """Closure of a cut joint from the world poses of its two frames.
-
-    A regular cut joint keeps its coordinates: frame_a moved by its transform must be
-    frame_b (3 position rows, 9 rotation-matrix rows; only the independent ones are kept,
-    see ``loops.py``). A cut Spherical joint leaves the positions only; a cut FreeMotion
-    constrains nothing.
-    """
-    rel_p, rel_R = Ra.T @ (pb - pa), Ra.T @ Rb
-    if comp.dof and not comp.regular:
-        if comp.type_name == "multibody.FreeMotion":
-            return ca.SX(0, 1)
-        return rel_p                               # Spherical: the origins meet
-    Rc, pc = comp.transform(qj)
-    return ca.vertcat(rel_p - pc, ca.vec(Rc.T @ rel_R - ca.SX.eye(3)))
+    return comp.closure(Ra.T @ Rb, Ra.T @ (pb - pa), qj)
 
 
 def _symbolic(value, env, funcs):
@@ -323,44 +300,7 @@ def _symbolic(value, env, funcs):
     if isinstance(value, list):
         return [_symbolic(v, env, funcs) for v in value]
     if isinstance(value, str):
-        return ca.SX(Expression(value).evaluate(env, funcs))
+        return ca.SX(parse(value).evaluate(env, funcs))
     if isinstance(value, (int, float)) and not isinstance(value, bool):
         return ca.SX(value)
     return value
-
-
-def _probes(asm, topo, net, bound, model):
-    for probe, target in topo.probes:
-        units = QUANTITIES[target.domain]
-        asked = probe.quantities if probe.quantities is not None else list(units)
-        if target.domain == "frame":
-            values = _frame_quantities(asm, topo, target, asked, bound)
-        elif target.domain in ("signal_in", "signal_out"):
-            values = {"value": net.signal.get(topo.set_of[target], ca.SX.nan())}
-        elif "acceleration" in asked and topo.set_of[target] in net.no_acceleration:
-            raise ModelError(network.acceleration_unavailable(model.place(probe), target))
-        else:
-            potential = dict(zip(list(units)[:3], (net.pos[target], net.vel[target],
-                                                   net.acc[target])))
-            values = {**potential, list(units)[3]: net.flow.get(target, 0)}
-        for quantity in asked:
-            asm.signals.append((f"{probe.name}.{quantity}", units[quantity],
-                                ca.SX(values[quantity])))
-
-
-def _frame_quantities(asm, topo, target, asked, bound):
-    """World-frame kinematics of a frame, differentiated exactly by CasADi; the cut force and
-    torque through the port from the wrench balance of everything behind it."""
-    R, pos = asm.pose(topo.set_of[target])
-    out = {"position": pos, "orientation": ca.reshape(R.T, 9, 1)}
-    if {"velocity", "acceleration"} & set(asked):
-        out["velocity"] = asm.rate(pos)
-        out["acceleration"] = asm.rate(out["velocity"])
-    if {"angular_velocity", "angular_acceleration"} & set(asked):
-        out["angular_velocity"] = asm.angular_velocity(R)
-        out["angular_acceleration"] = asm.rate(out["angular_velocity"])
-    if {"force", "torque"} & set(asked):
-        from .wrench import cut_wrench          # only models that ask for it pay for it
-        force, moment = cut_wrench(asm, topo, target, bound)
-        out["force"], out["torque"] = force, moment - ca.cross(pos, force)
-    return out

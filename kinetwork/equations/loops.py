@@ -31,7 +31,7 @@ loops has more coordinates than degrees of freedom; three formulations are offer
     zero; it is there to compare with.
 """
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 
 import casadi as ca
 import numpy as np
@@ -76,7 +76,10 @@ class Equations:
     residual: ca.SX = None          # kept closure equations, in q
     lam: ca.SX = None               # multiplier of every closure row (0 for dropped ones)
     q: ca.SX = None                 # coordinates, where they are not the states themselves
-    extra: dict = field(default_factory=dict)
+    #: the closure's Jacobian in the dependent speeds (in q): the partition holds while it is
+    #: regular; where it turns singular the mechanism folds flat or locks
+    dependent_jacobian: ca.SX = None
+    dependent_names: list = None    # the dependent speeds, by name
 
 
 def formulate(asm, topo, values, formulation="partition", rate=BAUMGARTE_RATE):
@@ -91,7 +94,7 @@ def formulate(asm, topo, values, formulation="partition", rate=BAUMGARTE_RATE):
     q = asm.q if eq.q is None else eq.q
 
     def in_states(exprs):
-        return ca.substitute(ca.vertcat(*exprs), ca.vertcat(asm.q, asm.qd, asm.qdd_sym),
+        return ca.substitute(ca.vertcat(*exprs), ca.vertcat(asm.q, asm.u, asm.udot),
                              ca.densify(ca.vertcat(q, eq.u, eq.udot)))
     z_mech = eq.z
     eq.x, eq.ode = ca.vertcat(eq.x, *net.x), ca.vertcat(eq.ode, in_states(net.rate))
@@ -133,7 +136,7 @@ def _mechanism(asm, topo, values, formulation, rate):
     if formulation not in FORMULATIONS:
         raise ModelError(f"loops={formulation!r}: unknown formulation; choose from "
                          f"{', '.join(FORMULATIONS)}")
-    q, u = asm.q, asm.qd
+    q, u = asm.q, asm.u
     names = asm.coordinate_names + asm.speed_names
     units = asm.coordinate_units + asm.speed_units
     given = np.array(asm.given, dtype=bool)
@@ -147,8 +150,8 @@ def _mechanism(asm, topo, values, formulation, rate):
         note = (f"{q.shape[0] + u.shape[0]} states for {u.shape[0]} degrees of freedom: the "
                 f"quaternion of each ball or free joint has 4 coordinates for 3 speeds, so "
                 f"that no orientation is singular" if quaternions else "")
-        return Equations(ca.vertcat(q, u), ca.SX(0, 1), ca.vertcat(asm.qdot, asm.qdd),
-                         ca.SX(0, 1), names, units, [], [], u, asm.qdd, "tree", note,
+        return Equations(ca.vertcat(q, u), ca.SX(0, 1), ca.vertcat(asm.qdot, asm.udot_tree),
+                         ca.SX(0, 1), names, units, [], [], u, asm.udot_tree, "tree", note,
                          initial=initial, lam=ca.SX(0, 1))
     return _Loops(asm, topo, values).equations(formulation, rate)
 
@@ -161,7 +164,7 @@ class _Loops:
         p_nom = np.array([values[k] for k in asm.param_names], dtype=float)
         self.phi = ca.vertcat(*[r for _, r in asm.cuts])
         self.owner = [i for i, (_, r) in enumerate(asm.cuts) for _ in range(r.shape[0])]
-        q, u = asm.q, asm.qd
+        q, u = asm.q, asm.u
         # velocity-level Jacobian: d(phi)/dt = J(q) u
         self.J = ca.jacobian(ca.jtimes(self.phi, q, asm.qdot), u) if u.shape[0] \
             else ca.SX(self.phi.shape[0], 0)
@@ -288,7 +291,7 @@ class _Loops:
         zs = newton(phi, zg)
         star = lambda e: ca.substitute(e, zg, zs)        # noqa: E731
         rate_dep = star(sub(_rows(asm.qdot, dep_q))) + PROJECTION_PULL * (zs - zg)
-        x = ca.vertcat(_rows(q, keep_q), zg, _rows(asm.qd, ind))
+        x = ca.vertcat(_rows(q, keep_q), zg, _rows(asm.u, ind))
         ode = ca.vertcat(star(sub(_rows(asm.qdot, keep_q))), rate_dep, star(sub(udot_i)))
         qn, un = asm.coordinate_names, asm.speed_names
         qu, uu = asm.coordinate_units, asm.speed_units
@@ -303,18 +306,21 @@ class _Loops:
                         self.phi.shape[0] - len(self.rows), initial, star(phi),
                         star(sub(lam)))
         out.q = ca.substitute(q, zg, zs)
+        out.dependent_jacobian = star(self.JD)
+        out.dependent_names = [un[k] for k in self.dep]
         return out
 
 
     def equations(self, formulation, rate):
         asm = self.asm
-        q, u = asm.q, asm.qd
+        q, u = asm.q, asm.u
         nv = u.shape[0]
         dep = self.dep
         ind = [k for k in range(nv) if k not in set(dep)]
         phi = _rows(self.phi, self.rows)
         J = _rows(self.J, self.rows)
         JD, JI = _cols(J, dep), _cols(J, ind)
+        self.JD = JD
         T = ca.SX.zeros(nv, len(ind))
         T[ind, :] = ca.SX.eye(len(ind))
         if dep:
@@ -358,7 +364,8 @@ class _Loops:
             return Equations(ca.vertcat(q, u), ca.SX(0, 1), ca.vertcat(asm.qdot, udot),
                              ca.SX(0, 1), qnames + unames, qunits + uunits, [], [], u, udot,
                              "baumgarte", note, len(rows), self.phi.shape[0] - len(rows),
-                             initial, phi, lam)
+                             initial, phi, lam, dependent_jacobian=JD,
+                             dependent_names=[unames[k] for k in dep])
         keep_q = [k for k in range(q.shape[0]) if k not in set(dep_q)]
         u_full = ca.densify(T @ _rows(u, ind))
         sub = lambda e: ca.substitute(e, u, u_full)     # noqa: E731
@@ -398,7 +405,9 @@ class _Loops:
                          [qunits[k] for k in keep_q] + [uunits[k] for k in ind],
                          [qnames[k] for k in dep_q], [qunits[k] for k in dep_q],
                          u_full, sub(udot), "partition", note, len(rows),
-                         self.phi.shape[0] - len(rows), initial, phi, sub(lam))
+                         self.phi.shape[0] - len(rows), initial, phi, sub(lam),
+                         dependent_jacobian=JD if dep else None,
+                         dependent_names=[unames[k] for k in dep])
 
 
 

@@ -30,6 +30,7 @@ import casadi as ca
 import networkx as nx
 
 from ..errors import ModelError
+from .signals import acceleration_unavailable
 
 MECHANICS = "the mechanics"
 
@@ -80,25 +81,25 @@ class Network:
         return out
 
 
-def build(model, topo, bound, q, qd, qdd_sym, qindex, uindex, t, inverse=None, p=None,
+def build(model, topo, bound, q, u, udot, qindex, uindex, t, inverse=None, p=None,
           p_values=None):
     """The Network of a validated model, in the symbols of the Assembly.
 
     ``inverse(a, armature, Q)`` is the tree's inverse dynamics (for InverseDynamics blocks):
     the generalized forces for speeds' rates ``a`` with the given armature, less ``Q``.
     """
-    return _Builder(model, topo, bound, q, qd, qdd_sym, qindex, uindex, t, inverse, p,
+    return _Builder(model, topo, bound, q, u, udot, qindex, uindex, t, inverse, p,
                     p_values).run()
 
 
 class _Builder:
-    def __init__(self, model, topo, bound, q, qd, qdd_sym, qindex, uindex, t, inverse, p,
+    def __init__(self, model, topo, bound, q, u, udot, qindex, uindex, t, inverse, p,
                  p_values):
         self.model, self.topo, self.bound = model, topo, bound
         self.inverse, self.p, self.p_values = inverse, p, p_values
-        self.q, self.qd, self.qdd, self.t = q, qd, qdd_sym, t
+        self.q, self.u, self.udot, self.t = q, u, udot, t
         self.qindex, self.uindex = qindex, uindex
-        n = qd.shape[0]
+        n = u.shape[0]
         self.net = Network({}, {}, {}, {}, ca.SX.zeros(n), ca.SX.zeros(n), ca.SX.zeros(n))
         self.k = {}                  # connection set -> ratio to its group's coordinate
         self.group_of = {}           # connection set -> group
@@ -120,7 +121,7 @@ class _Builder:
                 self.net.pos[ref], self.net.vel[ref], self.net.acc[ref] = k * theta, k * w, k * a
         self._block_states()
         self._flows("compliant")               # springs and dampers need no signal
-        self._passive = ca.SX.zeros(self.qd.shape[0])
+        self._passive = ca.SX.zeros(self.u.shape[0])
         for group in self.topo.oned:
             self._inertia(group)
         for node in self._order():
@@ -152,7 +153,7 @@ class _Builder:
             joint = group.definer.component
             j = joint.coordinate_ports[group.definer.name]
             i, u = self.qindex[joint.name][j], self.uindex[joint.name][j]
-            self.coord[group.index] = (self.q[i], self.qd[u], self.qdd[u])
+            self.coord[group.index] = (self.q[i], self.u[u], self.udot[u])
         elif kind == "fixed":
             comp = self.bound[group.definer.component.name]
             position = comp.position() if comp.role == "fixed" else 0
@@ -160,7 +161,7 @@ class _Builder:
         elif kind == "prescribed":
             comp = self.bound[group.definer.component.name]
             ref = ca.SX(comp.reference)
-            if comp.type_name.endswith(".Speed"):
+            if comp.derivative == 1:             # a speed: the position is integrated
                 theta = self._state(f"{comp.name}.{_pos(group)}", _units(group)[0],
                                     comp.position0, ref)
                 self.coord[group.index] = (theta, ref, ca.jacobian(ref, t))
@@ -230,10 +231,9 @@ class _Builder:
         """Evaluate a block's or a sensor's output into its signal set."""
         s = self.topo.set_of[comp.port_ref("y")]
         b = self.bound[comp.name]
-        if comp.type_name == "signals.InverseDynamics":
-            value = self._inverse_dynamics(comp)
-        elif comp.role == "block":
-            value = b.output(self._inputs(comp), self.block_x.get(comp.name, []), self.t)
+        if comp.role == "block":
+            value = b.evaluate(self._inputs(comp), self.block_x.get(comp.name, []), self.t,
+                               _Mechanics(self))
         elif comp.quantity == "flow":
             value = self.net.flow[comp.port_ref("flange_a")]
         else:
@@ -285,21 +285,6 @@ class _Builder:
     def _massless_at(self, ref):
         group = self.group_of.get(self.topo.set_of[ref])
         return group is not None and group.kind == "massless"
-
-    def _inverse_dynamics(self, comp):
-        joint = self.model.components.get(comp.joint)
-        if joint is None or joint.name not in self.uindex or joint.dof != 1:
-            raise ModelError(f"{self.model.place(comp, 'joint')}: {comp.joint!r} is not a "
-                             f"joint with one degree of freedom of this model")
-        n = self.qd.shape[0]
-        inputs = self._inputs(comp)
-        a = ca.vertcat(*[inputs.get(f"a{i + 1}") if inputs.get(f"a{i + 1}") is not None
-                         else ca.SX(0) for i in range(n)]) if n <= 4 else None
-        if a is None:
-            raise ModelError(f"{self.model.place(comp)}: InverseDynamics takes at most 4 "
-                             f"joint coordinates; this model has {n}")
-        tau = self.inverse(a, self.net.armature, self._passive)
-        return tau[self.uindex[joint.name][0]]
 
     def _block_rates(self):
         for name, xs in self.block_x.items():
@@ -362,14 +347,12 @@ class _Builder:
             if comp.role != role:
                 continue
             b = self.bound[comp.name]
-            if comp.role == "source":
-                u = self._inputs(comp).get("u")
-                if u is not None:             # the signal replaces the amount parameter
-                    b = b.bound({**b._values, type(comp).amount.name: u})
+            # a source's signal input, when wired, replaces its torque or force parameter
+            u = self._inputs(comp).get("u") if comp.role == "source" else None
             refs = {pn: comp.port_ref(pn) for pn in comp.ports if comp.ports[pn].domain
                     in ("rotational", "translational")}
             out = b.flows({pn: net.pos.get(r, 0) for pn, r in refs.items()},
-                          {pn: net.vel.get(r, 0) for pn, r in refs.items()}, self.t)
+                          {pn: net.vel.get(r, 0) for pn, r in refs.items()}, self.t, u)
             for pn, f in out.items():
                 flow[refs[pn]] = f
 
@@ -430,7 +413,7 @@ class _Builder:
                              f"on it depends on where it is (or not linearly)")
         position = -ca.substitute(gen, theta, ca.SX(0)) / dp
         self.pending[theta] = position
-        self.pending[w] = ca.jtimes(position, self.q, self.qd) + ca.jacobian(position, self.t)
+        self.pending[w] = ca.jtimes(position, self.q, self.u) + ca.jacobian(position, self.t)
         self.pending[a] = ca.SX.nan()
 
     def _rigid_flows(self, group):
@@ -488,9 +471,28 @@ class _Builder:
                 yield joint.port_ref(pname), self.uindex[joint.name][j]
 
 
-def acceleration_unavailable(where, ref):
-    return (f"{where}: the acceleration of {ref.path} is not available: that flange has no "
-            f"inertia (a damper sets its speed); measure its speed or position instead")
+class _Mechanics:
+    """What a block that uses the model's own dynamics (``signals.InverseDynamics``) is
+    handed: the number of speeds, a joint's speed index, and the inverse dynamics."""
+
+    def __init__(self, builder):
+        self._b = builder
+        self.n_speeds = builder.u.shape[0]
+
+    def speed_of(self, joint_name):
+        """Index of the speed of a one-degree-of-freedom joint of the model, or None."""
+        joint = self._b.model.components.get(joint_name)
+        if joint is None or joint.name not in self._b.uindex or joint.dof != 1:
+            return None
+        return self._b.uindex[joint.name][0]
+
+    def inverse(self, a):
+        """M(q) a + C(q, u) u + G(q) - Q_passive for the speeds' rates ``a`` (a list)."""
+        b = self._b
+        return b.inverse(ca.vertcat(*[ca.SX(v) for v in a]), b.net.armature, b._passive)
+
+    def refuse(self, comp, key, message):
+        return ModelError(f"{self._b.model.place(comp, key)}: {message}")
 
 
 def _measures(comp):

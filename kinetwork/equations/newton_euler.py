@@ -11,7 +11,7 @@ from dataclasses import dataclass, field
 
 import casadi as ca
 
-from ..spatial import skew
+from ..spatial import skew, vee
 
 ZERO6 = ca.SX.zeros(6, 1)
 
@@ -26,7 +26,7 @@ class Body:
     S: ca.SX             # 6 x dof motion subspace, body coordinates
     cJ: ca.SX            # 6x1 velocity-product acceleration of the joint (S-dot qd)
     inertia: ca.SX       # 6x6 spatial inertia about the body origin, body coordinates
-    index: list          # positions of this joint's coordinates in q
+    speeds: list         # positions of this joint's speeds in u
     X: ca.SX = field(init=False)     # parent-to-body motion transform, built once
 
     def __post_init__(self):
@@ -72,7 +72,7 @@ def aba(bodies, qd, tau, a0, armature=None):
     X = [b.X for b in bodies]
     v, c, IA, pA = [None] * n, [None] * n, [None] * n, [None] * n
     for k, b in enumerate(bodies):
-        vJ = b.S @ qd[b.index]
+        vJ = b.S @ qd[b.speeds]
         v[k] = (X[k] @ v[b.parent] if b.parent >= 0 else ZERO6) + vJ
         c[k] = crm(v[k]) @ vJ + b.cJ
         IA[k] = b.inertia
@@ -83,8 +83,8 @@ def aba(bodies, qd, tau, a0, armature=None):
         U[k] = IA[k] @ b.S
         D[k] = b.S.T @ U[k]
         if armature is not None:
-            D[k] = D[k] + ca.diag(armature[b.index])
-        u[k] = tau[b.index] - b.S.T @ pA[k]
+            D[k] = D[k] + ca.diag(armature[b.speeds])
+        u[k] = tau[b.speeds] - b.S.T @ pA[k]
         if b.parent >= 0:
             Ia = IA[k] - U[k] @ _solve(D[k], U[k].T)
             pa = pA[k] + Ia @ c[k] + U[k] @ _solve(D[k], u[k])
@@ -95,7 +95,7 @@ def aba(bodies, qd, tau, a0, armature=None):
     for k, b in enumerate(bodies):
         ap = X[k] @ (a[b.parent] if b.parent >= 0 else a0) + c[k]
         qdd_k = _solve(D[k], u[k] - U[k].T @ ap)
-        qdd[b.index] = qdd_k
+        qdd[b.speeds] = qdd_k
         a[k] = ap + b.S @ qdd_k
     return qdd
 
@@ -112,14 +112,14 @@ def crba(bodies, n_q, armature=None):
     M = ca.SX.zeros(n_q, n_q)
     for k, b in enumerate(bodies):
         F = IC[k] @ b.S
-        M[b.index, b.index] = b.S.T @ F
+        M[b.speeds, b.speeds] = b.S.T @ F
         j = k
         while bodies[j].parent >= 0:
             F = X[j].T @ F
             j = bodies[j].parent
             block = F.T @ bodies[j].S
-            M[b.index, bodies[j].index] = block
-            M[bodies[j].index, b.index] = block.T
+            M[b.speeds, bodies[j].speeds] = block
+            M[bodies[j].speeds, b.speeds] = block.T
     return M if armature is None else M + ca.diag(armature)
 
 
@@ -130,15 +130,23 @@ def rnea(bodies, qd, qdd, a0, armature=None):
     X = [b.X for b in bodies]
     v, a, f = [None] * n, [None] * n, [None] * n
     for k, b in enumerate(bodies):
-        vJ = b.S @ qd[b.index]
+        vJ = b.S @ qd[b.speeds]
         v[k] = (X[k] @ v[b.parent] if b.parent >= 0 else ZERO6) + vJ
         a[k] = (X[k] @ a[b.parent] if b.parent >= 0 else X[k] @ a0) \
-            + b.S @ qdd[b.index] + crm(v[k]) @ vJ + b.cJ
+            + b.S @ qdd[b.speeds] + crm(v[k]) @ vJ + b.cJ
         f[k] = b.inertia @ a[k] + crf(v[k]) @ (b.inertia @ v[k])
     tau = ca.SX.zeros(qd.shape[0], 1)
     for k in reversed(range(n)):
         b = bodies[k]
-        tau[b.index] = b.S.T @ f[k]
+        tau[b.speeds] = b.S.T @ f[k]
         if b.parent >= 0:
             f[b.parent] = f[b.parent] + X[k].T @ f[k]
     return tau if armature is None else tau + armature * qdd
+
+
+def motion_subspace(comp, qj, uj, Re, re):
+    """Spatial velocity of the moved frame relative to the fixed one per unit joint speed,
+    in the moved frame's axes (6 x dof), from the rate of the joint's transform (Re, re)."""
+    qdot = comp.rate(qj, uj)
+    w = vee(Re.T @ ca.reshape(ca.jtimes(ca.vec(Re), qj, qdot), 3, 3))
+    return ca.jacobian(ca.vertcat(w, Re.T @ ca.jtimes(re, qj, qdot)), uj)

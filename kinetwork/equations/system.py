@@ -1,4 +1,10 @@
-"""System: a compiled model, its states, parameters and CasADi Functions."""
+"""System: the equations of a validated model as CasADi expressions and Functions.
+
+A System is built once per model content (``Model.compile`` keeps it) and is not changed by
+running it: whatever a run compiles or caches (C code, integrators) lives in
+``kinetwork.simulation``. Model parameters stay symbols, so one System serves every
+parameter value.
+"""
 
 import functools
 
@@ -6,14 +12,8 @@ import casadi as ca
 import numpy as np
 
 from ..errors import ModelError
-from . import jit as _jit
 from .assemble import assemble
 from .loops import BAUMGARTE_RATE, formulate, newton
-
-#: Jacobians larger than this (instructions) are not compiled to C: Newton iterations use
-#: finite differences of the compiled right-hand side instead (an N = 128 chain's exact
-#: Jacobian is 2.5 million instructions, minutes of gcc)
-JACOBIAN_JIT_LIMIT = 200_000
 
 
 class System:
@@ -25,13 +25,16 @@ class System:
         Joint coordinates, then their speeds (``"shoulder.q"``, ..., ``"shoulder.qd"``).
     x0 : numpy.ndarray
         Initial state for the model's parameter values.
+    signals : list of Signal
+        What the probes record: name, unit, shape of each quantity.
     """
 
-    def __init__(self, model, loops="partition", baumgarte_rate=None):
+    def __init__(self, model, loops="partition", baumgarte_rate=None, topology=None):
         self.model = model
-        self.topology = model.validate()
-        self.asm = asm = assemble(model, self.topology)
-        self.eq = eq = formulate(asm, self.topology, model.parameter_values(), loops,
+        self.topology = topology if topology is not None else model.validate()
+        values = model.parameter_values()
+        self.asm = asm = assemble(model, self.topology, values)
+        self.eq = eq = formulate(asm, self.topology, values, loops,
                                  BAUMGARTE_RATE if baumgarte_rate is None else baumgarte_rate)
         self.param_names = asm.param_names
         self.coordinate_names = asm.coordinate_names
@@ -47,31 +50,33 @@ class System:
         self.f_dae = ca.Function("dae", [asm.t, eq.x, eq.z, asm.p],
                                  [ca.densify(eq.ode), ca.densify(eq.alg)],
                                  ["t", "x", "z", "p"], ["ode", "alg"])
+        self.signals = [sig.described() for sig in asm.signals]
         self.probe_targets = {probe.name: target.path for probe, target in self.topology.probes}
-        self.signal_names = [name for name, _, _ in asm.signals]
-        self.signal_units = {name: unit for name, unit, _ in asm.signals}
-        self.signal_sizes = {name: expr.numel() for name, _, expr in asm.signals}
+        # signals are written in the assembly's coordinates, speeds, their rates and the
+        # multipliers; the formulation says what those are in the states (x, z)
         coords = asm.q if eq.q is None else eq.q
-        # dense: a structurally zero acceleration (a body with no inertia about an axis)
-        # must still replace its symbol
-        values = ca.densify(ca.vertcat(coords, eq.u, eq.udot, eq.lam))
-        outs = [ca.substitute(expr, ca.vertcat(asm.q, asm.qd, asm.qdd_sym, asm.lam_sym), values)
-                for _, _, expr in asm.signals]
+        values_in_states = ca.densify(ca.vertcat(coords, eq.u, eq.udot, eq.lam))
+        kinematics = ca.vertcat(asm.q, asm.u, asm.udot, asm.lam)
+        outs = [ca.substitute(sig.flat(), kinematics, values_in_states) for sig in asm.signals]
         # outputs read the whole state: differential, then algebraic
         self.f_out = ca.Function("outputs", [asm.t, ca.vertcat(eq.x, eq.z), asm.p],
                                  [ca.vertcat(*outs) if outs else ca.SX(0, 1)])
-        self._f_mass = None
+        jd = eq.dependent_jacobian
+        #: the closure's Jacobian in the dependent speeds, of the full state (None: no loop
+        #: whose partition can turn singular)
+        self.f_dependent = None if jd is None or jd.numel() == 0 else ca.Function(
+            "dependent_jacobian", [ca.vertcat(eq.x, eq.z), asm.p],
+            [ca.densify(ca.substitute(jd, asm.q, ca.densify(coords)))])
+        self.dependent_names = eq.dependent_names or []
         if self.formulation == "tree" and self.speed_names and not self.n_algebraic:
             self._check_mass_matrix()
         else:                  # initial values that contradict the loops: refused now
             self.initial_full_p(self.param_vector())
-        self._f_terms = None
-        self._f_jac = None
-        self._f_residual = None
         self._z_last = None
-        self._integrators = {}
-        self._compiled = {}
-        self.jit_stats = {}
+
+    @property
+    def signal_names(self):
+        return [sig.name for sig in self.signals]
 
     def _check_mass_matrix(self):
         """Refuse a mass matrix that is singular at the initial state (a joint that moves no
@@ -105,18 +110,16 @@ class System:
         integrator solves them only to its tolerance."""
         if not self.n_algebraic or not len(X):
             return X
-        key = ("polish", len(X))
-        if key not in self._compiled:
-            if "polish" not in self._compiled:
-                self._compiled["polish"] = ca.Function(
-                    "polish", [ca.vertcat(self._x, self._z), self.asm.p],
-                    [newton(self.eq.alg, self._z)])
-            self._compiled[key] = self._compiled["polish"].map(len(X))
-        Z = np.asarray(self._compiled[key](np.asarray(X).T, p)).T
+        Z = np.asarray(self._f_polish.map(len(X))(np.asarray(X).T, p)).T
         out = np.array(X, dtype=float)
         ok = np.all(np.isfinite(Z), axis=1)
         out[ok, self.n_states:] = Z[ok]
         return out
+
+    @functools.cached_property
+    def _f_polish(self):
+        return ca.Function("polish", [ca.vertcat(self._x, self._z), self.asm.p],
+                           [newton(self.eq.alg, self._z)])
 
     @property
     def dof(self):
@@ -142,15 +145,19 @@ class System:
     def constraint_residual(self, X, params=None):
         """Largest |closure residual| of the kept loop equations at each row of full states
         X (n_points, n_states + n_algebraic); zeros for a model without loops."""
+        return self.constraint_residual_p(X, self.param_vector(params))
+
+    def constraint_residual_p(self, X, p):
+        """``constraint_residual`` for a parameter vector already checked."""
         X = np.atleast_2d(np.asarray(X, dtype=float))
         if self.eq.residual is None:
             return np.zeros(len(X))
-        if self._f_residual is None:
-            self._f_residual = ca.Function("residual", [ca.vertcat(self._x, self._z),
-                                                        self.asm.p],
-                                           [ca.norm_inf(self.eq.residual)])
-        out = self._f_residual.map(len(X))(X.T, self.param_vector(params))
-        return np.asarray(out).ravel()
+        return np.asarray(self._f_residual.map(len(X))(X.T, p)).ravel()
+
+    @functools.cached_property
+    def _f_residual(self):
+        return ca.Function("residual", [ca.vertcat(self._x, self._z), self.asm.p],
+                           [ca.norm_inf(self.eq.residual)])
 
     # -- parameters -----------------------------------------------------------------------
     def param_vector(self, params=None):
@@ -197,27 +204,29 @@ class System:
         p = self.param_vector(params)
         if not self.n_algebraic:
             return np.asarray(self.f_rhs(t, x, p)).ravel()
-        if "rootfinder" not in self._compiled:
-            z, xp = ca.SX.sym("z", self.n_algebraic), ca.SX.sym("xp", self.n_states + p.size)
-            alg = ca.Function("alg", [z, xp], [self.f_dae(0, xp[:self.n_states], z,
-                                                          xp[self.n_states:])[1]])
-            self._compiled["rootfinder"] = ca.rootfinder("closure", "newton", alg,
-                                                         {"abstol": 1e-13})
         if self._z_last is None:
             self._z_last = self.initial_full_p(p)[1]
         try:
-            z = np.asarray(self._compiled["rootfinder"](self._z_last, np.concatenate([x, p])))
+            z = np.asarray(self._closure_solver(self._z_last, np.concatenate([x, p])))
         except RuntimeError:
             raise ModelError("the loops cannot close at this state x (Newton on the "
                              "dependent coordinates failed)") from None
         self._z_last = z.ravel()
         return np.asarray(self.f_dae(t, x, z, p)[0]).ravel()
 
+    @functools.cached_property
+    def _closure_solver(self):
+        z, xp = ca.SX.sym("z", self.n_algebraic), ca.SX.sym("xp", self.n_states + self.asm.p.numel())
+        alg = ca.Function("alg", [z, xp], [self.f_dae(0, xp[:self.n_states], z,
+                                                      xp[self.n_states:])[1]])
+        return ca.rootfinder("closure", "newton", alg, {"abstol": 1e-13})
+
+    @functools.cached_property
+    def _f_mass(self):
+        return ca.Function("M", [self.asm.q, self.asm.p], [self.asm.mass_matrix()])
+
     def mass_matrix(self, q, params=None):
         """Joint-space mass matrix M(q) of the tree, numpy (n, n)."""
-        if self._f_mass is None:
-            a = self.asm
-            self._f_mass = ca.Function("M", [a.q, a.p], [a.mass_matrix()])
         q = self._vector(q, len(self.coordinate_names), "q")
         return np.asarray(self._f_mass(q, self.param_vector(params)))
 
@@ -227,7 +236,7 @@ class System:
         V holds the Coriolis and centripetal terms minus the generalized forces of the 1-D
         elements (so a shoulder spring-damper adds c*q + d*qd); G holds gravity.
         """
-        f = self._terms_function()
+        f = self._f_terms
         M, V, G = f(t, self._vector(q, len(self.coordinate_names), "q"),
                     self._vector(qd, len(self.speed_names), "qd"),
                     self.param_vector(params))
@@ -237,7 +246,7 @@ class System:
         """Symbolic M, V, G (CasADi SX) with their symbols: q, qd, p (parameters), t."""
         a = self.asm
         M, V, G = a.terms()
-        return {"M": M, "V": V, "G": G, "q": a.q, "qd": a.qd, "p": a.p, "t": a.t,
+        return {"M": M, "V": V, "G": G, "q": a.q, "qd": a.u, "p": a.p, "t": a.t,
                 "param_names": list(a.param_names)}
 
     def outputs(self, t, x, params=None):
@@ -245,24 +254,19 @@ class System:
         n_algebraic)): differential states, then the algebraic variables of loops)."""
         return self.outputs_p(t, x, self.param_vector(params))
 
-    def outputs_p(self, t, x, p, jit=False):
-        """Probe signals for a parameter vector already checked by ``param_vector``; with
-        ``jit`` computed by compiled C."""
+    def outputs_p(self, t, x, p, f_out=None):
+        """Probe signals for a parameter vector already checked by ``param_vector``;
+        ``f_out`` replaces the output Function (its compiled twin)."""
         t = np.atleast_1d(np.asarray(t, dtype=float))
         X = np.atleast_2d(np.asarray(x, dtype=float))
-        jit = jit and bool(self.signal_names)
-        key = ("outputs", len(t), jit)
-        if key not in self._compiled:
-            if jit and "outputs" not in self._compiled:
-                self._compiled["outputs"] = _jit.external(self.f_out, False, self.jit_stats)
-            self._compiled[key] = (self._compiled["outputs"] if jit else self.f_out).map(len(t))
-        return np.asarray(self._compiled[key](t[None, :], X.T, p)).T
+        f = f_out or self.f_out
+        return np.asarray(f.map(len(t))(t[None, :], X.T, p)).T
 
     @functools.cached_property
     def damped(self):
         """Whether a generalized force depends on the speeds (dampers): only then can the
-        model be stiff in the sense of ``kinetwork.solver.integrate.stiffness``."""
-        return bool(ca.depends_on(self.asm.Q, self.asm.qd)) if self.n_states else False
+        model be stiff in the sense of ``kinetwork.simulation.driver.stiffness``."""
+        return bool(ca.depends_on(self.asm.Q, self.asm.u)) if self.n_states else False
 
     # -- size -----------------------------------------------------------------------------
     def size(self):
@@ -280,119 +284,25 @@ class System:
                 "formulation": self.formulation, "loop_equations": self.eq.loop_rows,
                 "redundant_equations": self.eq.loop_redundant}
 
-    # -- compiled code ----------------------------------------------------------------------
-    def rhs_function(self, jit=False, jacobian=False):
-        """The right-hand side as a CasADi Function of (t, x, p): SX, or compiled C with ``jit``.
-
-        With ``jacobian`` the compiled library also holds the exact Jacobian, if it is small
-        enough (``JACOBIAN_JIT_LIMIT``); otherwise derivatives are finite differences.
-        """
-        if not jit:
-            return self.f_rhs
-        jacobian = jacobian and self._jacobian_small()
-        key = ("rhs", jacobian)
-        if key not in self._compiled:
-            self._compiled[key] = _jit.external(self.f_rhs, jacobian, self.jit_stats)
-        return self._compiled[key]
-
-    def jacobian_numeric_function(self, jit=False):
-        """d(xdot)/dx as a Function of (t, x, p) for scipy's implicit methods, compiled with
-        ``jit`` when small enough."""
-        if not (jit and self._jacobian_small()):
-            return self.jacobian_function()
-        if "jac" not in self._compiled:
-            self._compiled["jac"] = _jit.external(self.jacobian_function(), False, self.jit_stats)
-        return self._compiled["jac"]
-
-    def _jacobian_small(self):
-        # a Jacobian costs about (operations x states): skip building one that cannot pass
-        f = self.f_rhs or self.f_dae
-        if f.n_instructions() * (self.n_states + self.n_algebraic) > 20 * JACOBIAN_JIT_LIMIT:
-            return False
-        return self.jacobian_function().n_instructions() <= JACOBIAN_JIT_LIMIT
-
-    def dae(self, jit=False, jacobian=False):
-        """The equations as the DAE Function CasADi's integrators take (t, x, z, p, u)."""
-        t, x = ca.MX.sym("t"), ca.MX.sym("x", self.n_states)
-        z = ca.MX.sym("z", self.n_algebraic)
-        p, empty = ca.MX.sym("p", len(self.param_names)), ca.MX(0, 1)
-        if self.n_algebraic:
-            f = self.f_dae
-            if jit:
-                jacobian = jacobian and self._jacobian_small()
-                key = ("dae", jacobian)
-                if key not in self._compiled:
-                    self._compiled[key] = _jit.external(self.f_dae, jacobian, self.jit_stats)
-                f = self._compiled[key]
-            ode, alg = f(t, x, z, p)
-        else:
-            ode, alg = self.rhs_function(jit, jacobian)(t, x, p), empty
-        return ca.Function("dae", [t, x, z, p, ca.MX.sym("u", 0)],
-                           [ode, alg, empty, empty], ca.dyn_in(), ca.dyn_out())
-
-    def integrator(self, plugin, grid, options=None, cache=True, jit=False, jacobian=True):
-        """A CasADi integrator over ``grid`` (outputs at grid[1:]), cached per settings.
-
-        ``options`` go to CasADi (``reltol``, ``abstol``, ...). With ``jit`` the right-hand
-        side is compiled C (``rhs_function``); ``jacobian`` says whether the method iterates
-        with Newton and so needs the exact Jacobian.
-        """
-        key = (plugin, grid[0], grid[-1], len(grid), jit, jacobian,
-               tuple(sorted((options or {}).items())))
-        if cache and key in self._integrators:
-            return self._integrators[key]
-        dae = self.dae(True, jacobian) if jit else \
-            {"x": self._x, "z": self._z, "p": self.asm.p, "t": self.asm.t, "ode": self.ode,
-             "alg": self.eq.alg}
-        opts = dict(options or {})
-        integ = ca.integrator("simulate", plugin, dae, float(grid[0]),
-                              [float(g) for g in grid[1:]], opts)
-        if cache:
-            self._integrators[key] = integ
-        return integ
-
     def jacobian_function(self):
         """d(xdot)/dx as a CasADi Function of (t, x, p), for implicit methods (with loops:
         d(xdot, alg)/d(x, z) of (t, x, z, p))."""
-        if self._f_jac is None:
-            a = self.asm
-            if self.n_algebraic:
-                v = ca.vertcat(self._x, self._z)
-                self._f_jac = ca.Function("jacobian", [a.t, self._x, self._z, a.p], [
-                    ca.densify(ca.jacobian(ca.vertcat(self.ode, self.eq.alg), v))])
-            else:
-                self._f_jac = ca.Function("jacobian", [a.t, self._x, a.p],
-                                          [ca.densify(ca.jacobian(self.ode, self._x))])
         return self._f_jac
 
-    def numeric(self, f, p):
-        """A fast Python callable ``(t, x) -> ndarray`` of a Function of (t, x, p).
+    @functools.cached_property
+    def _f_jac(self):
+        a = self.asm
+        if self.n_algebraic:
+            v = ca.vertcat(self._x, self._z)
+            return ca.Function("jacobian", [a.t, self._x, self._z, a.p], [
+                ca.densify(ca.jacobian(ca.vertcat(self.ode, self.eq.alg), v))])
+        return ca.Function("jacobian", [a.t, self._x, a.p],
+                           [ca.densify(ca.jacobian(self.ode, self._x))])
 
-        Uses ``Function.buffer``: ~0.5 us a call instead of ~16 us for a plain call, which is
-        what scipy's integrators pay on every right-hand-side evaluation.
-        """
-        buf, trigger = f.buffer()
-        t_in, x_in = np.zeros(1), np.zeros(self.n_states)
-        p_in = np.array(p, dtype=float)
-        shape = f.size_out(0)
-        out = np.zeros(shape[0] * shape[1])          # dense, column-major like CasADi
-        for i, arr in enumerate((t_in, x_in, p_in)):
-            buf.set_arg(i, memoryview(arr))
-        buf.set_res(0, memoryview(out))
-
-        # CasADi keeps raw pointers: the buffer and every array must outlive the trigger
-        def call(t, x, _keep=(buf, p_in)):
-            t_in[0] = t
-            x_in[:] = x
-            trigger()
-            return out.reshape(shape, order="F").copy() if shape[1] > 1 else out.copy()
-        return call
-
-    def _terms_function(self):
-        if self._f_terms is None:
-            a = self.asm
-            self._f_terms = ca.Function("terms", [a.t, a.q, a.qd, a.p], list(a.terms()))
-        return self._f_terms
+    @functools.cached_property
+    def _f_terms(self):
+        a = self.asm
+        return ca.Function("terms", [a.t, a.q, a.u, a.p], list(a.terms()))
 
     @staticmethod
     def _vector(v, n, what):

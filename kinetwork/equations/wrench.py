@@ -23,7 +23,7 @@ probe reports the torque about the frame's own origin.
 import casadi as ca
 
 from ..spatial import skew, vec3
-from .assemble import closure_rows, motion_subspace
+from .newton_euler import motion_subspace
 
 
 def cut_wrench(asm, topo, target, bound):
@@ -108,7 +108,7 @@ class _Balance:
             return ca.SX.zeros(3), ca.SX.zeros(3)
         c = self.bound[comp.name]
         qj = asm.q[asm.qindex[comp.name]]
-        uj = asm.qd[asm.uindex[comp.name]]
+        uj = asm.u[asm.uindex[comp.name]]
         S = motion_subspace(c, qj, uj, *c.transform(qj))
         wrench = S @ asm.Q_drive[asm.uindex[comp.name]]
         R, p = asm.pose(self.topo.set_of[comp.port_ref("frame_b")])
@@ -156,9 +156,9 @@ class _Balance:
         R_s, p_s = ca.SX.sym("R", 3, 3), ca.SX.sym("p", 3)
         w, v = ca.SX.sym("w", 3), ca.SX.sym("v", 3)
         if port == "frame_a":
-            rows, pose = closure_rows(comp, R_s, p_s, Rb, pb, qj), (Ra, pa)
+            rows, pose = comp.closure(R_s.T @ Rb, R_s.T @ (pb - p_s), qj), (Ra, pa)
         else:
-            rows, pose = closure_rows(comp, Ra, pa, R_s, p_s, qj), (Rb, pb)
+            rows, pose = comp.closure(Ra.T @ R_s, Ra.T @ (p_s - pa), qj), (Rb, pb)
         # (w, v): world twist, v the velocity of the point at the world origin; in the
         # shared body's axes the frame turns at R0^T w and its origin moves at R0^T v_origin
         origin_velocity = v + ca.cross(w, p0 + R0 @ p_s)
@@ -168,6 +168,6 @@ class _Balance:
                           ca.vertcat(ca.vec(R_s), p_s),
                           ca.densify(ca.vertcat(ca.vec(pose[0]), pose[1])))
         lo, hi = self.rows[i]
-        wrench = G.T @ asm.lam_sym[lo:hi]
+        wrench = G.T @ asm.lam[lo:hi]
         # the dual of (w, v) is (moment about the world origin, force)
         return wrench[3:], wrench[:3]

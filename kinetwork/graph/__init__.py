@@ -1,0 +1,2 @@
+"""The wiring: the model, its validation (topology: connection sets, spanning tree, loops) and
+its files."""

@@ -7,27 +7,24 @@ nothing from the file. Every problem is reported with its place in the file
 when the whole file is sound.
 """
 
-import copy
 import json
 import math
 import os
-import secrets
-import stat
 
-from ..components.base import REGISTRY, finite, suggest
+from ..components.base import REGISTRY
 from ..errors import ModelError
-from .model import Model, check_setting
+from ..util import suggest
+from .model import Model
+from .settings import check_setting
+from .writer import FORMAT, KEYS, VERSION, _kind, _plain, dumps, model_to_dict, save
 
-FORMAT, VERSION, SUPPORTED = "kinetwork.model", 1, (1,)
-#: top-level keys, in the order files are written
-KEYS = ("format", "version", "name", "description", "parameters", "components", "connections",
-        "simulation", "layout")
+SUPPORTED = (1,)
+__all__ = ["FORMAT", "KEYS", "VERSION", "dumps", "load", "loads", "model_from_dict",
+           "model_to_dict", "save"]
 REQUIRED = ("format", "version", "name", "components")
 COMPONENT_KEYS = ("name", "type", "params")
 #: among the names of broken components: some entry had no usable name (no identifier is "*")
 UNNAMED = "*"
-#: a list of scalars stays on one line up to this many characters
-WIDTH = 80
 
 
 # -- reading ----------------------------------------------------------------------------------
@@ -245,113 +242,6 @@ def _layout(model, layout, broken, problems):
     return _copy(layout)
 
 
-# -- writing ----------------------------------------------------------------------------------
-def model_to_dict(model):
-    """The model as a file's top-level object: plain JSON values, in file order.
-
-    Component ``params`` hold only what was given, so a later change of a default reaches old
-    files. A model may be incomplete (an editor saves work in progress), but what :func:`load`
-    would refuse for its form is refused here, so a saved file always reads back.
-
-    Raises
-    ------
-    ModelError
-        A component type not in the registry, a bad ``simulation`` block, a layout entry for
-        no component, or a value that is not plain, finite JSON; each with its place.
-    """
-    problems, components = [], []
-    for i, comp in enumerate(model.components.values()):
-        if REGISTRY.get(comp.type_name) is not type(comp):
-            problems.append(f'components[{i}] "{comp.name}": type {type(comp).__name__} is not '
-                            f"in the component registry, so no file could load it")
-        components.append({"name": comp.name, "type": comp.type_name,
-                           "params": copy.deepcopy(comp.given)})
-    data = {"format": FORMAT, "version": VERSION, "name": model.name,
-            "description": "" if model.description is None else model.description,
-            "parameters": dict(model.parameters), "components": components,
-            "connections": [[a.path, b.path] for a, b in model.connections],
-            "simulation": copy.deepcopy(model.simulation), "layout": copy.deepcopy(model.layout)}
-    if not isinstance(data["description"], str):
-        problems.append(f"description: must be a string, got {_kind(data['description'])}")
-    _simulation(data["simulation"], problems)
-    if isinstance(data["layout"], dict):
-        problems.extend(f"layout.{key}: no component {key!r}" for key in data["layout"]
-                        if key not in model.components)
-    _plain(data, "", problems)
-    if problems:
-        raise ModelError(problems)
-    return data
-
-
-def dumps(model):
-    """The file's text for ``model``.
-
-    Indented JSON with the keys in file order, short lists of scalars on one line (vectors,
-    matrix rows, connection pairs) and a final newline; numbers keep their Python form.
-
-    Returns
-    -------
-    str
-    """
-    return _render(model_to_dict(model), 0) + "\n"
-
-
-def save(model, path):
-    """Write ``model`` to ``path`` atomically: a failed save leaves the old file whole.
-
-    The text goes to a temporary file in the same folder, is flushed to disk, then replaces
-    ``path`` in one step; on any failure the temporary file is removed.
-
-    Parameters
-    ----------
-    model : Model
-    path : str or os.PathLike
-
-    Raises
-    ------
-    ModelError
-        The model cannot be written as a file (see :func:`model_to_dict`); nothing is written.
-    OSError
-        The file system refused; the old file is unchanged.
-    """
-    text = dumps(model).encode("utf-8")       # every refusal comes before the disk is touched
-    path = os.path.realpath(os.fspath(path))      # through a symlink, not replacing it
-    folder, base = os.path.split(path)
-    tmp = os.path.join(folder, f".{base}.{secrets.token_hex(4)}.tmp")
-    try:
-        # 0o666 lets the umask apply, as to any new file (mkstemp would force 0o600)
-        with open(os.open(tmp, os.O_WRONLY | os.O_CREAT | os.O_EXCL, 0o666), "wb") as fh:
-            fh.write(text)
-            fh.flush()
-            os.fsync(fh.fileno())
-        if os.path.exists(path):
-            os.chmod(tmp, stat.S_IMODE(os.stat(path).st_mode))
-        os.replace(tmp, path)
-    except BaseException:
-        if os.path.exists(tmp):
-            os.unlink(tmp)
-        raise
-
-
-def _render(value, level):
-    """JSON as ``indent=2`` writes it, but a short list of scalars on one line.
-
-    So a vector, a matrix row and a connection pair each read on one line.
-    """
-    pad = "  " * level
-    if isinstance(value, dict) and value:
-        items = [f"{pad}  {json.dumps(k)}: {_render(v, level + 1)}" for k, v in value.items()]
-        return "{\n" + ",\n".join(items) + f"\n{pad}}}"
-    if isinstance(value, (list, tuple)) and value:
-        if not any(isinstance(v, (dict, list, tuple)) for v in value):
-            flat = json.dumps(value, allow_nan=False)
-            if len(flat) <= WIDTH:
-                return flat
-        items = [f"{pad}  {_render(v, level + 1)}" for v in value]
-        return "[\n" + ",\n".join(items) + f"\n{pad}]"
-    return json.dumps(value, allow_nan=False)
-
-
 # -- helpers ----------------------------------------------------------------------------------
 class _Object(dict):
     """A parsed JSON object that remembers keys given twice (``json`` keeps the last)."""
@@ -376,22 +266,6 @@ def _repeated(value, where, problems):
     elif isinstance(value, list):
         for j, item in enumerate(value):
             _repeated(item, f"{where}[{j}]", problems)
-
-
-def _plain(value, where, problems):
-    """Report what is not plain, finite JSON (a file holds no NaN and no Python objects)."""
-    if isinstance(value, dict):
-        for key, item in value.items():
-            if not isinstance(key, str):
-                problems.append(f"{where}: key {key!r} is not a string")
-            _plain(item, f"{where}.{key}" if where else str(key), problems)
-    elif isinstance(value, (list, tuple)):
-        for j, item in enumerate(value):
-            _plain(item, f"{where}[{j}]", problems)
-    elif isinstance(value, (int, float)) and not finite(value):
-        problems.append(f"{where}: must be finite, got {value!r:.40}")
-    elif value is not None and not isinstance(value, (str, int, float)):
-        problems.append(f"{where}: {type(value).__name__} is not a JSON value")
 
 
 def _attempt(problems, place, fn, *args):
@@ -422,12 +296,6 @@ def _copy(value):
     # plain dicts and lists in the model, not the parser's _Object
     return ({k: _copy(v) for k, v in value.items()} if isinstance(value, dict) else
             [_copy(v) for v in value] if isinstance(value, list) else value)
-
-
-def _kind(value):
-    kinds = ((dict, "an object"), (list, "a list"), (str, "a string"), (bool, "a boolean"),
-             (type(None), "null"))
-    return next((words for kind, words in kinds if isinstance(value, kind)), f"{value!r:.40}")
 
 
 def _at(source, problem):

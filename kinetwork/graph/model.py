@@ -2,17 +2,30 @@
 
 import math
 import re
+import threading
 
 import numpy as np
 
-from ..components.base import ANY, Component, PortRef, check_number, finite, suggest
+from ..components.base import ANY, Component, PortRef
+from ..util import check_number, suggest
+from .writer import save
 from ..errors import ModelError
-from ..expr import CONSTANTS, FUNCTIONS, Expression
+from ..expr import CONSTANTS, FUNCTIONS, parse
 
-_IDENT = re.compile(r"^[A-Za-z_][A-Za-z0-9_]*$")
+_IDENT = re.compile(r"[A-Za-z_][A-Za-z0-9_]{0,199}\Z")      # whole, as NAME_LIMIT in base.py
 RESERVED = {"t", *CONSTANTS, *FUNCTIONS}
-#: the experiment settings a model carries (``Model.simulation``)
-SIMULATION_KEYS = ("t_end", "n_points", "method", "rtol", "atol", "step")
+
+#: what turns a validated model into a System: installed by ``kinetwork.equations`` when it
+#: is imported (layers only look down, so the model does not import what compiles it)
+_compiler = None
+_compile_lock = threading.RLock()
+
+
+def install_compiler(build):
+    """Set the function ``build(model, loops, baumgarte_rate, topology)`` -> System that
+    ``Model.compile`` calls."""
+    global _compiler
+    _compiler = build
 
 
 class Model:
@@ -44,6 +57,8 @@ class Model:
         self.layout = {}
         #: component name -> how messages locate it (files say 'components[3] "mass1"')
         self.places = {}
+        self._validated = None         # (content key, parameter values, Topology)
+        self._compiled = {}            # (content key, loops, rate) -> System
         for key, value in (parameters or {}).items():
             self.set_parameter(key, value)
 
@@ -138,50 +153,60 @@ class Model:
             raise ModelError(problems)
         return out
 
+    def content_key(self):
+        """What the equations of the model depend on, as a hashable value: the parameter
+        names, every component (the object, its type and given parameters) and the wiring.
+        Parameter *values* are not in it: they stay symbols in a compiled System."""
+        comps = tuple((id(c), name, type(c).__qualname__, repr(sorted(c.given.items())))
+                      for name, c in self.components.items())
+        wiring = tuple((a.path, id(a.component), b.path, id(b.component))
+                       for a, b in self.connections)
+        return tuple(self.parameters), comps, wiring
+
     def validate(self):
-        """Check the whole model; return its Topology or raise one ModelError listing all."""
+        """Check the whole model; return its Topology or raise one ModelError listing all.
+
+        The Topology of an unchanged model (same content, same parameter values) is kept, so
+        loading a file and compiling it validate once."""
         from .topology import analyze
-        return analyze(self)
+        key, values = self.content_key(), dict(self.parameters)
+        if self._validated is not None and self._validated[:2] == (key, values):
+            return self._validated[2]
+        topology = analyze(self)
+        self._validated = (key, values, topology)
+        return topology
 
     def compile(self, loops="partition", baumgarte_rate=None):
         """Validate and build the equations: a ``kn.System``.
 
-        ``loops`` chooses the formulation of kinematic loops (see ``kinetwork.solver.loops``):
+        ``loops`` chooses the formulation of kinematic loops (see ``kinetwork.equations.loops``):
         "partition" (default; independent coordinates, dependent ones solved exactly at every
         step: a DAE for IDAS), "projected" (an ODE for any method, its dependent coordinates
         Newton-projected onto the closure in every evaluation) or "baumgarte" (an ODE in all
         coordinates, stabilised at ``baumgarte_rate`` [1/s], default 10; 0 leaves the drift
-        unchecked).
+        unchecked). A model whose content has not changed since its last compilation gives
+        the same System back, without building it again.
         """
-        from ..solver.system import System
-        return System(self, loops=loops, baumgarte_rate=baumgarte_rate)
+        key = (self.content_key(), loops, baumgarte_rate)
+        with _compile_lock:
+            if key not in self._compiled:
+                if _compiler is None:
+                    raise ModelError("no compiler installed: import kinetwork (its equations "
+                                     "layer installs one)")
+                system = _compiler(self, loops=loops, baumgarte_rate=baumgarte_rate,
+                                   topology=self.validate())
+                # a System is built for one content: any other is stale now
+                self._compiled = {k: v for k, v in self._compiled.items() if k[0] == key[0]}
+                self._compiled[key] = system
+            return self._compiled[key]
 
     def save(self, path):
         """Write the model as JSON (atomically: a failed save leaves the old file whole)."""
-        from .io import save
         save(self, path)
 
     def __repr__(self):
         return (f"<Model {self.name!r}: {len(self.components)} components, "
                 f"{len(self.connections)} connections>")
-
-
-def check_setting(key, value):
-    """The problem with one experiment setting, or None; files and ``simulate`` share it."""
-    where = f"simulation.{key}"
-    number = isinstance(value, (int, float)) and not isinstance(value, bool)
-    if key not in SIMULATION_KEYS:
-        return (f"{where}: unknown setting{suggest(key, SIMULATION_KEYS)}; "
-                f"settings are {', '.join(SIMULATION_KEYS)}")
-    if key == "method":
-        if not isinstance(value, str) or not value:
-            return f"{where}: must be a method name, got {value!r:.40}"
-    elif key == "n_points":
-        if not number or not isinstance(value, int) or value < 2:
-            return f"{where}: must be an integer >= 2, got {value!r:.40}"
-    elif not number or not finite(value) or value <= 0:
-        return f"{where}: must be a finite number > 0, got {value!r:.40}"
-    return None
 
 
 def evaluate(value, spec, env, where):
@@ -202,7 +227,7 @@ def evaluate(value, spec, env, where):
 
 def _scalar(value, spec, env, where, bounds=True):
     if isinstance(value, str):
-        expr = Expression(value)
+        expr = parse(value)
         unknown = sorted(expr.names - set(env))
         if unknown:
             raise ModelError(f"{where} = {value!r}: unknown name {unknown[0]!r}"

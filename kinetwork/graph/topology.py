@@ -92,7 +92,17 @@ def analyze(model):
     for comp in model.components.values():
         for pname in comp.ports:
             graph.add_node(comp.port_ref(pname))
-    graph.add_edges_from(model.connections)
+    stale = []
+    for i, (a, b) in enumerate(model.connections):
+        gone = [p for p in (a, b) if model.components.get(p.component.name) is not p.component]
+        if gone:                # a component taken out of model.components by hand
+            stale.append(f"connections[{i}] {a.path} - {b.path}: component "
+                         f"{gone[0].component.name!r} is not in the model any more "
+                         f"(remove its connections too)")
+        else:
+            graph.add_edge(a, b)
+    if stale:
+        raise ModelError(problems + stale)
     order = _order(model)                      # once: it ranks every component
     sets = [sorted(s, key=order) for s in nx.connected_components(graph)]
     sets.sort(key=lambda s: order(s[0]))
@@ -177,24 +187,18 @@ def _probes(model, graph, probes, problems):
     return out
 
 
-#: preference for keeping a part in the spanning tree (the rest are cut): rigid parts are
-#: never cut if a joint can be, a Spherical is cut before other joints (three position
-#: constraints, no coordinates) and a FreeMotion first of all (cutting it removes nothing)
 def _keep_weight(comp):
-    if comp.dof == 0:
-        return 4
-    if comp._values.get("cut", False):
-        return -1
-    if comp.type_name == "multibody.FreeMotion":
-        return 0
-    return 3 if comp.regular else 1
+    """Preference for keeping a part in the spanning tree (the rest are cut): a joint marked
+    ``cut`` goes first, then as its class ranks itself (``cut_preference``)."""
+    return -1 if comp._values.get("cut", False) else comp.cut_preference
 
 
 def _tree(model, topo, roles, problems):
     """Spanning tree of frame sets from the ground; the joints left out cut the loops."""
     frames = nx.MultiGraph()
     frames.add_node(topo.root)
-    joints = roles.get("joint", [])
+    # joints and rigid parts are the edges, in model order (ties go to the part added first)
+    joints = [c for c in model.components.values() if c.role in ("joint", "part")]
     for rank, comp in enumerate(joints):
         a, b = topo.set_of[comp.port_ref("frame_a")], topo.set_of[comp.port_ref("frame_b")]
         if a == b:
@@ -209,8 +213,7 @@ def _tree(model, topo, roles, problems):
             frames.add_node(topo.set_of[comp.port_ref(pname)])
 
     reached = nx.node_connected_component(frames, topo.root)
-    for comp in [*roles.get("joint", []), *roles.get("body", []),
-                 *roles.get("frame_force", [])]:
+    for comp in [*joints, *roles.get("body", []), *roles.get("frame_force", [])]:
         for pname in comp.ports:
             if comp.ports[pname].domain == "frame" and \
                     topo.set_of[comp.port_ref(pname)] not in reached:
@@ -311,7 +314,7 @@ def _oned(model, topo, values, problems):
                 "fixed" if definers else "free" if inertias else
                 "world" if len(ports) <= 1 else "massless")
         if kind == "free" and values is not None and all(
-                values[e.name][type(e).amount.name] == 0 for e in inertias):
+                e.bound(values[e.name]).inertia() == 0 for e in inertias):
             problems.append(f"connection set {where}: the inertia of "
                             f"{', '.join(e.name for e in inertias)} is zero and nothing "
                             f"holds the flange, so its motion is not determined")

@@ -1,311 +1,514 @@
-"""simulate(): integrate a model with CasADi's integrators or scipy's, looked up in METHODS."""
+"""simulate(): the one integrator driver.
+
+The driver owns everything around the integration: the output grid, the step budget, the
+time limit, progress reports, cancellation (SIGINT, SIGTERM, or a ``cancel`` callable), the
+capture of what the solvers print, partial results, opt-in restarts and the watch over
+kinematic loops. A method (``methods.py``) only integrates: it is started at a state and
+advanced over a few output times at a time.
+
+CasADi's integrators run in compiled code that Python cannot interrupt, so the driver hands
+them chunks of the output grid: between chunks it reads the clock and the cancel flag, reports
+progress and checks the loops. A chunk is sized by the work the last one took (equation
+evaluations times the instructions of one evaluation) to about ``CHUNK_WORK``: a fraction of a
+second on any machine, and the same chunks on every machine, so a run's numbers (a multistep
+method restarts at each chunk) never depend on how fast the machine is or how loaded.
+"""
 
 import contextlib
 import ctypes
 import io
+import math
 import os
+import signal
 import sys
 import tempfile
+import threading
 import time
-from dataclasses import dataclass
-from typing import Callable
 
 import numpy as np
 
-from ..components.base import suggest
+from ..equations.system import System
 from ..errors import ModelError, SimulationError
-from ..graph.model import check_setting
+from ..graph.settings import check_setting
+from ..util import suggest
 from . import jit as _jit
+from .compiled import compiled
+from .methods import METHODS, Failure, choose
 from .results import Results
-from .system import System
 
 DEFAULTS = {"t_end": 10.0, "n_points": 1001, "method": "auto", "rtol": 1e-6, "atol": 1e-8,
             "step": None}
+#: a chunk of a CasADi integration is sized to about this much work (evaluations of the
+#: equations times their instructions; ~1 ns an instruction compiled, ~10 in CasADi's virtual
+#: machine): cancellation, time limits and progress are served between chunks
+CHUNK_WORK = 3e7
+#: the first chunk holds this fraction of the output intervals; later ones grow at most
+#: CHUNK_GROWTH-fold (each chunk restarts a multistep method: few chunks for a fast run)
+FIRST_CHUNK = 1 / 16
+CHUNK_GROWTH = 16
+#: a kinematic loop whose Jacobian in the dependent speeds has a larger condition number is
+#: at a singular configuration
+SINGULAR_CONDITION = 1e8
+#: ... and near one, for the message of a failure, beyond this
+NEAR_SINGULAR_CONDITION = 1e4
+#: restarts after a failure, with ``restart=True``, at most
+MAX_RESTARTS = 3
+#: a restarted run must keep the loops closed to this (m, or rotation-matrix entries)
+RESTART_CLOSURE = 1e-6
+
+#: the solvers print through file descriptors 1 and 2, which belong to the whole process:
+#: one integration section at a time captures them
+_SOLVER_LOCK = threading.RLock()
 
 
-@dataclass(frozen=True)
-class Method:
-    """One integration method a user can pick.
+class Run:
+    """One call of ``simulate``: the settings every method reads, and the driver's state."""
 
-    ``run(system, grid, x0, p, settings)`` returns (states on the grid, failure reason or None,
-    statistics); ``fixed`` methods take ``settings["step"]`` instead of tolerances; ``newton``
-    methods iterate with the Jacobian (compiled with the right-hand side under JIT).
+    def __init__(self, system, p, x0, grid, settings, jit, cancel, progress, restart):
+        self.system, self.p, self.x0, self.grid = system, p, x0, grid
+        self.compiled = compiled(system)
+        self.t_start, self.t_end = float(grid[0]), float(grid[-1])
+        self.spacing = float(grid[1] - grid[0])
+        self.rtol, self.atol = settings["rtol"], settings["atol"]
+        self.step = settings["step"]
+        self.steps_per_interval = max(1, math.ceil(self.spacing / (self.step or self.spacing)
+                                                   * (1 - 1e-12)))
+        self.max_steps = settings["max_steps"]
+        self.started = time.perf_counter()
+        limit = settings["time_limit"]
+        self.deadline = self.started + limit if limit else None
+        self.jit = jit
+        self.cancel, self.progress, self.restart = cancel, progress, restart
+        self.signal = None              # the signal that stopped the run, if one did
+        self.instructions = (system.f_rhs or system.f_dae).n_instructions()
+        self.said = []                  # what the solvers printed
+
+    # -- what methods use --------------------------------------------------------------------
+    @contextlib.contextmanager
+    def solver_section(self):
+        """Run compiled solver code with its printing captured (and serialised: see
+        ``_SOLVER_LOCK``)."""
+        box = None
+        try:
+            with _SOLVER_LOCK, _solver_output() as box:
+                yield
+        finally:                        # a failing solver's words are the ones wanted
+            if box is not None and box["text"].strip():
+                self.said.append(box["text"])
+
+    def rate(self, t, X):
+        """d(x)/dt at a consistent full state X = (x, z), as IDAS's ``init_xdot``."""
+        nx = self.system.n_states
+        rate = self.system.f_dae(t, X[:nx], X[nx:], self.p)[0]
+        return tuple(float(v) for v in np.asarray(rate).ravel())
+
+    def integrators(self, key, build):
+        """A CasADi integrator kept with the System: the same chunks of the same run reuse it."""
+        return self.compiled.memo(key, build)
+
+    def stop_reason(self):
+        """Why the run must stop now (cancelled, interrupted, out of time), or None."""
+        if self.signal is not None:
+            return f"interrupted by {signal.Signals(self.signal).name}"
+        if self.cancel is not None and self.cancel():
+            return "cancelled"
+        if self.deadline is not None and time.perf_counter() > self.deadline:
+            return "the time limit set for the run was reached"
+        return None
+
+    def check_stop(self, states):
+        """For steppers, at every step: a Failure holding ``states`` when the run must stop."""
+        reason = self.stop_reason()
+        if reason is not None:
+            raise Failure(reason, states)
+
+    # -- the watch over loops ------------------------------------------------------------------
+    def conditioning(self, X):
+        """(condition number, sign of the determinant) of the loops' Jacobian in the
+        dependent speeds at each full state in X; None for a model without such loops."""
+        f = self.system.f_dependent
+        if f is None or not len(X):
+            return None
+        n = f.size1_out(0)
+        J = np.asarray(f.map(len(X))(np.asarray(X).T, self.p)).reshape(n, len(X), n)
+        J = np.transpose(J, (1, 0, 2))
+        with np.errstate(all="ignore"):
+            s = np.linalg.svd(J, compute_uv=False)
+            cond = np.where(s[:, -1] > 0, s[:, 0] / s[:, -1], np.inf)
+            sign = np.linalg.slogdet(J)[0]
+        return cond, sign
+
+    def singular(self, X, before):
+        """Index of the first row of X at which the loops pass a singular configuration (the
+        dependent Jacobian turns singular, or its determinant changes sign from the row
+        ``before``), or None."""
+        both = self.conditioning(np.vstack([before[None, :], X]))
+        if both is None:
+            return None
+        cond, sign = both
+        for i in range(1, len(cond)):
+            if not np.isfinite(cond[i]) or cond[i] > SINGULAR_CONDITION or \
+                    (sign[i] * sign[i - 1] < 0):
+                return i - 1
+        return None
+
+    def singular_words(self, t):
+        system = self.system
+        loops = "; ".join(" - ".join(c.loop) for c in system.topology.cuts)
+        return (f"the kinematic loop ({loops}) reaches a singular configuration (a dead "
+                f"point) at about t = {t:g} s: the closure no longer fixes the dependent speeds "
+                f"({', '.join(system.dependent_names)}), so the mechanism folds flat, locks or "
+                f"branches there; choose other independent coordinates (give q0 of the joints "
+                f"that drive it, or mark another joint cut), or stop before it")
+
+
+def simulate(model, t_end=None, n_points=None, method=None, rtol=None, atol=None,
+             params=None, t_start=0.0, step=None, jit=None, max_steps=None,
+             time_limit=None, progress=None, cancel=None, restart=False):
+    """Integrate ``model`` (a Model or a compiled System) and record its probes.
+
+    Settings not given come from the model's ``simulation`` block, then from DEFAULTS.
+
+    Parameters
+    ----------
+    model : Model or System
+        A Model is compiled (once: an unchanged model gives back its System).
+    t_end : float
+        End time [s]; the output grid has ``n_points`` equally spaced points from ``t_start``.
+    method : str
+        One of METHODS (``kinetwork methods`` lists them). ``auto`` (default): CVODES Adams,
+        or CVODES BDF when the stiffness test finds the problem stiff at the start, or when
+        Adams fails on it; IDAS for models with loops.
+    rtol, atol : float
+        Tolerances of the variable-step methods.
+    step : float, optional
+        Largest step [s] of the fixed-step methods (``rk``, ``collocation``, ``midpoint``);
+        default: the output spacing.
+    params : dict, optional
+        Model parameter values for this run; no recompilation.
+    jit : bool, optional
+        Compile the equations to C (cached on disk, see ``kinetwork.simulation.jit``). True
+        insists (a ModelError when it cannot be done); None (default) compiles when a C
+        compiler is found and ``KINETWORK_JIT`` is not 0, and falls back to CasADi's virtual
+        machine, with a warning, when compilation fails.
+    max_steps : int, optional
+        Step budget per output interval (SUNDIALS' mxstep; counted here for scipy's, whose
+        default is SCIPY_STEP_BUDGET): when it runs out the run stops with a SimulationError.
+    time_limit : float, optional
+        Wall-clock limit [s] of the run, compilation included.
+    progress : callable, optional
+        Called with the simulated time reached, now and then.
+    cancel : callable, optional
+        Called now and then; a true answer stops the run (a SimulationError holding what was
+        computed). SIGINT and SIGTERM stop a run in the main thread the same way.
+    restart : bool, optional
+        After a solver failure, start the method afresh from the last state reached (at most
+        MAX_RESTARTS times), if that state is sound: finite, the loops closed, and the
+        restarted run continuing it without a jump. Each restart is in ``stats["restarts"]``.
+        Off by default: a failure is a SimulationError.
+
+    Returns
+    -------
+    Results
+        ``results.settings["method"]`` is the method that ran; ``results.stats`` its counts.
+
+    Raises
+    ------
+    ModelError
+        Bad settings or parameters.
+    SimulationError
+        The integration failed or was stopped; ``err.results`` holds the results up to
+        ``err.t_reached``.
     """
-    run: Callable
-    doc: str
-    fixed: bool = False
-    newton: bool = False
-    dae: bool = False          # handles algebraic variables (the loops' dependent coordinates)
-
-
-def _casadi(plugin, newton, **options):
-    """A CasADi integrator plugin: the whole integration runs in compiled code."""
-    sundials = plugin in ("cvodes", "idas")
-
-    def run(system, grid, x0, p, settings):
-        opts = dict(options)
-        nx = system.n_states
-        if sundials:
-            opts.update(reltol=settings["rtol"], abstol=settings["atol"])
-            if plugin == "idas":
-                # the consistent initial rate is f(t0, x0) (loops: z0 is consistent already):
-                # IDAS's own search for it fails when it is large (a stiff spring)
-                opts.update(calc_ic=False, init_xdot=_rate0(system, grid[0], x0, p))
-        else:       # fixed steps: CasADi counts them over the whole horizon; a blow-up is
-            opts["show_eval_warnings"] = False           # reported once, below
-            opts["number_of_finite_elements"] = \
-                _steps_per_interval(grid, settings["step"]) * (len(grid) - 1)
-        jit = settings["jit"]
-        m = None if sundials else opts["number_of_finite_elements"] // (len(grid) - 1)
-        if settings.get("max_steps"):
-            if sundials:
-                opts["max_num_steps"] = int(settings["max_steps"])
-            elif m > settings["max_steps"]:
-                return x0[None, :], (f"the step budget of {settings['max_steps']} steps per "
-                                     f"output interval is smaller than the {m} steps of "
-                                     f"{settings['step'] or float(grid[1] - grid[0]):g} s that "
-                                     f"the fixed-step method takes"), {}
-        if settings.get("time_limit") or settings.get("progress"):
-            # in chunks: the clock is read and the progress told between them
-            chunk = max(1, (len(grid) - 1) // CHUNKS)
-            limit = settings.get("time_limit")
-            X, failure = _chunks(system, plugin, grid, x0, p, opts, jit, newton, chunk, m,
-                                 deadline=settings["started"] + limit if limit else None,
-                                 progress=settings.get("progress"))
-            X, bad = _finite(X)
-            return X, bad or failure, {"chunks": -(-(len(grid) - 1) // chunk)}
-        integ = system.integrator(plugin, grid, opts, jit=jit, jacobian=newton,
-                                  cache=plugin != "idas")       # idas: options hold x0
-        try:
-            out = integ(x0=x0[:nx], z0=x0[nx:], p=p)
-        except RuntimeError as exc:
-            X, reason = _chunks(system, plugin, grid, x0, p, opts, jit, newton, 1, m,
-                                first_error=str(exc))
-            return X, reason, {"restarted": "at every output time, after: " + _reason(str(exc))}
-        X = np.vstack([x0, np.vstack([np.asarray(out["xf"]), np.asarray(out["zf"])]).T])
-        stats = integ.stats()
-        if not sundials:
-            X, failure = _finite(X)
-            return X, failure, {"steps": m * (len(X) - 1),
-                                "step": float(grid[1] - grid[0]) / m}
-        return X, None, {"steps": int(stats["nsteps"]), "rhs_evaluations": int(stats["nfevals"]),
-                         "jacobian_evaluations": int(stats["n_call_jacF"])}
-    return run
-
-
-def _steps_per_interval(grid, step):
-    """Equal steps per output interval, none longer than ``step`` (default: the spacing)."""
-    dt = float(grid[1] - grid[0])
-    return max(1, int(np.ceil(dt / (step or dt) * (1 - 1e-12))))
-
-
-def _finite(X):
-    """States up to the first non-finite one, and the reason if there is one."""
-    good = np.all(np.isfinite(X), axis=1)
-    if good.all():
-        return X, None
-    return X[:int(np.argmin(good))], "the state became non-finite (Inf or NaN)"
-
-
-#: a run under a time limit or with a progress report goes in about this many chunks
-CHUNKS = 50
-
-
-def _chunks(system, plugin, grid, x0, p, options, jit, newton, chunk, m, deadline=None,
-            first_error="", progress=None):
-    """Integrate ``chunk`` output intervals at a time, each from where the last one ended:
-    after a failure (``chunk`` = 1 keeps everything computed before it: a fresh start per
-    output interval can even pass where the continued run failed), or to read the clock
-    against ``deadline``. Returns (X, reason): reason is None when every interval went
-    through."""
-    X = [np.asarray(x0, dtype=float)]
-    nx = system.n_states
-    opts = {**options, "disable_internal_warnings": True} if plugin in ("cvodes", "idas") \
-        else dict(options)
-    k = 0
-    while k < len(grid) - 1:
-        sub = grid[k:k + chunk + 1]
-        if m is not None:                      # fixed steps: counted over the chunk
-            opts["number_of_finite_elements"] = m * (len(sub) - 1)
-        if plugin == "idas":                   # idas starts from its consistent rate
-            opts["init_xdot"] = _rate0(system, sub[0], X[-1], p)
-        integ = system.integrator(plugin, sub, opts, cache=False, jit=jit, jacobian=newton)
-        try:
-            out = integ(x0=X[-1][:nx], z0=X[-1][nx:], p=p)
-        except RuntimeError as exc:
-            if len(sub) <= 2:
-                return np.array(X), _reason(str(exc) or first_error)
-            part, reason = _chunks(system, plugin, sub, X[-1], p, options, jit, newton, 1, m,
-                                   first_error=str(exc))
-            X.extend(part[1:])
-            if reason is not None:
-                return np.array(X), reason
+    system = model if isinstance(model, System) else model.compile()
+    given = {"t_end": t_end, "n_points": n_points, "method": method, "rtol": rtol,
+             "atol": atol, "step": step}
+    settings = {**DEFAULTS, **system.model.simulation,
+                **{k: v for k, v in given.items() if v is not None}}
+    key = _check(system, settings, t_start, max_steps, time_limit)
+    chosen = METHODS[key]
+    chosen.check(system)
+    p = system.param_vector(params)        # checks the overrides once for the whole run
+    x0 = np.concatenate(system.initial_full_p(p))
+    _check_finite_start(system, t_start, x0, p, params)
+    grid = np.linspace(t_start, settings["t_end"], int(settings["n_points"]))
+    settings.update(max_steps=max_steps, time_limit=time_limit, n_points=len(grid),
+                    rtol=float(settings["rtol"]), atol=float(settings["atol"]))
+    stats = {}
+    jit_on = _jit.enabled(jit) and system.n_states > 0
+    run = Run(system, p, x0, grid, settings, None, cancel, progress, restart)
+    with _signals_stop(run):
+        if jit_on:
+            run.jit = {"stats": stats, "required": jit is True, "deadline": run.deadline,
+                       "cancelled": lambda: run.stop_reason() is not None}
+        if not system.n_states:       # everything welded to the ground: nothing to integrate
+            X, failure, key = np.tile(x0, (len(grid), 1)), None, "none"
+        elif key == "auto":
+            X, failure, key = _auto(run, stats)
         else:
-            X.extend(np.vstack([np.asarray(out["xf"]), np.asarray(out["zf"])]).T)
-        k += len(sub) - 1
-        if progress is not None:
-            progress(float(grid[k]))
-        if deadline is not None and time.perf_counter() > deadline and k < len(grid) - 1:
-            return np.array(X), "the time limit set for the run was reached"
-    return np.array(X), None
+            X, failure, method_stats = _integrate(run, chosen)
+            stats.update(method_stats)
+    if run.said:
+        stats["solver_output"] = "".join(run.said)
+    stats["jit"] = bool(run.jit) and not stats.get("jit_fallback")
+    t = grid[:len(X)]
+    X = system.polish(X, p)
+    f_out = compiled(system).outputs(run.jit)
+    outputs = system.outputs_p(t, X, p, f_out) if len(t) else np.zeros((0, 0))
+    results = Results(t, X, system.state_names + system.algebraic_names, outputs,
+                      system.signals, stats=stats,
+                      state_units=system.state_units + system.algebraic_units,
+                      settings={"t_start": t_start, "t_end": settings["t_end"],
+                                "n_points": settings["n_points"], "method": key,
+                                "rtol": settings["rtol"], "atol": settings["atol"],
+                                "step": settings["step"], "jit": stats["jit"],
+                                "max_steps": max_steps, "time_limit": time_limit,
+                                "restart": restart, "params": dict(params or {})},
+                      probe_targets=system.probe_targets)
+    if failure is not None:
+        reached = float(t[-1]) if len(t) else float(t_start)
+        results.partial = {"t_reached": reached, "reason": failure}
+        said = _last_words(stats.get("solver_output", ""))
+        raise SimulationError(f"{key} failed after t = {reached:g} s (of "
+                              f"{settings['t_end']:g} s): {failure}"
+                              + (f" (the solver said: {said})" if said else ""),
+                              results=results, t_reached=reached, reason=failure,
+                              signal=run.signal)
+    return results
 
 
-def _rate0(system, t, X, p):
-    """d(x)/dt at a consistent full state X = (x, z), as IDAS's ``init_xdot``."""
-    nx = system.n_states
-    rate = system.f_dae(t, X[:nx], X[nx:], p)[0]
-    return tuple(float(v) for v in np.asarray(rate).ravel())
+def _check(system, settings, t_start, max_steps, time_limit):
+    """The method's table key, once every setting is checked (one ModelError for all)."""
+    problems = [m for k in DEFAULTS if settings[k] is not None
+                and (m := check_setting(k, settings[k]))]
+    if not isinstance(t_start, (int, float)) or isinstance(t_start, bool) or \
+            not math.isfinite(t_start):
+        problems.append(f"t_start: must be a finite number, got {t_start!r:.40}")
+    elif not problems and settings["t_end"] <= t_start:
+        problems.append(f"simulation.t_end: must be > t_start = {t_start}, "
+                        f"got {settings['t_end']}")
+    for name, value, kind in (("max_steps", max_steps, int), ("time_limit", time_limit, float)):
+        if value is not None and (isinstance(value, bool) or not isinstance(value, (int, float))
+                                  or not math.isfinite(value) or value <= 0
+                                  or (kind is int and int(value) != value)):
+            problems.append(f"{name}: must be a positive {'integer' if kind is int else 'number'}"
+                            f", got {value!r:.40}")
+    if problems:
+        raise ModelError(problems)
+    key = settings["method"].lower()
+    if key not in METHODS:
+        raise ModelError(f"method {settings['method']!r:.60}: unknown{suggest(key, METHODS)}; "
+                         f"methods are {', '.join(METHODS)}")
+    if system.n_algebraic and not METHODS[key].dae:
+        raise ModelError(
+            f"method {settings['method']!r} integrates ODEs only, and {system.model.name!r} "
+            f"has kinematic loops whose dependent coordinates are algebraic variables; use "
+            f"{', '.join(k for k, m in METHODS.items() if m.dae)}, or compile the model with "
+            f"loops='projected' or loops='baumgarte' (ODEs)")
+    return key
 
 
-#: SUNDIALS return flags, in plain words
-FLAGS = {
-    "TOO_MUCH_WORK": "too many steps before the next output time: the solution may blow up "
-                     "there, or the problem is stiff for this method",
-    "TOO_MUCH_ACC": "the tolerances asked for are below machine precision",
-    "ERR_FAIL": "the error test failed repeatedly: the step size collapsed",
-    "CONV_FAIL": "the Newton iteration failed to converge repeatedly: the step size collapsed",
-    "RHSFUNC_ERR": "the right-hand side became non-finite (Inf or NaN): a force or a "
-                   "parameter expression blows up",
-    "RHSFUNC_FAIL": "the right-hand side became non-finite (Inf or NaN): a force or a "
-                    "parameter expression blows up",
-    "RES_FAIL": "the residual became non-finite (Inf or NaN)",
-    "REP_RES_ERR": "the equations became non-finite (Inf or NaN) again and again: with loops, "
-                   "the mechanism may have reached a dead point where the independent "
-                   "coordinates (those with a given q0) can no longer drive it",
-    "LSETUP_FAIL": "the linear solver setup failed (singular iteration matrix)",
-    "LSOLVE_FAIL": "the linear solver failed (singular iteration matrix)",
-}
+def _check_finite_start(system, t, x0, p, params):
+    """Refuse, before integrating, a model whose numbers overflow double precision at the
+    start (a parameter of 1e300 squared in an inertia): its equations are not finite there."""
+    bad = not np.all(np.isfinite(x0))
+    if not bad and system.n_states:
+        nx = system.n_states
+        with np.errstate(all="ignore"):
+            ode, alg = system.f_dae(t, x0[:nx], x0[nx:], p)
+        bad = not (np.all(np.isfinite(np.asarray(ode))) and np.all(np.isfinite(np.asarray(alg))))
+    if not bad:
+        return
+    values = system.model.parameter_values(params)
+    big = sorted(values.items(), key=lambda kv: -abs(kv[1]))[:3]
+    raise ModelError(f"the equations of {system.model.name!r} are not finite at the initial "
+                     f"state (t = {t:g}): a number overflows double precision or divides by "
+                     f"zero there; check the parameters"
+                     + (f" (largest: {', '.join(f'{k} = {v:g}' for k, v in big)})"
+                        if big else "") + " and the initial values")
 
 
-def _reason(message):
-    for flag, words in FLAGS.items():
-        if flag in message:
-            return words
-    lines = [ln.strip() for ln in message.splitlines() if ln.strip()]
-    return (lines or ["integrator failed"])[-1]
+def _auto(run, stats):
+    names, why = choose(run)
+    stats.update(why)
+    for i, name in enumerate(names):
+        X, failure, method_stats = _integrate(run, METHODS[name])
+        if failure is None or i == len(names) - 1 or run.stop_reason() is not None:
+            stats.update(method_stats)
+            return X, failure, name
+        stats["adams_failure"] = failure
+    raise AssertionError("unreachable")
 
 
-def _scipy(name):
-    """A scipy ODE solver (the stepper class solve_ivp uses) fed by the compiled CasADi
-    right-hand side and Jacobian, stepped here so that a step budget or a time limit stops
-    it with everything up to that point kept."""
-    implicit = name in ("Radau", "BDF", "LSODA")
-
-    def run(system, grid, x0, p, settings):
-        import scipy.integrate                 # 0.4 s to import: only when asked for
-        jit = settings["jit"]
-        kwargs = {"jac": system.numeric(system.jacobian_numeric_function(jit), p)} \
-            if implicit else {}
-        fun = system.numeric(system.rhs_function(jit), p)
-        budget, limit = settings.get("max_steps"), settings.get("time_limit")
-        X, k, steps, in_interval, failure = [np.asarray(x0, dtype=float)], 1, 0, 0, None
-        with np.errstate(all="ignore"):      # a blow-up is reported below, not warned
-            solver = getattr(scipy.integrate, name)(
-                fun, grid[0], x0, grid[-1], rtol=settings["rtol"], atol=settings["atol"],
-                **kwargs)
-            while k < len(grid):
-                message = solver.step()
-                steps, in_interval = steps + 1, in_interval + 1
-                if solver.status == "failed":
-                    failure = message
-                    break
-                if grid[k] <= solver.t:
-                    dense = solver.dense_output()
-                    while k < len(grid) and grid[k] <= solver.t:
-                        X.append(dense(grid[k]))
-                        k, in_interval = k + 1, 0
-                    if settings.get("progress"):
-                        settings["progress"](float(grid[k - 1]))
-                if not np.all(np.isfinite(solver.y)):
-                    failure = "the state became non-finite (Inf or NaN)"
-                    break
-                if budget and in_interval >= budget and k < len(grid):
-                    failure = (f"the step budget of {budget} steps per output interval ran "
-                               f"out at t = {solver.t:g} s: the problem may be stiff for "
-                               f"this method, or the solution blows up")
-                    break
-                if limit and time.perf_counter() - settings["started"] > limit:
-                    failure = "the time limit set for the run was reached"
-                    break
-        stats = {"steps": steps, "rhs_evaluations": int(solver.nfev),
-                 "jacobian_evaluations": int(solver.njev)}
-        X, bad = _finite(np.array(X))
-        return X, bad or failure, stats
-    return run
-
-
-def _midpoint(system, grid, x0, p, settings):
-    from .geometric import Midpoint
-    if system.formulation != "tree" or not all(system.asm.regular):
-        raise ModelError("method 'midpoint' works in canonical coordinates of a tree of "
-                         "angles and distances; this model has kinematic loops or a "
-                         "quaternion joint (Spherical, FreeMotion): use 'auto' or 'idas'")
-    key = ("midpoint", settings["jit"])
-    if key not in system._compiled:
-        system._compiled[key] = Midpoint(system, settings["jit"])
-    return system._compiled[key].run(grid, x0, p, _steps_per_interval(grid, settings["step"]))
+def _integrate(run, method):
+    """States on the grid from ``method``, chunk by chunk: (X, failure or None, stats)."""
+    grid, n = run.grid, len(run.grid)
+    X = [np.asarray(run.x0, dtype=float)]
+    stats, restarts = {}, []           # stats: of the steppers replaced by restarts
+    if method.fixed and run.max_steps and run.steps_per_interval > run.max_steps:
+        return np.array(X), (f"the step budget of {run.max_steps} steps per output interval "
+                             f"is smaller than the {run.steps_per_interval} steps of "
+                             f"{run.step or run.spacing:g} s that the fixed-step method "
+                             f"takes"), stats
+    try:
+        stepper = method.start(run, grid[0], X[0])
+    except Failure as failure:
+        return np.array(X), failure.reason, stats
+    chunk = n - 1 if method.stepper else max(1, int((n - 1) * FIRST_CHUNK))
+    k, failure = 0, None
+    while k < n - 1:
+        failure = run.stop_reason()
+        if failure is not None:
+            break
+        m = min(chunk, n - 1 - k)
+        times = grid[k + 1:k + 1 + m]
+        work_before = _work(run, stepper.stats)
+        try:
+            new = stepper.advance(times)
+        except Failure as exc:
+            new = exc.states if exc.states is not None else np.zeros((0, len(X[0])))
+            failure = exc.reason
+            if not len(new) and m > 1 and not method.stepper:
+                # CasADi keeps nothing of a failed call: go again an output at a time,
+                # to keep every output before the failure (and stop there all the same)
+                new, failure = _piecewise(run, method, grid[k], X[-1], times, failure)
+        if run.system.f_dependent is not None:
+            new, failure = _watch(run, X, new, failure)
+        X.extend(new)
+        k = len(X) - 1
+        if run.progress is not None and len(new):
+            run.progress(float(grid[k]))
+        if failure is not None:
+            if run.stop_reason() is None and _restart(run, method, X, restarts, failure):
+                stats = _merge(stats, stepper.stats)
+                stepper, failure = restarts[-1]["stepper"], None
+                chunk = 1
+                continue
+            break
+        if not method.stepper:
+            work = max(_work(run, stepper.stats) - work_before, 1.0)
+            chunk = max(1, min(CHUNK_GROWTH * m, int(m * CHUNK_WORK / work)))
+    if failure is not None and run.system.f_dependent is not None and \
+            run.stop_reason() is None and "singular" not in failure:
+        failure += _near_singular(run, np.array(X), grid)
+    stats = _merge(stats, stepper.stats)
+    if restarts:
+        stats["restarts"] = [{"t": r["t"], "after": r["after"]} for r in restarts]
+    return np.array(X), failure, stats
 
 
-#: method name (case-insensitive) -> Method
-METHODS = {
-    "auto": Method(None, "cvodes-adams, or cvodes (BDF) when the stiffness test says so; "
-                   "idas for models with loops", dae=True),
-    "cvodes-adams": Method(_casadi("cvodes", False, linear_multistep_method="adams",
-                                   nonlinear_solver_iteration="functional"),
-                           "SUNDIALS CVODES, variable-order Adams-Moulton with functional "
-                           "iteration: non-stiff, no Jacobian"),
-    "cvodes": Method(_casadi("cvodes", True), "SUNDIALS CVODES, variable-order BDF with "
-                     "Newton iteration: stiff", newton=True),
-    "idas": Method(_casadi("idas", True), "SUNDIALS IDAS, variable-order BDF on the residual "
-                   "form: stiff, and the method of models with loops", newton=True, dae=True),
-    "rk": Method(_casadi("rk", False), "CasADi's classical Runge-Kutta 4, fixed step",
-                 fixed=True),
-    "collocation": Method(_casadi("collocation", True),
-                          "CasADi's Radau IIA collocation (order 5), fixed step: stiff",
-                          fixed=True, newton=True, dae=True),
-    "midpoint": Method(_midpoint, "implicit midpoint rule in canonical coordinates, fixed "
-                       "step: symplectic, for long undamped runs", fixed=True, newton=True),
-    **{m.lower(): Method(_scipy(m), f"scipy solve_ivp {m}", newton=m in ("Radau", "BDF", "LSODA"))
-       for m in ("RK45", "DOP853", "Radau", "BDF", "LSODA")},
-}
+def _work(run, stats):
+    """The work a method has done so far: evaluations of the equations (a Jacobian counted as
+    one per state) times the instructions of one evaluation."""
+    evaluations = stats.get("rhs_evaluations", stats.get("steps", 0) * 4) + \
+        stats.get("jacobian_evaluations", 0) * (run.system.n_states + run.system.n_algebraic)
+    return evaluations * run.instructions
 
 
-#: the stiffness test of ``auto``: see ``stiffness``
-STIFF_HORIZON_STEPS = 1e3
-STIFF_RATIO = 10.0
+def _merge(total, more):
+    out = dict(total)
+    for k, v in more.items():
+        out[k] = out.get(k, 0) + v if isinstance(v, int) and k in out and \
+            not isinstance(v, bool) else v
+    return out
 
 
-def _jacobian_fd(f, t, x):
-    """Central finite differences: 2n evaluations, O(n) each; no O(n^2) symbolic Jacobian."""
-    J = np.empty((len(x), len(x)))
-    for i in range(len(x)):
-        dx = 1e-6 * max(1.0, abs(x[i]))
-        e = np.zeros(len(x))
-        e[i] = dx
-        J[:, i] = (f(t, x + e) - f(t, x - e)) / (2 * dx)
-    return J
+def _piecewise(run, method, t, x, times, reason):
+    """The outputs a failed chunk reached, found by integrating it an output at a time from
+    its start; the run stops at the end of them all the same (a fresh start can pass where
+    the continued run failed: that would be a silent restart)."""
+    out = []
+    try:
+        stepper = method.start(run, t, x)
+        for s in times:
+            out.append(stepper.advance(np.array([s]))[0])
+    except Failure as exc:
+        if exc.states is not None and len(exc.states):
+            out.extend(exc.states)
+        reason = exc.reason
+    return np.array(out).reshape(-1, len(x)), reason
 
 
-def stiffness(system, x0, p, t_start, t_end, jit=False):
-    """The stiffness test of the ``auto`` method, on the Jacobian at the initial state.
+def _watch(run, X, new, failure):
+    """(rows, failure): the new rows up to a singular configuration of the loops, and the
+    failure that stops the run there, if any."""
+    if not len(new):
+        return new, failure
+    i = run.singular(new, X[-1])
+    if i is None:
+        return new, failure
+    return new[:i], run.singular_words(float(run.grid[len(X) + i]))
 
-    With λ the eigenvalues of d(xdot)/dx at (t_start, x0), the fastest decay rate is
-    σ = max(-Re λ) and the fastest other motion is ω = max(max Re λ, max |Im λ|). The problem
-    is stiff when σ (t_end - t_start) > STIFF_HORIZON_STEPS (an explicit or Adams method
-    would need over ~10^3 steps for stability alone) and σ > STIFF_RATIO ω (that decay is
-    much faster than anything the solution must follow). An undamped mechanism is never stiff by
-    this test (its eigenvalues come in ±λ pairs); a hard, heavily damped spring is.
 
-    Returns (stiff, σ, ω).
-    """
-    J = _jacobian_fd(system.numeric(system.rhs_function(jit), p), t_start, x0)
-    lam = np.linalg.eigvals(J) if J.size else np.zeros(0)
-    if not np.all(np.isfinite(lam)) or lam.size == 0:
-        return False, 0.0, 0.0
-    sigma = float(max(0.0, np.max(-lam.real)))
-    omega = float(max(0.0, np.max(lam.real), np.max(np.abs(lam.imag))))
-    stiff = sigma * (t_end - t_start) > STIFF_HORIZON_STEPS and sigma > STIFF_RATIO * omega
-    return stiff, sigma, omega
+def _near_singular(run, X, grid):
+    """A note for a failure of a model with loops that ended at a singular configuration: the
+    Jacobian in the dependent speeds is ill-conditioned at the last output, or its
+    determinant, extrapolated from the last two outputs, vanishes before the next one (a
+    dead point that the integrator could not pass)."""
+    both = run.conditioning(X[-2:])
+    if both is None:
+        return ""
+    cond, _ = both
+    f, n = run.system.f_dependent, run.system.f_dependent.size1_out(0)
+    det = [float(np.linalg.det(np.asarray(f(row, run.p)).reshape(n, n))) for row in X[-2:]]
+    folding = len(det) == 2 and det[0] * det[1] > 0 and abs(det[1]) < abs(det[0]) and \
+        abs(det[1]) < abs(det[0] - det[1])
+    if cond[-1] < NEAR_SINGULAR_CONDITION and not folding:
+        return ""
+    return (f"; there (t = {grid[len(X) - 1]:g} s) the loop is at a singular configuration, "
+            f"a dead point: its Jacobian in the dependent speeds "
+            f"({', '.join(run.system.dependent_names)}) has condition number "
+            f"{cond[-1]:.2g} and its determinant goes to zero, so the mechanism folds flat, "
+            f"locks or branches")
+
+
+def _restart(run, method, X, restarts, failure):
+    """With ``restart=True``: start ``method`` afresh from the last state, if it is sound and
+    the restarted run continues it without a jump. Returns whether the run goes on."""
+    if not run.restart or len(restarts) >= MAX_RESTARTS or len(X) < 2 or len(X) >= len(run.grid):
+        return False
+    system, last, before = run.system, X[-1], X[-2]
+    if not np.all(np.isfinite(last)) or \
+            system.constraint_residual_p(last[None, :], run.p)[0] > RESTART_CLOSURE:
+        return False
+    k = len(X) - 1
+    try:
+        stepper = method.start(run, run.grid[k], last)
+        nxt = stepper.advance(run.grid[k + 1:k + 2])
+    except Failure:
+        return False
+    # continuity: the first restarted interval moves about as much as the last good one did
+    scale = run.atol + run.rtol * np.abs(last)
+    if np.any(np.abs(nxt[0] - last) > 10 * np.abs(last - before) + 100 * scale):
+        return False
+    if system.constraint_residual_p(nxt, run.p)[0] > RESTART_CLOSURE:
+        return False
+    X.append(nxt[0])
+    restarts.append({"t": float(run.grid[k]), "after": failure, "stepper": stepper})
+    return True
+
+
+@contextlib.contextmanager
+def _signals_stop(run):
+    """SIGINT and SIGTERM stop the run between chunks (main thread only: Python delivers
+    signals there), instead of a KeyboardInterrupt inside CasADi or a kill."""
+    if threading.current_thread() is not threading.main_thread():
+        yield
+        return
+
+    def stop(signum, frame):
+        run.signal = signum
+    saved = {}
+    for sig in (signal.SIGINT, signal.SIGTERM):
+        try:
+            saved[sig] = signal.signal(sig, stop)
+        except (ValueError, OSError):     # not settable here (an embedded interpreter)
+            pass
+    try:
+        yield
+    finally:
+        for sig, handler in saved.items():
+            signal.signal(sig, handler)
 
 
 @contextlib.contextmanager
@@ -313,11 +516,12 @@ def _solver_output():
     """What the integrators print (SUNDIALS' failure chatter, CasADi's warnings) captured
     instead of reaching the user's terminal: CasADi writes through Python's sys.stdout and
     sys.stderr, plain C code to file descriptors 1 and 2; both are caught. The text is in the
-    yielded dict's "text" afterwards."""
+    yielded dict's "text" afterwards. Callers hold ``_SOLVER_LOCK``."""
     box = {"text": ""}
     python_level = io.StringIO()
     for stream in (sys.stdout, sys.stderr):
-        stream.flush()
+        with contextlib.suppress(Exception):
+            stream.flush()
     try:
         saved = [os.dup(1), os.dup(2)]
     except OSError:                            # no file descriptors to redirect
@@ -348,145 +552,3 @@ def _last_words(text):
         return ""
     line = lines[-1]
     return line if len(line) <= 200 else line[:197] + "..."
-
-
-def simulate(model, t_end=None, n_points=None, method=None, rtol=None, atol=None,
-             params=None, t_start=0.0, step=None, jit=None, max_steps=None,
-             time_limit=None, progress=None):
-    """Integrate ``model`` (a Model or a compiled System) and record its probes.
-
-    Settings not given come from the model's ``simulation`` block, then from DEFAULTS.
-
-    Parameters
-    ----------
-    model : Model or System
-    t_end : float
-        End time [s]; the output grid has ``n_points`` equally spaced points from ``t_start``.
-    method : str
-        One of METHODS (``kinetwork methods`` lists them). ``auto`` (default): CVODES Adams,
-        or CVODES BDF when ``stiffness`` finds the problem stiff at the start, or when Adams
-        fails on it.
-    rtol, atol : float
-        Tolerances of the variable-step methods.
-    step : float, optional
-        Largest step [s] of the fixed-step methods (``rk``, ``collocation``, ``midpoint``);
-        default: the output spacing.
-    params : dict, optional
-        Model parameter values for this run; no recompilation.
-    jit : bool, optional
-        Compile the right-hand side to C (cached on disk, see ``kinetwork.solver.jit``).
-        Default: when a C compiler is found and ``KINETWORK_JIT`` is not 0.
-    max_steps : int, optional
-        Step budget per output interval of the variable-step methods (SUNDIALS' mxstep;
-        counted here for scipy's): when it runs out the run stops with a SimulationError.
-    time_limit : float, optional
-        Wall-clock limit [s] of the integration; the run stops with a SimulationError
-        holding what it computed (CasADi methods read the clock between chunks of output
-        intervals, scipy's at every step; the midpoint rule ignores it).
-    progress : callable, optional
-        Called with the simulated time reached, now and then (CasADi methods then run in
-        chunks of output intervals); ``kinetwork run`` draws a progress bar with it.
-
-    Returns
-    -------
-    Results
-        ``results.settings["method"]`` is the method that ran; ``results.stats`` its counts.
-
-    Raises
-    ------
-    ModelError
-        Bad settings or parameters.
-    SimulationError
-        The integration failed; ``err.results`` holds the results up to ``err.t_reached``.
-    """
-    system = model if isinstance(model, System) else model.compile()
-    given = {"t_end": t_end, "n_points": n_points, "method": method, "rtol": rtol,
-             "atol": atol, "step": step}
-    settings = {**DEFAULTS, **system.model.simulation,
-                **{k: v for k, v in given.items() if v is not None}}
-    problems = [m for k in DEFAULTS if settings[k] is not None
-                and (m := check_setting(k, settings[k]))]
-    if not problems and settings["t_end"] <= t_start:
-        problems.append(f"simulation.t_end: must be > t_start = {t_start}, "
-                        f"got {settings['t_end']}")
-    for name, value, kind in (("max_steps", max_steps, int), ("time_limit", time_limit, float)):
-        if value is not None and (isinstance(value, bool) or not isinstance(value, (int, float))
-                                  or value <= 0 or (kind is int and int(value) != value)):
-            problems.append(f"{name}: must be a positive {'integer' if kind is int else 'number'}"
-                            f", got {value!r}")
-    if problems:
-        raise ModelError(problems)
-    key = settings["method"].lower()
-    if key not in METHODS:
-        raise ModelError(f"method {settings['method']!r}: unknown{suggest(key, METHODS)}; "
-                         f"methods are {', '.join(METHODS)}")
-    if system.n_algebraic and not METHODS[key].dae:
-        raise ModelError(
-            f"method {settings['method']!r} integrates ODEs only, and {system.model.name!r} "
-            f"has kinematic loops whose dependent coordinates are algebraic variables; use "
-            f"{', '.join(k for k, m in METHODS.items() if m.dae)}, or compile the model with "
-            f"loops='projected' or loops='baumgarte' (ODEs)")
-    p = system.param_vector(params)        # checks the overrides once for the whole run
-    x0 = np.concatenate(system.initial_full_p(p))
-    grid = np.linspace(t_start, settings["t_end"], int(settings["n_points"]))
-    settings.update(max_steps=max_steps, time_limit=time_limit, progress=progress,
-                    started=time.perf_counter())
-    settings.update(jit=_jit.enabled(jit) and system.n_states > 0, t_start=t_start,
-                    n_points=int(settings["n_points"]),
-                    rtol=float(settings["rtol"]), atol=float(settings["atol"]))
-    system.jit_stats.clear()
-    stats = {}
-    with _solver_output() as said:
-        if not system.n_states:       # everything welded to the ground: nothing to integrate
-            X, failure, key = np.tile(x0, (len(grid), 1)), None, "none"
-        elif key == "auto":
-            X, failure, stats, key = _auto(system, grid, x0, p, settings)
-        else:
-            X, failure, stats = METHODS[key].run(system, grid, x0, p, settings)
-    if said["text"].strip():
-        stats["solver_output"] = said["text"]
-    stats.update(jit=settings["jit"], **system.jit_stats)
-    t = grid[:len(X)]
-    X = system.polish(X, p)
-    t_end = settings["t_end"]
-    outputs = system.outputs_p(t, X, p, settings["jit"]) if len(t) else np.zeros((0, 0))
-    results = Results(t, X, system.state_names + system.algebraic_names, outputs,
-                      system.signal_names, system.signal_sizes, system.signal_units, stats=stats,
-                      state_units=system.state_units + system.algebraic_units,
-                      settings={"t_start": t_start, "t_end": t_end,
-                                "n_points": settings["n_points"], "method": key,
-                                "rtol": settings["rtol"], "atol": settings["atol"],
-                                "step": settings["step"], "jit": settings["jit"],
-                                "max_steps": max_steps, "time_limit": time_limit,
-                                "params": dict(params or {})},
-                      probe_targets=system.probe_targets)
-    if failure is not None:
-        reached = float(t[-1]) if len(t) else float(t_start)
-        said = _last_words(stats.get("solver_output", ""))
-        raise SimulationError(f"{key} failed after t = {reached:g} s (of {t_end:g} s): "
-                              f"{failure}" + (f" (the solver said: {said})" if said else ""),
-                              results=results, t_reached=reached, reason=failure)
-    return results
-
-
-def _auto(system, grid, x0, p, settings):
-    """The default: Adams unless the stiffness test (or a failure of Adams) says BDF.
-
-    A model without damping (generalized forces independent of the speeds) is conservative
-    up to its time-dependent drives: its eigenvalues come in ±λ pairs and it is never stiff by
-    the test, so the test (an eigenvalue problem of 2n x 2n) is not run.
-    """
-    if system.n_algebraic:
-        X, failure, stats = METHODS["idas"].run(system, grid, x0, p, settings)
-        return X, failure, {**stats, "loops": system.formulation_note}, "idas"
-    why = {"stiff": False, "damped": system.damped}
-    if system.damped:
-        stiff, sigma, omega = stiffness(system, x0, p, grid[0], grid[-1], settings["jit"])
-        why.update(stiff=bool(stiff), decay_rate=sigma, motion_rate=omega)
-    if not why["stiff"]:
-        X, failure, stats = METHODS["cvodes-adams"].run(system, grid, x0, p, settings)
-        if failure is None:
-            return X, None, {**stats, **why}, "cvodes-adams"
-        why["adams_failure"] = failure
-    X, failure, stats = METHODS["cvodes"].run(system, grid, x0, p, settings)
-    return X, failure, {**stats, **why}, "cvodes"

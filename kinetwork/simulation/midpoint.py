@@ -19,8 +19,8 @@ import casadi as ca
 import numpy as np
 
 from . import jit as _jit
-from .newton_euler import aba, rnea
-from .system import JACOBIAN_JIT_LIMIT
+from ..equations.newton_euler import aba, rnea
+from .compiled import JACOBIAN_JIT_LIMIT
 
 
 class Midpoint:
@@ -31,24 +31,25 @@ class Midpoint:
     converge (a step too large for the motion) is reported by ``run``, not raised inside CasADi.
     """
 
-    def __init__(self, system, jit=False):
+    def __init__(self, system, jit=None):
+        """``jit``: None, or the options of ``jit.external`` (compile the step to C)."""
         a = system.asm
         n = len(a.coordinate_names)
         zero, w = ca.SX.zeros(n), ca.SX.sym("w", n)
         a_grav = ca.vertcat(ca.SX.zeros(3), -a.gravity)
         # M(q) w by RNEA with no speed and no gravity; M(q) qd and its rate by differentiation
         Mw = a.mass_times(w)
-        Mqd = ca.substitute(Mw, w, a.qd)
-        Mdot_qd = ca.substitute(ca.jtimes(Mw, a.q, a.qd), w, a.qd)
-        fp = Mdot_qd - rnea(a.bodies, a.qd, zero, a_grav) + a.Q
-        f_Mqd = ca.Function("Mqd", [a.q, a.qd, a.p], [Mqd])
-        f_fp = ca.Function("fp", [a.t, a.q, a.qd, a.p], [fp])
-        f_qdd = ca.Function("qdd", [a.t, a.q, a.qd, a.p], [a.qdd])
+        Mqd = ca.substitute(Mw, w, a.u)
+        Mdot_qd = ca.substitute(ca.jtimes(Mw, a.q, a.u), w, a.u)
+        fp = Mdot_qd - rnea(a.bodies, a.u, zero, a_grav) + a.Q
+        f_Mqd = ca.Function("Mqd", [a.q, a.u, a.p], [Mqd])
+        f_fp = ca.Function("fp", [a.t, a.q, a.u, a.p], [fp])
+        f_qdd = ca.Function("qdd", [a.t, a.q, a.u, a.p], [a.udot_tree])
         # qd = M(q)^-1 p by the articulated-body algorithm (p as the joint forces, no speed,
         # no gravity): O(n), no mass matrix
         f_vel = ca.Function("velocity", [a.q, w, a.p],
                             [ca.substitute(aba(a.bodies, zero, w, ca.SX.zeros(6), a.armature),
-                                           a.qd, zero)])
+                                           a.u, zero)])
 
         v, q0, p0 = ca.SX.sym("v", n), ca.SX.sym("q0", n), ca.SX.sym("p0", n)
         t0, h, par = ca.SX.sym("t0"), ca.SX.sym("h"), ca.SX.sym("par", a.p.shape[0])
@@ -74,13 +75,13 @@ class Midpoint:
             self._step = ca.Function("step", [z, hh, pp],
                                      [ca.vertcat(nxt, ca.fmax(z[-1], miss))])
             if jit:
-                self._step = _jit.external(self._step, stats=system.jit_stats)
+                self._step = _jit.external(self._step, **jit)
         else:
             # CasADi's Newton rootfinder, its residual compiled with its Jacobian if small
             if jit:
                 if residual.jacobian().n_instructions() <= JACOBIAN_JIT_LIMIT:
-                    residual = _jit.external(residual, jacobian=True, stats=system.jit_stats)
-                predict, advance = (_jit.external(f, stats=system.jit_stats)
+                    residual = _jit.external(residual, True, **jit)
+                predict, advance = (_jit.external(f, **jit)
                                     for f in (predict, advance))
             solve = ca.rootfinder("midpoint", "newton", residual,
                                   {"abstol": 1e-12, "abstolStep": 1e-14, "max_iter": 30,

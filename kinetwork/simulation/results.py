@@ -1,10 +1,16 @@
-"""Results: the time grid, states and probe signals of a simulation, read by name."""
+"""Results: the time grid, states and probe signals of a simulation, read by name.
+
+Each signal comes with its ``Signal`` descriptor (name, unit, shape, probe, quantity, the port
+measured), made where the quantity was defined; results, CSV columns and plots read them, never
+guessing a shape from a size.
+"""
 
 import csv
+import io
 
 import numpy as np
 
-from ..components.base import suggest
+from ..util import atomic_write, suggest
 
 
 class Results:
@@ -13,12 +19,14 @@ class Results:
     Scalars read as (n_points,), vectors as (n_points, 3), orientations as (n_points, 3, 3).
     """
 
-    def __init__(self, t, states, state_names, signals, signal_names, sizes, units,
-                 stats=None, state_units=None, settings=None, probe_targets=None):
+    def __init__(self, t, states, state_names, values, signals, stats=None, state_units=None,
+                 settings=None, probe_targets=None):
         self.t = np.asarray(t, dtype=float)
         self.states = np.asarray(states, dtype=float).reshape(len(self.t), len(state_names))
         self.state_names = list(state_names)
-        self.units = dict(units)
+        #: the Signal descriptor of every probe signal, in order
+        self.signals = {sig.name: sig for sig in signals}
+        self.units = {name: sig.unit for name, sig in self.signals.items()}
         self.units.update(zip(self.state_names, state_units or [""] * len(self.state_names)))
         #: integrator counters: rhs_evaluations, jacobian_evaluations, steps (CasADi methods)
         self.stats = dict(stats or {})
@@ -26,15 +34,15 @@ class Results:
         self.settings = dict(settings or {})
         #: probe name -> the port it measures ("shoulder.axis")
         self.probe_targets = dict(probe_targets or {})
-        self._signals = {}
+        #: None, or {"t_reached", "reason"} when the run stopped before t_end
+        self.partial = None
+        self._values = {}
         col = 0
-        signals = np.asarray(signals, dtype=float).reshape(len(self.t), -1)
-        for name in signal_names:
-            size = sizes[name]
-            block = signals[:, col:col + size]
-            col += size
-            self._signals[name] = (block[:, 0] if size == 1 else
-                                   block if size == 3 else block.reshape(-1, 3, 3))
+        values = np.asarray(values, dtype=float).reshape(len(self.t), -1)
+        for sig in self.signals.values():
+            block = values[:, col:col + sig.size]
+            col += sig.size
+            self._values[sig.name] = block.reshape(len(self.t), *sig.shape)
 
     @property
     def method(self):
@@ -43,32 +51,31 @@ class Results:
 
     @property
     def signal_names(self):
-        return list(self._signals)
+        return list(self.signals)
 
     @property
     def probes(self):
         """Probe name -> the quantities it recorded, in order."""
         out = {}
-        for name in self._signals:
-            probe, quantity = name.split(".", 1)
-            out.setdefault(probe, []).append(quantity)
+        for sig in self.signals.values():
+            out.setdefault(sig.probe, []).append(sig.quantity)
         return out
 
     def keys(self):
-        return ["t", *self._signals, *self.state_names]
+        return ["t", *self.signals, *self.state_names]
 
     def __getitem__(self, key):
         if key == "t":
             return self.t
-        if key in self._signals:
-            return self._signals[key]
+        if key in self._values:
+            return self._values[key]
         if key in self.state_names:
             return self.states[:, self.state_names.index(key)]
-        raise KeyError(f"{key!r}{suggest(key, self.keys())}; available: "
+        raise KeyError(f"{key!r:.200}{suggest(key, self.keys())}; available: "
                        f"{', '.join(self.keys())}")
 
     def __contains__(self, key):
-        return key == "t" or key in self._signals or key in self.state_names
+        return key == "t" or key in self._values or key in self.state_names
 
     def __len__(self):
         return len(self.t)
@@ -76,31 +83,48 @@ class Results:
     def columns(self):
         """(header, 2-D array) of the CSV: t, then every probe signal, vectors expanded."""
         header, cols = ["t"], [self.t[:, None]]
-        for name, value in self._signals.items():
-            if value.ndim == 1:
-                header.append(name)
-                cols.append(value[:, None])
-            elif value.ndim == 2:
-                header += [f"{name}[{i}]" for i in range(3)]
-                cols.append(value)
-            else:
-                header += [f"{name}[{i},{j}]" for i in range(3) for j in range(3)]
-                cols.append(value.reshape(len(self.t), 9))
+        for name, sig in self.signals.items():
+            header += sig.column_names()
+            cols.append(self._values[name].reshape(len(self.t), sig.size))
         return header, np.hstack(cols)
 
     def to_csv(self, path):
-        """Write t and every probe signal as CSV with a header row."""
+        """Write t and every probe signal as CSV with a header row, atomically (a failed
+        write leaves an old file whole). Partial results end with a comment line
+        ``# partial: ...`` saying where and why the run stopped."""
         header, data = self.columns()
-        with open(path, "w", newline="") as fh:
-            writer = csv.writer(fh)
-            writer.writerow(header)
-            writer.writerows([repr(float(v)) for v in row] for row in data)
+        text = io.StringIO(newline="")
+        writer = csv.writer(text)
+        writer.writerow(header)
+        writer.writerows([repr(float(v)) for v in row] for row in data)
+        if self.partial is not None:
+            reason = " ".join(str(self.partial["reason"]).split())
+            text.write(f"# partial: the run stopped at t = {self.partial['t_reached']!r} s: "
+                       f"{reason}\n")
+
+        def write(tmp):
+            with open(tmp, "w", newline="") as fh:
+                fh.write(text.getvalue())
+        atomic_write(path, write)
 
     def plot(self, probes=None, **kwargs):
         """Probe plots: one row per probe, one panel per quantity (matplotlib Figure)."""
-        from ..plot import plot_results
-        return plot_results(self, probes=probes, **kwargs)
+        if _plotter is None:
+            raise RuntimeError("no plotter installed: import kinetwork")
+        return _plotter(self, probes=probes, **kwargs)
 
     def __repr__(self):
         return (f"<Results {len(self.t)} points, t = {self.t[0]:g} .. {self.t[-1]:g}, "
-                f"{len(self._signals)} signals>")
+                f"{len(self.signals)} signals>")
+
+
+#: what draws ``Results.plot``: installed by ``kinetwork.plot`` when it is imported (the plot
+#: is a face over the results, a layer above them)
+_plotter = None
+
+
+def install_plotter(plot):
+    """Set the function ``plot(results, probes=None, **kwargs)`` -> Figure of
+    ``Results.plot``."""
+    global _plotter
+    _plotter = plot

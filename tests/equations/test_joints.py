@@ -393,10 +393,9 @@ def probe_values(system, x):
     """{signal name: value} of the system's probes at state x (t = 0)."""
     flat = np.asarray(system.outputs(0.0, x[None, :]), dtype=float).ravel()
     out, i = {}, 0
-    for name in system.signal_names:
-        size = system.signal_sizes[name]
-        out[name] = flat[i:i + size] if size != 9 else flat[i:i + size].reshape(3, 3)
-        i += size
+    for sig in system.signals:
+        out[sig.name] = flat[i:i + sig.size].reshape(sig.shape)
+        i += sig.size
     return out
 
 

@@ -4,10 +4,11 @@ model and machine (on-disk cache), and a missing or failing compiler is said in 
 import numpy as np
 import pytest
 from conftest import double_pendulum
-from test_pinocchio import build_kinetwork, random_mechanism
+from equations.test_pinocchio import build_kinetwork, random_mechanism
 
 import kinetwork as kn
-from kinetwork.solver import jit, system as system_module
+from kinetwork.simulation import compiled as compiled_module, jit
+from kinetwork.simulation.compiled import compiled, numeric
 
 
 @pytest.fixture
@@ -21,9 +22,10 @@ def test_compiled_rhs_and_jacobian_equal_the_virtual_machine(cache, seed):
     system = build_kinetwork(*random_mechanism(seed, 5)).compile()
     p = system.param_vector()
     rng = np.random.default_rng(seed)
-    vm, c = system.numeric(system.f_rhs, p), system.numeric(system.rhs_function(jit=True), p)
-    jac_vm = system.numeric(system.jacobian_function(), p)
-    jac_c = system.numeric(system.jacobian_numeric_function(jit=True), p)
+    n, c_system = system.n_states, compiled(system)
+    vm, c = numeric(system.f_rhs, p, n), numeric(c_system.rhs({"stats": {}}), p, n)
+    jac_vm = numeric(system.jacobian_function(), p, n)
+    jac_c = numeric(c_system.jacobian({"stats": {}}), p, n)
     for _ in range(20):
         t, x = rng.uniform(0, 5), rng.normal(size=system.n_states)
         np.testing.assert_allclose(c(t, x), vm(t, x), rtol=1e-12, atol=1e-12)
@@ -72,7 +74,7 @@ def test_kinetwork_jit_0_turns_the_default_off(cache, monkeypatch):
 
 
 def test_large_jacobians_fall_back_to_finite_differences(cache, monkeypatch):
-    monkeypatch.setattr(system_module, "JACOBIAN_JIT_LIMIT", 0)
+    monkeypatch.setattr(compiled_module, "JACOBIAN_JIT_LIMIT", 0)
     system = double_pendulum(q0=(0.8, -0.5)).compile()
     res = kn.simulate(system, t_end=3.0, n_points=301, method="cvodes", rtol=1e-9,
                       atol=1e-11, jit=True)

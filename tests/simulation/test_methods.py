@@ -6,6 +6,7 @@ import numpy as np
 import pytest
 
 import kinetwork as kn
+from kinetwork.simulation.compiled import numeric
 from conftest import double_pendulum
 from reference import seed_reference
 
@@ -39,8 +40,8 @@ def test_method_matches_closed_form(system, method, jit):
 
 def test_buffered_callable_survives_garbage_collection(system):
     p = system.param_vector()
-    fast = system.numeric(system.f_rhs, p)
-    jac = system.numeric(system.jacobian_function(), p)
+    fast = numeric(system.f_rhs, p, system.n_states)
+    jac = numeric(system.jacobian_function(), p, system.n_states)
     rng = np.random.default_rng(1)
     for _ in range(50):
         junk = [np.full(64, np.nan) for _ in range(200)]      # reuse freed memory

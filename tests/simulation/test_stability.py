@@ -11,8 +11,14 @@ from reference import PAPER, seed_energy, seed_mvg, seed_reference
 from scenes import chain  # the bench's chains of n uniform rods on revolute z joints
 
 import kinetwork as kn
-from kinetwork.solver import integrate
-from kinetwork.solver.integrate import stiffness
+from kinetwork.simulation import methods
+from kinetwork.simulation.methods import stiffness
+
+
+def _stiffness(system):
+    """The stiffness test of ``auto`` on the system's own right-hand side, at x0."""
+    rhs = lambda t, x: system.rhs(t, x)  # noqa: E731
+    return stiffness(rhs, 0.0, 10.0, system.x0)
 
 
 def seed(q0=(0.05, 0.05), **params):
@@ -26,7 +32,7 @@ def seed(q0=(0.05, 0.05), **params):
 @pytest.mark.parametrize("k, stiff", [(1.0, False), (1e4, True), (1e5, True), (1e6, True)])
 def test_stiffness_test_finds_the_hard_damped_spring(k, stiff):
     system = seed(c=k, d=k)
-    found, sigma, omega = stiffness(system, system.x0, system.param_vector(), 0.0, 10.0)
+    found, sigma, omega = _stiffness(system)
     assert found is stiff
     if stiff:
         # the overdamped shoulder mode decays at about d / m_eff, the shoulder's effective
@@ -39,13 +45,13 @@ def test_stiffness_test_finds_the_hard_damped_spring(k, stiff):
                                    lambda: seed(q0=(2.5, 2.0), d=0.0)], ids=["chain16", "chaotic"])
 def test_undamped_mechanisms_are_never_stiff(build):
     system = build()
-    found, sigma, omega = stiffness(system, system.x0, system.param_vector(), 0.0, 10.0)
+    found, sigma, omega = _stiffness(system)
     assert not found
     assert sigma <= omega * (1 + 1e-6)          # eigenvalues in +-lambda pairs
 
 
 def test_auto_skips_the_test_on_undamped_models(monkeypatch):
-    monkeypatch.setattr(integrate, "stiffness", None)     # calling it would fail
+    monkeypatch.setattr(methods, "stiffness", None)     # calling it would fail
     res = kn.simulate(chain(4), t_end=1.0)
     assert res.method == "cvodes-adams"
     assert res.stats["stiff"] is False and res.stats["damped"] is False
@@ -78,7 +84,7 @@ def test_adams_fails_on_the_stiffest_scene_and_auto_falls_back(monkeypatch):
         kn.simulate(system, t_end=0.2, n_points=21, method="cvodes-adams")
     assert err.value.t_reached < 0.2
     # were the stiffness test to miss it, the failure of Adams still hands over to BDF
-    monkeypatch.setattr(integrate, "stiffness", lambda *a, **k: (False, 0.0, 0.0))
+    monkeypatch.setattr(methods, "stiffness", lambda *a, **k: (False, 0.0, 0.0))
     res = kn.simulate(system, t_end=0.2, n_points=21)
     assert res.method == "cvodes" and "too many steps" in res.stats["adams_failure"]
 

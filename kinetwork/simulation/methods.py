@@ -1,0 +1,363 @@
+"""The integration methods a user can pick: one small class each, in one table (``METHODS``).
+
+A method is started at a state and then ``advance``d by the driver (``driver.py``) over a
+few output times at a time: the driver owns the output grid, budgets, time limits, progress,
+cancellation, partial results and restarts, so a method only integrates. Two kinds exist:
+
+- a whole-horizon CasADi integrator (CVODES, IDAS, RK, collocation, the midpoint rule): each
+  ``advance`` runs in compiled code from the last state to the requested times;
+- a scipy stepper (``OdeSolver`` subclasses): ``advance`` steps it, reading its dense output.
+
+Adding a method is one class (or one instance of these) and one entry in ``METHODS``.
+"""
+
+import casadi as ca
+import numpy as np
+
+from ..errors import ModelError
+from .compiled import numeric
+
+
+class Failure(Exception):
+    """A method could not reach the times asked for; ``states`` holds the rows it did reach
+    (at the first of those times), ``reason`` says why in plain words."""
+
+    def __init__(self, reason, states=None):
+        super().__init__(reason)
+        self.reason = reason
+        self.states = states
+
+
+class Method:
+    """One integration method.
+
+    ``fixed`` methods take a step size instead of tolerances; ``newton`` methods iterate with
+    the Jacobian (compiled with the right-hand side under JIT); ``dae`` methods take the
+    algebraic variables of loops; ``stepper`` methods are advanced step by step in Python
+    (the driver reads the clock and the cancel flag at every step).
+    """
+    fixed = False
+    newton = False
+    dae = False
+    stepper = False
+
+    def __init__(self, doc):
+        self.doc = doc
+
+    def check(self, system):
+        """Refuse (ModelError) a system this method cannot integrate."""
+
+    def start(self, run, t, x):
+        """An object with ``advance(times) -> states`` and ``stats``, starting at (t, x)."""
+        raise NotImplementedError
+
+
+# -- CasADi's integrators ---------------------------------------------------------------------
+#: SUNDIALS return flags, in plain words
+SUNDIALS_FLAGS = {
+    "TOO_MUCH_WORK": "too many steps before the next output time: the solution may blow up "
+                     "there, or the problem is stiff for this method",
+    "TOO_MUCH_ACC": "the tolerances asked for are below machine precision",
+    "ERR_FAIL": "the error test failed repeatedly: the step size collapsed",
+    "CONV_FAIL": "the Newton iteration failed to converge repeatedly: the step size collapsed",
+    "RHSFUNC_ERR": "the right-hand side became non-finite (Inf or NaN): a force or a "
+                   "parameter expression blows up",
+    "RHSFUNC_FAIL": "the right-hand side became non-finite (Inf or NaN): a force or a "
+                    "parameter expression blows up",
+    "RES_FAIL": "the residual became non-finite (Inf or NaN)",
+    "REP_RES_ERR": "the equations became non-finite (Inf or NaN) again and again: with loops, "
+                   "the mechanism may have reached a dead point where the independent "
+                   "coordinates (those with a given q0) can no longer drive it",
+    "LSETUP_FAIL": "the linear solver setup failed (singular iteration matrix)",
+    "LSOLVE_FAIL": "the linear solver failed (singular iteration matrix)",
+}
+
+
+def solver_words(message):
+    """What a solver said in a CasADi error, without CasADi's own framing."""
+    lines = [ln.strip() for ln in message.splitlines() if ln.strip()]
+    last = lines[-1] if lines else ""
+    after = last.rsplit("documentation.", 1)[-1].strip()
+    last = after or last.rsplit(": ", 1)[-1]
+    return last[:300] + "\n"
+
+
+def solver_reason(message):
+    """A CasADi integrator's error in plain words."""
+    for flag, words in SUNDIALS_FLAGS.items():
+        if flag in message:
+            return words
+    lines = [ln.strip() for ln in message.splitlines() if ln.strip()]
+    return (lines or ["integrator failed"])[-1][:300]
+
+
+class Casadi(Method):
+    """A CasADi integrator plugin: each ``advance`` runs in compiled code."""
+
+    def __init__(self, plugin, doc, newton=False, fixed=False, dae=False, **options):
+        super().__init__(doc)
+        self.plugin, self.options = plugin, options
+        self.newton, self.fixed, self.dae = newton, fixed, dae
+        self.sundials = plugin in ("cvodes", "idas")
+
+    def start(self, run, t, x):
+        return _CasadiRun(self, run, t, x)
+
+
+class _CasadiRun:
+    def __init__(self, method, run, t, x):
+        self.method, self.run = method, run
+        self.t, self.x = float(t), np.asarray(x, dtype=float)
+        self.stats = {"steps": 0}
+        if method.sundials:
+            self.stats.update(rhs_evaluations=0, jacobian_evaluations=0)
+
+    def options(self, times):
+        m, run = self.method, self.run
+        opts = dict(m.options)
+        if m.sundials:
+            opts.update(reltol=run.rtol, abstol=run.atol)
+            if run.max_steps:
+                opts["max_num_steps"] = int(run.max_steps)
+        else:       # fixed steps: counted over the chunk; a blow-up is reported once, below
+            opts["show_eval_warnings"] = False
+            opts["number_of_finite_elements"] = run.steps_per_interval * len(times)
+        return opts
+
+    def integrator(self, times, opts):
+        m, run = self.method, self.run
+        dae = run.compiled.dae(run.jit, m.newton)
+        key = ("integrator", m.plugin, self.t, tuple(times), tuple(sorted(opts.items())),
+               bool(run.jit))
+        build = lambda: ca.integrator("simulate", m.plugin, dae, self.t,  # noqa: E731
+                                      [float(s) for s in times], opts)
+        if m.plugin == "idas":          # its options hold the state's rate: not reusable
+            return build()
+        return run.integrators(key, build)
+
+    def advance(self, times):
+        m, run = self.method, self.run
+        nx = run.system.n_states
+        opts = self.options(times)
+        if m.plugin == "idas":
+            # the consistent initial rate is f(t0, x0) (loops: z0 is consistent already):
+            # IDAS's own search for it fails when it is large (a stiff spring)
+            opts.update(calc_ic=False, init_xdot=run.rate(self.t, self.x))
+        integ = self.integrator(times, opts)
+        try:
+            with run.solver_section():
+                out = integ(x0=self.x[:nx], z0=self.x[nx:], p=run.p)
+        except RuntimeError as exc:
+            run.said.append(solver_words(str(exc)))
+            raise Failure(solver_reason(str(exc))) from None
+        X = np.vstack([np.asarray(out["xf"]), np.asarray(out["zf"])]).T
+        if m.sundials:
+            st = integ.stats()
+            self.stats["steps"] += int(st["nsteps"])
+            self.stats["rhs_evaluations"] += int(st["nfevals"])
+            self.stats["jacobian_evaluations"] += int(st["n_call_jacF"])
+        else:
+            self.stats["steps"] += run.steps_per_interval * len(times)
+            self.stats["step"] = run.spacing / run.steps_per_interval
+        good = np.all(np.isfinite(X), axis=1)
+        if not good.all():
+            raise Failure("the state became non-finite (Inf or NaN)", X[:int(np.argmin(good))])
+        self.t, self.x = float(times[-1]), X[-1]
+        return X
+
+
+# -- scipy's steppers -------------------------------------------------------------------------
+class Scipy(Method):
+    """A scipy ODE solver (the stepper class ``solve_ivp`` uses) fed by the compiled CasADi
+    right-hand side and Jacobian."""
+    stepper = True
+
+    def __init__(self, name):
+        super().__init__(f"scipy solve_ivp {name}")
+        self.name = name
+        self.newton = name in ("Radau", "BDF", "LSODA")
+
+    def start(self, run, t, x):
+        import scipy.integrate                 # 0.4 s to import: only when asked for
+        system = run.system
+        kwargs = {"jac": numeric(run.compiled.jacobian(run.jit), run.p, system.n_states)} \
+            if self.newton else {}
+        fun = numeric(run.compiled.rhs(run.jit), run.p, system.n_states)
+        with np.errstate(all="ignore"):
+            solver = getattr(scipy.integrate, self.name)(
+                fun, t, x, run.t_end, rtol=run.rtol, atol=run.atol, **kwargs)
+        return _ScipyRun(solver, run)
+
+
+#: scipy's steppers stop after this many steps within one output interval unless
+#: ``max_steps`` says otherwise (a stiff problem under an explicit method would step forever)
+SCIPY_STEP_BUDGET = 100_000
+
+
+class _ScipyRun:
+    def __init__(self, solver, run):
+        self.solver, self.run = solver, run
+        self.budget = run.max_steps or SCIPY_STEP_BUDGET
+        self.steps = 0
+        self.stats = {}
+
+    def advance(self, times):
+        solver, run = self.solver, self.run
+        out, in_interval = [], 0
+        with np.errstate(all="ignore"):     # a blow-up is reported below, not warned
+            while len(out) < len(times):
+                message = solver.step()
+                in_interval, self.steps = in_interval + 1, self.steps + 1
+                if solver.status == "failed":
+                    raise Failure(message, np.array(out).reshape(-1, len(solver.y)))
+                if not np.all(np.isfinite(solver.y)):
+                    raise Failure("the state became non-finite (Inf or NaN)",
+                                  np.array(out).reshape(-1, len(solver.y)))
+                if times[len(out)] <= solver.t:
+                    dense = solver.dense_output()
+                    while len(out) < len(times) and times[len(out)] <= solver.t:
+                        out.append(dense(times[len(out)]))
+                    in_interval = 0
+                    continue
+                if in_interval >= self.budget:
+                    raise Failure(f"the step budget of {self.budget} steps per output "
+                                  f"interval ran out at t = {solver.t:g} s: the problem may be "
+                                  f"stiff for this method, or the solution blows up",
+                                  np.array(out).reshape(-1, len(solver.y)))
+                run.check_stop(np.array(out).reshape(-1, len(solver.y)))
+        self.stats = {"steps": self.steps,
+                      "rhs_evaluations": int(solver.nfev),
+                      "jacobian_evaluations": int(solver.njev)}
+        return np.array(out)
+
+
+# -- the midpoint rule ------------------------------------------------------------------------
+class MidpointRule(Method):
+    """The implicit midpoint rule in canonical coordinates (``midpoint.py``)."""
+    fixed = True
+    newton = True
+
+    def check(self, system):
+        if system.formulation != "tree" or not all(system.asm.regular):
+            raise ModelError("method 'midpoint' works in canonical coordinates of a tree of "
+                             "angles and distances; this model has kinematic loops or a "
+                             "quaternion joint (Spherical, FreeMotion): use 'auto' or 'idas'")
+
+    def start(self, run, t, x):
+        from .midpoint import Midpoint
+        stepper = run.compiled.memo(("midpoint", bool(run.jit)),
+                                    lambda: Midpoint(run.system, run.jit))
+        return _MidpointRun(stepper, run, t, x)
+
+
+class _MidpointRun:
+    def __init__(self, stepper, run, t, x):
+        self.stepper, self.run = stepper, run
+        self.t, self.x = float(t), np.asarray(x, dtype=float)
+        self.stats = {"steps": 0}
+
+    def advance(self, times):
+        grid = np.concatenate([[self.t], times])
+        with self.run.solver_section():
+            X, failure, stats = self.stepper.run(grid, self.x, self.run.p,
+                                                 self.run.steps_per_interval)
+        self.stats["steps"] += stats["steps"]
+        self.stats.update(step=self.run.spacing / self.run.steps_per_interval,
+                          residual=max(stats["residual"], self.stats.get("residual", 0.0)))
+        if failure is not None:
+            raise Failure(failure, X[1:])
+        self.t, self.x = float(times[-1]), X[-1]
+        return X[1:]
+
+
+class Auto(Method):
+    """The default, chosen per model by the driver (``choose``)."""
+    dae = True
+
+    def __init__(self):
+        super().__init__("cvodes-adams, or cvodes (BDF) when the stiffness test says so; "
+                         "idas for models with loops")
+
+
+#: method name (case-insensitive) -> Method
+METHODS = {
+    "auto": Auto(),
+    "cvodes-adams": Casadi("cvodes", "SUNDIALS CVODES, variable-order Adams-Moulton with "
+                           "functional iteration: non-stiff, no Jacobian",
+                           linear_multistep_method="adams",
+                           nonlinear_solver_iteration="functional"),
+    "cvodes": Casadi("cvodes", "SUNDIALS CVODES, variable-order BDF with Newton iteration: "
+                     "stiff", newton=True),
+    "idas": Casadi("idas", "SUNDIALS IDAS, variable-order BDF on the residual form: stiff, "
+                   "and the method of models with loops", newton=True, dae=True),
+    "rk": Casadi("rk", "CasADi's classical Runge-Kutta 4, fixed step", fixed=True),
+    "collocation": Casadi("collocation", "CasADi's Radau IIA collocation (order 5), fixed "
+                          "step: stiff", newton=True, fixed=True, dae=True),
+    "midpoint": MidpointRule("implicit midpoint rule in canonical coordinates, fixed step: "
+                             "symplectic, for long undamped runs"),
+    **{m.lower(): Scipy(m) for m in ("RK45", "DOP853", "Radau", "BDF", "LSODA")},
+}
+#: the methods that iterate with a Jacobian
+IMPLICIT = tuple(name for name, m in METHODS.items() if m.newton)
+
+
+# -- the choice of ``auto`` -------------------------------------------------------------------
+#: the stiffness test of ``auto``: see ``stiffness``
+STIFF_HORIZON_STEPS = 1e3
+STIFF_RATIO = 10.0
+
+
+def _jacobian_fd(f, t, x):
+    """Central finite differences: 2n evaluations, O(n) each; no O(n^2) symbolic Jacobian."""
+    J = np.empty((len(x), len(x)))
+    for i in range(len(x)):
+        dx = 1e-6 * max(1.0, abs(x[i]))
+        e = np.zeros(len(x))
+        e[i] = dx
+        J[:, i] = (f(t, x + e) - f(t, x - e)) / (2 * dx)
+    return J
+
+
+def stiffness(rhs, t_start, t_end, x0):
+    """The stiffness test of the ``auto`` method, on the Jacobian at the initial state.
+
+    ``rhs(t, x)`` is the right-hand side. With λ the eigenvalues of d(xdot)/dx at
+    (t_start, x0), the fastest decay rate is σ = max(-Re λ) and the fastest other motion is
+    ω = max(max Re λ, max |Im λ|). The problem is stiff when σ (t_end - t_start) >
+    STIFF_HORIZON_STEPS (an explicit or Adams method would need over ~10^3 steps for stability
+    alone) and σ > STIFF_RATIO ω (that decay is much faster than anything the solution must
+    follow). An undamped mechanism is never stiff by this test (its eigenvalues come in ±λ
+    pairs); a hard, heavily damped spring is.
+
+    Returns (stiff, σ, ω).
+    """
+    J = _jacobian_fd(rhs, t_start, x0)
+    with np.errstate(all="ignore"):
+        lam = np.linalg.eigvals(J) if J.size and np.all(np.isfinite(J)) else np.zeros(0)
+    if not np.all(np.isfinite(lam)) or lam.size == 0:
+        return False, 0.0, 0.0
+    sigma = float(max(0.0, np.max(-lam.real)))
+    omega = float(max(0.0, np.max(lam.real), np.max(np.abs(lam.imag))))
+    stiff = sigma * (t_end - t_start) > STIFF_HORIZON_STEPS and sigma > STIFF_RATIO * omega
+    return stiff, sigma, omega
+
+
+def choose(run):
+    """What ``auto`` runs: (method names to try in order, why). IDAS for models with
+    algebraic variables; else Adams unless the stiffness test says BDF, and BDF again when
+    Adams fails.
+
+    A model without damping (generalized forces independent of the speeds) is conservative
+    up to its time-dependent drives: its eigenvalues come in ±λ pairs and it is never stiff by
+    the test, so the test (an eigenvalue problem of 2n x 2n) is not run.
+    """
+    system = run.system
+    if system.n_algebraic:
+        return ["idas"], {"loops": system.formulation_note}
+    why = {"stiff": False, "damped": system.damped}
+    if system.damped:
+        rhs = numeric(run.compiled.rhs(run.jit), run.p, system.n_states)
+        stiff, sigma, omega = stiffness(rhs, run.t_start, run.t_end, run.x0)
+        why.update(stiff=bool(stiff), decay_rate=sigma, motion_rate=omega)
+    return (["cvodes"] if why["stiff"] else ["cvodes-adams", "cvodes"]), why
+

@@ -1,0 +1,77 @@
+"""Small helpers every layer uses: checked numbers, near-match suggestions, quoting of user
+input in messages, and atomic file writes. The bottom layer: it imports nothing of kinetwork
+but the errors."""
+
+import difflib
+import math
+import os
+import secrets
+import stat
+
+import numpy as np
+
+from .errors import ModelError
+
+#: user input quoted in a message is cut to this many characters
+QUOTE_LIMIT = 200
+
+
+def finite(value):
+    """math.isfinite that says False, not OverflowError, for a huge int."""
+    try:
+        return math.isfinite(value)
+    except OverflowError:
+        return False
+
+
+def check_number(value, where, what="a number"):
+    """A finite real number, or a ModelError naming ``where``."""
+    if isinstance(value, np.generic):
+        value = value.item()
+    if isinstance(value, bool) or not isinstance(value, (int, float)):
+        raise ModelError(f"{where}: must be {what}, got {quote(value)}")
+    if not finite(value):
+        got = (f"an integer of {len(str(value))} digits" if isinstance(value, int)
+               else repr(value))
+        raise ModelError(f"{where}: must be finite, got {got}")
+    return value
+
+
+def suggest(name, choices):
+    """' (did you mean 'x'?)' for the closest of ``choices``, or ''."""
+    close = difflib.get_close_matches(str(name)[:QUOTE_LIMIT], list(choices), n=1)
+    return f" (did you mean {close[0]!r}?)" if close else ""
+
+
+def quote(value, limit=QUOTE_LIMIT):
+    """``repr(value)``, cut to ``limit`` characters: messages never echo unbounded input."""
+    try:
+        text = repr(value)
+    except Exception:                 # a hostile __repr__: say what it is, not what it says
+        text = f"<{type(value).__name__}>"
+    return text if len(text) <= limit else text[:limit - 3] + "..."
+
+
+def atomic_write(path, write, mode=0o666):
+    """Write a file in one step: ``write(tmp_path)`` fills a temporary file in the same folder,
+    which is flushed to disk and then replaces ``path``. A failure (a full disk, a signal)
+    leaves the old file whole and removes the temporary one.
+
+    A symbolic link is followed, not replaced; the old file's permissions are kept.
+    """
+    path = os.path.realpath(os.fspath(path))
+    folder, base = os.path.split(path)
+    tmp = os.path.join(folder, f".{base}.{secrets.token_hex(4)}.tmp")
+    try:
+        # 0o666 lets the umask apply, as to any new file (mkstemp would force 0o600)
+        os.close(os.open(tmp, os.O_WRONLY | os.O_CREAT | os.O_EXCL, mode))
+        write(tmp)
+        with open(tmp, "rb+") as fh:
+            os.fsync(fh.fileno())
+        if os.path.exists(path):
+            os.chmod(tmp, stat.S_IMODE(os.stat(path).st_mode))
+        os.replace(tmp, path)
+    except BaseException:
+        if os.path.exists(tmp):
+            os.unlink(tmp)
+        raise
