@@ -91,6 +91,9 @@ class System:
         acc = ca.SX.sym("acc", n)
         f = ca.Function("M_columns", [a.q, acc, a.p], [a.mass_times(acc)])
         M = np.asarray(f.map(n)(x0[:len(self.coordinate_names)], np.eye(n), p))
+        if not np.all(np.isfinite(M)):
+            raise ModelError(overflow_message(self.model, "the mass matrix", p,
+                                              self.param_names))
         values, vectors = np.linalg.eigh((M + M.T) / 2)
         scale = max(np.max(np.abs(M)), 1.0)
         if values[0] > 1e-12 * scale:
@@ -315,3 +318,18 @@ class System:
         alg = f", {self.n_algebraic} algebraic" if self.n_algebraic else ""
         return (f"<System {self.model.name!r}: {self.n_states} states{alg}, "
                 f"{len(self.signal_names)} signals>")
+
+
+#: a number beyond this in the state or its rate at the start is taken as an overflow to come
+#: (its square is beyond double precision): no physical model has one
+OVERFLOW = 1e150
+
+
+def overflow_message(model, what, p, names):
+    """Why a model whose numbers overflow double precision is refused, naming the largest
+    parameter values."""
+    big = sorted(zip(names, np.asarray(p, dtype=float)), key=lambda kv: -abs(kv[1]))[:3]
+    return (f"{what} of {model.name!r} is not finite or beyond {OVERFLOW:g} at the initial "
+            f"state: a number overflows double precision there (or a division by zero); check "
+            f"the parameters" + (f" (largest: {', '.join(f'{k} = {v:g}' for k, v in big)})"
+                                 if big else "") + " and the initial values")

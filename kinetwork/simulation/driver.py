@@ -27,7 +27,7 @@ import time
 
 import numpy as np
 
-from ..equations.system import System
+from ..equations.system import OVERFLOW, System, overflow_message
 from ..errors import ModelError, SimulationError
 from ..graph.settings import check_setting
 from ..util import suggest
@@ -230,7 +230,7 @@ def simulate(model, t_end=None, n_points=None, method=None, rtol=None, atol=None
     chosen.check(system)
     p = system.param_vector(params)        # checks the overrides once for the whole run
     x0 = np.concatenate(system.initial_full_p(p))
-    _check_finite_start(system, t_start, x0, p, params)
+    _check_finite_start(system, t_start, x0, p)
     grid = np.linspace(t_start, settings["t_end"], int(settings["n_points"]))
     settings.update(max_steps=max_steps, time_limit=time_limit, n_points=len(grid),
                     rtol=float(settings["rtol"]), atol=float(settings["atol"]))
@@ -308,24 +308,18 @@ def _check(system, settings, t_start, max_steps, time_limit):
     return key
 
 
-def _check_finite_start(system, t, x0, p, params):
+def _check_finite_start(system, t, x0, p):
     """Refuse, before integrating, a model whose numbers overflow double precision at the
-    start (a parameter of 1e300 squared in an inertia): its equations are not finite there."""
-    bad = not np.all(np.isfinite(x0))
-    if not bad and system.n_states:
+    start (g = 1e300, a length of 1e300 squared in an inertia): its state or its rates are
+    not finite there, or so large that the next products will not be."""
+    values = [x0]
+    if system.n_states:
         nx = system.n_states
         with np.errstate(all="ignore"):
-            ode, alg = system.f_dae(t, x0[:nx], x0[nx:], p)
-        bad = not (np.all(np.isfinite(np.asarray(ode))) and np.all(np.isfinite(np.asarray(alg))))
-    if not bad:
+            values += [np.asarray(v) for v in system.f_dae(t, x0[:nx], x0[nx:], p)]
+    if all(np.all(np.abs(v) < OVERFLOW) for v in values):   # NaN fails too
         return
-    values = system.model.parameter_values(params)
-    big = sorted(values.items(), key=lambda kv: -abs(kv[1]))[:3]
-    raise ModelError(f"the equations of {system.model.name!r} are not finite at the initial "
-                     f"state (t = {t:g}): a number overflows double precision or divides by "
-                     f"zero there; check the parameters"
-                     + (f" (largest: {', '.join(f'{k} = {v:g}' for k, v in big)})"
-                        if big else "") + " and the initial values")
+    raise ModelError(overflow_message(system.model, "the equations", p, system.param_names))
 
 
 def _auto(run, stats):
@@ -354,7 +348,11 @@ def _integrate(run, method):
         stepper = method.start(run, grid[0], X[0])
     except Failure as failure:
         return np.array(X), failure.reason, stats
-    chunk = n - 1 if method.stepper else max(1, int((n - 1) * FIRST_CHUNK))
+    # the first chunk: a fraction of the grid, and no more work than a chunk should take if a
+    # variable-step method takes one step an output (a fixed-step one takes its many)
+    per_interval = 4 * run.instructions * (run.steps_per_interval if method.fixed else 1)
+    chunk = n - 1 if method.stepper else \
+        max(1, min(int((n - 1) * FIRST_CHUNK), int(CHUNK_WORK / per_interval)))
     k, failure = 0, None
     while k < n - 1:
         failure = run.stop_reason()
@@ -382,7 +380,7 @@ def _integrate(run, method):
             if run.stop_reason() is None and _restart(run, method, X, restarts, failure):
                 stats = _merge(stats, stepper.stats)
                 stepper, failure = restarts[-1]["stepper"], None
-                chunk = 1
+                k, chunk = len(X) - 1, 1
                 continue
             break
         if not method.stepper:

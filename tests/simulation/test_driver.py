@@ -1,0 +1,211 @@
+"""The one integrator driver: chunks, cancellation, budgets, restarts, the watch over loops,
+threads, and refusing numbers that overflow before integrating."""
+
+import os
+import sys
+import threading
+
+import numpy as np
+import pytest
+from scenes import double_pendulum
+from scenes.reference import seed_reference
+
+import kinetwork as kn
+from kinetwork.simulation import driver, methods
+from kinetwork.simulation.methods import METHODS, Failure
+
+
+def five_bar():
+    """A planar loop of five revolutes (a ground link of 2 m, four links of 1 m, two degrees
+    of freedom) falling under gravity from a pentagon until it folds flat at t ~ 0.73 s."""
+    m = kn.Model("five_bar")
+    m.add(kn.multibody.Ground("ground", gravity=[0, -9.81, 0]))
+    m.add(kn.multibody.FixedTranslation("base", r=[2.0, 0, 0]))
+    m.connect("ground.frame", "base.frame_a")
+    prev = "ground.frame"
+    for i, guess in enumerate([1.2, -0.9, -0.9, -0.9]):
+        m.add(kn.multibody.Revolute(f"j{i}", axis=[0, 0, 1], q0=0.9 if i == 0 else None,
+                                    q0_guess=guess))
+        m.add(kn.multibody.FixedTranslation(f"l{i}", r=[1.0, 0, 0]))
+        m.add(kn.multibody.RigidBody(f"b{i}", mass=1.0, r_cm=[0.5, 0, 0],
+                                     inertia=[0, 0, 1 / 12]))
+        m.connect(prev, f"j{i}.frame_a")
+        m.connect(f"j{i}.frame_b", f"l{i}.frame_a")
+        m.connect(f"j{i}.frame_b", f"b{i}.frame_a")
+        prev = f"l{i}.frame_b"
+    m.add(kn.multibody.Revolute("j4", axis=[0, 0, 1]))
+    m.connect(prev, "j4.frame_a")
+    m.connect("j4.frame_b", "base.frame_b")
+    return m
+
+
+@pytest.mark.parametrize("loops", ["partition", "projected", "baumgarte"])
+def test_every_formulation_stops_where_the_loop_folds_flat(loops):
+    """Before: partition stopped with a message that did not say why, projected and baumgarte
+    carried on and disagreed. Now all three stop at the fold, naming it and its joints."""
+    system = five_bar().compile(loops=loops)
+    with pytest.raises(kn.SimulationError) as info:
+        kn.simulate(system, t_end=10.0, n_points=1001)
+    err = info.value
+    assert "singular configuration" in err.reason and "j2" in err.reason
+    assert 0.6 < err.t_reached < 0.8
+    assert err.results.t[-1] == err.t_reached and np.all(np.isfinite(err.results.states))
+    # the partial results are sound up to there: the loop stays closed (Baumgarte's only
+    # keeps the residual small, as it does everywhere)
+    closed = 1e-4 if loops == "baumgarte" else 1e-8
+    assert np.max(system.constraint_residual(err.results.states)) < closed
+
+
+def test_the_same_run_gives_the_same_numbers():
+    """Chunks are sized by work, not wall time: a run is repeatable bit for bit."""
+    model = double_pendulum(q0=(1.0, -0.5))
+    a = kn.simulate(model, t_end=5.0, rtol=1e-9, atol=1e-11)
+    b = kn.simulate(double_pendulum(q0=(1.0, -0.5)), t_end=5.0, rtol=1e-9, atol=1e-11)
+    assert np.array_equal(a.states, b.states)
+    ref = seed_reference(a.t, x0=(1.0, -0.5, 0, 0))
+    assert np.max(np.abs(a.states - ref)) < 1e-6
+
+
+def test_a_second_run_of_an_unchanged_model_does_not_rebuild_it(monkeypatch):
+    model = double_pendulum()
+    kn.simulate(model, t_end=0.5)
+    system = model.compile()
+    monkeypatch.setattr("kinetwork.graph.model._compiler",
+                        lambda *a, **k: pytest.fail("compiled again"))
+    assert model.compile() is system
+    kn.simulate(model, t_end=0.5, params={"c": 2.0})
+
+
+def test_a_changed_component_parameter_rebuilds_and_is_simulated():
+    model = double_pendulum()
+    first = kn.simulate(model, t_end=1.0)
+    model.components["mass2"].mass = "2*m2"
+    second = kn.simulate(model, t_end=1.0)
+    assert not np.allclose(first["probe2.angle"], second["probe2.angle"])
+    again = kn.loads(kn.dumps(model))
+    np.testing.assert_allclose(kn.simulate(again, t_end=1.0).states, second.states)
+
+
+def test_cancel_stops_a_casadi_run_between_chunks_with_partial_results():
+    calls = []
+
+    def cancel():
+        calls.append(1)
+        return len(calls) > 1
+    with pytest.raises(kn.SimulationError) as info:
+        kn.simulate(double_pendulum(), t_end=1000.0, n_points=100001, cancel=cancel,
+                    rtol=1e-10, atol=1e-12)
+    err = info.value
+    assert err.reason == "cancelled" and 0 < err.t_reached < 1000.0
+    assert err.results.partial == {"t_reached": err.t_reached, "reason": "cancelled"}
+    assert len(err.results.t) == round(err.t_reached / 0.01) + 1
+
+
+@pytest.mark.parametrize("method", ["dop853", "midpoint", "rk"])
+def test_every_kind_of_method_honours_cancel_and_time_limit(method):
+    with pytest.raises(kn.SimulationError, match="cancelled"):
+        kn.simulate(double_pendulum(), t_end=100.0, n_points=10001, method=method,
+                    cancel=lambda: True)
+    with pytest.raises(kn.SimulationError, match="time limit"):
+        kn.simulate(double_pendulum(), t_end=1e5, n_points=100001, method=method,
+                    time_limit=0.5, step=1e-3)
+
+
+def test_scipy_methods_have_a_default_step_budget(monkeypatch):
+    monkeypatch.setattr(methods, "SCIPY_STEP_BUDGET", 30)
+    with pytest.raises(kn.SimulationError, match="step budget of 30 steps"):
+        kn.simulate(double_pendulum(), t_end=10.0, n_points=3, method="rk45")
+
+
+class _FailOnce(methods.Casadi):
+    """CVODES, but its first run fails once at ``t_fail`` (a transient solver failure), and,
+    with ``jump``, a restarted run lands somewhere else (a state that is not continuous)."""
+
+    def __init__(self, t_fail, jump=False):
+        base = METHODS["cvodes-adams"]
+        super().__init__(base.plugin, "test", **base.options)
+        self.t_fail, self.jump, self.failed = t_fail, jump, False
+
+    def start(self, run, t, x):
+        inner = super().start(run, t, x)
+        outer = self
+
+        class Stepper:
+            stats = inner.stats
+
+            def advance(self, times):
+                if not outer.failed and times[-1] > outer.t_fail:
+                    outer.failed = True
+                    keep = times[times <= outer.t_fail]
+                    raise Failure("a transient failure", inner.advance(keep) if len(keep)
+                                  else None)
+                out = inner.advance(times)
+                return out + 1.0 if outer.jump and outer.failed else out
+        return Stepper()
+
+
+def test_restarts_are_opt_in_and_checked(monkeypatch):
+    model = double_pendulum(q0=(0.8, -0.5))
+    grid_ref = lambda t: seed_reference(t, x0=(0.8, -0.5, 0, 0))  # noqa: E731
+    monkeypatch.setitem(METHODS, "flaky", _FailOnce(0.5))
+    with pytest.raises(kn.SimulationError, match="a transient failure") as info:
+        kn.simulate(model, t_end=2.0, n_points=201, method="flaky", rtol=1e-9, atol=1e-11)
+    assert info.value.t_reached == pytest.approx(0.5)
+    monkeypatch.setitem(METHODS, "flaky", _FailOnce(0.5))
+    res = kn.simulate(model, t_end=2.0, n_points=201, method="flaky", rtol=1e-9, atol=1e-11,
+                      restart=True)
+    assert [r["t"] for r in res.stats["restarts"]] == [pytest.approx(0.5)]
+    assert np.max(np.abs(res.states - grid_ref(res.t))) < 1e-6
+    monkeypatch.setitem(METHODS, "flaky", _FailOnce(0.5, jump=True))
+    with pytest.raises(kn.SimulationError, match="a transient failure"):
+        kn.simulate(model, t_end=2.0, n_points=201, method="flaky", restart=True)
+
+
+def test_numbers_that_overflow_are_refused_before_integrating():
+    """Before: g = 1e300 returned states frozen at x0 with no error."""
+    with pytest.raises(kn.ModelError, match="overflows double precision.*g = 1e\\+300"):
+        kn.simulate(double_pendulum(), t_end=1.0, params={"g": 1e300})
+    with pytest.raises(kn.ModelError, match="mass matrix.*overflows.*L1 = 1e\\+300"):
+        kn.simulate(double_pendulum(L1=1e300), t_end=1.0)
+
+
+@pytest.mark.parametrize("cache", ["cold", "warm"])
+def test_four_threads_simulate_one_system_at_once(tmp_path, monkeypatch, cache):
+    """Threads share one System: right numbers in each, and stdout and stderr left where they
+    were (the solvers' words are captured one section at a time)."""
+    monkeypatch.setenv("KINETWORK_CACHE", str(tmp_path / "cache"))
+    system = double_pendulum(q0=(0.8, -0.5)).compile()
+    if cache == "warm":
+        kn.simulate(system, t_end=0.1, jit=True)
+    before = [os.fstat(fd) for fd in (1, 2)]
+    results, errors = {}, []
+
+    def work(i):
+        try:
+            results[i] = kn.simulate(system, t_end=2.0, n_points=201, rtol=1e-9, atol=1e-11,
+                                     jit=True, params={"c": 1.0 + i})
+        except Exception as exc:      # noqa: BLE001  (reported below)
+            errors.append(exc)
+    threads = [threading.Thread(target=work, args=(i,)) for i in range(4)]
+    for th in threads:
+        th.start()
+    for th in threads:
+        th.join(120)
+    assert not errors and len(results) == 4
+    after = [os.fstat(fd) for fd in (1, 2)]
+    assert [(s.st_dev, s.st_ino) for s in before] == [(s.st_dev, s.st_ino) for s in after]
+    for i, res in results.items():
+        alone = kn.simulate(system, t_end=2.0, n_points=201, rtol=1e-9, atol=1e-11, jit=True,
+                            params={"c": 1.0 + i})
+        np.testing.assert_allclose(res.states, alone.states, rtol=0, atol=1e-12)
+    print("still printing", file=sys.stderr)
+
+
+def test_a_run_in_a_thread_cannot_install_signal_handlers_but_still_runs():
+    out = {}
+    th = threading.Thread(target=lambda: out.update(r=kn.simulate(double_pendulum(),
+                                                                  t_end=0.5)))
+    th.start()
+    th.join(60)
+    assert len(out["r"].t) == 1001
+    assert driver.signal.getsignal(driver.signal.SIGINT) is not None
