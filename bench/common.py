@@ -13,6 +13,9 @@ import numpy as np
 HERE = pathlib.Path(__file__).resolve().parent
 RESULTS = HERE / "results"
 sys.path.insert(0, str(HERE))
+# the scenes and the independent references are shared with the tests: the package
+# tests/scenes (``from scenes import chains``); this is the one place bench puts it on the path
+sys.path.insert(1, str(HERE.parent / "tests"))
 
 #: 1e-3 ... 1e-12: the tolerances a variable-step method is swept over
 TOLERANCES = [10.0 ** -k for k in range(3, 13)]

@@ -15,8 +15,9 @@ import time
 
 import numpy as np
 
+import common  # noqa: F401  (puts tests/ on the path, for the scenes)
 import kinetwork as kn
-from reference import seed_reference
+from scenes.reference import seed_reference
 
 HERE = pathlib.Path(__file__).resolve().parent
 ROOT = HERE.parent

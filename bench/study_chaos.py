@@ -20,10 +20,10 @@ import time
 import numpy as np
 
 from common import RESULTS, load, machine, table, timed, write_csv, write_markdown
-from reference import seed_reference
+from scenes.reference import seed_reference
 
 import kinetwork as kn
-import scenes
+from scenes import chains as scenes
 
 Q0 = (2.5, 2.0)
 SPACING = 0.01

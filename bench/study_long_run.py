@@ -22,10 +22,10 @@ import time
 import numpy as np
 
 from common import RESULTS, load, machine, table, timed, write_csv, write_markdown
-from reference import PAPER, seed_mvg
+from scenes.reference import PAPER, seed_mvg
 
 import kinetwork as kn
-import scenes
+from scenes import chains as scenes
 
 SPACING = 0.5
 PARAMS = {**PAPER, "d": 0.0}

@@ -49,8 +49,8 @@ import numpy as np
 from common import RESULTS, load, machine, table, timed, write_csv, write_markdown
 
 import kinetwork as kn
-import loop_scenes as ls
-import reference_loops as rl
+from scenes import loops as ls
+from scenes import reference_loops as rl
 from kinetwork.simulation.compiled import JACOBIAN_JIT_LIMIT, compiled
 
 THETA0 = 1.0

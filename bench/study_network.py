@@ -15,17 +15,15 @@ results/study_network.csv and results/study_network.png.
 """
 
 import argparse
-import sys
 import time
 
 import numpy as np
 
 from common import RESULTS, machine, table, write_csv, write_markdown
 
-sys.path.insert(0, str(RESULTS.parent))
-import drive_scenes  # noqa: E402
-import kinetwork as kn  # noqa: E402
-from scenes import seed  # noqa: E402
+import kinetwork as kn
+from scenes import drives as drive_scenes
+from scenes import seed
 
 ONED = ("rotational", "translational")
 

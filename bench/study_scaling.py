@@ -28,7 +28,7 @@ import numpy as np
 
 from common import RESULTS, STYLE, chart, load, machine, table, timed, write_csv, write_markdown
 
-import scenes
+from scenes import chains as scenes
 import kinetwork as kn
 from kinetwork.graph.topology import analyze
 from kinetwork.simulation import jit

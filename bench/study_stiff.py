@@ -34,10 +34,10 @@ from scipy.integrate import solve_ivp
 
 import common
 from common import RESULTS, load, machine, table, timed, write_csv, write_markdown
-from reference import PAPER, seed_mvg
+from scenes.reference import PAPER, seed_mvg
 
 import kinetwork as kn
-import scenes
+from scenes import chains as scenes
 from kinetwork.simulation.methods import STIFF_HORIZON_STEPS, STIFF_RATIO
 
 RTOL, ATOL = 1e-6, 1e-8

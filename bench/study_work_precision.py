@@ -36,9 +36,9 @@ import numpy as np
 import kinetwork as kn
 
 import common
-import scenes
+from scenes import chains as scenes
 from common import machine, max_error, table, timed, write_csv, write_markdown
-from reference import seed_reference
+from scenes.reference import seed_reference
 
 sys.path.insert(0, str(common.HERE / "peers"))
 import mujoco_peer

@@ -7,7 +7,7 @@ import sys
 import numpy as np
 import pytest
 from conftest import double_pendulum
-from reference import seed_reference
+from scenes.reference import seed_reference
 
 import kinetwork as kn
 from kinetwork.cli import main

@@ -6,10 +6,10 @@ import sys
 import matplotlib
 import numpy as np
 import pytest
-from conftest import double_pendulum
 
 import kinetwork as kn
 from kinetwork.plot import save_plot, unit_label
+from scenes import double_pendulum
 
 matplotlib.use("Agg")                        # tests never open windows
 import matplotlib.pyplot as plt  # noqa: E402

@@ -6,12 +6,12 @@ import casadi as ca
 import numpy as np
 import pytest
 import sympy as sp
-from conftest import SEED_PARAMS, double_pendulum
-from reference import seed_mvg
 
 import kinetwork as kn
 from kinetwork.symbolic import (equations_sympy, function_to_sympy, number, tidy, to_sympy,
                                 to_sympy_shared)
+from scenes import SEED_PARAMS, double_pendulum
+from scenes.reference import seed_mvg
 
 X, Y = ca.SX.sym("x"), ca.SX.sym("y")
 SX_, SY_ = sp.symbols("x y", real=True)

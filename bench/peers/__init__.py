@@ -1,6 +1,7 @@
 """The tools a kinetwork user would otherwise reach for, behind one interface.
 
-Each module builds its own model from a scene's plain data (``scenes.ChainSpec``):
+Each module builds its own model from a scene's plain data (``ChainSpec`` of
+``tests/scenes/chains.py``):
 
 ``NAME``
     the tool as it appears in tables

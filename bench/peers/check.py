@@ -4,7 +4,7 @@
    setting against kinetwork (DOP853, rtol 1e-12, atol 1e-14), max joint-angle error over
    10 s. Next to it, each side's own integration error, estimated against a tighter run of
    itself, so that a disagreement larger than both is a modelling difference, not integration
-   error. The seed is also compared with the paper's closed form (``bench/reference.py``).
+   error. The seed is also compared with the paper's closed form (``tests/scenes/reference.py``).
 2. Model checks: MuJoCo's 1e-15 kg m^2 point inertia on the seed (measured with pinocchio, with
    and without it), the pinocchio and MuJoCo energy helpers on the same states, and their
    energy drift over 10 s of chain8 (undamped).
@@ -24,9 +24,10 @@ import numpy as np
 HERE = pathlib.Path(__file__).resolve().parent
 sys.path.insert(0, str(HERE.parent))
 
+import common  # noqa: E402, F401  (puts tests/ on the path, for the scenes)
 import kinetwork as kn  # noqa: E402
-import scenes  # noqa: E402
-from reference import seed_reference  # noqa: E402
+from scenes import chains as scenes  # noqa: E402
+from scenes.reference import seed_reference  # noqa: E402
 from peers import mujoco_peer, pinocchio_peer, sympy_peer  # noqa: E402
 
 #: name -> (kinetwork model, spec); spatial2 is there for sympy, which cannot derive spatial6

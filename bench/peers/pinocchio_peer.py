@@ -4,7 +4,7 @@ What a robotics user would write: a ``pin.Model`` built by hand from the chain, 
 right-hand side around ``pin.aba``. Joint ``i`` is a ``JointModelRevoluteUnaligned`` on
 ``spec.axis[i]``, placed at the parent's ``offset`` (the ground's origin for the first joint);
 its body is ``pin.Inertia(mass, r_cm, inertia)``, CoM and inertia about it in the joint's
-frame, as in ``tests/solver/test_pinocchio.py``. The spring-dampers enter as the joint torque
+frame, as in ``tests/equations/test_pinocchio.py``. The spring-dampers enter as the joint torque
 ``tau = -(k q + d qd)``.
 
 Tolerances: ``atol = rtol * 1e-2`` throughout (the angles are of order 0.1..1 rad).

@@ -13,7 +13,8 @@ import time
 
 sys.path.insert(0, str(pathlib.Path(__file__).resolve().parents[1]))
 
-import scenes  # noqa: E402
+import common  # noqa: E402, F401  (puts tests/ on the path, for the scenes)
+from scenes import chains as scenes  # noqa: E402
 from peers import sympy_peer  # noqa: E402
 
 

@@ -6,8 +6,8 @@ import numpy as np
 import pytest
 
 import kinetwork as kn
-from conftest import SEED_PARAMS, double_pendulum
-from reference import seed_mvg, seed_reference
+from scenes import SEED_PARAMS, double_pendulum, fourbar
+from scenes.reference import seed_mvg, seed_reference
 
 T = np.linspace(0.0, 3.0, 301)
 PORTS = {"shoulder_a": "shoulder.frame_a", "shoulder_b": "shoulder.frame_b",
@@ -100,8 +100,7 @@ def test_flows_balance_at_every_frame_connection():
     """Kirchhoff's law for frames: at every connection set the flows into the components
     there sum to zero, forces and torques, in a four-bar driven at its cut joint, pulled by
     a line spring and pushed by a world force (every kind of flow the wrench balance has)."""
-    import loop_scenes
-    model = loop_scenes.fourbar(probes=False)
+    model = fourbar(probes=False)
     mb = kn.multibody
     model.add(kn.rotational.Torque("motor", tau="2*sin(3*t)"))
     model.connect("motor.flange", "C.axis")

@@ -1,5 +1,5 @@
 """Kinematic loops against independent references: the closed-form closure and the
-one-degree-of-freedom Lagrange equation of ``bench/reference_loops.py``, energy, and the
+one-degree-of-freedom Lagrange equation of ``tests/scenes/reference_loops.py``, energy, and the
 wrench balance of each link for the cut forces."""
 
 import json
@@ -8,8 +8,9 @@ import numpy as np
 import pytest
 
 import kinetwork as kn
-import loop_scenes as scenes
-import reference_loops as ref
+import scenes
+from scenes import double_pendulum
+from scenes import reference_loops as ref
 
 mb = kn.multibody
 T = np.linspace(0.0, 10.0, 1001)
@@ -336,7 +337,6 @@ def test_cut_flag_on_a_joint_outside_any_loop_is_refused():
     model = scenes.fourbar(probes=False)
     model.components["A"]._values["cut"] = True          # A is in the loop: fine
     model.compile()
-    from conftest import double_pendulum
     pendulum = double_pendulum()
     pendulum.components["elbow"]._values["cut"] = True
     with pytest.raises(kn.ModelError, match="elbow is marked cut but closes no kinematic loop"):

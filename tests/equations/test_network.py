@@ -6,10 +6,9 @@ import numpy as np
 import pytest
 from scipy.integrate import solve_ivp
 
-import drive_scenes
 import kinetwork as kn
-from conftest import SEED_PARAMS, double_pendulum
-from reference import seed_mvg
+from scenes import SEED_PARAMS, double_pendulum, drives
+from scenes.reference import seed_mvg
 
 rot, sig, mb = kn.rotational, kn.signals, kn.multibody
 P = {k: SEED_PARAMS[k] for k in ("L1", "L2", "m1", "m2", "c", "d", "g")}
@@ -77,7 +76,7 @@ def test_gear_flows_follow_the_ratio():
 def test_flexible_coupling_gives_the_rotor_its_own_state():
     """drive_train: hinge with a load, and a rotor behind a spring-damper coupling and a gear;
     against the two-body equations written by hand."""
-    model = drive_scenes.drive_train()
+    model = drives.drive_train()
     system = model.compile()
     assert system.state_names == ["hinge.q", "hinge.qd", "rotor.phi", "rotor.w"]
     c, d, J, n, tau = 200.0, 0.5, 0.01, 10.0, 0.5
@@ -163,13 +162,13 @@ def _pid_reference(t_eval, drive, step, sine):
 
 
 def test_pid_controlled_arm_agrees_with_the_closed_loop_closed_form():
-    model = drive_scenes.arm_pid()
+    model = drives.arm_pid()
     system = model.compile()
     assert system.state_names[:4] == ["shoulder.q", "elbow.q", "shoulder.qd", "elbow.qd"]
     assert system.n_states == 8                       # rotors add nothing, PIDs two each
     t = np.linspace(0.0, 6.0, 601)
     res = kn.simulate(system, rtol=1e-11, atol=1e-12)
-    ref = _pid_reference(t, drive_scenes.DRIVE, drive_scenes.STEP, drive_scenes.SINE)
+    ref = _pid_reference(t, drives.DRIVE, drives.STEP, drives.SINE)
     assert np.max(np.abs(res.states[:, :4] - ref[:, :4])) < 1e-6
     # and it does what the model says: the shoulder settles within 1e-3 rad by t = 2 s
     late = res.t >= 2.0
@@ -305,12 +304,12 @@ def test_computed_torque_from_the_models_own_dynamics_leaves_a_linear_error():
     """arm_computed_torque: InverseDynamics blocks evaluate the model's M, V, G (spring-damper
     included) at the measured state, so each error e = r - q obeys e'' + kd e' + kp e = 0
     exactly: at kp = 100, kd = 20 it is (e0 + (e0' + 10 e0) t) exp(-10 t)."""
-    system = drive_scenes.arm_computed_torque().compile()
+    system = drives.arm_computed_torque().compile()
     assert system.n_states == 4                    # the controller has no state of its own
     res = kn.simulate(system)
     t, w = res.t, np.pi
     for joint, probe in (("shoulder", "probe1"), ("elbow", "probe2")):
-        amp, phase = drive_scenes.SINES[joint]
+        amp, phase = drives.SINES[joint]
         e0, ed0 = amp * np.sin(phase) - 0.05, amp * w * np.cos(phase)
         expected = (e0 + (ed0 + 10 * e0) * t) * np.exp(-10 * t)
         assert np.max(np.abs(amp * np.sin(w * t + phase) - res[f"{probe}.angle"]

@@ -4,6 +4,7 @@ import numpy as np
 import pytest
 
 import kinetwork as kn
+from scenes import double_pendulum
 
 TIGHT = {"rtol": 1e-10, "atol": 1e-12}
 
@@ -159,7 +160,6 @@ def test_torque_source_in_time_exact():
 
 
 def test_parameters_change_without_recompiling(seed_model):
-    from conftest import double_pendulum
     system = seed_model.compile()
     changed = kn.simulate(system, t_end=3.0, params={"c": 5.0, "m2": 2.5}, **TIGHT)
     rebuilt = kn.simulate(double_pendulum(c=5.0, m2=2.5), t_end=3.0, **TIGHT)

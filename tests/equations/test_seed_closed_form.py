@@ -31,8 +31,8 @@ import sympy as sp
 from scipy.integrate import solve_ivp
 
 import kinetwork as kn
-from conftest import double_pendulum
-from reference import seed_mvg    # bench/reference.py: the paper's formulas, in numpy
+from scenes import double_pendulum
+from scenes.reference import seed_mvg    # the paper's formulas, in numpy
 
 #: the paper's numerical values (section 3.15)
 PAPER = {"L1": 1.0, "L2": 1.0, "m1": 1.0, "m2": 1.0, "c": 1.0, "d": 1.0, "g": 9.8}

@@ -436,7 +436,7 @@ def test_killing_a_save_halfway_leaves_the_old_file_whole(tmp_path):
         "m = chain(400)\n"
         "print('ready', flush=True)\n"
         "while True:\n"
-        "    m.save(%r)\n") % (str(pathlib.Path(__file__).resolve().parents[2] / "bench"),
+        "    m.save(%r)\n") % (str(pathlib.Path(__file__).resolve().parents[1]),
                             str(path))
     names = set()
     for delay in (0.05, 0.13, 0.21, 0.34):

@@ -5,7 +5,7 @@ import copy
 import pytest
 
 import kinetwork as kn
-from conftest import double_pendulum
+from scenes import double_pendulum
 
 mb, rot = kn.multibody, kn.rotational
 

@@ -4,7 +4,7 @@ inverted, refused with the place named."""
 import pytest
 
 import kinetwork as kn
-from conftest import double_pendulum
+from scenes import double_pendulum
 
 mb = kn.multibody
 

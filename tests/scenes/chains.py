@@ -23,7 +23,7 @@ import numpy as np
 
 import kinetwork as kn
 
-ROOT = pathlib.Path(__file__).resolve().parents[1]
+ROOT = pathlib.Path(__file__).resolve().parents[2]
 SEED_FILE = ROOT / "models" / "double_pendulum.json"
 G = 9.81
 

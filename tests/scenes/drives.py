@@ -1,6 +1,6 @@
 """The scenes of issue 5 (drives, gears, sensors, feedback) as kinetwork models.
 
-``python bench/drive_scenes.py`` writes ``models/arm_pid.json``, ``models/drive_train.json``
+``python tests/scenes/drives.py`` writes ``models/arm_pid.json``, ``models/drive_train.json``
 and ``models/arm_computed_torque.json`` from these builders; the tests compare them with
 closed-loop simulations written directly from the seed's closed-form M, V, G.
 
@@ -17,7 +17,7 @@ import pathlib
 
 import kinetwork as kn
 
-ROOT = pathlib.Path(__file__).resolve().parents[1]
+ROOT = pathlib.Path(__file__).resolve().parents[2]
 SEED_FILE = ROOT / "models" / "double_pendulum.json"
 
 #: motor, gearbox and controller of each joint of ``arm_pid``

@@ -1,7 +1,7 @@
 """The scenes of issue 4 (loops, free bodies, line forces) as kinetwork models.
 
 Their geometry is that of ``reference_loops`` (the independent closed-form references), so
-the tests and the loop study compare like with like. ``python bench/loop_scenes.py`` writes
+the tests and the loop study compare like with like. ``python tests/scenes/loops.py`` writes
 the example files ``models/fourbar.json`` and the others from these builders.
 
 fourbar          crank-rocker: ground link d = 1, crank a = 0.3, coupler b = 1, rocker c = 0.8
@@ -22,7 +22,7 @@ import numpy as np
 
 import kinetwork as kn
 
-ROOT = pathlib.Path(__file__).resolve().parents[1]
+ROOT = pathlib.Path(__file__).resolve().parents[2]
 mb = kn.multibody
 G = 9.81
 

@@ -1,11 +1,12 @@
-"""Checks of bench/reference_loops.py (the independent four-bar / slider-crank references of
+"""Checks of ``reference_loops`` (the independent four-bar / slider-crank references of
 issue 4) by independent means: distances, finite differences, energy, a linearised period."""
 
 import numpy as np
 import pytest
-import reference_loops as ref
 from scipy.integrate import cumulative_trapezoid
 from scipy.optimize import brentq
+
+from scenes import reference_loops as ref
 
 THETAS = np.linspace(0.0, 2 * np.pi, 721, endpoint=False)
 FD_STEP = 1e-6

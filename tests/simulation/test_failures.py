@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 import kinetwork as kn
-from scenes import stiff
+from scenes import chain, spatial_fourbar, stiff
 
 
 @pytest.fixture(scope="module")
@@ -40,7 +40,6 @@ def test_the_step_budget_is_generous_enough_for_a_well_posed_run():
 
 @pytest.mark.parametrize("method", ["cvodes-adams", "rk45"])
 def test_a_time_limit_stops_the_run_and_keeps_what_it_computed(method):
-    from scenes import chain
     model = chain(32)
     full = kn.simulate(model, t_end=2.0, n_points=201, method=method)
     with pytest.raises(kn.SimulationError, match="time limit") as info:
@@ -55,10 +54,9 @@ def test_a_dead_point_stops_the_run_by_name(capfd):
     """IDAS on the spatial four-bar with a rocker too short to go round: it reaches a dead
     point at t ~ 0.32 s. The run stops there, with the loop named, on every machine (the
     chunks of a run do not depend on its speed), and never "succeeds" past it."""
-    import loop_scenes
     for _ in range(2):                       # the same answer again (cached integrators)
         with pytest.raises(kn.SimulationError) as info:
-            kn.simulate(loop_scenes.spatial_fourbar(c=0.3), t_end=2.0, n_points=201,
+            kn.simulate(spatial_fourbar(c=0.3), t_end=2.0, n_points=201,
                         rtol=1e-8, atol=1e-10)
         err = info.value
         assert "dead point" in err.reason and "singular configuration" in err.reason

@@ -3,12 +3,12 @@ model and machine (on-disk cache), and a missing or failing compiler is said in 
 
 import numpy as np
 import pytest
-from conftest import double_pendulum
-from equations.test_pinocchio import build_kinetwork, random_mechanism
 
 import kinetwork as kn
 from kinetwork.simulation import compiled as compiled_module, jit
 from kinetwork.simulation.compiled import compiled, numeric
+from scenes import build_kinetwork, double_pendulum, random_mechanism
+from scenes.reference import seed_reference
 
 
 @pytest.fixture
@@ -78,6 +78,5 @@ def test_large_jacobians_fall_back_to_finite_differences(cache, monkeypatch):
     system = double_pendulum(q0=(0.8, -0.5)).compile()
     res = kn.simulate(system, t_end=3.0, n_points=301, method="cvodes", rtol=1e-9,
                       atol=1e-11, jit=True)
-    from reference import seed_reference
     ref = seed_reference(res.t, x0=(0.8, -0.5, 0, 0))
     np.testing.assert_allclose(res.states, ref, atol=1e-6)

@@ -7,8 +7,8 @@ import pytest
 
 import kinetwork as kn
 from kinetwork.simulation.compiled import numeric
-from conftest import double_pendulum
-from reference import seed_reference
+from scenes import double_pendulum
+from scenes.reference import seed_reference
 
 
 @pytest.fixture(scope="module")

@@ -6,13 +6,12 @@ references are independent of kinetwork: the seed paper's closed form (bench/ref
 
 import numpy as np
 import pytest
-from conftest import double_pendulum
-from reference import PAPER, seed_energy, seed_mvg, seed_reference
-from scenes import chain  # the bench's chains of n uniform rods on revolute z joints
 
 import kinetwork as kn
 from kinetwork.simulation import methods
 from kinetwork.simulation.methods import stiffness
+from scenes import chain, double_pendulum   # chain: n uniform rods on revolute z joints
+from scenes.reference import PAPER, seed_energy, seed_mvg, seed_reference
 
 
 def _stiffness(system):
