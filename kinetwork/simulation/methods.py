@@ -77,9 +77,9 @@ def solver_words(message):
     """What a solver said in a CasADi error, without CasADi's own framing."""
     lines = [ln.strip() for ln in message.splitlines() if ln.strip()]
     last = lines[-1] if lines else ""
-    after = last.rsplit("documentation.", 1)[-1].strip()
-    last = after or last.rsplit(": ", 1)[-1]
-    return last[:300] + "\n"
+    if "documentation." in last:        # SUNDIALS' flag (said in plain words already) ...
+        last = last.rsplit("documentation.", 1)[-1].strip()     # ... and what follows it
+    return last[:300] + "\n" if last else ""
 
 
 def solver_reason(message):
