@@ -6,6 +6,7 @@ System that goes away with it. Building is serialised by one lock, so threads th
 the same System at once build each function once.
 """
 
+import collections
 import threading
 import weakref
 
@@ -19,6 +20,9 @@ from . import jit as _jit
 #: Jacobian is 2.5 million instructions, minutes of gcc)
 JACOBIAN_JIT_LIMIT = 200_000
 
+#: CasADi integrators kept per System (the chunks of recent runs), least recently used dropped
+INTEGRATORS_KEPT = 64
+
 _TABLE = weakref.WeakKeyDictionary()
 _LOCK = threading.RLock()
 
@@ -29,6 +33,7 @@ class Compiled:
     def __init__(self, system):
         self._system = weakref.ref(system)
         self._cache = {}
+        self._integrators = collections.OrderedDict()
 
     @property
     def system(self):
@@ -101,6 +106,20 @@ class Compiled:
             return ca.Function("dae", [t, x, z, p, ca.MX.sym("u", 0)],
                                [ode, alg, empty, empty], ca.dyn_in(), ca.dyn_out())
         return self._get(("dae", jacobian), build)
+
+    def integrator(self, key, build):
+        """A CasADi integrator built once for ``key`` (its grid and options): the same chunks
+        of the same run, again, reuse it. Only the most recent INTEGRATORS_KEPT are kept."""
+        with _LOCK:
+            if key in self._integrators:
+                self._integrators.move_to_end(key)
+                return self._integrators[key]
+        made = build()
+        with _LOCK:
+            self._integrators[key] = made
+            while len(self._integrators) > INTEGRATORS_KEPT:
+                self._integrators.popitem(last=False)
+        return made
 
     def memo(self, key, build):
         """Anything else a method builds once per System (the midpoint rule's step)."""

@@ -104,7 +104,7 @@ class Run:
 
     def integrators(self, key, build):
         """A CasADi integrator kept with the System: the same chunks of the same run reuse it."""
-        return self.compiled.memo(key, build)
+        return self.compiled.integrator(key, build)
 
     def stop_reason(self):
         """Why the run must stop now (cancelled, interrupted, out of time), or None."""
