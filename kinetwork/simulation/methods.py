@@ -172,10 +172,9 @@ class Scipy(Method):
     right-hand side and Jacobian."""
     stepper = True
 
-    def __init__(self, name):
+    def __init__(self, name, implicit=False):
         super().__init__(f"scipy solve_ivp {name}")
-        self.name = name
-        self.newton = name in ("Radau", "BDF", "LSODA")
+        self.name, self.newton = name, implicit
 
     def start(self, run, t, x):
         import scipy.integrate                 # 0.4 s to import: only when asked for
@@ -295,10 +294,12 @@ METHODS = {
                           "step: stiff", newton=True, fixed=True, dae=True),
     "midpoint": MidpointRule("implicit midpoint rule in canonical coordinates, fixed step: "
                              "symplectic, for long undamped runs"),
-    **{m.lower(): Scipy(m) for m in ("RK45", "DOP853", "Radau", "BDF", "LSODA")},
+    "rk45": Scipy("RK45"),
+    "dop853": Scipy("DOP853"),
+    "radau": Scipy("Radau", implicit=True),
+    "bdf": Scipy("BDF", implicit=True),
+    "lsoda": Scipy("LSODA", implicit=True),
 }
-#: the methods that iterate with a Jacobian
-IMPLICIT = tuple(name for name, m in METHODS.items() if m.newton)
 
 
 # -- the choice of ``auto`` -------------------------------------------------------------------
