@@ -1,0 +1,84 @@
+"""Safe expressions (kinetwork/expr.py): what parses, what is refused, evaluation over numbers
+and over CasADi symbols, and the parse cache."""
+
+import math
+
+import casadi as ca
+import pytest
+
+import kinetwork as kn
+from kinetwork.expr import ARITY, FUNCTIONS, Expression, casadi_functions, parse
+
+
+@pytest.mark.parametrize("text, value", [
+    ("-L1/2", -0.75), ("2*sin(3*t)", 2 * math.sin(0.6)), ("L1**2 + pi", 2.25 + math.pi),
+    ("atan2(1, L1)", math.atan2(1, 1.5)), ("max(-1, min(2, 3))", 2.0), ("1e-3", 1e-3),
+])
+def test_expressions(text, value):
+    assert Expression(text).evaluate({"L1": 1.5, "t": 0.2}) == pytest.approx(value)
+
+
+@pytest.mark.parametrize("text", [
+    "__import__('os').system('true')", "L1.real", "[1, 2]", "lambda: 1", "x if y else z",
+    "open('f')", "'abc'", "L1[0]", "True", "a < b", "{1: 2}", "f'{x}'", "1 +",
+    "sin(x=1)", "x" * 3000,
+])
+def test_expressions_refuse_anything_but_arithmetic(text):
+    with pytest.raises(kn.ModelError):
+        Expression(text)
+
+
+@pytest.mark.parametrize("text, message", [
+    ("open('f')", r"call of 'open' is not allowed"),
+    ("sine(t)", r"call of 'sine' is not allowed \(did you mean 'sin'\?\)"),
+    ("L1.real", r"Attribute is not allowed"),
+    ("(lambda: 1)()", r"calling anything but a named function"),
+    ("sin(x=1)", r"sin\(\) takes no keyword arguments"),
+    ("'abc'", r"only numbers are allowed as constants"),
+    ("1 +", r"cannot parse expression"),
+    ("1\x00", r"cannot parse expression"),
+    ("\ud800", r"lone surrogate"),
+    ("x" * 2001, r"longer than 2000 characters"),
+    (3.0, r"expression must be a string"),
+])
+def test_refusals_say_why(text, message):
+    with pytest.raises(kn.ModelError, match=message):
+        Expression(text)
+
+
+@pytest.mark.parametrize("name", sorted(FUNCTIONS))
+def test_every_function_takes_its_arity_and_no_other(name):
+    n = ARITY[name]
+    Expression(f"{name}({', '.join(['0.5'] * n)})")
+    for wrong in (n - 1, n + 1):
+        takes = f"{n} argument{'s' if n > 1 else ''}"
+        with pytest.raises(kn.ModelError, match=rf"{name}\(\) takes {takes}, got {wrong}"):
+            Expression(f"{name}({', '.join(['0.5'] * wrong)})")
+
+
+def test_names_are_the_free_symbols_constants_excluded():
+    assert Expression("a*sin(b*t) + pi - e").names == {"a", "b", "t"}
+    assert Expression("2.5").names == set()
+
+
+def test_deep_nesting_is_refused_not_crashed():
+    with pytest.raises(kn.ModelError, match="nested too deeply"):
+        Expression("-" * 1999 + "1").evaluate({})          # 2000 characters: not too long
+    assert Expression("-(-(-(1)))").evaluate({}) == -1.0
+
+
+def test_the_same_tree_evaluates_over_casadi_symbols():
+    expr = parse("a*sin(t) + max(a, 2) + atan2(t, 1) + sign(-a)")
+    a, t = ca.SX.sym("a"), ca.SX.sym("t")
+    f = ca.Function("f", [a, t], [expr.evaluate({"a": a, "t": t}, casadi_functions())])
+    assert float(f(3.0, 0.5)) == pytest.approx(expr.evaluate({"a": 3.0, "t": 0.5}))
+    assert set(casadi_functions()) == set(FUNCTIONS)
+
+
+def test_parse_is_cached_per_text():
+    assert parse("L1/2 + c") is parse("L1/2 + c")
+    assert parse("L1/2 + c") is not parse("L1/2 + d")
+    with pytest.raises(kn.ModelError):        # a refusal is not cached as a value
+        parse("open('f')")
+    with pytest.raises(kn.ModelError):
+        parse("open('f')")
