@@ -111,7 +111,7 @@ def test_energy_of_the_spatial_loop_is_conserved_over_100_s():
     system = scenes.spatial_fourbar().compile()
     res = kn.simulate(system, t_end=100.0, n_points=2001)
     a = system.asm
-    full = ca.vertcat(system._x, system._z)
+    full = ca.vertcat(system.eq.x, system.eq.z)
     values = system.model.numeric_values()
     potential = 0
     for body, frame_set in system.topology.bodies:
@@ -151,7 +151,7 @@ def test_collocation_integrates_the_dae():
 
 def test_user_chosen_cut_gives_the_same_motion():
     model = scenes.fourbar(probes=False)
-    model.components["D"]._values["cut"] = True
+    model.components["D"].cut = True
     system = model.compile()
     assert "D.q" not in system.state_names
     res = kn.simulate(system, t_end=2.0, n_points=201)
@@ -169,7 +169,7 @@ def test_a_loop_that_cannot_close_names_its_parts():
 
 def test_a_given_angle_that_cannot_be_reached_is_refused():
     model = scenes.fourbar(probes=False)
-    model.components["D"]._values["q0"] = 3.0            # rocker pointing away: no assembly
+    model.components["D"].q0 = 3.0                    # rocker pointing away: no assembly
     with pytest.raises(kn.ModelError, match="cannot close.*given q0 \\(A.q, D.q\\)"):
         model.compile()
 
@@ -319,7 +319,7 @@ def test_rhs_of_the_dae_solves_the_closure_first():
 
 def test_initial_speed_of_a_dependent_joint_is_refused_with_the_way_out():
     model = scenes.fourbar(probes=False)
-    model.components["D"]._values["qd0"] = 1.0          # the rocker speed follows the crank
+    model.components["D"].qd0 = 1.0                  # the rocker speed follows the crank
     with pytest.raises(kn.ModelError, match=r"qd0 of D.qd: this speed is fixed by the loop"
                                             r".*independent coordinate \(A.qd\)"):
         model.compile().x0
@@ -335,9 +335,9 @@ def test_dependent_speeds_follow_the_crank_speed():
 
 def test_cut_flag_on_a_joint_outside_any_loop_is_refused():
     model = scenes.fourbar(probes=False)
-    model.components["A"]._values["cut"] = True          # A is in the loop: fine
-    model.compile()
+    model.components["A"].cut = True                     # A is in the loop: fine
+    assert [c.component.name for c in model.compile().topology.cuts] == ["A"]
     pendulum = double_pendulum()
-    pendulum.components["elbow"]._values["cut"] = True
+    pendulum.components["elbow"].cut = True
     with pytest.raises(kn.ModelError, match="elbow is marked cut but closes no kinematic loop"):
         pendulum.compile()

@@ -189,7 +189,7 @@ def test_reversed_joint_mirrors_coordinate():
     """A revolute wired frame_b-to-ground turns the other way: q_reversed = -q."""
     def build(reverse):
         m = pendulum(q0=0.0)
-        m.components["pivot"]._values["q0"] = -0.4 if reverse else 0.4
+        m.components["pivot"].q0 = -0.4 if reverse else 0.4
         if reverse:
             m.connections = [(m.port("pivot.frame_b"), m.port("ground.frame")),
                              (m.port("pivot.frame_a"), m.port("bob.frame_a"))]

@@ -101,14 +101,19 @@ def drop(model, a, b):
     (lambda m: (m.add(kn.Probe("wrong", quantities=["angle"])),
                 m.connect("wrong.port", "mass1.frame_a")), "'angle' is not a quantity of a frame"),
     # two torques on a flange with no inertia, spring or damper cannot balance (a spring in
-    # series with a damper can: that is a Maxwell element, see tests/solver/test_network.py)
+    # series with a damper can: that is a Maxwell element, see tests/equations/test_network.py)
     (lambda m: (m.add(rot.Torque("free", tau=1.0)), m.add(rot.Torque("free2", tau=2.0)),
                 m.connect("free.flange", "free2.flange")), "has no defined rotational"),
     (lambda m: (m.add(rot.Fixed("lock")), m.connect("lock.flange", "elbow.axis")),
      "rigidly ties joint flange elbow.axis"),
-    (lambda m: m.components["mass1"]._values.update(mass="m9"), "unknown name 'm9'"),
-    (lambda m: m.components["mass1"]._values.update(mass="m1/(L1-1)"), "cannot be evaluated"),
-    (lambda m: m.components["mass1"]._values.update(mass="m1-2"), "mass1.mass = -1.0 kg"),
+    (lambda m: m.components["mass1"].set_param("mass", "m9"), "unknown name 'm9'"),
+    (lambda m: m.components["mass1"].set_param("mass", "m1/(L1-1)"), "cannot be evaluated"),
+    (lambda m: m.components["mass1"].set_param("mass", "m1-2"), "mass1.mass = -1.0 kg"),
+    # a component deleted by hand, its connections left behind: named, not a KeyError
+    (lambda m: m.components.pop("mass1"), r"connections\[1\] shoulder.frame_b - "
+                                          r"mass1.frame_a: component 'mass1' is not in the "
+                                          r"model any more \(remove its connections too\)"),
+    (lambda m: m.components.pop("probe2"), "component 'probe2' is not in the model any more"),
 ])
 def test_structural_problems(edit, match):
     model = broken(edit)

@@ -1,6 +1,7 @@
 """Physical validation: bodies that no rigid body can be, and mass matrices that cannot be
 inverted, refused with the place named."""
 
+import numpy as np
 import pytest
 
 import kinetwork as kn
@@ -18,8 +19,7 @@ mb = kn.multibody
 ])
 def test_impossible_inertias_are_refused(inertia, message):
     model = double_pendulum()
-    model.components["mass1"]._values["inertia"] = kn.multibody.RigidBody(
-        "x", mass=1.0, inertia=inertia).inertia
+    model.components["mass1"].inertia = inertia      # structure checked here, physics below
     with pytest.raises(kn.ModelError, match=message.replace("(", r"\(")):
         model.compile()
 
@@ -29,9 +29,13 @@ def test_idealised_and_limiting_inertias_are_accepted(inertia):
     """A planar link given only its moment about the joint axis, and bodies on the edge of the
     inequality (a thin disc: I_z = I_x + I_y), are fine."""
     model = double_pendulum(inertia=(0.1, 0.2))
-    model.components["mass1"]._values["inertia"] = kn.multibody.RigidBody(
-        "x", mass=1.0, inertia=inertia).inertia
-    model.compile()
+    model.components["mass1"].inertia = inertia
+    # accepted, and in the mass matrix: about z, the links' moments add to the point masses'
+    # M (both joints turn link 2, only the shoulder link 1)
+    q = [0.3, -0.7]
+    added = model.compile().mass_matrix(q) - double_pendulum().compile().mass_matrix(q)
+    i1, i2 = inertia[2], 0.2
+    np.testing.assert_allclose(added, [[i1 + i2, i2], [i2, i2]], rtol=1e-12, atol=1e-14)
 
 
 def test_a_joint_that_moves_nothing_is_refused_by_name():
