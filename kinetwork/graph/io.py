@@ -10,12 +10,14 @@ when the whole file is sound.
 import json
 import math
 import os
+import re
+import stat
 
-from ..components.base import REGISTRY
+from ..components.base import _NAME, NAME_LIMIT, REGISTRY
 from ..errors import ModelError
-from ..util import suggest
+from ..util import QUOTE_LIMIT, quote, suggest
 from .model import Model
-from .settings import check_setting
+from .settings import check_setting, check_steps
 from .writer import FORMAT, KEYS, VERSION, _kind, _plain, dumps, model_to_dict, save
 
 SUPPORTED = (1,)
@@ -25,6 +27,14 @@ REQUIRED = ("format", "version", "name", "components")
 COMPONENT_KEYS = ("name", "type", "params")
 #: among the names of broken components: some entry had no usable name (no identifier is "*")
 UNNAMED = "*"
+#: the largest model file read (bytes; text of a loads() call: characters). A model is text
+#: of kilobytes to megabytes: /dev/zero or an endless pipe is refused once this much is read
+MAX_FILE_SIZE = 64 * 2**20
+#: characters a model name may have; and what no name or description holds: control
+#: characters (Unicode's Cc), lone surrogates (Cs: not text, no file can hold them), line and
+#: paragraph separators (Zl, Zp). A regular expression: a description may be megabytes long
+MODEL_NAME_LIMIT = NAME_LIMIT
+_NOT_TEXT = re.compile("[\x00-\x1f\x7f-\x9f\ud800-\udfff\u2028\u2029]")
 
 
 # -- reading ----------------------------------------------------------------------------------
@@ -47,11 +57,19 @@ def load(path, validate=True):
         Every problem with the file, each message starting with the file name and the place.
     """
     source = os.fspath(path)
+    too_big = f"{source}: larger than {MAX_FILE_SIZE // 2**20} MiB, too large for a model file"
     try:
         with open(source, "rb") as fh:
-            raw = fh.read()
+            info = os.fstat(fh.fileno())
+            if stat.S_ISREG(info.st_mode) and info.st_size > MAX_FILE_SIZE:
+                raise ModelError(f"{too_big} ({info.st_size} bytes)")
+            # at most one byte past the limit: a device or a pipe without end is refused by
+            # size, not read until memory runs out
+            raw = fh.read(MAX_FILE_SIZE + 1)
     except OSError as exc:
         raise ModelError(f"{source}: cannot read the file ({exc.strerror or exc})") from exc
+    if len(raw) > MAX_FILE_SIZE:
+        raise ModelError(too_big)
     try:
         text = raw.decode("utf-8-sig")     # tolerate the BOM some editors write
     except UnicodeDecodeError as exc:
@@ -68,6 +86,11 @@ def loads(text, source=None, validate=True):
     source : str, optional
         Where the text came from, prefixed to every message.
     """
+    if not isinstance(text, (str, bytes, bytearray)):
+        raise ModelError(_at(source, f"expected JSON text, got {type(text).__name__}"))
+    if len(text) > MAX_FILE_SIZE:
+        raise ModelError(_at(source, f"{len(text)} characters, more than the "
+                                     f"{MAX_FILE_SIZE} a model may have"))
     try:
         data = json.loads(text, object_pairs_hook=_Object.from_pairs, parse_int=_int)
     except json.JSONDecodeError as exc:
@@ -108,32 +131,42 @@ def _build(data, problems):
         problems.append(f"top level: must be an object {{...}}, got {_kind(data)}")
         return None
     _repeated(data, "", problems)
-    problems.extend(f"{key!r}: unknown key{suggest(key, KEYS)}; keys are {', '.join(KEYS)}"
-                    for key in data if key not in KEYS)
+    problems.extend(f"{quote(key)}: unknown key{suggest(key, KEYS)}; keys are "
+                    f"{', '.join(KEYS)}" for key in data if key not in KEYS)
     problems.extend(f"{key}: required key missing" for key in REQUIRED if key not in data)
     # another format or version: whatever else looks wrong is noise, so stop here
     fmt, version = data.get("format", FORMAT), data.get("version", VERSION)
     if fmt != FORMAT:
-        problems.append(f"format: {fmt!r} is not a kinetwork model file (expected {FORMAT!r})")
+        problems.append(f"format: {quote(fmt)} is not a kinetwork model file "
+                        f"(expected {FORMAT!r})")
         return None
     if type(version) is not int or version not in SUPPORTED:
-        problems.append(f"version: {version!r} is not supported; this kinetwork reads version "
+        problems.append(f"version: {quote(version)} is not supported; this kinetwork reads "
+                        f"version "
                         f"{', '.join(map(str, SUPPORTED))}")
         return None
     name = data.get("name", "unnamed")
-    if not isinstance(name, str) or not name:
-        problems.append(f"name: must be a non-empty string, got {name!r:.40}")
+    problem = _model_name(name)
+    if problem:
+        problems.append(f"name: {problem}")
         name = "unnamed"
     model = Model(name)
     model.description = data.get("description", "")
     if not isinstance(model.description, str):
         problems.append(f"description: must be a string, got {_kind(model.description)}")
+    elif (problem := _text(model.description, allowed="\t\n\r")):
+        problems.append(f"description: {problem}")
     parameters = data.get("parameters", {})
     if not isinstance(parameters, dict):
         problems.append(f"parameters: must be an object of numbers, got {_kind(parameters)}")
     else:
         for key, value in parameters.items():
-            _attempt(problems, "parameters", model.set_parameter, key, value)
+            if not _NAME.fullmatch(key):     # said here with the name cut
+                problems.append(f"parameters: parameter name {quote(key)}: must be an "
+                                f"identifier (letters, digits, underscore; not starting with a "
+                                f"digit; at most {NAME_LIMIT} characters)")
+            else:
+                _attempt(problems, "parameters", model.set_parameter, key, value)
     broken = (_components(model, data["components"], problems) if "components" in data
               else {UNNAMED})
     _connections(model, data.get("connections", []), broken, problems)
@@ -151,7 +184,8 @@ def _components(model, entries, problems):
     broken, seen = set(), {}
     for i, entry in enumerate(entries):
         name = entry.get("name") if isinstance(entry, dict) else None
-        place = f'components[{i}] "{name}"' if isinstance(name, str) else f"components[{i}]"
+        place = f'components[{i}] "{_cut(name)}"' if isinstance(name, str) else \
+            f"components[{i}]"
         if isinstance(name, str) and name in seen:
             problems.append(f"{place}: duplicate name, already used by components[{seen[name]}]")
             continue
@@ -172,8 +206,9 @@ def _component(entry, place, problems):
         problems.append(f'{place}: must be an object {{"name", "type", "params"}}, '
                         f"got {_kind(entry)}")
         return None
-    problems.extend(f"{place}: unknown key {key!r}{suggest(key, COMPONENT_KEYS)}; keys are "
-                    f"{', '.join(COMPONENT_KEYS)}" for key in entry if key not in COMPONENT_KEYS)
+    problems.extend(f"{place}: unknown key {quote(key)}{suggest(key, COMPONENT_KEYS)}; keys "
+                    f"are {', '.join(COMPONENT_KEYS)}" for key in entry
+                    if key not in COMPONENT_KEYS)
     missing = [key for key in ("name", "type") if key not in entry]
     problems.extend(f"{place}: required key {key!r} missing" for key in missing)
     kind, params = entry.get("type"), entry.get("params", {})
@@ -181,13 +216,13 @@ def _component(entry, place, problems):
         return None
     if not isinstance(kind, str) or kind not in REGISTRY:
         # resolved only through the registry: a dotted path in a file is never imported
-        problems.append(f"{place}: unknown type {kind!r:.60}{suggest(kind, REGISTRY)}")
+        problems.append(f"{place}: unknown type {quote(kind, 60)}{suggest(kind, REGISTRY)}")
         return None
     if not isinstance(params, dict):
         problems.append(f"{place} params: must be an object, got {_kind(params)}")
         return None
     return REGISTRY[kind].from_params(entry["name"], params,
-                                      place=lambda key: f"{place} params.{key}")
+                                      place=lambda key: f"{place} params.{_cut(key)}")
 
 
 def _connections(model, pairs, broken, problems):
@@ -197,11 +232,11 @@ def _connections(model, pairs, broken, problems):
     for i, pair in enumerate(pairs):
         if not isinstance(pair, list) or len(pair) != 2:
             problems.append(f'connections[{i}]: must be a pair ["component.port", '
-                            f'"component.port"], got {pair!r:.80}')
+                            f'"component.port"], got {quote(pair, 80)}')
             continue
         refs = []
         for j, ref in enumerate(pair):
-            place = f'connections[{i}][{j}] "{ref}"' if isinstance(ref, str) else \
+            place = f'connections[{i}][{j}] "{_cut(ref)}"' if isinstance(ref, str) else \
                 f"connections[{i}][{j}]"
             refs.append(_attempt(problems, place, _port, model, ref, broken))
         if all(refs):
@@ -211,12 +246,12 @@ def _connections(model, pairs, broken, problems):
 def _port(model, ref, broken):
     """The PortRef, or None when it belongs to a component that already failed."""
     if not isinstance(ref, str) or ref.count(".") != 1:
-        raise ModelError(f"must be a string 'component.port', got {ref!r:.80}")
+        raise ModelError(f"must be a string 'component.port', got {quote(ref, 80)}")
     cname, pname = ref.split(".")
     if cname in broken or (UNNAMED in broken and cname not in model.components):
         return None
     if cname not in model.components:
-        raise ModelError(f"no component {cname!r}{suggest(cname, model.components)}")
+        raise ModelError(f"no component {quote(cname)}{suggest(cname, model.components)}")
     return model.components[cname].port_ref(pname)
 
 
@@ -225,7 +260,10 @@ def _simulation(settings, problems):
     if not isinstance(settings, dict):
         problems.append(f"simulation: must be an object, got {_kind(settings)}")
         return {}
-    problems.extend(filter(None, (check_setting(k, v) for k, v in settings.items())))
+    found = [p for p in (check_setting(k, v) for k, v in settings.items()) if p]
+    if not found and "step" in settings and "t_end" in settings:     # what they cost together
+        found = [p for p in [check_steps(settings["t_end"], settings["step"])] if p]
+    problems.extend(found)
     return dict(settings)
 
 
@@ -236,9 +274,9 @@ def _layout(model, layout, broken, problems):
         return {}
     for key, value in layout.items():
         if key not in model.components and key not in broken and UNNAMED not in broken:
-            problems.append(f"layout.{key}: no component {key!r}"
+            problems.append(f"layout.{_cut(key)}: no component {quote(key)}"
                             f"{suggest(key, model.components)}")
-        _plain(value, f"layout.{key}", problems)
+        _plain(value, f"layout.{_cut(key)}", problems)
     return _copy(layout)
 
 
@@ -259,10 +297,10 @@ class _Object(dict):
 
 def _repeated(value, where, problems):
     if isinstance(value, dict):
-        problems.extend(f"{where or 'top level'}: key {key!r} appears more than once"
+        problems.extend(f"{where or 'top level'}: key {quote(key)} appears more than once"
                         for key in getattr(value, "repeated", ()))
         for key, item in value.items():
-            _repeated(item, f"{where}.{key}" if where else key, problems)
+            _repeated(item, f"{where}.{_cut(key)}" if where else _cut(key), problems)
     elif isinstance(value, list):
         for j, item in enumerate(value):
             _repeated(item, f"{where}[{j}]", problems)
@@ -277,7 +315,8 @@ def _attempt(problems, place, fn, *args):
     except Exception as exc:    # noqa: BLE001
         # odd shapes in a file reach code written for well-formed values: a file may be
         # refused, but never crash the loader
-        problems.append(f"{place}: cannot be read ({type(exc).__name__}: {exc})")
+        problems.append(f"{place}: cannot be read ({type(exc).__name__}: "
+                        f"{_cut(str(exc), QUOTE_LIMIT)})")
     return None
 
 
@@ -300,3 +339,32 @@ def _copy(value):
 
 def _at(source, problem):
     return f"{source}: {problem}" if source else problem
+
+
+def _cut(text, limit=NAME_LIMIT):
+    """Text from the file for a message's place: as it is when short, else cut; characters
+    that do not print (a newline, a lone surrogate) escaped as in Python."""
+    text = text if len(text) <= limit else text[:limit - 3] + "..."
+    return "".join(c if c.isprintable() else repr(c)[1:-1] for c in text)
+
+
+def _text(text, allowed=""):
+    """The problem with free text from a file, or None: lone surrogates (no file can hold
+    them) and control characters other than ``allowed`` are refused, naming where."""
+    for found in _NOT_TEXT.finditer(text):
+        char = found.group()
+        if char not in allowed:
+            what = "a lone surrogate" if "\ud800" <= char <= "\udfff" else \
+                f"the control character {char!r}"
+            return f"{what} at character {found.start()} of {quote(text, 60)}"
+    return None
+
+
+def _model_name(name):
+    """The problem with a model name, or None: any printable text up to MODEL_NAME_LIMIT
+    characters (spaces and non-ASCII letters welcome), no control characters."""
+    if not isinstance(name, str) or not name:
+        return f"must be a non-empty string, got {quote(name, 40)}"
+    if len(name) > MODEL_NAME_LIMIT:
+        return f"at most {MODEL_NAME_LIMIT} characters, got {len(name)}: {quote(name, 60)}"
+    return _text(name)
