@@ -137,12 +137,20 @@ class Table(PartialBlock, library=LIB):
     """y interpolated linearly in ``table`` rows [x, y] at u (or at time t when u is not
     wired), extrapolated linearly from the end rows."""
     u = Port("signal_in", "Abscissa (unwired: time)", optional=True)
-    table = Param(kind="table", doc="Rows [x, y], x increasing")
+    table = Param(kind="table", doc="Rows [x, y], x increasing (at most 100 000)")
+    #: a table of up to this many rows is an expression (``kinetwork equations`` prints it);
+    #: a longer one a CasADi interpolant, which costs time linear in the rows to build and
+    #: compile to C, where the expression's cost grows with their square (10 000 rows:
+    #: 5 s to build, 100 000: 6 min)
+    expression_rows = 100
 
     def output(self, u, x, t):
-        xs = ca.DM([row[0] for row in self.table])
-        ys = ca.DM([row[1] for row in self.table])
-        return ca.pw_lin(t if u["u"] is None else u["u"], xs, ys)
+        at = t if u["u"] is None else u["u"]
+        xs = [row[0] for row in self.table]
+        ys = [row[1] for row in self.table]
+        if len(xs) <= self.expression_rows:
+            return ca.pw_lin(at, ca.DM(xs), ca.DM(ys))
+        return ca.interpolant(f"{self.name}_table", "linear", [xs], ys)(at)
 
 
 class Integrator(PartialSISO, library=LIB):
