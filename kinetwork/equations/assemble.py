@@ -259,6 +259,21 @@ def _zero_pose(comp):
     return [1.0 if label == "quat[0]" else 0.0 for label in labels]
 
 
+#: length [m] below which a line force has no direction (Modelica's s_small)
+S_SMALL = 1e-10
+
+
+def line_length(d):
+    """The length of a line force along ``d``, regularised as sqrt(d.d + S_SMALL^2).
+
+    At zero length the direction d/s of the force is undefined; so regularised, s and its
+    rate stay smooth, d/s is zero there and the force vanishes (Modelica's line forces divide
+    by max(s, s_small) to the same end). Beyond a micrometre it differs from |d| by less than
+    1e-14 m.
+    """
+    return ca.sqrt(ca.dot(d, d) + S_SMALL**2)
+
+
 def _frame_forces(asm, topo, bound, t):
     """Generalized forces of line forces and world forces/torques: the power they put in,
     differentiated by the speeds (a force on a frame enters as J^T f)."""
@@ -270,7 +285,7 @@ def _frame_forces(asm, topo, bound, t):
         if "frame_a" in comp.ports:
             _, pa = asm.pose(topo.set_of[comp.port_ref("frame_a")])
             _, pb = asm.pose(topo.set_of[comp.port_ref("frame_b")])
-            s = ca.norm_2(pb - pa)
+            s = line_length(pb - pa)
             s_d = ca.jtimes(s, asm.q, asm.qdot)
             # the tension times the rate of the length, differentiated by the speeds with
             # the tension held (a damper's law depends on the speeds itself)

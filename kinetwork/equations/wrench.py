@@ -129,14 +129,15 @@ class _Balance:
 
     def _applied(self, comp, port):
         """Force applied by a force element at ``port`` and its moment about the origin."""
+        from .assemble import line_length      # the same length as the equations of motion
         asm, c = self.asm, self.bound[comp.name]
         _, pb = asm.pose(self.topo.set_of[comp.port_ref(port)])
         if "frame_a" in comp.ports:
             _, pa = asm.pose(self.topo.set_of[comp.port_ref("frame_a")])
             _, pb_ = asm.pose(self.topo.set_of[comp.port_ref("frame_b")])
             d = pb_ - pa
-            s = ca.norm_2(d)
-            e = d / s
+            s = line_length(d)
+            e = d / s                           # zero at zero length: no force
             tension = c.law(s, ca.jtimes(s, asm.q, asm.qdot))
             force = (-tension * e) if port == "frame_b" else tension * e
             return force, ca.cross(pb, force)
