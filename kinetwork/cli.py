@@ -1,23 +1,32 @@
 """The ``kinetwork`` command: run, validate and derive the equations of a model file; list
 the integration methods; run the benchmark studies.
 
-Exit codes: 0 success, 1 a refused model or an unwritable output, 2 a usage error (argparse),
-3 a failed integration (whatever was computed before the failure is still written).
+Exit codes: 0 success, 1 a refused model or an unwritable output, 2 a usage error (argparse,
+or outputs that would overwrite the model or each other), 3 a failed integration (whatever
+was computed before the failure is still written), 128 + the signal number when SIGINT or
+SIGTERM stopped a run (130, 143; what was computed is written all the same).
 """
 
 import argparse
 import collections
 import contextlib
 import os
+import signal
 import sys
 import textwrap
 import time
 
 import kinetwork as kn
 
+from .graph.settings import check_output, check_settings
 from .simulation.driver import DEFAULTS, METHODS
+from .util import finite, quote
 
-EXIT_MODEL, EXIT_SIMULATION = 1, 3         # usage errors exit with argparse's 2
+EXIT_MODEL, EXIT_USAGE, EXIT_SIMULATION = 1, 2, 3
+#: signals that stop a run with its partial results written, exiting 128 + the signal
+STOPPING = (signal.SIGINT, signal.SIGTERM)
+#: what ``validate`` prints of long texts and lists: a summary, not the model again
+SHOWN_CHARACTERS, SHOWN_ITEMS = 500, 20
 
 
 def _parameter(text):
@@ -26,10 +35,31 @@ def _parameter(text):
     try:
         if not sep or not name.strip():
             raise ValueError
-        return name.strip(), float(value)
+        number = float(value)
     except ValueError:
-        raise argparse.ArgumentTypeError(f"expected NAME=VALUE with a number, got {text!r}") \
-            from None
+        raise argparse.ArgumentTypeError(f"expected NAME=VALUE with a number, got "
+                                         f"{quote(text)}") from None
+    if not finite(number):
+        raise argparse.ArgumentTypeError(f"{quote(name.strip())}: must be a finite number, "
+                                         f"got {value.strip()}")
+    return name.strip(), number
+
+
+def _positive(kind):
+    """argparse type of a finite number > 0 (``kind`` int or float)."""
+    def parse(text):
+        try:
+            value = kind(text)
+        except ValueError:
+            raise argparse.ArgumentTypeError(
+                f"expected {'an integer' if kind is int else 'a number'}, got "
+                f"{quote(text)}") from None
+        if not finite(value) or value <= 0:
+            raise argparse.ArgumentTypeError(f"must be a finite number > 0, got "
+                                             f"{quote(text, 40)}")
+        return value
+    parse.__name__ = kind.__name__       # argparse names the type in its messages
+    return parse
 
 
 class _HelpFormatter(argparse.HelpFormatter):
@@ -81,9 +111,9 @@ def build_parser():
     run.add_argument("--param", type=_parameter, action="append", default=[],
                      metavar="NAME=VALUE",
                      help="set a model parameter for this run (repeat for several)")
-    run.add_argument("--max-steps", type=int, metavar="N",
+    run.add_argument("--max-steps", type=_positive(int), metavar="N",
                      help="step budget per output interval of the variable-step methods")
-    run.add_argument("--time-limit", type=float, metavar="S",
+    run.add_argument("--time-limit", type=_positive(float), metavar="S",
                      help="wall-clock limit of the integration [s]")
     run.add_argument("--quiet", "-q", action="store_true",
                      help="print nothing but errors (on stderr)")
@@ -96,9 +126,13 @@ def build_parser():
 
     val = sub.add_parser(
         "validate", help="check a model and summarise it",
-        description="Check MODEL.json and summarise it: components, degrees of freedom, "
-                    "states, loops, equation size, parameters.")
+        description="Check MODEL.json and summarise it: components, connections, degrees of "
+                    "freedom, loops, parameters. The equations are not built unless "
+                    "--compile asks for them (states, equation size).")
     val.add_argument("model", metavar="MODEL.json", help="model file")
+    val.add_argument("--compile", action="store_true",
+                     help="also build the equations and summarise them: states, algebraic "
+                          "variables, equation size (takes longer on large models)")
 
     sub.add_parser("schema", help="print the JSON Schema of model files",
                    description="Print the JSON Schema (draft 2020-12) of the model format, "
@@ -204,17 +238,30 @@ def _progress_bar(args, model, t_end):
 
 
 def _run(args):
+    clash = _clashing_paths(args)
+    if clash:
+        _error(clash)
+        return EXIT_USAGE
     model = _load(args.model)
     if args.plot:
         from .plot import check_plot_path
         check_plot_path(args.plot)
+    given = {"t_end": args.t_end, "n_points": args.n_points, "method": args.method,
+             "rtol": args.rtol, "atol": args.atol, "step": args.step}
+    settings = {**DEFAULTS, **model.simulation,
+                **{k: v for k, v in given.items() if v is not None}}
+    problems = check_settings(settings)     # before building anything
+    if problems:
+        raise kn.ModelError(problems)
     start = time.perf_counter()
     system = model.compile()
     compiled = time.perf_counter()
-    t_end = args.t_end if args.t_end is not None else \
-        model.simulation.get("t_end", DEFAULTS["t_end"])
+    n_values = 1 + system.n_states + system.n_algebraic + sum(sig.size for sig in system.signals)
+    problem = check_output(settings["n_points"], n_values)
+    if problem:
+        raise kn.ModelError(problem)
     try:
-        with _progress_bar(args, model, t_end) as progress:
+        with _progress_bar(args, model, settings["t_end"]) as progress:
             results = kn.simulate(system, t_end=args.t_end, n_points=args.n_points,
                                   method=args.method, rtol=args.rtol, atol=args.atol,
                                   step=args.step, jit=args.jit, params=dict(args.param),
@@ -222,18 +269,20 @@ def _run(args):
                                   progress=progress)
     except kn.SimulationError as exc:
         _error(exc)
+        stopped = exc.signal in STOPPING
         if exc.results is not None and len(exc.results.t):
+            what = "interrupted" if stopped else "failed"
             try:
-                _outputs(args, exc.results, f"{model.name} (failed at t = {exc.t_reached:g} s)")
+                _outputs(args, exc.results, f"{model.name} ({what} at t = {exc.t_reached:g} s)")
             except kn.ModelError as write_exc:
                 _error(write_exc)
-        return EXIT_SIMULATION
+        return 128 + int(exc.signal) if stopped else EXIT_SIMULATION
     done = time.perf_counter()
     if args.quiet:
         _outputs(args, results, model.name)
         return 0
     t = results.t
-    print(f"{model.name}: {system.n_states} states ({', '.join(system.state_names)})")
+    print(f"{model.name}: {system.n_states} states ({_listing(system.state_names)})")
     if args.param:
         print("parameters set: " + ", ".join(f"{k} = {v:g}" for k, v in args.param))
     stats = results.stats
@@ -249,51 +298,110 @@ def _run(args):
     return 0
 
 
+def _clashing_paths(args):
+    """Why the outputs of a run would overwrite its model or each other, or None."""
+    named = [("the model file", args.model), ("--out", args.out), ("--plot", args.plot)]
+    named = [(what, path) for what, path in named if path]
+    for i, (what_a, a) in enumerate(named):
+        for what_b, b in named[i + 1:]:
+            if _same_file(a, b):
+                return (f"{what_b} {quote(b)} is {what_a} {'itself' if a == b else quote(a)}"
+                        f": choose another path, nothing was run")
+    return None
+
+
+def _same_file(a, b):
+    """Whether two paths name one file: the same after links are resolved, or (existing) the
+    same file by device and inode (a hard link)."""
+    if os.path.realpath(a) == os.path.realpath(b):
+        return True
+    try:
+        return os.path.samefile(a, b)
+    except OSError:                 # one does not exist yet: not the same file
+        return False
+
+
+def _listing(items, limit=SHOWN_ITEMS):
+    """Items joined by commas, the first ``limit`` of a longer list and how many in all."""
+    items = list(items)
+    shown = ", ".join(map(str, items[:limit]))
+    return shown if len(items) <= limit else f"{shown}, ... ({len(items)} in all)"
+
+
+def _shown(text, limit=SHOWN_CHARACTERS):
+    """Free text, cut to ``limit`` characters with the length said."""
+    return text if len(text) <= limit else f"{text[:limit]}... ({len(text)} characters)"
+
+
 def _validate(args):
-    model = _load(args.model)
-    system = model.compile()          # validates; one ModelError lists every problem
-    topo = system.topology
-    comps = model.components.values()
-    kinds = collections.Counter(c.type_name for c in comps)
-    units = dict(zip(system.state_names, system.state_units))
-    n_values = sum(sig.size for sig in system.signals)
-    size = system.size()
+    model = _load(args.model)           # reading validates: one ModelError lists every problem
+    topo = model.validate()             # the same Topology again, not a second analysis
+    kinds = collections.Counter(c.type_name for c in model.components.values())
+    groups = collections.Counter(g.kind for g in topo.oned)
     lines = [
         f"model {model.name!r} ({args.model}): valid",
-        *([textwrap.fill(f"description: {model.description}", 88, subsequent_indent="  ",
-                         break_on_hyphens=False)] if model.description else []),
+        *([textwrap.fill(f"description: {_shown(model.description)}", 88,
+                         subsequent_indent="  ", break_on_hyphens=False)]
+          if model.description else []),
         f"components: {len(model.components)} ("
         + ", ".join(f"{n} {kind}" for kind, n in kinds.most_common()) + ")",
         f"connections: {len(model.connections)}",
-        f"degrees of freedom: {system.dof}",
-        f"states: {system.n_states}"
-        + (" (" + ", ".join(f"{s} [{units[s]}]" if units[s] else s
-                            for s in system.state_names) + ")" if system.n_states else ""),
-        *([f"algebraic: {system.n_algebraic} ("
-           + ", ".join(f"{s} [{u}]" if u else s for s, u in
-                       zip(system.algebraic_names, system.algebraic_units)) + ")"]
-          if system.n_algebraic else []),
-        f"loops: {len(topo.loops) or 'none'}"
-        + "".join(f"\n  {' - '.join(cut.loop)} (cut at {cut.component.name})"
-                  for cut in topo.cuts),
-        *([textwrap.fill(f"why these states: {system.formulation_note}", 88,
-                         subsequent_indent="  ")] if system.formulation_note else []),
-        *([textwrap.fill(network, 88, subsequent_indent="  ")]
-          if (network := system.asm.net.summary(topo)) else []),
-        f"equations: {size['states']} states, {size['algebraic']} algebraic variables, "
-        f"{len(system.signal_names)} probe signals ({n_values} values); right-hand side "
-        f"{size['operations']} operations per evaluation ("
-        + ("articulated-body algorithm, O(N)" if system.formulation == "tree" else
-           "mass matrix projected on the independent speeds") + ")",
-        f"parameters: {len(model.parameters)}"
-        + (" (" + ", ".join(f"{k} = {v:g}" for k, v in model.parameters.items()) + ")"
-           if model.parameters else ""),
     ]
+    loops = f"loops: {len(topo.loops) or 'none'}" + "".join(
+        f"\n  {' - '.join(cut.loop)} (cut at {cut.component.name})"
+        for cut in topo.cuts[:SHOWN_ITEMS]) + (
+        f"\n  ... ({len(topo.cuts)} in all)" if len(topo.cuts) > SHOWN_ITEMS else "")
+    if args.compile:
+        lines += _compiled_summary(model.compile(), topo, loops)
+    else:
+        # the joints' degrees of freedom and the free 1-D groups' are exact without the
+        # equations; loops take away as many as their independent closure equations
+        dof = topo.dof + groups["free"]
+        lines += [f"degrees of freedom: {dof}" if not topo.loops else
+                  f"degrees of freedom: at most {dof}, less one per independent closure "
+                  f"equation of the loops (--compile counts them)", loops]
+    if not args.compile and groups:
+        lines.append("1-D rigid groups: " + ", ".join(
+            f"{groups[k]} {what}" for k, what in (
+                ("joint", "on joint axes"), ("free", "free (an angle and a speed each)"),
+                ("massless", "massless"), ("prescribed", "prescribed"), ("fixed", "fixed"))
+            if groups[k]))
+    lines.append(f"parameters: {len(model.parameters)}" + (
+        " (" + _listing(f"{k} = {v:g}" for k, v in model.parameters.items()) + ")"
+        if model.parameters else ""))
     if model.simulation:
         lines.append("simulation: " + ", ".join(f"{k} = {v}"
                                                 for k, v in model.simulation.items()))
     print("\n".join(lines))
     return 0
+
+
+def _compiled_summary(system, topo, loops):
+    """The lines of ``validate --compile`` from the equations: degrees of freedom, states,
+    algebraic variables, the ``loops`` line, formulation, 1-D network, equation size."""
+    units = dict(zip(system.state_names, system.state_units))
+    n_values = sum(sig.size for sig in system.signals)
+    size = system.size()
+    network = system.asm.net.summary(topo)
+    return [
+        f"degrees of freedom: {system.dof}",
+        f"states: {system.n_states}"
+        + (" (" + _listing(f"{s} [{units[s]}]" if units[s] else s
+                           for s in system.state_names) + ")" if system.n_states else ""),
+        *([f"algebraic: {system.n_algebraic} ("
+           + _listing(f"{s} [{u}]" if u else s for s, u in
+                      zip(system.algebraic_names, system.algebraic_units)) + ")"]
+          if system.n_algebraic else []),
+        loops,
+        *([textwrap.fill(f"why these states: {system.formulation_note}", 88,
+                         subsequent_indent="  ")] if system.formulation_note else []),
+        *([textwrap.fill(network, 88, subsequent_indent="  ")] if network else []),
+        f"equations: {size['states']} states, {size['algebraic']} algebraic variables, "
+        f"{len(system.signal_names)} probe signals ({n_values} values); right-hand side "
+        f"{size['operations']} operations per evaluation ("
+        + ("articulated-body algorithm, O(N)" if system.formulation == "tree" else
+           "mass matrix projected on the independent speeds") + ")",
+    ]
 
 
 def _schema(args):
@@ -331,7 +439,15 @@ def _equations(args):
 
     model = _load(args.model)
     system = model.compile()
-    eq = equations_sympy(system, simplified=args.simplify)
+    try:
+        eq = equations_sympy(system, simplified=args.simplify)
+    except ValueError as exc:
+        if "OP_CALL" not in str(exc):
+            raise
+        raise kn.ModelError(
+            f"{model.name}: the equations cannot be printed in closed form: they call a "
+            f"function, the interpolant of a signals.Table of more than "
+            f"{kn.signals.Table.expression_rows} rows") from None
     mats = {key: eq[key] for key in ("M", "V", "G")}
     shared = eq["shared"]
     if not eq["simplified"] and args.simplify is None:

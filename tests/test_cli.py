@@ -86,7 +86,7 @@ def test_run_defaults_come_from_the_model(tmp_path):
 
 
 def test_validate_summarises(seed_file, capsys):
-    assert main(["validate", str(seed_file)]) == 0
+    assert main(["validate", "--compile", str(seed_file)]) == 0
     out = capsys.readouterr().out
     system = double_pendulum().compile()
     for line in [

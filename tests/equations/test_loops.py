@@ -212,7 +212,7 @@ def test_validate_states_the_reason_for_the_state_count(tmp_path, capsys):
     from kinetwork import cli
     path = tmp_path / "fourbar.json"
     scenes.fourbar().save(path)
-    assert cli.main(["validate", str(path)]) == 0
+    assert cli.main(["validate", "--compile", str(path)]) == 0
     out = capsys.readouterr().out
     assert "states: 2 (A.q [rad], A.qd [rad/s])" in out and "algebraic: 3" in out
     assert "degrees of freedom: 1" in out and "coordinate partitioning" in out
