@@ -118,7 +118,8 @@ class Expression:
         try:
             return ev(self._tree)
         except RecursionError:
-            raise ModelError(f"expression nested too deeply ({len(self.text)} characters)") from None
+            raise ModelError(f"expression nested too deeply ({len(self.text)} "
+                             f"characters)") from None
 
     def __repr__(self):
         return f"Expression({self.text!r})"

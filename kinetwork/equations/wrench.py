@@ -129,15 +129,16 @@ class _Balance:
 
     def _applied(self, comp, port):
         """Force applied by a force element at ``port`` and its moment about the origin."""
-        from .assemble import line_length      # the same length as the equations of motion
         asm, c = self.asm, self.bound[comp.name]
         _, pb = asm.pose(self.topo.set_of[comp.port_ref(port)])
         if "frame_a" in comp.ports:
             _, pa = asm.pose(self.topo.set_of[comp.port_ref("frame_a")])
             _, pb_ = asm.pose(self.topo.set_of[comp.port_ref("frame_b")])
             d = pb_ - pa
-            s = line_length(d)
-            e = d / s                           # zero at zero length: no force
+            # regularised as assemble.line_length (s_small = 1e-10 m), which the equations of
+            # motion use: finite, and no force at zero length (e = 0 there)
+            s = ca.sqrt(ca.dot(d, d) + 1e-20)
+            e = d / s
             tension = c.law(s, ca.jtimes(s, asm.q, asm.qdot))
             force = (-tension * e) if port == "frame_b" else tension * e
             return force, ca.cross(pb, force)
