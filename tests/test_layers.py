@@ -1,0 +1,112 @@
+"""The layers of kinetwork only look down, and no module imports itself back.
+
+Every module is read with ``ast`` (nothing is imported): each import, at any depth (inside
+functions too), relative or absolute, is resolved to the kinetwork module it names. Layers,
+lowest first (the package docstring's list): the helpers ``errors``, ``util``, ``expr``,
+``spatial``; ``components``; ``graph``; ``equations``; ``simulation``; the faces ``plot``,
+``schema``, ``symbolic``, ``cli`` (and ``kinetwork/__init__.py``, which gathers them all). A
+module of a sub-package is in its package's layer. A module may import from its own layer and
+those below it; the imports must not form a cycle, within a layer either.
+"""
+
+import ast
+import os
+import pathlib
+
+import networkx as nx
+import pytest
+
+import kinetwork
+
+PACKAGE = pathlib.Path(kinetwork.__file__).resolve().parent
+LAYERS = [("errors", "util", "expr", "spatial"), ("components",), ("graph",), ("equations",),
+          ("simulation",), ("plot", "schema", "symbolic", "cli", "")]
+RANK = {name: rank for rank, names in enumerate(LAYERS) for name in names}
+
+
+def module_name(path):
+    """``kinetwork.graph.model`` of ``.../kinetwork/graph/model.py`` (``__init__`` files name
+    their package)."""
+    parts = path.relative_to(PACKAGE.parent).with_suffix("").parts
+    return ".".join(parts[:-1] if parts[-1] == "__init__" else parts)
+
+
+MODULES = {module_name(p): p for p in sorted(PACKAGE.rglob("*.py"))}
+
+
+def layer(module):
+    """The layer of a module: the first name below ``kinetwork`` ("" for the package)."""
+    parts = module.split(".")
+    return parts[1] if len(parts) > 1 else ""
+
+
+def imports(module):
+    """(line, kinetwork module) of every import in ``module``, at any depth."""
+    path = MODULES[module]
+    tree = ast.parse(path.read_text(), filename=str(path))
+    package = module if path.name == "__init__.py" else module.rpartition(".")[0]
+    found = []
+    for node in ast.walk(tree):
+        if isinstance(node, ast.Import):
+            found += [(node.lineno, alias.name) for alias in node.names]
+        elif isinstance(node, ast.ImportFrom):
+            if node.level:
+                base = package.split(".")
+                base = base[:len(base) - (node.level - 1)]
+                target = ".".join(base + ([node.module] if node.module else []))
+            else:
+                target = node.module
+            for alias in node.names:
+                # ``from . import plot``: the module kinetwork.plot, else a name of the package
+                sub = f"{target}.{alias.name}"
+                found.append((node.lineno, sub if sub in MODULES else target))
+    out = []
+    for line, name in found:
+        while name and name not in MODULES and "." in name:
+            name = name.rpartition(".")[0]          # ``import kinetwork.graph.model.x``
+        if name in MODULES:
+            out.append((line, name))
+    return out
+
+
+def test_every_module_is_in_a_layer():
+    unplaced = sorted({layer(m) for m in MODULES} - set(RANK))
+    assert not unplaced, f"modules in no layer: {unplaced}"
+    assert len(MODULES) > 30          # the walk found the package, not an empty folder
+
+
+def test_imports_only_look_down():
+    upward = [f"{os.path.relpath(MODULES[m], PACKAGE.parent)}:{line}: {m} "
+              f"({layer(m) or 'kinetwork'}) imports {target} ({layer(target) or 'kinetwork'})"
+              for m in MODULES for line, target in imports(m)
+              if RANK[layer(target)] > RANK[layer(m)]]
+    assert not upward, "imports from a higher layer:\n" + "\n".join(upward)
+
+
+def test_no_import_cycles():
+    graph = nx.DiGraph()
+    graph.add_nodes_from(MODULES)
+    for m in MODULES:
+        graph.add_edges_from((m, target) for _, target in imports(m) if target != m)
+    cycles = sorted(" -> ".join(c + [c[0]]) for c in nx.simple_cycles(graph))
+    assert not cycles, "import cycles:\n" + "\n".join(cycles)
+
+
+@pytest.mark.parametrize("source, module, expected", [
+    ("from ..errors import ModelError", "kinetwork.graph.model", "kinetwork.errors"),
+    ("from . import plot as _plot", "kinetwork", "kinetwork.plot"),
+    ("from .base import Component", "kinetwork.components.multibody",
+     "kinetwork.components.base"),
+    ("def f():\n    from .topology import analyze", "kinetwork.graph.model",
+     "kinetwork.graph.topology"),
+    ("import kinetwork.simulation.jit", "kinetwork.cli", "kinetwork.simulation.jit"),
+    ("from kinetwork.components import multibody", "kinetwork.cli",
+     "kinetwork.components.multibody"),
+    ("from kinetwork import Model", "kinetwork.cli", "kinetwork"),
+])
+def test_imports_are_resolved_to_modules(source, module, expected, monkeypatch, tmp_path):
+    """The resolution itself, on small sources: relative, absolute, nested, of a name."""
+    fake = tmp_path / MODULES[module].name
+    fake.write_text(source + "\n")
+    monkeypatch.setitem(MODULES, module, fake)
+    assert [target for _, target in imports(module)] == [expected]
