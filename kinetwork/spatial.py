@@ -72,3 +72,18 @@ def quat_product(a, b):
     """Hamilton product a * b."""
     aw, av, bw, bv = a[0], a[1:4], b[0], b[1:4]
     return ca.vertcat(aw * bw - ca.dot(av, bv), aw * bv + bw * av + ca.cross(av, bv))
+
+
+#: length [m] below which a line force has no direction (Modelica's s_small)
+S_SMALL = 1e-10
+
+
+def line_length(d):
+    """The length of a line force along ``d``, regularised as sqrt(d.d + S_SMALL^2).
+
+    At zero length the direction d/s of the force is undefined; so regularised, s and its
+    rate stay smooth, d/s is zero there and the force vanishes (Modelica's line forces divide
+    by max(s, s_small) to the same end). Beyond a micrometre it differs from |d| by less than
+    1e-14 m.
+    """
+    return ca.sqrt(ca.dot(d, d) + S_SMALL**2)

@@ -13,6 +13,8 @@ from fractions import Fraction
 import casadi as ca
 import sympy as sp
 
+from .errors import ModelError
+
 
 def _flag(relation):
     # CasADi comparisons are numbers (1 or 0), so they must stay usable in arithmetic.
@@ -196,8 +198,7 @@ def function_to_sympy(f, replacements, prefix=None):
             elif op in _BINARY:
                 value = _BINARY[op](work[arg[0]], work[arg[1]])
             else:
-                raise ValueError(f"CasADi operation {_OP_NAMES.get(op, op)} has no sympy "
-                                 f"translation")
+                raise _untranslatable(op)
             if value in known:            # CasADi's graph may hold the same node twice
                 value = known[value]
             elif uses.get(k, 0) > 1 and not value.is_Atom:
@@ -219,8 +220,7 @@ def _uses(program):
         elif op in (ca.OP_INPUT, ca.OP_CONST):
             reads = []
         else:
-            raise ValueError(f"CasADi operation {_OP_NAMES.get(op, op)} has no sympy "
-                             f"translation")
+            raise _untranslatable(op)
         for slot in reads:
             uses[owner[slot]] = uses.get(owner[slot], 0) + 1
         if op != ca.OP_OUTPUT:
@@ -309,3 +309,12 @@ def equations_sympy(system, simplified=None):
     M, V, G = mats
     return {"M": M, "V": V, "G": G, "shared": shared, "q": q, "qd": qd, "params": params,
             "t": t, "size": size, "simplified": simplified}
+
+
+def _untranslatable(op):
+    """The error for a CasADi operation with no sympy counterpart: a ModelError for a call of
+    a function (the interpolant of a long ``signals.Table``), which a user can meet."""
+    if op == ca.OP_CALL:
+        return ModelError("the equations call a function (the interpolant of a signals.Table "
+                          "of many rows): they cannot be written in closed form")
+    return ValueError(f"CasADi operation {_OP_NAMES.get(op, op)} has no sympy translation")

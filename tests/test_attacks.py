@@ -322,7 +322,7 @@ def test_a_line_force_of_normal_length_is_unchanged(monkeypatch):
     run = dict(t_end=1.0, n_points=101, rtol=1e-10, atol=1e-12, jit=False)
     scene = ((0.3, 0.1, -0.2), (0.0, 1.0, 0.5), 0.1, 9.8)
     regular = kn.simulate(line_scene(*scene), **run)
-    monkeypatch.setattr("kinetwork.equations.assemble.S_SMALL", 0.0)   # the plain |d|
+    monkeypatch.setattr("kinetwork.spatial.S_SMALL", 0.0)   # the plain |d|
     plain = kn.simulate(line_scene(*scene), **run)
     np.testing.assert_allclose(regular.states, plain.states, rtol=0, atol=1e-12)
     np.testing.assert_allclose(regular["probe.force"], plain["probe.force"], rtol=0,

@@ -12,7 +12,7 @@ from dataclasses import dataclass, field
 import casadi as ca
 
 from ..expr import casadi_functions, parse
-from ..spatial import vec3, vee
+from ..spatial import line_length, vec3, vee
 from . import network
 from .newton_euler import Body, aba, crba, motion_subspace, rnea, spatial_inertia
 from .signals import probe_signals
@@ -257,21 +257,6 @@ def _zero_pose(comp):
     """Coordinates of the joint's home pose (identity quaternion for quaternion joints)."""
     labels = comp.coordinate_labels()
     return [1.0 if label == "quat[0]" else 0.0 for label in labels]
-
-
-#: length [m] below which a line force has no direction (Modelica's s_small)
-S_SMALL = 1e-10
-
-
-def line_length(d):
-    """The length of a line force along ``d``, regularised as sqrt(d.d + S_SMALL^2).
-
-    At zero length the direction d/s of the force is undefined; so regularised, s and its
-    rate stay smooth, d/s is zero there and the force vanishes (Modelica's line forces divide
-    by max(s, s_small) to the same end). Beyond a micrometre it differs from |d| by less than
-    1e-14 m.
-    """
-    return ca.sqrt(ca.dot(d, d) + S_SMALL**2)
 
 
 def _frame_forces(asm, topo, bound, t):

@@ -22,7 +22,7 @@ probe reports the torque about the frame's own origin.
 
 import casadi as ca
 
-from ..spatial import skew, vec3
+from ..spatial import line_length, skew, vec3
 from .newton_euler import motion_subspace
 
 
@@ -135,9 +135,7 @@ class _Balance:
             _, pa = asm.pose(self.topo.set_of[comp.port_ref("frame_a")])
             _, pb_ = asm.pose(self.topo.set_of[comp.port_ref("frame_b")])
             d = pb_ - pa
-            # regularised as assemble.line_length (s_small = 1e-10 m), which the equations of
-            # motion use: finite, and no force at zero length (e = 0 there)
-            s = ca.sqrt(ca.dot(d, d) + 1e-20)
+            s = line_length(d)       # as the equations of motion: no force at zero length
             e = d / s
             tension = c.law(s, ca.jtimes(s, asm.q, asm.qdot))
             force = (-tension * e) if port == "frame_b" else tension * e

@@ -16,7 +16,7 @@ import stat
 from ..components.base import _NAME, NAME_LIMIT, REGISTRY
 from ..errors import ModelError
 from ..util import QUOTE_LIMIT, quote, suggest
-from .model import Model
+from .model import Model, model_name_problem, text_problem
 from .settings import check_setting, check_steps
 from .writer import FORMAT, KEYS, VERSION, _kind, _plain, dumps, model_to_dict, save
 
@@ -30,11 +30,6 @@ UNNAMED = "*"
 #: the largest model file read (bytes; text of a loads() call: characters). A model is text
 #: of kilobytes to megabytes: /dev/zero or an endless pipe is refused once this much is read
 MAX_FILE_SIZE = 64 * 2**20
-#: characters a model name may have; and what no name or description holds: control
-#: characters (Unicode's Cc), lone surrogates (Cs: not text, no file can hold them), line and
-#: paragraph separators (Zl, Zp). A regular expression: a description may be megabytes long
-MODEL_NAME_LIMIT = NAME_LIMIT
-_NOT_TEXT = re.compile("[\x00-\x1f\x7f-\x9f\ud800-\udfff\u2028\u2029]")
 
 
 # -- reading ----------------------------------------------------------------------------------
@@ -146,7 +141,7 @@ def _build(data, problems):
                         f"{', '.join(map(str, SUPPORTED))}")
         return None
     name = data.get("name", "unnamed")
-    problem = _model_name(name)
+    problem = model_name_problem(name)
     if problem:
         problems.append(f"name: {problem}")
         name = "unnamed"
@@ -154,7 +149,7 @@ def _build(data, problems):
     model.description = data.get("description", "")
     if not isinstance(model.description, str):
         problems.append(f"description: must be a string, got {_kind(model.description)}")
-    elif (problem := _text(model.description, allowed="\t\n\r")):
+    elif (problem := text_problem(model.description, allowed="\t\n\r")):
         problems.append(f"description: {problem}")
     parameters = data.get("parameters", {})
     if not isinstance(parameters, dict):
@@ -348,23 +343,3 @@ def _cut(text, limit=NAME_LIMIT):
     return "".join(c if c.isprintable() else repr(c)[1:-1] for c in text)
 
 
-def _text(text, allowed=""):
-    """The problem with free text from a file, or None: lone surrogates (no file can hold
-    them) and control characters other than ``allowed`` are refused, naming where."""
-    for found in _NOT_TEXT.finditer(text):
-        char = found.group()
-        if char not in allowed:
-            what = "a lone surrogate" if "\ud800" <= char <= "\udfff" else \
-                f"the control character {char!r}"
-            return f"{what} at character {found.start()} of {quote(text, 60)}"
-    return None
-
-
-def _model_name(name):
-    """The problem with a model name, or None: any printable text up to MODEL_NAME_LIMIT
-    characters (spaces and non-ASCII letters welcome), no control characters."""
-    if not isinstance(name, str) or not name:
-        return f"must be a non-empty string, got {quote(name, 40)}"
-    if len(name) > MODEL_NAME_LIMIT:
-        return f"at most {MODEL_NAME_LIMIT} characters, got {len(name)}: {quote(name, 60)}"
-    return _text(name)

@@ -7,13 +7,18 @@ import threading
 import numpy as np
 
 from ..components.base import ANY, Component, PortRef
-from ..util import check_number, suggest
+from ..util import check_number, quote, suggest
 from .writer import save
 from ..errors import ModelError
 from ..expr import CONSTANTS, FUNCTIONS, parse
 
 _IDENT = re.compile(r"[A-Za-z_][A-Za-z0-9_]{0,199}\Z")      # whole, as NAME_LIMIT in base.py
 RESERVED = {"t", *CONSTANTS, *FUNCTIONS}
+#: characters a model name may have; and what no name or description holds: control
+#: characters (Unicode's Cc), lone surrogates (Cs: not text, no file can hold them), line and
+#: paragraph separators (Zl, Zp). A regular expression: a description may be megabytes long
+MODEL_NAME_LIMIT = 200
+_NOT_TEXT = re.compile("[\x00-\x1f\x7f-\x9f\ud800-\udfff\u2028\u2029]")
 
 #: what turns a validated model into a System: installed by ``kinetwork.equations`` when it
 #: is imported (layers only look down, so the model does not import what compiles it)
@@ -45,8 +50,8 @@ class Model:
     """
 
     def __init__(self, name, parameters=None, description="", simulation=None):
-        if not isinstance(name, str) or not name:
-            raise ModelError(f"model name must be a non-empty string, got {name!r}")
+        if (problem := model_name_problem(name)) is not None:
+            raise ModelError(f"model name: {problem}")
         self.name = name
         self.description = description
         self.components = {}
@@ -66,7 +71,7 @@ class Model:
     def set_parameter(self, name, value):
         """Add or change a model parameter."""
         if not isinstance(name, str) or not _IDENT.match(name):
-            raise ModelError(f"parameter name {name!r}: must be an identifier")
+            raise ModelError(f"parameter name {quote(name, 60)}: must be an identifier")
         if name in RESERVED:
             raise ModelError(f"parameter name {name!r} is reserved (time, constants, functions)")
         self.parameters[name] = check_number(value, f"parameters.{name}")
@@ -106,10 +111,11 @@ class Model:
                                  f"model {self.name!r} (add it first)")
             return ref
         if not isinstance(ref, str) or ref.count(".") != 1:
-            raise ModelError(f"port reference {ref!r}: expected 'component.port'")
+            raise ModelError(f"port reference {quote(ref)}: expected 'component.port'")
         cname, pname = ref.split(".")
         if cname not in self.components:
-            raise ModelError(f"{ref}: no component {cname!r}{suggest(cname, self.components)}")
+            raise ModelError(f"{quote(ref)}: no component {quote(cname, 60)}"
+                             f"{suggest(cname, self.components)}")
         return self.components[cname].port_ref(pname)
 
     # -- checking -----------------------------------------------------------------------
@@ -244,3 +250,25 @@ def _scalar(value, spec, env, where, bounds=True):
     elif not math.isfinite(number):
         raise ModelError(f"{where}: must be finite, got {number}")
     return number
+
+
+def text_problem(text, allowed=""):
+    """The problem with free text from a file, or None: lone surrogates (no file can hold
+    them) and control characters other than ``allowed`` are refused, naming where."""
+    for found in _NOT_TEXT.finditer(text):
+        char = found.group()
+        if char not in allowed:
+            what = "a lone surrogate" if "\ud800" <= char <= "\udfff" else \
+                f"the control character {char!r}"
+            return f"{what} at character {found.start()} of {quote(text, 60)}"
+    return None
+
+
+def model_name_problem(name):
+    """The problem with a model name, or None: any printable text up to MODEL_NAME_LIMIT
+    characters (spaces and non-ASCII letters welcome), no control characters."""
+    if not isinstance(name, str) or not name:
+        return f"must be a non-empty string, got {quote(name, 40)}"
+    if len(name) > MODEL_NAME_LIMIT:
+        return f"at most {MODEL_NAME_LIMIT} characters, got {len(name)}: {quote(name, 60)}"
+    return text_problem(name)

@@ -29,8 +29,8 @@ import numpy as np
 
 from ..equations.system import OVERFLOW, System, overflow_message
 from ..errors import ModelError, SimulationError
-from ..graph.settings import check_setting
-from ..util import suggest
+from ..graph.settings import check_output, check_settings
+from ..util import quote, suggest
 from . import jit as _jit
 from .compiled import compiled
 from .methods import METHODS, Failure, choose
@@ -42,9 +42,9 @@ DEFAULTS = {"t_end": 10.0, "n_points": 1001, "method": "auto", "rtol": 1e-6, "at
 #: equations times their instructions; ~1 ns an instruction compiled, ~10 in CasADi's virtual
 #: machine): cancellation, time limits and progress are served between chunks
 CHUNK_WORK = 3e7
-#: the first chunk holds this fraction of the output intervals; later ones grow at most
-#: CHUNK_GROWTH-fold (each chunk restarts a multistep method: few chunks for a fast run)
-FIRST_CHUNK = 1 / 16
+#: the first chunk is one output interval (how much work one takes is not known before);
+#: later ones grow at most CHUNK_GROWTH-fold (each chunk restarts a multistep method: few
+#: chunks for a fast run)
 CHUNK_GROWTH = 16
 #: a kinematic loop whose Jacobian in the dependent speeds has a larger condition number is
 #: at a singular configuration
@@ -279,14 +279,17 @@ def simulate(model, t_end=None, n_points=None, method=None, rtol=None, atol=None
 
 def _check(system, settings, t_start, max_steps, time_limit):
     """The method's table key, once every setting is checked (one ModelError for all)."""
-    problems = [m for k in DEFAULTS if settings[k] is not None
-                and (m := check_setting(k, settings[k]))]
     if not isinstance(t_start, (int, float)) or isinstance(t_start, bool) or \
             not math.isfinite(t_start):
-        problems.append(f"t_start: must be a finite number, got {t_start!r:.40}")
-    elif not problems and settings["t_end"] <= t_start:
+        raise ModelError(f"t_start: must be a finite number, got {quote(t_start, 40)}")
+    problems = check_settings({k: settings[k] for k in DEFAULTS}, t_start)
+    if not problems and settings["t_end"] <= t_start:
         problems.append(f"simulation.t_end: must be > t_start = {t_start}, "
                         f"got {settings['t_end']}")
+    if not problems:        # what the results would hold: time, the full state, the probes
+        values = 1 + system.n_states + system.n_algebraic + \
+            sum(sig.size for sig in system.signals)
+        problems += filter(None, [check_output(int(settings["n_points"]), values)])
     for name, value, kind in (("max_steps", max_steps, int), ("time_limit", time_limit, float)):
         if value is not None and (isinstance(value, bool) or not isinstance(value, (int, float))
                                   or not math.isfinite(value) or value <= 0
@@ -348,11 +351,7 @@ def _integrate(run, method):
         stepper = method.start(run, grid[0], X[0])
     except Failure as failure:
         return np.array(X), failure.reason, stats
-    # the first chunk: a fraction of the grid, and no more work than a chunk should take if a
-    # variable-step method takes one step an output (a fixed-step one takes its many)
-    per_interval = 4 * run.instructions * (run.steps_per_interval if method.fixed else 1)
-    chunk = n - 1 if method.stepper else \
-        max(1, min(int((n - 1) * FIRST_CHUNK), int(CHUNK_WORK / per_interval)))
+    chunk = n - 1 if method.stepper else 1
     k, failure = 0, None
     while k < n - 1:
         failure = run.stop_reason()
@@ -453,8 +452,9 @@ def _near_singular(run, X, grid):
         abs(det[1]) < abs(det[0] - det[1])
     if cond[-1] < NEAR_SINGULAR_CONDITION and not folding:
         return ""
-    return (f"; there (t = {grid[len(X) - 1]:g} s) the loop is at a singular configuration, "
-            f"a dead point: its Jacobian in the dependent speeds "
+    loops = "; ".join(" - ".join(c.loop) for c in run.system.topology.cuts)
+    return (f"; there (t = {grid[len(X) - 1]:g} s) the kinematic loop ({loops}) is at a "
+            f"singular configuration, a dead point: its Jacobian in the dependent speeds "
             f"({', '.join(run.system.dependent_names)}) has condition number "
             f"{cond[-1]:.2g} and its determinant goes to zero, so the mechanism folds flat, "
             f"locks or branches")
