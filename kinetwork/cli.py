@@ -138,6 +138,12 @@ def build_parser():
                    description="Print the JSON Schema (draft 2020-12) of the model format, "
                                "generated from the component declarations: point an editor "
                                "at it for completion and checks.")
+    cache = sub.add_parser(
+        "cache", help="show or empty the cache of compiled models",
+        description="Show the folder of compiled models (the JIT cache), how many libraries it "
+                    "holds and their size, the most recently used first; --clear empties it "
+                    "of what kinetwork wrote there.")
+    cache.add_argument("--clear", action="store_true", help="remove every compiled library")
     sub.add_parser("methods", help="list the integration methods",
                    description="List the integration methods a model can be run with.")
 
@@ -167,7 +173,8 @@ def main(argv=None):
     """Run the ``kinetwork`` command; returns the exit code."""
     args = build_parser().parse_args(argv)
     command = {"run": _run, "validate": _validate, "equations": _equations,
-               "methods": _methods, "bench": _bench, "schema": _schema}[args.command]
+               "methods": _methods, "bench": _bench, "schema": _schema,
+               "cache": _cache}[args.command]
     try:
         return command(args)
     except kn.ModelError as exc:
@@ -407,6 +414,23 @@ def _compiled_summary(system, topo, loops):
 def _schema(args):
     import json
     print(json.dumps(kn.schema(), indent=2))
+    return 0
+
+
+def _cache(args):
+    from .simulation import jit
+    if args.clear:
+        removed = jit.clear_cache()
+        print(f"removed {removed} file{'s' * (removed != 1)} from {jit.cache_dir()}")
+        return 0
+    info = jit.cache_info()
+    print(f"{info['folder']}: {info['entries']} compiled librar"
+          f"{'y' if info['entries'] == 1 else 'ies'}, {info['bytes'] / 2**20:.1f} MiB "
+          f"(at most {jit.MAX_CACHE_BYTES / 2**20:.0f} MiB are kept)")
+    for name, size, _ in info["libraries"][:20]:
+        print(f"  {name}  {size / 1024:.0f} KiB")
+    if info["entries"] > 20:
+        print(f"  ... and {info['entries'] - 20} more")
     return 0
 
 

@@ -212,3 +212,19 @@ def test_equations_of_a_model_with_a_long_table_are_refused_in_words(tmp_path, c
     assert main(["equations", str(tmp_path / "table.json")]) == 1
     captured = capsys.readouterr()
     assert "cannot be printed in closed form" in captured.err and no_traceback(captured)
+
+
+def test_cache_shows_and_clears_only_what_kinetwork_built(tmp_path, monkeypatch, capsys):
+    from kinetwork import cli
+    folder = tmp_path / "cache"
+    monkeypatch.setenv("KINETWORK_CACHE", str(folder))
+    assert cli.main(["run", "models/double_pendulum.json", "-q", "--jit", "--t-end", "0.1"]) == 0
+    capsys.readouterr()
+    assert cli.main(["cache"]) == 0
+    shown = capsys.readouterr().out
+    assert f"{folder}: 2 compiled libraries" in shown and "rhs_" in shown
+    (folder / "notes.txt").write_text("mine")
+    assert cli.main(["cache", "--clear"]) == 0
+    assert "removed 4 files" in capsys.readouterr().out
+    assert sorted(p.name for p in folder.iterdir()) == ["notes.txt"]
+    assert cli.main(["cache"]) == 0 and ": 0 compiled libraries" in capsys.readouterr().out
