@@ -463,15 +463,7 @@ def _equations(args):
 
     model = _load(args.model)
     system = model.compile()
-    try:
-        eq = equations_sympy(system, simplified=args.simplify)
-    except ValueError as exc:
-        if "OP_CALL" not in str(exc):
-            raise
-        raise kn.ModelError(
-            f"{model.name}: the equations cannot be printed in closed form: they call a "
-            f"function, the interpolant of a signals.Table of more than "
-            f"{kn.signals.Table.expression_rows} rows") from None
+    eq = equations_sympy(system, simplified=args.simplify)     # ModelError for a Table's call
     mats = {key: eq[key] for key in ("M", "V", "G")}
     shared = eq["shared"]
     if not eq["simplified"] and args.simplify is None:

@@ -316,5 +316,5 @@ def _untranslatable(op):
     a function (the interpolant of a long ``signals.Table``), which a user can meet."""
     if op == ca.OP_CALL:
         return ModelError("the equations call a function (the interpolant of a signals.Table "
-                          "of many rows): they cannot be written in closed form")
+                          "of many rows): they cannot be printed in closed form")
     return ValueError(f"CasADi operation {_OP_NAMES.get(op, op)} has no sympy translation")

@@ -86,24 +86,32 @@ class Compiled:
         return self._get("jacobian_small", decide)
 
     def dae(self, jit=None, jacobian=False):
-        """The equations as CasADi's integrators take them: a dict of SX (VM), or an MX
-        Function of (t, x, z, p, u) around the compiled code (CasADi's integrators compile
-        nothing themselves unless handed a compiled Function)."""
+        """The equations as CasADi's integrators take them, in the time tau since the start of
+        a chunk: their parameters are the model's then that start t0 (t = t0 + tau), so one
+        integrator serves every chunk of the same length. A dict of SX (VM), or an MX
+        Function of (tau, x, z, [p; t0], u) around the compiled code (CasADi's integrators
+        compile nothing themselves unless handed a compiled Function)."""
         system = self.system
+        eq, a = system.eq, system.asm
         if not jit:
-            eq, a = system.eq, system.asm
-            return {"x": eq.x, "z": eq.z, "p": a.p, "t": a.t, "ode": eq.ode, "alg": eq.alg}
+            def build_sx():
+                tau, t0 = ca.SX.sym("tau"), ca.SX.sym("t0")
+                shift = lambda e: ca.substitute(e, a.t, tau + t0)  # noqa: E731
+                return {"x": eq.x, "z": eq.z, "p": ca.vertcat(a.p, t0), "t": tau,
+                        "ode": shift(eq.ode), "alg": shift(eq.alg)}
+            return self._get("dae_sx", build_sx)
         jacobian = jacobian and self.jacobian_small()
 
         def build():
-            t, x = ca.MX.sym("t"), ca.MX.sym("x", system.n_states)
+            tau, x = ca.MX.sym("tau"), ca.MX.sym("x", system.n_states)
             z = ca.MX.sym("z", system.n_algebraic)
-            p, empty = ca.MX.sym("p", len(system.param_names)), ca.MX(0, 1)
+            pt, empty = ca.MX.sym("p", len(system.param_names) + 1), ca.MX(0, 1)
+            t, p = tau + pt[-1], pt[:-1]
             if system.n_algebraic:
                 ode, alg = self._external(system.f_dae, jacobian, jit)(t, x, z, p)
             else:
                 ode, alg = self.rhs(jit, jacobian)(t, x, p), empty
-            return ca.Function("dae", [t, x, z, p, ca.MX.sym("u", 0)],
+            return ca.Function("dae", [tau, x, z, pt, ca.MX.sym("u", 0)],
                                [ode, alg, empty, empty], ca.dyn_in(), ca.dyn_out())
         return self._get(("dae", jacobian), build)
 

@@ -16,6 +16,7 @@ method restarts at each chunk) never depend on how fast the machine is or how lo
 
 import contextlib
 import ctypes
+import functools
 import io
 import math
 import os
@@ -33,15 +34,16 @@ from ..graph.settings import check_output, check_settings
 from ..util import quote, suggest
 from . import jit as _jit
 from .compiled import compiled
-from .methods import METHODS, Failure, choose
+from .methods import METHODS, Failure, choose, shift_times
 from .results import Results
 
 DEFAULTS = {"t_end": 10.0, "n_points": 1001, "method": "auto", "rtol": 1e-6, "atol": 1e-8,
             "step": None}
 #: a chunk of a CasADi integration is sized to about this much work (evaluations of the
-#: equations times their instructions; ~1 ns an instruction compiled, ~10 in CasADi's virtual
-#: machine): cancellation, time limits and progress are served between chunks
-CHUNK_WORK = 3e7
+#: equations times their instructions: ~1 ns an instruction compiled, ~10 in CasADi's virtual
+#: machine, so ~0.2 s either way): cancellation, time limits and progress are served between
+#: chunks, and each chunk restarts the method (a BDF method recomputes its Jacobian)
+CHUNK_WORK = {"compiled": 2e8, "vm": 2e7}
 #: the first chunk is one output interval (how much work one takes is not known before);
 #: later ones grow at most CHUNK_GROWTH-fold (each chunk restarts a multistep method: few
 #: chunks for a fast run)
@@ -82,19 +84,28 @@ class Run:
         self.signal = None              # the signal that stopped the run, if one did
         self.instructions = (system.f_rhs or system.f_dae).n_instructions()
         self.said = []                  # what the solvers printed
+        self._sink = None               # the file that catches it
 
     # -- what methods use --------------------------------------------------------------------
     @contextlib.contextmanager
-    def solver_section(self):
+    def solver_section(self, t0=0.0):
         """Run compiled solver code with its printing captured (and serialised: see
-        ``_SOLVER_LOCK``)."""
+        ``_SOLVER_LOCK``); the code integrates in the time since ``t0``, so the times it
+        names are shifted back by ``t0``."""
         box = None
+        if self._sink is None:
+            self._sink = tempfile.TemporaryFile()
         try:
-            with _SOLVER_LOCK, _solver_output() as box:
+            with _SOLVER_LOCK, _solver_output(self._sink) as box:
                 yield
         finally:                        # a failing solver's words are the ones wanted
             if box is not None and box["text"].strip():
-                self.said.append(box["text"])
+                self.said.append(shift_times(box["text"], t0))
+
+    def close(self):
+        if self._sink is not None:
+            self._sink.close()
+            self._sink = None
 
     def rate(self, t, X):
         """d(x)/dt at a consistent full state X = (x, z), as IDAS's ``init_xdot``."""
@@ -237,7 +248,7 @@ def simulate(model, t_end=None, n_points=None, method=None, rtol=None, atol=None
     stats = {}
     jit_on = _jit.enabled(jit) and system.n_states > 0
     run = Run(system, p, x0, grid, settings, None, cancel, progress, restart)
-    with _signals_stop(run):
+    with _running(run):
         if jit_on:
             run.jit = {"stats": stats, "required": jit is True, "deadline": run.deadline,
                        "cancelled": lambda: run.stop_reason() is not None}
@@ -383,8 +394,7 @@ def _integrate(run, method):
                 continue
             break
         if not method.stepper:
-            work = max(_work(run, stepper.stats) - work_before, 1.0)
-            chunk = max(1, min(CHUNK_GROWTH * m, int(m * CHUNK_WORK / work)))
+            chunk = _next_chunk(run, m, _work(run, stepper.stats) - work_before, n - 1 - k)
     if failure is not None and run.system.f_dependent is not None and \
             run.stop_reason() is None and "singular" not in failure:
         failure += _near_singular(run, np.array(X), grid)
@@ -392,6 +402,18 @@ def _integrate(run, method):
     if restarts:
         stats["restarts"] = [{"t": r["t"], "after": r["after"]} for r in restarts]
     return np.array(X), failure, stats
+
+
+def _next_chunk(run, m, work, remaining):
+    """Output intervals of the next chunk, from the work the last one (``m`` intervals) took:
+    the rest at once when even sixteen times its estimate is within a chunk's work (a fast
+    run goes in two calls), else a power of two (each length's integrator is kept) sized to
+    a chunk's work, at most CHUNK_GROWTH times the last."""
+    target = CHUNK_WORK["compiled" if run.jit else "vm"]
+    per_interval = max(work, 1.0) / m
+    if CHUNK_GROWTH * per_interval * remaining <= target:
+        return remaining
+    return 2 ** int(np.log2(max(1, min(CHUNK_GROWTH * m, target / per_interval))))
 
 
 def _work(run, stats):
@@ -487,11 +509,15 @@ def _restart(run, method, X, restarts, failure):
 
 
 @contextlib.contextmanager
-def _signals_stop(run):
-    """SIGINT and SIGTERM stop the run between chunks (main thread only: Python delivers
-    signals there), instead of a KeyboardInterrupt inside CasADi or a kill."""
+def _running(run):
+    """While a run goes: SIGINT and SIGTERM stop it between chunks (main thread only: Python
+    delivers signals there), instead of a KeyboardInterrupt inside CasADi or a kill; after
+    it, the file that caught the solvers' words is closed."""
     if threading.current_thread() is not threading.main_thread():
-        yield
+        try:
+            yield
+        finally:
+            run.close()
         return
 
     def stop(signum, frame):
@@ -505,17 +531,21 @@ def _signals_stop(run):
     try:
         yield
     finally:
+        run.close()
         for sig, handler in saved.items():
             signal.signal(sig, handler)
 
 
 @contextlib.contextmanager
-def _solver_output():
+def _solver_output(sink):
     """What the integrators print (SUNDIALS' failure chatter, CasADi's warnings) captured
     instead of reaching the user's terminal: CasADi writes through Python's sys.stdout and
-    sys.stderr, plain C code to file descriptors 1 and 2; both are caught. The text is in the
-    yielded dict's "text" afterwards. Callers hold ``_SOLVER_LOCK``."""
+    sys.stderr, plain C code to file descriptors 1 and 2; both are caught, in the file
+    ``sink`` (emptied first). The text is in the yielded dict's "text" afterwards. Callers
+    hold ``_SOLVER_LOCK``."""
     box = {"text": ""}
+    sink.seek(0)
+    sink.truncate()
     python_level = io.StringIO()
     for stream in (sys.stdout, sys.stderr):
         with contextlib.suppress(Exception):
@@ -524,8 +554,7 @@ def _solver_output():
         saved = [os.dup(1), os.dup(2)]
     except OSError:                            # no file descriptors to redirect
         saved = None
-    with tempfile.TemporaryFile() as sink, contextlib.redirect_stdout(python_level), \
-            contextlib.redirect_stderr(python_level):
+    with contextlib.redirect_stdout(python_level), contextlib.redirect_stderr(python_level):
         if saved:
             os.dup2(sink.fileno(), 1)
             os.dup2(sink.fileno(), 2)
@@ -533,7 +562,7 @@ def _solver_output():
             yield box
         finally:
             if saved:
-                ctypes.CDLL(None).fflush(None)
+                _libc().fflush(None)
                 os.dup2(saved[0], 1)
                 os.dup2(saved[1], 2)
                 for fd in saved:
@@ -541,6 +570,11 @@ def _solver_output():
                 sink.seek(0)
             box["text"] = python_level.getvalue() + (
                 sink.read().decode("utf-8", "replace") if saved else "")
+
+
+@functools.lru_cache(maxsize=1)
+def _libc():
+    return ctypes.CDLL(None)
 
 
 def _last_words(text):

@@ -11,6 +11,8 @@ cancellation, partial results and restarts, so a method only integrates. Two kin
 Adding a method is one class (or one instance of these) and one entry in ``METHODS``.
 """
 
+import re
+
 import casadi as ca
 import numpy as np
 
@@ -73,6 +75,17 @@ SUNDIALS_FLAGS = {
 }
 
 
+_TIME = re.compile(r"\b(t\s*=\s*)([-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?)")
+
+
+def shift_times(text, t0):
+    """The solvers' words with the times they name (``t = 0.0032``) moved by ``t0``: they
+    integrate each chunk in the time since its start."""
+    if not t0:
+        return text
+    return _TIME.sub(lambda m: f"{m.group(1)}{float(m.group(2)) + t0:g}", text)
+
+
 def solver_words(message):
     """What a solver said in a CasADi error, without CasADi's own framing."""
     lines = [ln.strip() for ln in message.splitlines() if ln.strip()]
@@ -125,12 +138,19 @@ class _CasadiRun:
         return opts
 
     def integrator(self, times, opts):
+        """An integrator over ``times`` in the time since ``self.t``: on an output grid of
+        equal intervals, the same one for every chunk of as many intervals."""
         m, run = self.method, self.run
         dae = run.compiled.dae(run.jit, m.newton)
-        key = ("integrator", m.plugin, self.t, tuple(times), tuple(sorted(opts.items())),
-               bool(run.jit))
-        build = lambda: ca.integrator("simulate", m.plugin, dae, self.t,  # noqa: E731
-                                      [float(s) for s in times], opts)
+        n = len(times)
+        if abs(times[-1] - self.t - n * run.spacing) <= 1e-9 * max(1.0, abs(times[-1])):
+            grid = ("uniform", n, run.spacing)          # equal intervals: j * spacing
+            taus = (np.arange(1, n + 1) * run.spacing).tolist()
+        else:
+            taus = (np.asarray(times, dtype=float) - self.t).tolist()
+            grid = tuple(taus)
+        key = ("integrator", m.plugin, grid, tuple(sorted(opts.items())), bool(run.jit))
+        build = lambda: ca.integrator("simulate", m.plugin, dae, 0.0, taus, opts)  # noqa: E731
         if m.plugin == "idas":          # its options hold the state's rate: not reusable
             return build()
         return run.integrators(key, build)
@@ -145,10 +165,10 @@ class _CasadiRun:
             opts.update(calc_ic=False, init_xdot=run.rate(self.t, self.x))
         integ = self.integrator(times, opts)
         try:
-            with run.solver_section():
-                out = integ(x0=self.x[:nx], z0=self.x[nx:], p=run.p)
+            with run.solver_section(self.t):
+                out = integ(x0=self.x[:nx], z0=self.x[nx:], p=np.append(run.p, self.t))
         except RuntimeError as exc:
-            run.said.append(solver_words(str(exc)))
+            run.said.append(shift_times(solver_words(str(exc)), self.t))
             raise Failure(solver_reason(str(exc))) from None
         X = np.vstack([np.asarray(out["xf"]), np.asarray(out["zf"])]).T
         if m.sundials:
