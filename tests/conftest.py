@@ -18,3 +18,11 @@ def jit_cache(tmp_path_factory):
 @pytest.fixture
 def seed_model():
     return double_pendulum()
+
+
+@pytest.fixture
+def seed_file(tmp_path):
+    """The seed model saved as a file, as the command line reads it."""
+    path = tmp_path / "double_pendulum.json"
+    double_pendulum().save(path)
+    return path

@@ -16,13 +16,6 @@ QUANTITIES = ["angle", "speed", "acceleration", "torque"]
 
 
 @pytest.fixture
-def seed_file(tmp_path):
-    path = tmp_path / "double_pendulum.json"
-    double_pendulum().save(path)
-    return path
-
-
-@pytest.fixture
 def blowup_file(tmp_path):
     """A torque 1/(1-t)^3 on the shoulder: every integrator fails just before t = 1."""
     m = double_pendulum()

@@ -41,13 +41,6 @@ def chain(n, probe=False):
 
 
 @pytest.fixture
-def seed_file(tmp_path):
-    path = tmp_path / "double_pendulum.json"
-    double_pendulum().save(path)
-    return path
-
-
-@pytest.fixture
 def no_compiler(monkeypatch):
     """Building a System fails the test: what it guards must not compile."""
     def refuse(*args, **kwargs):
