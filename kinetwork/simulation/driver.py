@@ -41,12 +41,14 @@ DEFAULTS = {"t_end": 10.0, "n_points": 1001, "method": "auto", "rtol": 1e-6, "at
             "step": None}
 #: a chunk of a CasADi integration is sized to about this much work (evaluations of the
 #: equations times their instructions: ~1 ns an instruction compiled, ~10 in CasADi's virtual
-#: machine, so ~0.2 s either way): cancellation, time limits and progress are served between
-#: chunks, and each chunk restarts the method (a BDF method recomputes its Jacobian)
-CHUNK_WORK = {"compiled": 2e8, "vm": 2e7}
-#: the first chunk is one output interval (how much work one takes is not known before);
-#: later ones grow at most CHUNK_GROWTH-fold (each chunk restarts a multistep method: few
-#: chunks for a fast run)
+#: machine, so 0.1 to 1 s): cancellation, time limits and progress are served between
+#: chunks, and each chunk restarts the method (a BDF method recomputes its Jacobian). The same
+#: with and without C, so that both give the same numbers
+CHUNK_WORK = 1e8
+#: the first chunk is sized as if each output interval took this many steps (how many it
+#: takes is not known before); later ones from the work the last took, growing at most
+#: CHUNK_GROWTH-fold (each chunk restarts a multistep method: few chunks for a fast run)
+FIRST_CHUNK_STEPS = 100
 CHUNK_GROWTH = 16
 #: a kinematic loop whose Jacobian in the dependent speeds has a larger condition number is
 #: at a singular configuration
@@ -325,14 +327,20 @@ def _check(system, settings, t_start, max_steps, time_limit):
 def _check_finite_start(system, t, x0, p):
     """Refuse, before integrating, a model whose numbers overflow double precision at the
     start (g = 1e300, a length of 1e300 squared in an inertia): its state or its rates are
-    not finite there, or so large that the next products will not be."""
+    not finite there, or so large that the next products will not be. Checked once per
+    start and parameter values."""
+    key = ("finite start", float(t), x0.tobytes(), np.asarray(p, dtype=float).tobytes())
+    compiled(system).memo(key, lambda: _finite_start(system, t, x0, p))
+
+
+def _finite_start(system, t, x0, p):
     values = [x0]
     if system.n_states:
         nx = system.n_states
         with np.errstate(all="ignore"):
             values += [np.asarray(v) for v in system.f_dae(t, x0[:nx], x0[nx:], p)]
     if all(np.all(np.abs(v) < OVERFLOW) for v in values):   # NaN fails too
-        return
+        return True
     raise ModelError(overflow_message(system.model, "the equations", p, system.param_names))
 
 
@@ -351,7 +359,7 @@ def _auto(run, stats):
 def _integrate(run, method):
     """States on the grid from ``method``, chunk by chunk: (X, failure or None, stats)."""
     grid, n = run.grid, len(run.grid)
-    X = [np.asarray(run.x0, dtype=float)]
+    X = _Rows(run.x0)
     stats, restarts = {}, []           # stats: of the steppers replaced by restarts
     if method.fixed and run.max_steps and run.steps_per_interval > run.max_steps:
         return np.array(X), (f"the step budget of {run.max_steps} steps per output interval "
@@ -362,7 +370,7 @@ def _integrate(run, method):
         stepper = method.start(run, grid[0], X[0])
     except Failure as failure:
         return np.array(X), failure.reason, stats
-    chunk = n - 1 if method.stepper else 1
+    chunk = n - 1 if method.stepper else _first_chunk(run, method, n - 1)
     k, failure = 0, None
     while k < n - 1:
         failure = run.stop_reason()
@@ -404,16 +412,61 @@ def _integrate(run, method):
     return np.array(X), failure, stats
 
 
+def _first_chunk(run, method, intervals):
+    """Output intervals of the first chunk, before any work is known: as many as fit a chunk's
+    work if each takes FIRST_CHUNK_STEPS steps (a fixed-step method: its own), so a cheap run
+    goes in one call; a power of two otherwise."""
+    steps = run.steps_per_interval if method.fixed else FIRST_CHUNK_STEPS
+    per_interval = 4 * steps * run.instructions
+    fit = CHUNK_WORK / per_interval
+    if fit >= intervals:
+        return intervals
+    return 2 ** int(np.log2(max(1.0, fit)))
+
+
+class _Rows:
+    """The states reached, kept as the blocks the chunks gave (a list of 10^5 rows costs more
+    to build and join than the integration of a small model)."""
+
+    def __init__(self, x0):
+        self.blocks = [np.asarray(x0, dtype=float)[None, :]]
+        self.n = 1
+
+    def __len__(self):
+        return self.n
+
+    def __getitem__(self, i):
+        if i < 0:
+            i += self.n
+        for block in self.blocks:
+            if i < len(block):
+                return block[i]
+            i -= len(block)
+        raise IndexError(i)
+
+    def extend(self, rows):
+        rows = np.asarray(rows, dtype=float).reshape(-1, self.blocks[0].shape[1])
+        if len(rows):
+            self.blocks.append(rows)
+            self.n += len(rows)
+
+    def append(self, row):
+        self.extend(np.asarray(row)[None, :])
+
+    def __array__(self, dtype=None, copy=None):
+        out = np.vstack(self.blocks)
+        return out if dtype is None else out.astype(dtype)
+
+
 def _next_chunk(run, m, work, remaining):
     """Output intervals of the next chunk, from the work the last one (``m`` intervals) took:
     the rest at once when even sixteen times its estimate is within a chunk's work (a fast
     run goes in two calls), else a power of two (each length's integrator is kept) sized to
     a chunk's work, at most CHUNK_GROWTH times the last."""
-    target = CHUNK_WORK["compiled" if run.jit else "vm"]
     per_interval = max(work, 1.0) / m
-    if CHUNK_GROWTH * per_interval * remaining <= target:
+    if CHUNK_GROWTH * per_interval * remaining <= CHUNK_WORK:
         return remaining
-    return 2 ** int(np.log2(max(1, min(CHUNK_GROWTH * m, target / per_interval))))
+    return 2 ** int(np.log2(max(1, min(CHUNK_GROWTH * m, CHUNK_WORK / per_interval))))
 
 
 def _work(run, stats):
