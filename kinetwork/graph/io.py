@@ -10,7 +10,6 @@ when the whole file is sound.
 import json
 import math
 import os
-import re
 import stat
 
 from ..components.base import _NAME, NAME_LIMIT, REGISTRY

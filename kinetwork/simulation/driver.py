@@ -15,13 +15,8 @@ method restarts at each chunk) never depend on how fast the machine is or how lo
 """
 
 import contextlib
-import ctypes
-import functools
-import io
 import math
-import os
 import signal
-import sys
 import tempfile
 import threading
 import time
@@ -33,7 +28,9 @@ from ..errors import ModelError, SimulationError
 from ..graph.settings import check_output, check_settings
 from ..util import quote, suggest
 from . import jit as _jit
+from .capture import SOLVER_LOCK, last_words, solver_output
 from .compiled import compiled
+from .loopwatch import near_singular, watch
 from .methods import METHODS, Failure, choose, shift_times
 from .results import Results
 
@@ -50,19 +47,11 @@ CHUNK_WORK = 1e8
 #: CHUNK_GROWTH-fold (each chunk restarts a multistep method: few chunks for a fast run)
 FIRST_CHUNK_STEPS = 100
 CHUNK_GROWTH = 16
-#: a kinematic loop whose Jacobian in the dependent speeds has a larger condition number is
-#: at a singular configuration
-SINGULAR_CONDITION = 1e8
-#: ... and near one, for the message of a failure, beyond this
-NEAR_SINGULAR_CONDITION = 1e4
 #: restarts after a failure, with ``restart=True``, at most
 MAX_RESTARTS = 3
 #: a restarted run must keep the loops closed to this (m, or rotation-matrix entries)
 RESTART_CLOSURE = 1e-6
 
-#: the solvers print through file descriptors 1 and 2, which belong to the whole process:
-#: one integration section at a time captures them
-_SOLVER_LOCK = threading.RLock()
 
 
 class Run:
@@ -92,13 +81,13 @@ class Run:
     @contextlib.contextmanager
     def solver_section(self, t0=0.0):
         """Run compiled solver code with its printing captured (and serialised: see
-        ``_SOLVER_LOCK``); the code integrates in the time since ``t0``, so the times it
+        ``capture.SOLVER_LOCK``); the code integrates in the time since ``t0``, so the times it
         names are shifted back by ``t0``."""
         box = None
         if self._sink is None:
             self._sink = tempfile.TemporaryFile()
         try:
-            with _SOLVER_LOCK, _solver_output(self._sink) as box:
+            with SOLVER_LOCK, solver_output(self._sink) as box:
                 yield
         finally:                        # a failing solver's words are the ones wanted
             if box is not None and box["text"].strip():
@@ -134,45 +123,6 @@ class Run:
         reason = self.stop_reason()
         if reason is not None:
             raise Failure(reason, states)
-
-    # -- the watch over loops ------------------------------------------------------------------
-    def conditioning(self, X):
-        """(condition number, sign of the determinant) of the loops' Jacobian in the
-        dependent speeds at each full state in X; None for a model without such loops."""
-        f = self.system.f_dependent
-        if f is None or not len(X):
-            return None
-        n = f.size1_out(0)
-        J = np.asarray(f.map(len(X))(np.asarray(X).T, self.p)).reshape(n, len(X), n)
-        J = np.transpose(J, (1, 0, 2))
-        with np.errstate(all="ignore"):
-            s = np.linalg.svd(J, compute_uv=False)
-            cond = np.where(s[:, -1] > 0, s[:, 0] / s[:, -1], np.inf)
-            sign = np.linalg.slogdet(J)[0]
-        return cond, sign
-
-    def singular(self, X, before):
-        """Index of the first row of X at which the loops pass a singular configuration (the
-        dependent Jacobian turns singular, or its determinant changes sign from the row
-        ``before``), or None."""
-        both = self.conditioning(np.vstack([before[None, :], X]))
-        if both is None:
-            return None
-        cond, sign = both
-        for i in range(1, len(cond)):
-            if not np.isfinite(cond[i]) or cond[i] > SINGULAR_CONDITION or \
-                    (sign[i] * sign[i - 1] < 0):
-                return i - 1
-        return None
-
-    def singular_words(self, t):
-        system = self.system
-        loops = "; ".join(" - ".join(c.loop) for c in system.topology.cuts)
-        return (f"the kinematic loop ({loops}) reaches a singular configuration (a dead "
-                f"point) at about t = {t:g} s: the closure no longer fixes the dependent speeds "
-                f"({', '.join(system.dependent_names)}), so the mechanism folds flat, locks or "
-                f"branches there; choose other independent coordinates (give q0 of the joints "
-                f"that drive it, or mark another joint cut), or stop before it")
 
 
 def simulate(model, t_end=None, n_points=None, method=None, rtol=None, atol=None,
@@ -281,7 +231,7 @@ def simulate(model, t_end=None, n_points=None, method=None, rtol=None, atol=None
     if failure is not None:
         reached = float(t[-1]) if len(t) else float(t_start)
         results.partial = {"t_reached": reached, "reason": failure}
-        said = _last_words(stats.get("solver_output", ""))
+        said = last_words(stats.get("solver_output", ""))
         raise SimulationError(f"{key} failed after t = {reached:g} s (of "
                               f"{settings['t_end']:g} s): {failure}"
                               + (f" (the solver said: {said})" if said else ""),
@@ -389,7 +339,7 @@ def _integrate(run, method):
                 # to keep every output before the failure (and stop there all the same)
                 new, failure = _piecewise(run, method, grid[k], X[-1], times, failure)
         if run.system.f_dependent is not None:
-            new, failure = _watch(run, X, new, failure)
+            new, failure = watch(run, X, new, failure)
         X.extend(new)
         k = len(X) - 1
         if run.progress is not None and len(new):
@@ -405,7 +355,7 @@ def _integrate(run, method):
             chunk = _next_chunk(run, m, _work(run, stepper.stats) - work_before, n - 1 - k)
     if failure is not None and run.system.f_dependent is not None and \
             run.stop_reason() is None and "singular" not in failure:
-        failure += _near_singular(run, np.array(X), grid)
+        failure += near_singular(run, np.array(X), grid)
     stats = _merge(stats, stepper.stats)
     if restarts:
         stats["restarts"] = [{"t": r["t"], "after": r["after"]} for r in restarts]
@@ -501,40 +451,6 @@ def _piecewise(run, method, t, x, times, reason):
     return np.array(out).reshape(-1, len(x)), reason
 
 
-def _watch(run, X, new, failure):
-    """(rows, failure): the new rows up to a singular configuration of the loops, and the
-    failure that stops the run there, if any."""
-    if not len(new):
-        return new, failure
-    i = run.singular(new, X[-1])
-    if i is None:
-        return new, failure
-    return new[:i], run.singular_words(float(run.grid[len(X) + i]))
-
-
-def _near_singular(run, X, grid):
-    """A note for a failure of a model with loops that ended at a singular configuration: the
-    Jacobian in the dependent speeds is ill-conditioned at the last output, or its
-    determinant, extrapolated from the last two outputs, vanishes before the next one (a
-    dead point that the integrator could not pass)."""
-    both = run.conditioning(X[-2:])
-    if both is None:
-        return ""
-    cond, _ = both
-    f, n = run.system.f_dependent, run.system.f_dependent.size1_out(0)
-    det = [float(np.linalg.det(np.asarray(f(row, run.p)).reshape(n, n))) for row in X[-2:]]
-    folding = len(det) == 2 and det[0] * det[1] > 0 and abs(det[1]) < abs(det[0]) and \
-        abs(det[1]) < abs(det[0] - det[1])
-    if cond[-1] < NEAR_SINGULAR_CONDITION and not folding:
-        return ""
-    loops = "; ".join(" - ".join(c.loop) for c in run.system.topology.cuts)
-    return (f"; there (t = {grid[len(X) - 1]:g} s) the kinematic loop ({loops}) is at a "
-            f"singular configuration, a dead point: its Jacobian in the dependent speeds "
-            f"({', '.join(run.system.dependent_names)}) has condition number "
-            f"{cond[-1]:.2g} and its determinant goes to zero, so the mechanism folds flat, "
-            f"locks or branches")
-
-
 def _restart(run, method, X, restarts, failure):
     """With ``restart=True``: start ``method`` afresh from the last state, if it is sound and
     the restarted run continues it without a jump. Returns whether the run goes on."""
@@ -587,53 +503,3 @@ def _running(run):
         run.close()
         for sig, handler in saved.items():
             signal.signal(sig, handler)
-
-
-@contextlib.contextmanager
-def _solver_output(sink):
-    """What the integrators print (SUNDIALS' failure chatter, CasADi's warnings) captured
-    instead of reaching the user's terminal: CasADi writes through Python's sys.stdout and
-    sys.stderr, plain C code to file descriptors 1 and 2; both are caught, in the file
-    ``sink`` (emptied first). The text is in the yielded dict's "text" afterwards. Callers
-    hold ``_SOLVER_LOCK``."""
-    box = {"text": ""}
-    sink.seek(0)
-    sink.truncate()
-    python_level = io.StringIO()
-    for stream in (sys.stdout, sys.stderr):
-        with contextlib.suppress(Exception):
-            stream.flush()
-    try:
-        saved = [os.dup(1), os.dup(2)]
-    except OSError:                            # no file descriptors to redirect
-        saved = None
-    with contextlib.redirect_stdout(python_level), contextlib.redirect_stderr(python_level):
-        if saved:
-            os.dup2(sink.fileno(), 1)
-            os.dup2(sink.fileno(), 2)
-        try:
-            yield box
-        finally:
-            if saved:
-                _libc().fflush(None)
-                os.dup2(saved[0], 1)
-                os.dup2(saved[1], 2)
-                for fd in saved:
-                    os.close(fd)
-                sink.seek(0)
-            box["text"] = python_level.getvalue() + (
-                sink.read().decode("utf-8", "replace") if saved else "")
-
-
-@functools.lru_cache(maxsize=1)
-def _libc():
-    return ctypes.CDLL(None)
-
-
-def _last_words(text):
-    """The solver's own last line (what it said when it failed), shortened."""
-    lines = [ln.strip() for ln in text.splitlines() if ln.strip()]
-    if not lines:
-        return ""
-    line = lines[-1]
-    return line if len(line) <= 200 else line[:197] + "..."
