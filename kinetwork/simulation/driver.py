@@ -104,10 +104,6 @@ class Run:
         rate = self.system.f_dae(t, X[:nx], X[nx:], self.p)[0]
         return tuple(float(v) for v in np.asarray(rate).ravel())
 
-    def integrators(self, key, build):
-        """A CasADi integrator kept with the System: the same chunks of the same run reuse it."""
-        return self.compiled.integrator(key, build)
-
     def stop_reason(self):
         """Why the run must stop now (cancelled, interrupted, out of time), or None."""
         if self.signal is not None:
@@ -428,10 +424,12 @@ def _work(run, stats):
 
 
 def _merge(total, more):
-    out = dict(total)
-    for k, v in more.items():
-        out[k] = out.get(k, 0) + v if isinstance(v, int) and k in out and \
-            not isinstance(v, bool) else v
+    """The statistics of a stepper and of the one that replaced it (a restart): counters
+    added, anything else (a step size, a residual) as the later one says."""
+    out = {**total, **more}
+    for key in total.keys() & more.keys():
+        if isinstance(more[key], int) and not isinstance(more[key], bool):
+            out[key] = total[key] + more[key]
     return out
 
 

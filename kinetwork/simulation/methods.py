@@ -153,7 +153,7 @@ class _CasadiRun:
         build = lambda: ca.integrator("simulate", m.plugin, dae, 0.0, taus, opts)  # noqa: E731
         if m.plugin == "idas":          # its options hold the state's rate: not reusable
             return build()
-        return run.integrators(key, build)
+        return run.compiled.integrator(key, build)
 
     def advance(self, times):
         m, run = self.method, self.run
