@@ -325,10 +325,7 @@ class Component:
             raise ModelError(f"{type(self).__name__} {self.name!r} has no parameter "
                              f"{quote(key)}{suggest(key, self.params)}; parameters: "
                              f"{', '.join(self.params) or 'none'}")
-        spec = self.params[key]
-        value = spec.normalize(value, f"{self.name}.{key}")
-        if value is None and not spec.optional:
-            raise ModelError(f"{self.name}.{key}: a value is required")
+        value = self.params[key].normalize(value, f"{self.name}.{key}")
         self.given[key] = value
         self._values[key] = value
 
@@ -340,8 +337,7 @@ class Component:
         if key == "name":
             raise ModelError(f"{self.name!r}: a component cannot be renamed; build a new one "
                              f"(a model refers to its components by name)")
-        by_file_name = {spec.name: spec for spec in self.params.values()}
-        if key in by_file_name:        # a parameter whose attribute has another name
+        if key in self.params:         # a parameter whose attribute has another name
             self.set_param(key, value)
             return
         raise ModelError(f"{type(self).__name__} {self.name!r} has no parameter "
