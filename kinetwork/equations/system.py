@@ -113,7 +113,7 @@ class System:
         integrator solves them only to its tolerance."""
         if not self.n_algebraic or not len(X):
             return X
-        Z = np.asarray(self._f_polish.map(len(X))(np.asarray(X).T, p)).T
+        Z = np.asarray(mapped(self._f_polish, len(X))(np.asarray(X).T, p)).T
         out = np.array(X, dtype=float)
         ok = np.all(np.isfinite(Z), axis=1)
         out[ok, self.n_states:] = Z[ok]
@@ -155,7 +155,7 @@ class System:
         X = np.atleast_2d(np.asarray(X, dtype=float))
         if self.eq.residual is None:
             return np.zeros(len(X))
-        return np.asarray(self._f_residual.map(len(X))(X.T, p)).ravel()
+        return np.asarray(mapped(self._f_residual, len(X))(X.T, p)).ravel()
 
     @functools.cached_property
     def _f_residual(self):
@@ -262,7 +262,7 @@ class System:
         ``f_out`` replaces the output Function (its compiled twin)."""
         t = np.atleast_1d(np.asarray(t, dtype=float))
         X = np.atleast_2d(np.asarray(x, dtype=float))
-        return np.asarray(_mapped(f_out or self.f_out, len(t))(t[None, :], X.T, p)).T
+        return np.asarray(mapped(f_out or self.f_out, len(t))(t[None, :], X.T, p)).T
 
     @functools.cached_property
     def damped(self):
@@ -335,6 +335,6 @@ def overflow_message(model, what, p, names):
 
 
 @functools.lru_cache(maxsize=64)
-def _mapped(f, n):
+def mapped(f, n):
     """``f.map(n)``, made once per Function and size (making it costs ~0.5 ms)."""
     return f.map(n)

@@ -4,6 +4,8 @@ partition of the speeds no longer holds, and every formulation must stop there, 
 
 import numpy as np
 
+from ..equations.system import mapped
+
 #: a kinematic loop whose Jacobian in the dependent speeds has a larger condition number is
 #: at a singular configuration
 SINGULAR_CONDITION = 1e8
@@ -18,7 +20,7 @@ def conditioning(run, X):
     if f is None or not len(X):
         return None
     n = f.size1_out(0)
-    J = np.asarray(f.map(len(X))(np.asarray(X).T, run.p)).reshape(n, len(X), n)
+    J = np.asarray(mapped(f, len(X))(np.asarray(X).T, run.p)).reshape(n, len(X), n)
     J = np.transpose(J, (1, 0, 2))
     with np.errstate(all="ignore"):
         s = np.linalg.svd(J, compute_uv=False)
