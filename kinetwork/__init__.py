@@ -16,6 +16,7 @@ from .equations.system import System
 from .errors import ModelError, SimulationError
 from .graph.io import dumps, load, loads
 from .graph.model import Model
+from .graph.subsystem import Subsystem
 from .schema import schema
 from .simulation.driver import simulate
 from .simulation.methods import METHODS
@@ -23,6 +24,6 @@ from .simulation.results import Results
 
 __version__ = "0.1.0"
 
-__all__ = ["METHODS", "Model", "ModelError", "Probe", "Results", "SimulationError", "System",
+__all__ = ["METHODS", "Model", "ModelError", "Probe", "Results", "SimulationError", "Subsystem", "System",
            "dumps", "load", "loads", "multibody", "rotational", "schema", "signals",
            "simulate", "translational"]

@@ -7,6 +7,7 @@ parsed tree serves validation with numbers and compilation with symbols.
 """
 
 import ast
+import copy
 import functools
 import math
 
@@ -70,6 +71,8 @@ class Expression:
         elif isinstance(node, ast.Name):
             if node.id not in CONSTANTS:
                 self.names.add(node.id)
+        elif isinstance(node, ast.Attribute) and dotted(node):
+            self.names.add(dotted(node))       # a parameter of a subsystem: "cyl1.L"
         elif isinstance(node, ast.BinOp) and type(node.op) in _BINARY:
             self._check(node.left)
             self._check(node.right)
@@ -109,6 +112,8 @@ class Expression:
                 if node.id in env:
                     return env[node.id]
                 return CONSTANTS[node.id]
+            if isinstance(node, ast.Attribute):
+                return env[dotted(node)]
             if isinstance(node, ast.BinOp):
                 return _BINARY[type(node.op)](ev(node.left), ev(node.right))
             if isinstance(node, ast.UnaryOp):
@@ -123,6 +128,42 @@ class Expression:
 
     def __repr__(self):
         return f"Expression({self.text!r})"
+
+
+def dotted(node):
+    """The path of a name like ``cyl1.piston.m`` (names of subsystem parameters are paths),
+    or None for any other attribute access."""
+    parts = []
+    while isinstance(node, ast.Attribute):
+        parts.append(node.attr)
+        node = node.value
+    if not isinstance(node, ast.Name):
+        return None
+    return ".".join([node.id, *reversed(parts)])
+
+
+def rename(text, names):
+    """``text`` with each free name in ``names`` (name -> expression text) replaced by its
+    expression, parenthesised as needed: how a subsystem's parameter expressions are written
+    in the names of the model it is placed in."""
+    tree = parse(text)._tree
+
+    class Renamer(ast.NodeTransformer):
+        def visit_Call(self, node):          # a function's name is not a free name
+            node.args = [self.visit(arg) for arg in node.args]
+            return node
+
+        def visit_Attribute(self, node):
+            path = dotted(node)
+            return _replacement(names[path]) if path in names else node
+
+        def visit_Name(self, node):
+            return _replacement(names[node.id]) if node.id in names else node
+    return ast.unparse(Renamer().visit(copy.deepcopy(tree)))
+
+
+def _replacement(text):
+    return ast.parse(text, mode="eval").body
 
 
 def casadi_functions():

@@ -9,7 +9,7 @@ schema cannot: wiring, units of expressions, physical sense).
 """
 
 from .components.base import REGISTRY
-from .graph.io import FORMAT, KEYS, VERSION
+from .graph.io import DEFINITION_KEYS, FORMAT, KEYS, KEYS_V2, VERSION
 from .graph.settings import SIMULATION_KEYS
 from .simulation.methods import METHODS
 
@@ -20,35 +20,74 @@ EXPRESSION = {"type": "string", "minLength": 1,
 SCALAR = {"anyOf": [NUMBER, EXPRESSION]}
 
 
+PORT_PATH = {"type": "string", "pattern": IDENT[:-1] + r"\.[A-Za-z_][A-Za-z0-9_]*$"}
+
+
 def schema():
-    """The JSON Schema (draft 2020-12) of a kinetwork model file, as a dict."""
+    """The JSON Schema (draft 2020-12) of a kinetwork model file, as a dict.
+
+    Version 1 files hold components of kinetwork's types; version 2 files may also expose
+    ``ports``, place subsystems (a ``type`` naming a definition) and keep ``definitions``,
+    inline or as ``{"file": "relative/path.json"}``."""
     types = sorted(REGISTRY)
+    body = {
+        "description": {"type": "string"},
+        "parameters": {"type": "object", "propertyNames": {"pattern": IDENT},
+                       "additionalProperties": NUMBER},
+        "ports": {"type": "object", "propertyNames": {"pattern": IDENT},
+                  "additionalProperties": PORT_PATH,
+                  "description": "ports shown when the model is placed as a subsystem: "
+                                 "name -> 'component.port'"},
+        "components": {"type": "array", "items": {"oneOf": [
+            *(_component(t) for t in types), _subsystem(types)]}},
+        "connections": {"type": "array", "items": {
+            "type": "array", "minItems": 2, "maxItems": 2, "items": PORT_PATH}},
+        "layout": {"type": "object"},
+    }
+    reference = {"type": "object", "required": ["file"], "additionalProperties": False,
+                 "properties": {"file": {
+                     "type": "string", "minLength": 1, "pattern": r"^(?![/\\])(?!.*://)",
+                     "description": "a model file, relative to this one, inside its folder"}}}
+    inline = {"type": "object", "additionalProperties": False,
+              "properties": {key: body[key] for key in DEFINITION_KEYS}}
     return {
         "$schema": "https://json-schema.org/draft/2020-12/schema",
-        "$id": "https://kinetwork.dev/schema/model-v1.json",
+        "$id": f"https://kinetwork.dev/schema/model-v{VERSION}.json",
         "title": "kinetwork model",
-        "description": "A wiring diagram of multibody, 1-D and signal components "
-                       f"(format {FORMAT!r}, version {VERSION}).",
+        "description": "A wiring diagram of multibody, 1-D and signal components, and of "
+                       f"subsystems (format {FORMAT!r}, versions 1 to {VERSION}).",
         "type": "object",
         "required": ["format", "version", "name", "components"],
         "additionalProperties": False,
         "properties": {
             "format": {"const": FORMAT},
-            "version": {"const": VERSION},
+            "version": {"enum": list(range(1, VERSION + 1))},
             "name": {"type": "string", "minLength": 1},
-            "description": {"type": "string"},
-            "parameters": {"type": "object", "propertyNames": {"pattern": IDENT},
-                           "additionalProperties": NUMBER},
-            "components": {"type": "array",
-                           "items": {"oneOf": [_component(t) for t in types]}},
-            "connections": {"type": "array", "items": {
-                "type": "array", "minItems": 2, "maxItems": 2,
-                "items": {"type": "string", "pattern": IDENT[:-1] + r"\.[A-Za-z_][A-Za-z0-9_]*$"}}},
+            **body,
             "simulation": {"type": "object", "additionalProperties": False,
                            "properties": _simulation()},
-            "layout": {"type": "object"},
+            "definitions": {"type": "object",
+                            "propertyNames": {"pattern": IDENT, "not": {"enum": types}},
+                            "additionalProperties": {"oneOf": [reference, inline]}},
         },
-        "propertyNames": {"enum": list(KEYS)},
+        "if": {"properties": {"version": {"const": 1}}},
+        "then": {"propertyNames": {"enum": list(KEYS)}},
+        "else": {"propertyNames": {"enum": list(KEYS_V2)}},
+    }
+
+
+def _subsystem(types):
+    return {
+        "type": "object", "title": "subsystem",
+        "description": "A placed subsystem: its type names a definition (of this file, a "
+                       "file next to it, or a library folder); params set its parameters.",
+        "required": ["name", "type"], "additionalProperties": False,
+        "properties": {
+            "name": {"type": "string", "pattern": IDENT},
+            "type": {"type": "string", "pattern": IDENT, "not": {"enum": types}},
+            "params": {"type": "object", "propertyNames": {"pattern": IDENT},
+                       "additionalProperties": SCALAR},
+        },
     }
 
 

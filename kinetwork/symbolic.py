@@ -234,11 +234,12 @@ def coordinate_symbol(state_name, prefix="q"):
     Multi-DOF joints ("ball.q[1]") give "q_ball_1"; named parts of a coordinate keep their
     name ("free.quat[2]" -> "q_free_quat_2", "free.w[0]" with prefix qd -> "qd_free_w_0").
     """
-    joint, _, coord = state_name.partition(".")
+    joint, _, coord = state_name.rpartition(".")
     label, _, rest = coord.partition("[")
     index = rest[:-1]
     named = f"_{label}" if label not in ("q", "qd") else ""
-    return f"{prefix}_{joint}{named}" + (f"_{index}" if index else "")
+    # a joint in a subsystem is named by path: "upper.joint" -> "upper_joint"
+    return f"{prefix}_{joint.replace('.', '_')}{named}" + (f"_{index}" if index else "")
 
 
 def simplify(expr, floor=0.0):

@@ -19,7 +19,7 @@ def test_expressions(text, value):
 
 
 @pytest.mark.parametrize("text", [
-    "__import__('os').system('true')", "L1.real", "[1, 2]", "lambda: 1", "x if y else z",
+    "__import__('os').system('true')", "L1.real()", "L1[0].real", "[1, 2]", "lambda: 1", "x if y else z",
     "open('f')", "'abc'", "L1[0]", "True", "a < b", "{1: 2}", "f'{x}'", "1 +",
     "sin(x=1)", "x" * 3000,
 ])
@@ -28,10 +28,23 @@ def test_expressions_refuse_anything_but_arithmetic(text):
         Expression(text)
 
 
+def test_a_dotted_name_is_a_path_never_an_attribute():
+    # the flat model of subsystems names parameters by path ("cyl1.L"): a dotted name is
+    # looked up whole, never as an attribute of anything
+    expr = Expression("-L1.real/2 + cyl1.piston.m")
+    assert expr.names == {"L1.real", "cyl1.piston.m"}
+    assert expr.evaluate({"L1.real": 4.0, "cyl1.piston.m": 1.0}) == -1.0
+    with pytest.raises(KeyError):
+        expr.evaluate({"L1": 4.0, "cyl1.piston.m": 1.0})
+    # in what a user writes, a path is refused: expressions use their own model's parameters
+    with pytest.raises(kn.ModelError, match=r"'L1.real' is not a parameter here"):
+        kn.multibody.RigidBody("b", mass="L1.real")
+
+
 @pytest.mark.parametrize("text, message", [
     ("open('f')", r"call of 'open' is not allowed"),
     ("sine(t)", r"call of 'sine' is not allowed \(did you mean 'sin'\?\)"),
-    ("L1.real", r"Attribute is not allowed"),
+    ("L1[0].real", r"Attribute is not allowed"),
     ("(lambda: 1)()", r"calling anything but a named function"),
     ("sin(x=1)", r"sin\(\) takes no keyword arguments"),
     ("'abc'", r"only numbers are allowed as constants"),

@@ -188,6 +188,11 @@ class Param:
                 expr = parse(value)
             except ModelError as exc:
                 raise ModelError(f"{where}: {exc}") from None
+            dotted = sorted(n for n in expr.names if "." in n)
+            if dotted:
+                raise ModelError(f"{where}: {quote(dotted[0])} is not a parameter here: "
+                                 f"expressions use the parameters of their own model (give a "
+                                 f"subsystem's parameters with its params)")
             if "t" in expr.names and not self.time:
                 raise ModelError(f"{where}: time 't' is not allowed in {quote(value)}; "
                                  f"this parameter is constant")

@@ -170,7 +170,7 @@ class _Loops:
             else ca.SX(self.phi.shape[0], 0)
         loop_coords = set(np.nonzero(np.asarray(
             ca.DM(ca.jacobian(self.phi, q).sparsity(), 1)).any(axis=0))[0])
-        quaternion = sorted({asm.coordinate_names[i].split(".")[0] for i in loop_coords
+        quaternion = sorted({asm.coordinate_names[i].rsplit(".", 1)[0] for i in loop_coords
                              if not asm.regular[i]})
         if quaternion:
             loops = "; ".join(", ".join(c.loop) for c, _ in asm.cuts)
@@ -247,7 +247,7 @@ class _Loops:
             speed = asm.speed_of[k]
             if asm.given[k] or asm.u_given[speed]:
                 tiers[2].append(speed)
-            elif names[k].split(".")[0] in cut_joints:
+            elif names[k].rsplit(".", 1)[0] in cut_joints:
                 tiers[0].append(speed)
             else:
                 tiers[1].append(speed)
@@ -268,7 +268,7 @@ class _Loops:
                 dep.append(tier[j])
                 basis = np.column_stack([basis, Jr[:, tier[j]]])
         if len(dep) < rank:
-            quaternion = sorted({n.split(".")[0] for k, n in enumerate(names)
+            quaternion = sorted({n.rsplit(".", 1)[0] for k, n in enumerate(names)
                                  if k in loop_coords and not asm.regular[k]})
             loops = "; ".join(", ".join(c.loop) for c, _ in asm.cuts)
             raise ModelError(

@@ -101,7 +101,7 @@ class System:
         null = vectors[:, values <= 1e-12 * scale]
         involved = [self.speed_names[i] for i in range(len(self.speed_names))
                     if np.max(np.abs(null[i])) > 1e-3]
-        joints = list(dict.fromkeys(n.split(".")[0] for n in involved))
+        joints = list(dict.fromkeys(n.rsplit(".", 1)[0] for n in involved))
         raise ModelError(f"the mass matrix is singular at the initial state: "
                          f"{', '.join(joints)} move(s) no mass or inertia in the direction of "
                          f"{', '.join(involved)} (give the bodies they carry mass or inertia, "

@@ -17,9 +17,13 @@ from ..errors import ModelError
 from ..util import QUOTE_LIMIT, quote, suggest
 from .model import Model, model_name_problem, text_problem
 from .settings import check_setting, check_steps
-from .writer import FORMAT, KEYS, VERSION, _kind, _plain, dumps, model_to_dict, save
+from .subsystem import Subsystem
+from .writer import (DEFINITION_KEYS, FORMAT, KEYS, KEYS_V2, VERSION, _kind, _plain, dumps,
+                     model_to_dict, save)
 
-SUPPORTED = (1,)
+SUPPORTED = (1, 2)
+#: folders of subsystem files, after a file's own definitions and its folder
+LIBRARY_ENV = "KINETWORK_LIBRARY"
 __all__ = ["FORMAT", "KEYS", "VERSION", "dumps", "load", "loads", "model_from_dict",
            "model_to_dict", "save"]
 REQUIRED = ("format", "version", "name", "components")
@@ -32,7 +36,7 @@ MAX_FILE_SIZE = 64 * 2**20
 
 
 # -- reading ----------------------------------------------------------------------------------
-def load(path, validate=True):
+def load(path, validate=True, library=None):
     """Read a model file.
 
     Parameters
@@ -40,6 +44,11 @@ def load(path, validate=True):
     path : str or os.PathLike
     validate : bool, optional
         Also check the wiring (``Model.validate``); False reads a model saved half-built.
+    library : list of folders, optional
+        Where subsystem definitions named by a component's ``type`` are looked for
+        (``<type>.json``), after the file's own ``definitions`` and its folder. The
+        environment variable ``KINETWORK_LIBRARY`` (folders separated by ``os.pathsep``)
+        adds more.
 
     Returns
     -------
@@ -51,6 +60,13 @@ def load(path, validate=True):
         Every problem with the file, each message starting with the file name and the place.
     """
     source = os.fspath(path)
+    text = _read(source)
+    folder = os.path.dirname(os.path.abspath(source))
+    return loads(text, source=source, validate=validate, library=library, folder=folder)
+
+
+def _read(source):
+    """The text of a model file, refused past MAX_FILE_SIZE or when not UTF-8."""
     too_big = f"{source}: larger than {MAX_FILE_SIZE // 2**20} MiB, too large for a model file"
     try:
         with open(source, "rb") as fh:
@@ -65,13 +81,12 @@ def load(path, validate=True):
     if len(raw) > MAX_FILE_SIZE:
         raise ModelError(too_big)
     try:
-        text = raw.decode("utf-8-sig")     # tolerate the BOM some editors write
+        return raw.decode("utf-8-sig")     # tolerate the BOM some editors write
     except UnicodeDecodeError as exc:
         raise ModelError(f"{source}: not UTF-8 text (byte {exc.start})") from None
-    return loads(text, source=source, validate=validate)
 
 
-def loads(text, source=None, validate=True):
+def loads(text, source=None, validate=True, library=None, folder=None):
     """Read a model from JSON text, as :func:`load` does.
 
     Parameters
@@ -79,6 +94,11 @@ def loads(text, source=None, validate=True):
     text : str
     source : str, optional
         Where the text came from, prefixed to every message.
+    library : list of folders, optional
+        As for :func:`load`.
+    folder : str, optional
+        The folder file references of ``definitions`` are relative to (and may not leave);
+        without it a text may not reference files.
     """
     if not isinstance(text, (str, bytes, bytearray)):
         raise ModelError(_at(source, f"expected JSON text, got {type(text).__name__}"))
@@ -93,10 +113,11 @@ def loads(text, source=None, validate=True):
                                      f"{exc.msg}{end}")) from None
     except (ValueError, RecursionError) as exc:
         raise ModelError(_at(source, f"invalid JSON ({exc})")) from None
-    return model_from_dict(data, source=source, validate=validate)
+    return model_from_dict(data, source=source, validate=validate,
+                           context=Context.top(folder, library))
 
 
-def model_from_dict(data, source=None, validate=True):
+def model_from_dict(data, source=None, validate=True, context=None):
     """Build a Model from a file's parsed JSON, or refuse it whole.
 
     Parameters
@@ -107,9 +128,13 @@ def model_from_dict(data, source=None, validate=True):
         File name, prefixed to every message.
     validate : bool, optional
         Also run ``Model.validate`` (wiring, loops, names used in expressions).
+    context : Context, optional
+        Where subsystem definitions are found (default: no folder, the library of
+        ``KINETWORK_LIBRARY``).
     """
     problems = []
-    model = _attempt(problems, "top level", _build, data, problems)
+    context = context or Context.top(None, None)
+    model = _attempt(problems, "top level", _build, data, problems, context)
     if problems:
         raise ModelError([_at(source, p) for p in problems])
     if validate:
@@ -120,16 +145,19 @@ def model_from_dict(data, source=None, validate=True):
     return model
 
 
-def _build(data, problems):
+def _build(data, problems, context):
     if not isinstance(data, dict):
         problems.append(f"top level: must be an object {{...}}, got {_kind(data)}")
         return None
     _repeated(data, "", problems)
-    problems.extend(f"{quote(key)}: unknown key{suggest(key, KEYS)}; keys are "
-                    f"{', '.join(KEYS)}" for key in data if key not in KEYS)
+    fmt, version = data.get("format", FORMAT), data.get("version", VERSION)
+    keys = KEYS_V2 if version == 2 else KEYS
+    problems.extend(f"{quote(key)}: unknown key{suggest(key, keys)}; keys are "
+                    f"{', '.join(keys)}" + (" (ports and definitions need version 2)"
+                                            if key in KEYS_V2 else "")
+                    for key in data if key not in keys)
     problems.extend(f"{key}: required key missing" for key in REQUIRED if key not in data)
     # another format or version: whatever else looks wrong is noise, so stop here
-    fmt, version = data.get("format", FORMAT), data.get("version", VERSION)
     if fmt != FORMAT:
         problems.append(f"format: {quote(fmt)} is not a kinetwork model file "
                         f"(expected {FORMAT!r})")
@@ -145,6 +173,17 @@ def _build(data, problems):
         problems.append(f"name: {problem}")
         name = "unnamed"
     model = Model(name)
+    context = context.file(_attempt(problems, "definitions", _entries,
+                                    data.get("definitions", {})) or {})
+    model.definitions = context.build_all(problems)
+    _body(model, data, problems, context)
+    model.simulation = _simulation(data.get("simulation", {}), problems)
+    return model
+
+
+def _body(model, data, problems, context):
+    """Read what a model file and an inline definition share: description, parameters,
+    ports, components, connections and layout."""
     model.description = data.get("description", "")
     if not isinstance(model.description, str):
         problems.append(f"description: must be a string, got {_kind(model.description)}")
@@ -161,16 +200,15 @@ def _build(data, problems):
                                 f"digit; at most {NAME_LIMIT} characters)")
             else:
                 _attempt(problems, "parameters", model.set_parameter, key, value)
-    broken = (_components(model, data["components"], problems) if "components" in data
-              else {UNNAMED})
+    broken = (_components(model, data["components"], problems, context)
+              if "components" in data else {UNNAMED})
     _connections(model, data.get("connections", []), broken, problems)
-    model.simulation = _simulation(data.get("simulation", {}), problems)
+    _ports(model, data.get("ports", {}), broken, problems)
     model.layout = _attempt(problems, "layout", _layout, model, data.get("layout", {}),
                             broken, problems)
-    return model
 
 
-def _components(model, entries, problems):
+def _components(model, entries, problems, context):
     """Add each entry; return the names of the failed ones, whose wiring goes unchecked."""
     if not isinstance(entries, list):
         problems.append(f"components: must be a list, got {_kind(entries)}")
@@ -184,18 +222,18 @@ def _components(model, entries, problems):
             problems.append(f"{place}: duplicate name, already used by components[{seen[name]}]")
             continue
         before = len(problems)
-        comp = _attempt(problems, place, _component, entry, place, problems)
+        comp = _attempt(problems, place, _component, entry, place, problems, context)
         if isinstance(name, str):
             seen[name] = i
         if comp is None or len(problems) > before:
             broken.add(name if isinstance(name, str) else UNNAMED)
         else:
-            model.add(comp)
-            model.places[comp.name] = place
+            _attempt(problems, place, model.add, comp)
+            model.places[comp.name] = context.where + place
     return broken
 
 
-def _component(entry, place, problems):
+def _component(entry, place, problems, context):
     if not isinstance(entry, dict):
         problems.append(f'{place}: must be an object {{"name", "type", "params"}}, '
                         f"got {_kind(entry)}")
@@ -208,15 +246,18 @@ def _component(entry, place, problems):
     kind, params = entry.get("type"), entry.get("params", {})
     if missing:
         return None
+    if not isinstance(params, dict):
+        problems.append(f"{place} params: must be an object, got {_kind(params)}")
+        return None
+    where = (lambda key: f"{place} params.{_cut(key)}")
+    if isinstance(kind, str) and kind not in REGISTRY and _NAME.fullmatch(kind):
+        definition = context.definition(kind, place)      # a subsystem
+        return Subsystem.from_params(entry["name"], params, place=where, model=definition)
     if not isinstance(kind, str) or kind not in REGISTRY:
         # resolved only through the registry: a dotted path in a file is never imported
         problems.append(f"{place}: unknown type {quote(kind, 60)}{suggest(kind, REGISTRY)}")
         return None
-    if not isinstance(params, dict):
-        problems.append(f"{place} params: must be an object, got {_kind(params)}")
-        return None
-    return REGISTRY[kind].from_params(entry["name"], params,
-                                      place=lambda key: f"{place} params.{_cut(key)}")
+    return REGISTRY[kind].from_params(entry["name"], params, place=where)
 
 
 def _connections(model, pairs, broken, problems):
@@ -249,6 +290,20 @@ def _port(model, ref, broken):
     return model.components[cname].port_ref(pname)
 
 
+def _ports(model, ports, broken, problems):
+    """The exposed ports: name -> "component.port"."""
+    if not isinstance(ports, dict):
+        problems.append(f"ports: must be an object of \"name\": \"component.port\", got "
+                        f"{_kind(ports)}")
+        return
+    for name, ref in ports.items():
+        place = f'ports.{_cut(name)} "{_cut(ref)}"' if isinstance(ref, str) else \
+            f"ports.{_cut(name)}"
+        target = _attempt(problems, place, _port, model, ref, broken)
+        if target is not None:
+            _attempt(problems, f"ports.{_cut(name)}", model.expose, name, target)
+
+
 def _simulation(settings, problems):
     """The experiment settings, checked as ``simulate`` will use them."""
     if not isinstance(settings, dict):
@@ -272,6 +327,161 @@ def _layout(model, layout, broken, problems):
                             f"{suggest(key, model.components)}")
         _plain(value, f"layout.{_cut(key)}", problems)
     return _copy(layout)
+
+
+# -- subsystem definitions ---------------------------------------------------------------------
+class Context:
+    """Where the definitions a file's components name are found, and what is being read.
+
+    A type that is no kinetwork component names a definition: one of the file's own
+    ``definitions`` (inline, or ``{"file": "parts/cylinder.json"}`` relative to the file and
+    inside ``root``), else ``<type>.json`` in the file's folder, else in a library folder.
+    Files are read once per load, so a definition used by many files is one Model.
+    """
+
+    def __init__(self, folder, root, library, chain, cache, where=""):
+        self.folder, self.root, self.library = folder, root, library
+        self.chain, self.cache, self.where = chain, cache, where
+        #: the file's definitions section; name -> Model, or None for one that failed
+        self.entries, self.built, self.building = {}, {}, []
+
+    @classmethod
+    def top(cls, folder, library):
+        extra = [d for d in os.environ.get(LIBRARY_ENV, "").split(os.pathsep) if d]
+        folders = [os.path.abspath(os.fspath(d)) for d in [*(library or []), *extra]]
+        real = os.path.realpath(folder) if folder else None
+        return cls(real, real, folders, [], {})
+
+    def file(self, entries):
+        """The context of one file, whose ``definitions`` section holds ``entries``."""
+        ctx = Context(self.folder, self.root, self.library, self.chain, self.cache, self.where)
+        ctx.entries = entries
+        return ctx
+
+    def inline(self, name):
+        """The context of an inline definition: the same file, its places prefixed."""
+        ctx = Context(self.folder, self.root, self.library, self.chain, self.cache,
+                      f"definitions.{name}.")
+        ctx.entries, ctx.built, ctx.building = self.entries, self.built, self.building
+        return ctx
+
+    def build_all(self, problems):
+        """Every definition of the file (a file keeps those no component uses yet)."""
+        out = {}
+        for name in self.entries:
+            model = _attempt(problems, f"definitions.{_cut(name)}", self.definition, name,
+                             f"definitions.{_cut(name)}")
+            if model is not None:
+                out[name] = model
+        return out
+
+    def definition(self, name, place):
+        """The Model of definition ``name``, or a ModelError naming where it was looked for."""
+        if name in self.built and name not in self.building:
+            if self.built[name] is None:
+                raise ModelError(f"definition {name!r} has problems (listed with it)")
+            return self.built[name]
+        if name in self.building:
+            cycle = " places ".join(self.building[self.building.index(name):] + [name])
+            raise ModelError(f"definitions place each other in a cycle: {cycle}")
+        self.built[name] = None
+        self.building.append(name)
+        try:
+            model = (self._entry(name, self.entries[name]) if name in self.entries else
+                     self._library(name, place))
+        finally:
+            self.building.pop()
+        self.built[name] = model
+        return model
+
+    def _entry(self, name, entry):
+        where = f"definitions.{_cut(name)}"
+        if isinstance(entry, dict) and "file" in entry:
+            extra = [k for k in entry if k != "file"]
+            if extra:
+                raise ModelError(f"{where}: a reference has only the key 'file', got "
+                                 f"{quote(extra[0])}")
+            return self._file(name, entry["file"], self.root, "file")
+        if not isinstance(entry, dict):
+            raise ModelError(f'{where}: must be an object (a model\'s parts) or {{"file": '
+                             f'"path.json"}}, got {_kind(entry)}')
+        problems = []
+        problems.extend(f"{where}: unknown key {quote(key)}{suggest(key, DEFINITION_KEYS)}; "
+                        f"keys are {', '.join(DEFINITION_KEYS)}"
+                        for key in entry if key not in DEFINITION_KEYS)
+        model = Model(name)
+        inner = []
+        _body(model, entry, inner, self.inline(name))
+        problems.extend(p if p.startswith(where) else f"{where}.{p}" for p in inner)
+        if problems:
+            raise ModelError(problems)
+        return model
+
+    def _library(self, name, place):
+        folders = ([self.folder] if self.folder else []) + self.library
+        for folder in folders:
+            path = os.path.join(folder, f"{name}.json")
+            if os.path.isfile(path):
+                kind = "folder" if folder == self.folder else "library"
+                root = self.root if kind == "folder" else os.path.realpath(folder)
+                return self._file(name, f"{name}.json", root, kind, folder)
+        looked = (f"; looked for {name}.json in " + ", ".join(folders)) if folders else ""
+        raise ModelError(f"unknown type {quote(name, 60)}{suggest(name, REGISTRY)}: no "
+                         f"kinetwork component, nor a definition in this file{looked}")
+
+    def _file(self, name, ref, root, kind, folder=None):
+        """Read the definition file ``ref`` (relative to the file being read)."""
+        where = f"definitions.{_cut(name)}" if kind == "file" else f"{name}.json"
+        if not isinstance(ref, str) or not ref:
+            raise ModelError(f"{where}: file must be a relative path, got {quote(ref)}")
+        if "://" in ref or ref.startswith(("/", "\\")) or os.path.isabs(ref) or \
+                (len(ref) > 1 and ref[1] == ":"):
+            raise ModelError(f"{where} file {quote(ref)}: must be a path relative to the "
+                             f"model's folder (no URL, no absolute path)")
+        base = folder or self.folder
+        if base is None:
+            raise ModelError(f"{where} file {quote(ref)}: a model read from text has no folder "
+                             f"to find it in (load the file, or pass folder=)")
+        path = os.path.realpath(os.path.join(base, ref))
+        if os.path.commonpath([path, root]) != root:
+            raise ModelError(f"{where} file {quote(ref)}: leaves the model's folder {root}; "
+                             f"definitions must be inside it")
+        if path in self.chain:
+            files = [os.path.relpath(p, root) for p in self.chain[self.chain.index(path):]]
+            raise ModelError(f"{where} file {quote(ref)}: files reference each other in a "
+                             f"cycle: {' references '.join(files + [files[0]])}")
+        if path not in self.cache:
+            text = _read(path)
+            try:
+                data = json.loads(text, object_pairs_hook=_Object.from_pairs, parse_int=_int)
+            except (ValueError, RecursionError) as exc:
+                raise ModelError(f"{where} file {quote(ref)}: invalid JSON ({exc})") from None
+            ctx = Context(os.path.dirname(path), root, self.library, [*self.chain, path],
+                          self.cache)
+            model = model_from_dict(data, source=os.path.relpath(path, root), validate=False,
+                                    context=ctx)
+            model.origin = (path, kind, dumps(model))
+            self.cache[path] = model
+        model = self.cache[path]
+        if model.name != name:
+            raise ModelError(f"{where} file {quote(ref)}: holds model {quote(model.name)}, "
+                             f"not {quote(name)} (a definition file's name is its type)")
+        return model
+
+
+def _entries(definitions):
+    if not isinstance(definitions, dict):
+        raise ModelError(f"must be an object of definitions by name, got {_kind(definitions)}")
+    problems = []
+    for name in definitions:
+        if not _NAME.fullmatch(name):
+            problems.append(f"{quote(name)}: a definition's name must be an identifier")
+        elif name in REGISTRY:
+            problems.append(f"{name}: a kinetwork component type has this name; choose "
+                            f"another")
+    if problems:
+        raise ModelError(problems)
+    return dict(definitions)
 
 
 # -- helpers ----------------------------------------------------------------------------------

@@ -8,6 +8,8 @@ import numpy as np
 
 from ..components.base import ANY, Component, PortRef
 from ..util import check_number, quote, suggest
+from .subsystem import Subsystem, check_placement, check_port_name, flatten, has_subsystems
+from .subsystem import parameter_values as _flat_parameter_values
 from .writer import save
 from ..errors import ModelError
 from ..expr import CONSTANTS, FUNCTIONS, parse
@@ -60,12 +62,29 @@ class Model:
         self.parameters = {}
         self.simulation = dict(simulation or {})
         self.layout = {}
-        #: component name -> how messages locate it (files say 'components[3] "mass1"')
+        #: ports this model shows when placed as a subsystem: name -> PortRef of a component
+        self.exposed = {}
+        #: subsystem definitions a file keeps with the model (name -> Model), used or not
+        self.definitions = {}
+        #: for a model read as a definition from a file: (real path, how it was found:
+        #: "file", "folder" or "library", its text as read); a saver writes a reference to
+        #: it while it is unchanged
+        self.origin = None
+        #: component name -> how messages locate it (files say 'components[3] "mass1"'; a
+        #: flat model's inner components (path shown, place in their definition's file))
         self.places = {}
         self._validated = None         # (content key, parameter values, Topology)
         self._compiled = {}            # (content key, loops, rate) -> System
+        self._flat = None              # (content key, flat model) of a model of subsystems
         for key, value in (parameters or {}).items():
             self.set_parameter(key, value)
+
+    def _init_flat(self, model):
+        """Set up as the empty flat model of ``model`` (names by path, no checks: the
+        flattening writes only what the inner models already checked)."""
+        Model.__init__(self, model.name, description=model.description,
+                       simulation=model.simulation)
+        self.parameters = dict(model.parameters)
 
     # -- building -----------------------------------------------------------------------
     def set_parameter(self, name, value):
@@ -82,8 +101,23 @@ class Model:
             raise ModelError(f"model.add expects a component, got {component!r}")
         if component.name in self.components:
             raise ModelError(f"duplicate component name {component.name!r}")
+        if isinstance(component, Subsystem):
+            check_placement(self, component)
         self.components[component.name] = component
         return component
+
+    def expose(self, name, port):
+        """Show ``port`` (``comp.port`` or ``"comp.port"``) as this model's port ``name``
+        when it is placed as a subsystem: ``link.expose("frame_a", "joint.frame_a")``."""
+        check_port_name(name)
+        if name in self.exposed:
+            raise ModelError(f"{self.name}: port {name!r} is already exposed (as "
+                             f"{self.exposed[name].path})")
+        try:
+            self.exposed[name] = self.port(port)
+        except ModelError as exc:
+            raise ModelError([f"{self.name} port {name!r}: {p}" for p in exc.problems]) \
+                from None
 
     def connect(self, a, b):
         """Wire two ports, given as ``comp.port`` attributes or ``"comp.port"`` strings."""
@@ -120,14 +154,36 @@ class Model:
 
     # -- checking -----------------------------------------------------------------------
     def place(self, component, key=None):
-        """Where a component (and one of its parameters) is, for messages."""
+        """Where a component (and one of its parameters) is, for messages: its path in a flat
+        model (``cyl3/piston.mass``, then where its definition's file has it), else its
+        place in the file, else its name."""
         base = self.places.get(component.name)
+        if isinstance(base, tuple):
+            shown, where = base
+            inner = f" ({where}{f' params.{key}' if key else ''})" if where else ""
+            return f"{shown}.{key}{inner}" if key else f"{shown}{inner}"
         if base is None:
             return f"{component.name}.{key}" if key else component.name
         return f"{base} params.{key}" if key else base
 
+    def flat(self):
+        """The model with every subsystem expanded in place, names by path: what validation
+        and compilation work on (the model itself when it places no subsystem). Kept while the
+        structure does not change; parameter values are always the current ones."""
+        if not has_subsystems(self):
+            return self
+        key = self.content_key()
+        if self._flat is None or self._flat[0] != key:
+            self._flat = (key, flatten(self))
+        flat = self._flat[1]
+        flat.parameters.update(_flat_parameter_values(self))
+        return flat
+
     def parameter_values(self, overrides=None):
-        """Model parameters with ``overrides`` applied and checked."""
+        """Model parameters with ``overrides`` applied and checked; with subsystems, also
+        theirs by path (``"cyl1.phi0"``)."""
+        if has_subsystems(self):
+            return self.flat().parameter_values(overrides)
         values = dict(self.parameters)
         for key, value in (overrides or {}).items():
             if key not in values:
@@ -141,8 +197,11 @@ class Model:
         """Every component parameter evaluated to numbers: {component name: {param: value}}.
 
         Gathers every unknown name, failed evaluation and violated bound into one ModelError.
-        Time-dependent parameters are evaluated at t = 0.
+        Time-dependent parameters are evaluated at t = 0. Subsystems' components are named
+        by path.
         """
+        if has_subsystems(self):
+            return self.flat().numeric_values(overrides)
         env = self.parameter_values(overrides)
         env_t = {**env, "t": 0.0}
         out, problems = {}, []
@@ -163,11 +222,13 @@ class Model:
         """What the equations of the model depend on, as a hashable value: the parameter
         names, every component (the object, its type and given parameters) and the wiring.
         Parameter *values* are not in it: they stay symbols in a compiled System."""
-        comps = tuple((id(c), name, type(c).__qualname__, repr(sorted(c.given.items())))
+        comps = tuple((id(c), name, c.signature()) if isinstance(c, Subsystem) else
+                      (id(c), name, type(c).__qualname__, repr(sorted(c.given.items())))
                       for name, c in self.components.items())
         wiring = tuple((a.path, id(a.component), b.path, id(b.component))
                        for a, b in self.connections)
-        return tuple(self.parameters), comps, wiring
+        exposed = tuple((k, v.path, id(v.component)) for k, v in self.exposed.items())
+        return tuple(self.parameters), comps, wiring, exposed
 
     def validate(self):
         """Check the whole model; return its Topology or raise one ModelError listing all.
@@ -175,6 +236,8 @@ class Model:
         The Topology of an unchanged model (same content, same parameter values) is kept, so
         loading a file and compiling it validate once."""
         from .topology import analyze
+        if has_subsystems(self):
+            return self.flat().validate()
         key, values = self.content_key(), dict(self.parameters)
         if self._validated is not None and self._validated[:2] == (key, values):
             return self._validated[2]
@@ -191,8 +254,11 @@ class Model:
         Newton-projected onto the closure in every evaluation) or "baumgarte" (an ODE in all
         coordinates, stabilised at ``baumgarte_rate`` [1/s], default 10; 0 leaves the drift
         unchecked). A model whose content has not changed since its last compilation gives
-        the same System back, without building it again.
+        the same System back, without building it again. A model of subsystems is compiled
+        flat: states, signals and parameters are named by path (``"cyl1.slide.q"``).
         """
+        if has_subsystems(self):
+            return self.flat().compile(loops, baumgarte_rate)
         key = (self.content_key(), loops, baumgarte_rate)
         with _compile_lock:
             if key not in self._compiled:

@@ -6,62 +6,148 @@ reads back.
 
 import copy
 import json
+import os
 
 from ..components.base import REGISTRY
 from ..errors import ModelError
 from ..util import atomic_write, finite
 from .settings import check_setting
+from .subsystem import Subsystem
 
-FORMAT, VERSION = "kinetwork.model", 1
-#: top-level keys, in the order files are written
+#: the newest version; a model is written in the smallest version that holds it: 1 unless it
+#: has subsystems or exposed ports
+FORMAT, VERSION = "kinetwork.model", 2
+#: top-level keys, in the order files are written (version 1, and version 2's)
 KEYS = ("format", "version", "name", "description", "parameters", "components", "connections",
         "simulation", "layout")
+KEYS_V2 = ("format", "version", "name", "description", "parameters", "ports", "components",
+           "connections", "simulation", "layout", "definitions")
+#: what an inline definition holds
+DEFINITION_KEYS = ("description", "parameters", "ports", "components", "connections", "layout")
 #: a list of scalars stays on one line up to this many characters
 WIDTH = 80
 
 
-def model_to_dict(model):
+def model_to_dict(model, folder=None):
     """The model as a file's top-level object: plain JSON values, in file order.
 
     Component ``params`` hold only what was given, so a later change of a default reaches old
     files. A model may be incomplete (an editor saves work in progress), but what :func:`load`
     would refuse for its form is refused here, so a saved file always reads back.
 
+    A model without subsystems or exposed ports is written as version 1, as before there were
+    any. Otherwise (version 2) the definitions its subsystems place go in ``definitions``:
+    a definition read from a file and unchanged since as a reference to that file (relative
+    to ``folder``, the folder the file is written to, when it lies inside it), one read from
+    a library folder not at all (found there again), any other inline.
+
     Raises
     ------
     ModelError
         A component type not in the registry, a bad ``simulation`` block, a layout entry for
-        no component, or a value that is not plain, finite JSON; each with its place.
+        no component, two definitions of one name, or a value that is not plain, finite
+        JSON; each with its place.
     """
-    problems, components = [], []
-    for i, comp in enumerate(model.components.values()):
-        if REGISTRY.get(comp.type_name) is not type(comp):
-            problems.append(f'components[{i}] "{comp.name}": type {type(comp).__name__} is not '
-                            f"in the component registry, so no file could load it")
-        components.append({"name": comp.name, "type": comp.type_name,
-                           "params": copy.deepcopy(comp.given)})
-    data = {"format": FORMAT, "version": VERSION, "name": model.name,
-            "description": "" if model.description is None else model.description,
-            "parameters": dict(model.parameters), "components": components,
-            "connections": [[a.path, b.path] for a, b in model.connections],
-            "simulation": copy.deepcopy(model.simulation), "layout": copy.deepcopy(model.layout)}
-    if not isinstance(data["description"], str):
-        problems.append(f"description: must be a string, got {_kind(data['description'])}")
+    problems = []
+    body = _body(model, problems, "")
+    definitions = _definitions(model, folder, problems)
+    v2 = bool(model.exposed or definitions or any(
+        isinstance(c, Subsystem) for c in model.components.values()))
+    data = {"format": FORMAT, "version": 2 if v2 else 1, "name": model.name,
+            **body, "simulation": copy.deepcopy(model.simulation)}
+    data["layout"] = data.pop("layout")
+    if v2:
+        data = {key: data[key] for key in KEYS_V2 if key in data}
+        if not model.exposed:
+            del data["ports"]
+        if definitions:
+            data["definitions"] = definitions
+    else:
+        del data["ports"]
     if isinstance(data["simulation"], dict):
         problems.extend(filter(None, (check_setting(k, v) for k, v in data["simulation"].items())))
     else:
         problems.append(f"simulation: must be an object, got {_kind(data['simulation'])}")
-    if isinstance(data["layout"], dict):
-        problems.extend(f"layout.{key}: no component {key!r}" for key in data["layout"]
-                        if key not in model.components)
     _plain(data, "", problems)
     if problems:
         raise ModelError(problems)
     return data
 
 
-def dumps(model):
-    """The file's text for ``model``.
+def _body(model, problems, where):
+    """What a file and an inline definition share, in file order."""
+    components = []
+    for i, comp in enumerate(model.components.values()):
+        if not isinstance(comp, Subsystem) and REGISTRY.get(comp.type_name) is not type(comp):
+            problems.append(f'{where}components[{i}] "{comp.name}": type '
+                            f"{type(comp).__name__} is not in the component registry, so no "
+                            f"file could load it")
+        components.append({"name": comp.name, "type": comp.type_name,
+                           "params": copy.deepcopy(comp.given)})
+    body = {"description": "" if model.description is None else model.description,
+            "parameters": dict(model.parameters),
+            "ports": {name: ref.path for name, ref in model.exposed.items()},
+            "components": components,
+            "connections": [[a.path, b.path] for a, b in model.connections],
+            "layout": copy.deepcopy(model.layout)}
+    if not isinstance(body["description"], str):
+        problems.append(f"{where}description: must be a string, got "
+                        f"{_kind(body['description'])}")
+    if isinstance(body["layout"], dict):
+        problems.extend(f"{where}layout.{key}: no component {key!r}" for key in body["layout"]
+                        if key not in model.components)
+    return body
+
+
+def _definitions(model, folder, problems):
+    """The ``definitions`` section: every definition the model keeps or places, nested ones
+    of inline definitions too, by name."""
+    out, seen = {}, {}
+
+    def visit(m):
+        placed = [c.definition for c in m.components.values() if isinstance(c, Subsystem)]
+        for d in [*m.definitions.values(), *placed]:
+            if d.name in seen:
+                if seen[d.name] is not d:
+                    problems.append(f"definitions.{d.name}: two different models are named "
+                                    f"{d.name!r}; a file names a definition once (rename one)")
+                continue
+            seen[d.name] = d
+            entry = _reference(d, folder)
+            if entry is None:
+                entry = _body(d, problems, f"definitions.{d.name}.")
+                entry = {k: v for k, v in entry.items() if v or k in ("components",)}
+                visit(d)
+            if entry:
+                out[d.name] = entry
+    visit(model)
+    return out
+
+
+def _reference(definition, folder):
+    """How a file refers to a definition read from a file and unchanged since: ``{"file":
+    relative path}``, or ``{}`` when a library (or the folder itself) finds it by name;
+    None when it must be written inline."""
+    if definition.origin is None:
+        return None
+    path, kind, text = definition.origin
+    if dumps(definition) != text:
+        return None                 # changed since it was read: the file keeps what it had
+    if kind == "library":
+        return {}
+    if folder is None:
+        return None
+    folder = os.path.realpath(folder)
+    if kind == "folder" and os.path.dirname(path) == folder:
+        return {}
+    rel = os.path.relpath(path, folder)
+    if rel.startswith(os.pardir) or os.path.isabs(rel):
+        return None
+    return {"file": rel.replace(os.sep, "/")}
+
+
+def dumps(model, folder=None):
+    """The file's text for ``model`` (to be written in ``folder``: see :func:`model_to_dict`).
 
     Indented JSON with the keys in file order, short lists of scalars on one line (vectors,
     matrix rows, connection pairs) and a final newline; numbers keep their Python form.
@@ -70,7 +156,7 @@ def dumps(model):
     -------
     str
     """
-    return _render(model_to_dict(model), 0) + "\n"
+    return _render(model_to_dict(model, folder), 0) + "\n"
 
 
 def save(model, path):
@@ -91,7 +177,8 @@ def save(model, path):
     OSError
         The file system refused; the old file is unchanged.
     """
-    text = dumps(model).encode("utf-8")       # every refusal comes before the disk is touched
+    folder = os.path.dirname(os.path.abspath(os.fspath(path)))
+    text = dumps(model, folder).encode("utf-8")   # every refusal before the disk is touched
 
     def write(tmp):
         with open(tmp, "wb") as fh:

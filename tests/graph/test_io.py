@@ -186,7 +186,7 @@ TEXT_CASES = {
 DATA_CASES = {
     # the top level
     "wrong format": (put("format", "bdsim"), ["format: 'bdsim' is not a kinetwork model"]),
-    "newer version": (put("version", 2), ["version: 2 is not supported", "version 1"]),
+    "newer version": (put("version", 3), ["version: 3 is not supported", "version 1, 2"]),
     "version as text": (put("version", "1"), ["version: '1' is not supported"]),
     "version as bool": (put("version", True), ["version: True is not supported"]),
     "missing format": (drop("format"), ["format: required key missing"]),

@@ -1,0 +1,277 @@
+"""Subsystems: a model placed in another model like a component, and the flattening that turns
+a model of subsystems into the flat model the equations are built from.
+
+A model becomes a definition by exposing ports (``Model.expose("frame_a", "crank.frame_a")``);
+its parameters are the subsystem's parameters. ``Subsystem("cyl1", cylinder, params={...})``
+places it: numbers and expressions in the outer model's parameters feed the inner ones.
+
+Flattening names everything by path: component ``cyl1.piston``, state ``cyl1.slide.q``, probe
+signal ``cyl1.p.position``, parameter ``cyl1.phi0``. A subsystem parameter given a number (or
+left at its definition's value) becomes a parameter of the flat model under its path, so
+``simulate(..., params={"cyl1.phi0": 0.3})`` changes it without a new compilation; one given an
+expression is that expression, written in the outer names.
+"""
+
+import copy
+
+import networkx as nx
+
+from ..components.base import ANY, Component, Param, Port, PortRef, _NAME
+from ..errors import ModelError
+from ..expr import parse, rename
+from ..util import quote, suggest
+
+#: how deep subsystems may nest (a cycle is refused by name long before)
+DEPTH_LIMIT = 64
+
+
+class Subsystem(Component):
+    """A model placed as a component: its exposed ports are the ports, its parameters the
+    parameters.
+
+    Parameters
+    ----------
+    name : str
+        Instance name: the first part of every inner path (``cyl1.piston.q``).
+    model : Model
+        The definition, with ports declared by ``Model.expose``.
+    params : dict, optional
+        Values of the definition's parameters for this instance: numbers, or expressions in
+        the parameters of the model the subsystem is placed in.
+    """
+
+    role = "subsystem"
+
+    def __init__(self, name, model, params=None):
+        if not hasattr(model, "exposed") or not hasattr(model, "components"):
+            raise ModelError(f"Subsystem {quote(name)}: expects a kn.Model as its definition, "
+                             f"got {quote(model, 60)}")
+        object.__setattr__(self, "definition", model)
+        if not isinstance(params, (dict, type(None))):
+            raise ModelError(f"Subsystem {quote(name)} params: must be a dict, got "
+                             f"{quote(params, 60)}")
+        self._declare(name, dict(params or {}), None)
+
+    @classmethod
+    def from_params(cls, name, params, place=None, model=None):
+        comp = cls.__new__(cls)
+        object.__setattr__(comp, "definition", model)
+        comp._declare(name, params, place)
+        return comp
+
+    def _type_name(self):
+        """What files call the definition: its name."""
+        return self.definition.name
+
+    def _ports(self):
+        """The exposed ports of the definition, each with the domain of the port it leads to."""
+        return {name: Port(_domain(ref), f"{ref.path} of {self.definition.name}")
+                for name, ref in self.definition.exposed.items()}
+
+    def _params(self):
+        """The definition's parameters, defaulting to its values."""
+        return {name: Param(value, name=name, doc=f"parameter {name} of "
+                            f"{self.definition.name}")
+                for name, value in self.definition.parameters.items()}
+
+    def __getattr__(self, key):
+        if not key.startswith("_") and key in self.ports:
+            return PortRef(self, key)
+        if not key.startswith("_") and key in self.definition.parameters:
+            return self._values[key]
+        return super().__getattr__(key)
+
+    def signature(self):
+        """What the equations of this instance depend on (values of given numbers do not:
+        they become parameters of the flat model)."""
+        given = tuple((k, v if isinstance(v, str) else "#") for k, v in sorted(self.given.items()))
+        return self.definition.content_key(), given
+
+    def __repr__(self):
+        return f"<Subsystem {self.name!r} of {self.definition.name!r}>"
+
+
+# set after the class is made: Component.__init_subclass__ gives every class plain tables
+Subsystem.type_name = property(Subsystem._type_name)
+Subsystem.ports = property(Subsystem._ports)
+Subsystem.params = property(Subsystem._params)
+
+
+def _domain(ref):
+    """The domain of an exposed port, followed through nested subsystems."""
+    for _ in range(DEPTH_LIMIT):
+        comp = ref.component
+        if not isinstance(comp, Subsystem):
+            return comp.ports[ref.name].domain
+        target = comp.definition.exposed.get(ref.name)
+        if target is None:
+            return ANY
+        ref = target
+    return ANY
+
+
+def definitions(model):
+    """Every definition placed in ``model``, nested ones included, each once, in the order
+    first met (a depth-first walk); a cycle is refused naming it."""
+    graph = nx.DiGraph()
+    graph.add_node(id(model))
+    order, stack = {}, [model]
+    while stack:
+        m = stack.pop()
+        for comp in m.components.values():
+            if isinstance(comp, Subsystem):
+                d = comp.definition
+                graph.add_edge(id(m), id(d))
+                if id(d) not in order and d is not model:
+                    order[id(d)] = d
+                    stack.append(d)
+    try:
+        cycle = nx.find_cycle(graph, id(model))
+    except nx.NetworkXNoCycle:
+        return list(order.values())
+    names = {id(model): model.name, **{k: d.name for k, d in order.items()}}
+    path = " places ".join(names[a] for a, _ in cycle) + f" places {names[cycle[0][0]]}"
+    raise ModelError(f"subsystems place each other in a cycle: {path}")
+
+
+def check_placement(model, sub):
+    """Refuse placing ``sub`` in ``model`` when its definition contains ``model``."""
+    d = sub.definition
+    if d is model or any(inner is model for inner in definitions(d)):
+        raise ModelError(f"{sub.name}: model {model.name!r} cannot contain itself (the "
+                         f"definition {d.name!r} places {model.name!r})")
+
+
+def has_subsystems(model):
+    return any(isinstance(c, Subsystem) for c in model.components.values())
+
+
+class _Flat:
+    """The walk that writes a model of subsystems as one flat model."""
+
+    def __init__(self, model, flat):
+        self.model, self.flat, self.problems = model, flat, []
+
+    def walk(self, m, prefix, scope, display, depth):
+        """Add ``m``'s components under ``prefix``; ``scope`` maps m's parameter names to
+        their text in flat names."""
+        if depth > DEPTH_LIMIT:
+            raise ModelError(f"{display}: subsystems nested more than {DEPTH_LIMIT} deep")
+        for comp in m.components.values():
+            path, shown = prefix + comp.name, display + comp.name
+            if isinstance(comp, Subsystem):
+                self.walk(comp.definition, path + ".", self.scope_of(m, comp, path, scope),
+                          shown + "/", depth + 1)
+                continue
+            twin = copy.copy(comp)
+            object.__setattr__(twin, "name", path)
+            given, values = {}, {}
+            for key, spec in comp.params.items():
+                value = comp._values[key]
+                if spec.kind == "real" and value is not None:
+                    value = _map(value, lambda text: rename(text, scope))
+                elif spec.kind == "name" and value is not None and prefix:
+                    value = prefix + value
+                values[key] = value
+                if key in comp.given:
+                    given[key] = value
+            object.__setattr__(twin, "given", given)
+            object.__setattr__(twin, "_values", values)
+            self.flat.components[path] = twin
+            where = m.places.get(comp.name)
+            if prefix:
+                self.flat.places[path] = (shown, where if isinstance(where, str) else None)
+            elif where is not None:
+                self.flat.places[path] = where
+        for a, b in m.connections:
+            pa, pb = self.port(m, prefix, a, depth), self.port(m, prefix, b, depth)
+            if pa is not None and pb is not None:
+                self.flat.connections.append((pa, pb))
+
+    def scope_of(self, m, sub, path, scope):
+        """The inner parameters of subsystem ``sub`` in flat names: a number becomes the flat
+        parameter ``path.name``, an expression is rewritten in the outer names."""
+        inner = {}
+        for key, default in sub.definition.parameters.items():
+            value = sub.given.get(key, default)
+            if isinstance(value, str):
+                expr = parse(value)
+                unknown = sorted(expr.names - set(scope))
+                if unknown:
+                    where = m.place(sub, key)
+                    self.problems.append(
+                        f"{where} = {value!r}: unknown name {unknown[0]!r}"
+                        f"{suggest(unknown[0], scope)}; parameters here are "
+                        f"{', '.join(scope) or 'none'}")
+                    inner[key] = "0"
+                else:
+                    inner[key] = f"({rename(value, scope)})"
+            else:
+                self.flat.parameters[f"{path}.{key}"] = value
+                inner[key] = f"{path}.{key}"
+        return inner
+
+    def port(self, m, prefix, ref, depth):
+        """The flat PortRef of ``ref`` (a port of one of ``m``'s components)."""
+        for _ in range(DEPTH_LIMIT):
+            comp = ref.component
+            if m.components.get(comp.name) is not comp:
+                self.problems.append(f"{prefix}{ref.path}: component {comp.name!r} is not in "
+                                     f"model {m.name!r} any more (remove its connections too)")
+                return None
+            if not isinstance(comp, Subsystem):
+                return PortRef(self.flat.components[prefix + comp.name], ref.name)
+            target = comp.definition.exposed.get(ref.name)
+            if target is None:
+                self.problems.append(f"{prefix}{ref.path}: {comp.definition.name!r} exposes no "
+                                     f"port {ref.name!r}{suggest(ref.name, comp.definition.exposed)}")
+                return None
+            m, prefix, ref = comp.definition, f"{prefix}{comp.name}.", target
+        raise ModelError(f"{prefix}{ref.path}: subsystems nested more than {DEPTH_LIMIT} deep")
+
+
+def flatten(model):
+    """The flat model of ``model`` (``model`` itself when it places no subsystem): components
+    and parameters named by path, connections through exposed ports resolved to the inner
+    ports. Refuses cycles, unknown exposed ports and unknown names, naming the path."""
+    if not has_subsystems(model):
+        return model
+    definitions(model)
+    flat = type(model).__new__(type(model))
+    flat._init_flat(model)
+    walker = _Flat(model, flat)
+    walker.walk(model, "", {k: k for k in model.parameters}, "", 0)
+    if walker.problems:
+        raise ModelError(walker.problems)
+    return flat
+
+
+def parameter_values(model, prefix="", out=None):
+    """The numbers of the flat model's parameters: the model's own, and every subsystem
+    parameter given a number or left at its definition's value, by path."""
+    out = {} if out is None else out
+    if not prefix:
+        out.update(model.parameters)
+    for comp in model.components.values():
+        if isinstance(comp, Subsystem):
+            path = prefix + comp.name
+            for key, default in comp.definition.parameters.items():
+                value = comp.given.get(key, default)
+                if not isinstance(value, str):
+                    out[f"{path}.{key}"] = value
+            parameter_values(comp.definition, path + ".", out)
+    return out
+
+
+def _map(value, fn):
+    """``fn`` applied to every expression string in a parameter value (nested lists)."""
+    if isinstance(value, str):
+        return fn(value)
+    if isinstance(value, list):
+        return [_map(v, fn) for v in value]
+    return value
+
+
+def check_port_name(name):
+    if not isinstance(name, str) or not _NAME.fullmatch(name):
+        raise ModelError(f"port name {quote(name, 60)}: must be an identifier")
