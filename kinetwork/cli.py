@@ -19,6 +19,7 @@ import time
 import kinetwork as kn
 
 from .graph.settings import check_output, check_settings
+from .graph.subsystem import subsystem_instances
 from .simulation.driver import DEFAULTS, METHODS
 from .util import finite, quote
 
@@ -166,6 +167,11 @@ def build_parser():
                      help="simplify into the paper's form, or print the Newton-Euler "
                           "expressions as built, with shared parts named (default: simplify "
                           "when that takes seconds, not hours)")
+    for command in (run, val, eqs):
+        command.add_argument("--library", action="append", default=[], metavar="DIR",
+                             help="a folder of subsystem files (TYPE.json), searched after "
+                                  "the model's own definitions and folder (repeat for "
+                                  "several; KINETWORK_LIBRARY adds more)")
     return parser
 
 
@@ -194,9 +200,9 @@ def _error(message):
     print(f"kinetwork: error: {message}", file=sys.stderr)
 
 
-def _load(path):
+def _load(path, library=None):
     try:
-        return kn.load(path)
+        return kn.load(path, library=library)
     except OSError as exc:
         raise kn.ModelError(f"cannot read {path}: {exc.strerror or exc}") from None
 
@@ -249,7 +255,7 @@ def _run(args):
     if clash:
         _error(clash)
         return EXIT_USAGE
-    model = _load(args.model)
+    model = _load(args.model, args.library)
     if args.plot:
         from .plot import check_plot_path
         check_plot_path(args.plot)
@@ -341,7 +347,10 @@ def _shown(text, limit=SHOWN_CHARACTERS):
 
 
 def _validate(args):
-    model = _load(args.model)           # reading validates: one ModelError lists every problem
+    model = _load(args.model, args.library)   # reading validates: one ModelError lists all
+    if model.exposed:
+        print("\n".join(_definition_summary(model, args.model)))
+        return 0
     topo = model.validate()             # the same Topology again, not a second analysis
     kinds = collections.Counter(c.type_name for c in model.components.values())
     groups = collections.Counter(g.kind for g in topo.oned)
@@ -353,6 +362,7 @@ def _validate(args):
         f"components: {len(model.components)} ("
         + ", ".join(f"{n} {kind}" for kind, n in kinds.most_common()) + ")",
         f"connections: {len(model.connections)}",
+        *_subsystems_summary(model),
     ]
     loops = f"loops: {len(topo.loops) or 'none'}" + "".join(
         f"\n  {' - '.join(cut.loop)} (cut at {cut.component.name})"
@@ -381,6 +391,44 @@ def _validate(args):
                                                 for k, v in model.simulation.items()))
     print("\n".join(lines))
     return 0
+
+
+def _subsystems_summary(model):
+    """Lines naming each subsystem definition, where it comes from and its instances by
+    path; nothing for a flat model."""
+    placed = subsystem_instances(model)
+    if not placed:
+        return []
+    flat = model.flat()
+    lines = [f"subsystems: {len(placed)} definition{'s' if len(placed) > 1 else ''}, "
+             f"{sum(len(p) for _, p in placed.values())} instances; flat: "
+             f"{len(flat.components)} components, {len(flat.connections)} connections"]
+    for name, (definition, paths) in placed.items():
+        origin = definition.origin
+        where = "inline" if origin is None else f"{origin[1]} {os.path.relpath(origin[0])}"
+        ports = ", ".join(definition.exposed)
+        lines.append(f"  {name} ({where}; ports {ports or 'none'}): "
+                     + _listing(paths))
+    return lines
+
+
+def _definition_summary(model, path):
+    """``validate`` of a definition file: its ports and parameters (it is wired where it is
+    placed, so its wiring is checked there)."""
+    kinds = collections.Counter(c.type_name for c in model.components.values())
+    ports = [f"{name} -> {ref.path} ({ref.domain})" for name, ref in model.exposed.items()]
+    return [
+        f"subsystem definition {model.name!r} ({path}): values valid; its wiring is checked "
+        f"where it is placed",
+        f"ports: {_listing(ports)}",
+        f"components: {len(model.components)} ("
+        + ", ".join(f"{n} {kind}" for kind, n in kinds.most_common()) + ")",
+        f"connections: {len(model.connections)}",
+        *_subsystems_summary(model)[1:],
+        f"parameters: {len(model.parameters)}" + (
+            " (" + _listing(f"{k} = {v:g}" for k, v in model.parameters.items()) + ")"
+            if model.parameters else ""),
+    ]
 
 
 def _compiled_summary(system, topo, loops):
@@ -461,7 +509,7 @@ def _equations(args):
 
     from .symbolic import equations_sympy
 
-    model = _load(args.model)
+    model = _load(args.model, args.library)
     system = model.compile()
     eq = equations_sympy(system, simplified=args.simplify)     # ModelError for a Table's call
     mats = {key: eq[key] for key in ("M", "V", "G")}

@@ -43,7 +43,8 @@ def load(path, validate=True, library=None):
     ----------
     path : str or os.PathLike
     validate : bool, optional
-        Also check the wiring (``Model.validate``); False reads a model saved half-built.
+        Also check the wiring (``Model.validate``; of a subsystem definition, a model with
+        exposed ports, only its values); False reads a model saved half-built.
     library : list of folders, optional
         Where subsystem definitions named by a component's ``type`` are looked for
         (``<type>.json``), after the file's own ``definitions`` and its folder. The
@@ -62,7 +63,10 @@ def load(path, validate=True, library=None):
     source = os.fspath(path)
     text = _read(source)
     folder = os.path.dirname(os.path.abspath(source))
-    return loads(text, source=source, validate=validate, library=library, folder=folder)
+    model = loads(text, source=source, validate=validate, library=library, folder=folder)
+    if model.exposed:           # a definition: placed elsewhere, it is saved as a reference
+        model.origin = (os.path.realpath(source), "file", dumps(model))
+    return model
 
 
 def _read(source):
@@ -139,7 +143,9 @@ def model_from_dict(data, source=None, validate=True, context=None):
         raise ModelError([_at(source, p) for p in problems])
     if validate:
         try:
-            model.validate()
+            # a definition (a model with exposed ports) is wired where it is placed: alone,
+            # only its values are checked
+            model.numeric_values() if model.exposed else model.validate()
         except ModelError as exc:
             raise ModelError([_at(source, p) for p in exc.problems]) from None
     return model

@@ -81,6 +81,13 @@ class Subsystem(Component):
             return self._values[key]
         return super().__getattr__(key)
 
+    def port_ref(self, name):
+        if name not in self.ports:
+            raise ModelError(f"subsystem {self.name!r} ({self.definition.name}) has no port "
+                             f"{quote(name)}{suggest(name, self.ports)}; ports: "
+                             f"{', '.join(self.ports) or 'none (expose some in the definition)'}")
+        return PortRef(self, name)
+
     def signature(self):
         """What the equations of this instance depend on (values of given numbers do not:
         they become parameters of the flat model)."""
@@ -132,6 +139,21 @@ def definitions(model):
     names = {id(model): model.name, **{k: d.name for k, d in order.items()}}
     path = " places ".join(names[a] for a, _ in cycle) + f" places {names[cycle[0][0]]}"
     raise ModelError(f"subsystems place each other in a cycle: {path}")
+
+
+def subsystem_instances(model):
+    """Each definition placed in ``model`` (nested too): name -> (Model, instance paths)."""
+    out = {}
+
+    def walk(m, prefix):
+        for comp in m.components.values():
+            if isinstance(comp, Subsystem):
+                d = comp.definition
+                out.setdefault(d.name, (d, []))[1].append(prefix + comp.name)
+                walk(d, f"{prefix}{comp.name}.")
+    definitions(model)              # a cycle is refused before the walk
+    walk(model, "")
+    return out
 
 
 def check_placement(model, sub):
