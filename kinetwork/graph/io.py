@@ -390,11 +390,13 @@ class Context:
         if name in self.building:
             cycle = " places ".join(self.building[self.building.index(name):] + [name])
             raise ModelError(f"definitions place each other in a cycle: {cycle}")
+        if name not in self.entries:
+            model = self.built[name] = self._library(name, place)   # a miss says so each time
+            return model
         self.built[name] = None
         self.building.append(name)
         try:
-            model = (self._entry(name, self.entries[name]) if name in self.entries else
-                     self._library(name, place))
+            model = self._entry(name, self.entries[name])
         finally:
             self.building.pop()
         self.built[name] = model
