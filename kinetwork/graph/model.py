@@ -9,7 +9,6 @@ import numpy as np
 from ..components.base import ANY, Component, PortRef
 from ..util import check_number, quote, suggest
 from .subsystem import Subsystem, check_placement, check_port_name, flatten, has_subsystems
-from .subsystem import parameter_values as _flat_parameter_values
 from .writer import save
 from ..errors import ModelError
 from ..expr import CONSTANTS, FUNCTIONS, parse
@@ -88,7 +87,19 @@ class Model:
 
     # -- building -----------------------------------------------------------------------
     def set_parameter(self, name, value):
-        """Add or change a model parameter."""
+        """Add or change a model parameter; a path (``"cyl1.phi0"``) sets the value given to
+        a parameter of a subsystem placed here (as ``model.components["cyl1"].phi0 = v``)."""
+        if isinstance(name, str) and "." in name:
+            instance, _, key = name.partition(".")
+            comp = self.components.get(instance)
+            if not isinstance(comp, Subsystem) or "." in key:
+                # a value deeper down belongs to a definition that other instances share
+                raise ModelError(f"parameter {quote(name, 60)}: a path names a parameter of a "
+                                 f"subsystem placed in {self.name!r} ('instance.parameter'); "
+                                 f"subsystems here: "
+                                 f"{', '.join(c.name for c in self.components.values() if isinstance(c, Subsystem)) or 'none'}")
+            comp.set_param(key, value)
+            return
         if not isinstance(name, str) or not _IDENT.match(name):
             raise ModelError(f"parameter name {quote(name, 60)}: must be an identifier")
         if name in RESERVED:
@@ -176,16 +187,20 @@ class Model:
         if self._flat is None or self._flat[0] != key:
             self._flat = (key, flatten(self))
         flat = self._flat[1]
-        flat.parameters.update(_flat_parameter_values(self))
+        flat.parameters.update(self.parameters)
         return flat
 
     def parameter_values(self, overrides=None):
-        """Model parameters with ``overrides`` applied and checked; with subsystems, also
-        theirs by path (``"cyl1.phi0"``)."""
-        if has_subsystems(self):
-            return self.flat().parameter_values(overrides)
+        """Model parameters with ``overrides`` applied and checked."""
         values = dict(self.parameters)
         for key, value in (overrides or {}).items():
+            if key not in values and "." in key:
+                instance, _, name = key.rpartition(".")
+                raise ModelError(
+                    f"params: {key!r} is a value of subsystem {instance!r}, a constant of "
+                    f"its equations: change it with model.set_parameter({key!r}, value), or "
+                    f"feed it from a model parameter (params={{{name!r}: \"my_{name}\"}} on "
+                    f"the subsystem) to vary it without a new compilation")
             if key not in values:
                 raise ModelError(f"params: unknown model parameter {key!r}"
                                  f"{suggest(key, values)}; parameters are "

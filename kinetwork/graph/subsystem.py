@@ -6,10 +6,11 @@ its parameters are the subsystem's parameters. ``Subsystem("cyl1", cylinder, par
 places it: numbers and expressions in the outer model's parameters feed the inner ones.
 
 Flattening names everything by path: component ``cyl1.piston``, state ``cyl1.slide.q``, probe
-signal ``cyl1.p.position``, parameter ``cyl1.phi0``. A subsystem parameter given a number (or
-left at its definition's value) becomes a parameter of the flat model under its path, so
-``simulate(..., params={"cyl1.phi0": 0.3})`` changes it without a new compilation; one given an
-expression is that expression, written in the outer names.
+signal ``cyl1.p.position``. A subsystem parameter given a number (or left at its definition's
+value) is a constant of the instance, as a component's parameter is, so a model of subsystems
+has the very equations of the same model written flat; one given an expression in the outer
+model's parameters is that expression written in the outer names, so a model parameter
+feeding it changes it without a new compilation.
 """
 
 import copy
@@ -78,7 +79,7 @@ class Subsystem(Component):
         if not key.startswith("_") and key in self.ports:
             return PortRef(self, key)
         if not key.startswith("_") and key in self.definition.parameters:
-            return self._values[key]
+            return self.given.get(key, self.definition.parameters[key])
         return super().__getattr__(key)
 
     def port_ref(self, name):
@@ -89,10 +90,10 @@ class Subsystem(Component):
         return PortRef(self, name)
 
     def signature(self):
-        """What the equations of this instance depend on (values of given numbers do not:
-        they become parameters of the flat model)."""
-        given = tuple((k, v if isinstance(v, str) else "#") for k, v in sorted(self.given.items()))
-        return self.definition.content_key(), given
+        """What the equations of this instance depend on: its definition, the values given
+        and the definition's own values (numbers are constants of the instance)."""
+        return (self.definition.content_key(), repr(sorted(self.given.items())),
+                repr(sorted(self.definition.parameters.items())))
 
     def __repr__(self):
         return f"<Subsystem {self.name!r} of {self.definition.name!r}>"
@@ -191,7 +192,7 @@ class _Flat:
             for key, spec in comp.params.items():
                 value = comp._values[key]
                 if spec.kind == "real" and value is not None:
-                    value = _map(value, lambda text: rename(text, scope))
+                    value = _map(value, lambda text: _constant(rename(text, scope)))
                 elif spec.kind == "name" and value is not None and prefix:
                     value = prefix + value
                 values[key] = value
@@ -229,8 +230,7 @@ class _Flat:
                 else:
                     inner[key] = f"({rename(value, scope)})"
             else:
-                self.flat.parameters[f"{path}.{key}"] = value
-                inner[key] = f"{path}.{key}"
+                inner[key] = repr(float(value))
         return inner
 
     def port(self, m, prefix, ref, depth):
@@ -268,21 +268,12 @@ def flatten(model):
     return flat
 
 
-def parameter_values(model, prefix="", out=None):
-    """The numbers of the flat model's parameters: the model's own, and every subsystem
-    parameter given a number or left at its definition's value, by path."""
-    out = {} if out is None else out
-    if not prefix:
-        out.update(model.parameters)
-    for comp in model.components.values():
-        if isinstance(comp, Subsystem):
-            path = prefix + comp.name
-            for key, default in comp.definition.parameters.items():
-                value = comp.given.get(key, default)
-                if not isinstance(value, str):
-                    out[f"{path}.{key}"] = value
-            parameter_values(comp.definition, path + ".", out)
-    return out
+def _constant(text):
+    """An expression without free names as its number (a subsystem's parameter given a
+    number is a constant of the instance, as a component's is: the flat model's equations
+    are those of the same model written flat), any other as it is."""
+    expr = parse(text)
+    return float(expr.evaluate({})) if not expr.names else text
 
 
 def _map(value, fn):

@@ -11,7 +11,10 @@ from hypothesis import strategies as st
 import kinetwork as kn
 
 MODELS = sorted((pathlib.Path(__file__).resolve().parents[2] / "models").glob("*.json"))
-BASES = [json.loads(p.read_text()) for p in MODELS]
+#: and the models of subsystems, their definitions inline (a text has no folder to find files)
+BASES = [json.loads(p.read_text()) for p in MODELS] + [
+    json.loads(kn.dumps(kn.load(p))) for p in
+    sorted((MODELS[0].parent / "robot").glob("arm_*.json"))]
 
 scalars = st.one_of(
     st.none(), st.booleans(), st.integers(-10**30, 10**30),

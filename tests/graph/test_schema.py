@@ -11,7 +11,7 @@ import pytest
 import kinetwork as kn
 from kinetwork.components.base import REGISTRY
 
-MODELS = sorted((pathlib.Path(__file__).resolve().parents[2] / "models").glob("*.json"))
+MODELS = sorted((pathlib.Path(__file__).resolve().parents[2] / "models").glob("**/*.json"))
 
 
 @pytest.fixture(scope="module")

@@ -294,6 +294,28 @@ def closure(phi, crankAngleOffset=0.0, cylinderInclination=0.0, **params):
     return {"alpha": alpha, "beta": beta, "s": s, "b1": beta - alpha, "b2": beta}
 
 
+def closure_expressions(phi, crankAngleOffset="crankAngleOffset",
+                        cylinderInclination="cylinderInclination", **params):
+    """:func:`closure` as kinetwork expressions in the names ``phi``, ``crankAngleOffset`` and
+    ``cylinderInclination`` (the parameters of the Cylinder definition): its loop joints'
+    starting guesses follow each instance's offset and inclination."""
+    p = {**CYLINDER, **params}
+    r, l = p["crankPinOffset"], p["rodLength"]
+    alpha = f"({phi} + {crankAngleOffset} - {cylinderInclination})"
+    beta = f"(-asin({r!r}/{l!r}*sin{alpha}))"
+    s = (f"{p['cylinderTopPosition'] - p['pistonLength']!r} - ({r!r}*cos{alpha} + "
+         f"{l!r}*cos{beta})")
+    return {"alpha": alpha, "beta": beta, "s": s, "b1": f"{beta} - {alpha}", "b2": beta}
+
+
+def _negative(value):
+    return f"-{value}" if isinstance(value, str) else -value
+
+
+def _number(value):
+    return value if isinstance(value, str) else float(value)
+
+
 def cylinder_length(**params):
     """MSL's cylinderLength = cylinderTopPosition - (pistonLength + rodLength -
     crankPinOffset): the gas force's L."""
@@ -328,7 +350,8 @@ def add_cylinder(model, prefix, crank_frame, cylinder_frame, *, phi0=0.0, gas=Tr
     unknown = set(params) - set(CYLINDER)
     if unknown:
         raise TypeError(f"unknown cylinder parameter(s): {sorted(unknown)}")
-    n = lambda local: f"{prefix}_{local}"                          # noqa: E731
+    # prefix None: the cylinder alone, a subsystem definition (names as they are)
+    n = (lambda local: local) if prefix is None else (lambda local: f"{prefix}_{local}")
     add = model.add
     x = [1.0, 0.0, 0.0]
     parts = cylinder_parts(rod_shape_offset=rod_shape_offset, **params)
@@ -346,7 +369,7 @@ def add_cylinder(model, prefix, crank_frame, cylinder_frame, *, phi0=0.0, gas=Tr
             model.connect(frame_a, n(f"{name}.frame_a"))
         return n(f"{name}.frame_b")
 
-    start = closure(phi0, **p)
+    start = closure_expressions(phi0, **p) if isinstance(phi0, str) else closure(phi0, **p)
 
     # -- the engine block side: cylinder_a -> mounting -> cylinder_b; inclination, top
     add(mb.FixedTranslation(n("mounting"), r=[p["crankLength"], 0, 0]))
@@ -358,7 +381,7 @@ def add_cylinder(model, prefix, crank_frame, cylinder_frame, *, phi0=0.0, gas=Tr
 
     # -- the crankshaft piece: crank_a -> crankAngle1 -> crank1..4 -> crankAngle2 -> crank_b
     add(mb.FixedRotation(n("crankAngle1"), axis=x, angle=p["crankAngleOffset"]))
-    add(mb.FixedRotation(n("crankAngle2"), axis=x, angle=-p["crankAngleOffset"]))
+    add(mb.FixedRotation(n("crankAngle2"), axis=x, angle=_negative(p["crankAngleOffset"])))
     tip = body("crank1", n("crankAngle1.frame_b"))
     pin = body("crank2", tip)
     tip = body("crank3", pin)
@@ -368,13 +391,13 @@ def add_cylinder(model, prefix, crank_frame, cylinder_frame, *, phi0=0.0, gas=Tr
     # -- the loop: crank pin -> mid -> b1 (cut) -> rod -> b2 -> piston -> cylinder -> top
     add(mb.FixedTranslation(n("mid"), r=[p["crankPinLength"] / 2, 0, 0]))
     model.connect(pin, n("mid.frame_a"))
-    add(mb.Revolute(n("b1"), axis=x, cut=True, q0_guess=float(start["b1"])))
+    add(mb.Revolute(n("b1"), axis=x, cut=True, q0_guess=_number(start["b1"])))
     model.connect(n("mid.frame_b"), n("b1.frame_a"))
     rod_end = body("connectingRod", n("b1.frame_b"))
-    add(mb.Revolute(n("b2"), axis=x, q0_guess=float(start["b2"])))
+    add(mb.Revolute(n("b2"), axis=x, q0_guess=_number(start["b2"])))
     model.connect(n("b2.frame_b"), rod_end)
     piston_top = body("piston", n("b2.frame_a"))
-    add(mb.Prismatic(n("cylinder"), axis=[0, -1, 0], q0_guess=float(start["s"])))
+    add(mb.Prismatic(n("cylinder"), axis=[0, -1, 0], q0_guess=_number(start["s"])))
     model.connect(n("cylinderTop.frame_b"), n("cylinder.frame_a"))
     model.connect(n("cylinder.frame_b"), piston_top)
 
@@ -485,6 +508,67 @@ def build_engine_v6(cylinders=V6_CYLINDERS, phi0=ENGINE["phi0"], w0=ENGINE["w0"]
             v_blend=v_blend, crankAngleOffset=math.radians(offset),
             cylinderInclination=math.radians(inclination), **cylinder_params)
     return model
+
+
+def cylinder_definition(gas=True, probes=True, v_blend=V_BLEND, **params):
+    """MSL's ``Loops.Utilities.Cylinder`` as a subsystem definition: the content of
+    :func:`add_cylinder`, its four frames exposed (``CYLINDER_PORTS``). Its parameters are
+    what differs between the cylinders of an engine: ``crankAngleOffset`` and
+    ``cylinderInclination`` [rad], and ``phi0``, the crankshaft angle at the start (the loop
+    joints' starting guesses)."""
+    model = kn.Model("Cylinder", parameters={"crankAngleOffset": 0.0,
+                                             "cylinderInclination": 0.0, "phi0": 0.0},
+                     description=(
+        "Modelica.Mechanics.MultiBody.Examples.Loops.Utilities.Cylinder: a piece of "
+        "crankshaft (crank_a to crank_b), the crank pin, connecting rod and piston in a "
+        "cylinder of the engine block (cylinder_a to cylinder_b), a planar loop cut at the "
+        "crank-pin revolute b1, and GasForce2 approximated by signal tables of the "
+        "compression and expansion pressures. Parameters: crankAngleOffset and "
+        "cylinderInclination [rad], phi0 the crankshaft angle at the start."))
+    add_cylinder(model, None, None, None, phi0="phi0", gas=gas, probes=probes,
+                 v_blend=v_blend, crankAngleOffset="crankAngleOffset",
+                 cylinderInclination="cylinderInclination", **params)
+    for port, inner in CYLINDER_PORTS.items():
+        model.expose(port, inner)
+    return model
+
+
+def build_engine_v6_subsystems(cylinders=V6_CYLINDERS, phi0=ENGINE["phi0"], w0=ENGINE["w0"],
+                               J_load=ENGINE["J_load"], load2=True, filter=True, gas=True,
+                               probes=True, v_blend=V_BLEND, definition=None):
+    """:func:`build_engine_v6` with each cylinder one instance of :func:`cylinder_definition`
+    (or ``definition``): ``cyl1`` ... ``cyl6``, their parts named by path
+    (``cyl3.piston``)."""
+    model = kn.Model("EngineV6", description=(
+        "Modelica.Mechanics.MultiBody.Examples.Loops.EngineV6 (MSL 3.2.x): six instances of "
+        "one Cylinder subsystem in a 60-degree V on one crankshaft (6 planar loops, 1 degree "
+        "of freedom), a 1 kg m^2 load started at 10 rad/s, load2 = -100 N m (w/200)^2 and "
+        "the engine torque filtered. See tests/scenes/engine.py."),
+        simulation={"t_end": 5.0, "n_points": 5001, "method": "auto", "rtol": 1e-6,
+                    "atol": 1e-8})
+    _add_crankshaft(model, phi0, w0, J_load, load2=load2 and J_load is not None,
+                    filter=filter and J_load is not None)
+    cylinder = definition or cylinder_definition(gas=gas, probes=probes, v_blend=v_blend)
+    crank, block = "bearing.frame_b", "world.frame"
+    for i, (offset, inclination) in enumerate(cylinders, start=1):
+        model.add(kn.Subsystem(f"cyl{i}", cylinder, params={
+            "crankAngleOffset": math.radians(offset),
+            "cylinderInclination": math.radians(inclination), "phi0": phi0}))
+        model.connect(crank, f"cyl{i}.crank_a")
+        model.connect(block, f"cyl{i}.cylinder_a")
+        crank, block = f"cyl{i}.crank_b", f"cyl{i}.cylinder_b"
+    return model
+
+
+def write_models(folder):
+    """``folder``/EngineV6.json placing ``folder``/Cylinder.json six times (the example in
+    ``models/engine_v6``)."""
+    folder = pathlib.Path(folder)
+    folder.mkdir(parents=True, exist_ok=True)
+    cylinder_definition().save(folder / "Cylinder.json")
+    cylinder = kn.load(folder / "Cylinder.json")
+    build_engine_v6_subsystems(definition=cylinder).save(folder / "EngineV6.json")
+    return folder / "EngineV6.json"
 
 
 def build_single_cylinder(phi0=0.5, w0=3.0, gravity=(0.0, 0.0, -9.81), J_load=None,
