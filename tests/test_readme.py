@@ -5,6 +5,8 @@ import re
 
 import numpy as np
 
+import kinetwork as kn
+
 from kinetwork.components.base import REGISTRY
 
 README = (pathlib.Path(__file__).resolve().parents[1] / "README.md").read_text()
@@ -34,3 +36,12 @@ def test_python_example_runs(tmp_path, monkeypatch):
     q, qd = res["shoulder.q"], res["shoulder.qd"]
     np.testing.assert_allclose(res["probe1.torque"], -(2.0 * q + 1.0 * qd), atol=1e-12)
     assert (tmp_path / "probes.png").stat().st_size > 10_000
+
+
+def test_subsystem_example_runs():
+    code = README.split("## Subsystems", 1)[1].split("```python", 1)[1].split("```", 1)[0]
+    scope = {"kn": kn}
+    exec(compile(code, "README.md", "exec"), scope)          # our own README, not user input
+    res = scope["res"]
+    assert res.state_names[:2] == ["upper.joint.q", "lower.joint.q"]
+    assert res["lower.p.angle"].shape == res.t.shape
