@@ -111,7 +111,8 @@ def build_parser():
     run.add_argument("--n-points", type=int, metavar="N", help="points on the output grid")
     run.add_argument("--param", type=_parameter, action="append", default=[],
                      metavar="NAME=VALUE",
-                     help="set a model parameter for this run (repeat for several)")
+                     help="set a model parameter for this run (repeat for several); a path "
+                          "(cyl1.phi0) sets a value of a subsystem")
     run.add_argument("--max-steps", type=_positive(int), metavar="N",
                      help="step budget per output interval of the variable-step methods")
     run.add_argument("--time-limit", type=_positive(float), metavar="S",
@@ -259,6 +260,14 @@ def _run(args):
     if args.plot:
         from .plot import check_plot_path
         check_plot_path(args.plot)
+    # a subsystem's value by path ("cyl1.phi0") is a constant of its instance: set on the
+    # model before it is compiled; model parameters go to the integrator
+    params = {}
+    for name, value in args.param:
+        if "." in name:
+            model.set_parameter(name, value)
+        else:
+            params[name] = value
     given = {"t_end": args.t_end, "n_points": args.n_points, "method": args.method,
              "rtol": args.rtol, "atol": args.atol, "step": args.step}
     settings = {**DEFAULTS, **model.simulation,
@@ -277,7 +286,7 @@ def _run(args):
         with _progress_bar(args, model, settings["t_end"]) as progress:
             results = kn.simulate(system, t_end=args.t_end, n_points=args.n_points,
                                   method=args.method, rtol=args.rtol, atol=args.atol,
-                                  step=args.step, jit=args.jit, params=dict(args.param),
+                                  step=args.step, jit=args.jit, params=params,
                                   max_steps=args.max_steps, time_limit=args.time_limit,
                                   progress=progress)
     except kn.SimulationError as exc:

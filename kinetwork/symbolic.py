@@ -8,6 +8,7 @@ joint coordinates and model parameters, then simplified into the paper's form.
 
 import math
 import operator
+import re
 from fractions import Fraction
 
 import casadi as ca
@@ -292,8 +293,16 @@ def equations_sympy(system, simplified=None):
             taken.add(name)
             out.append(sp.Symbol(name, real=True))
     t = sp.Symbol("t", real=True)
+    # states of signal blocks and 1-D networks a force depends on (a PID's integral)
+    x = []
+    for label in eq["x_names"]:
+        name = "x_" + re.sub(r"\W+", "_", label).strip("_")
+        while name in taken:
+            name += "_"
+        taken.add(name)
+        x.append(sp.Symbol(name, real=True))
     symbols_in = [(eq["q"], q), (eq["qd"], qd), (eq["p"], list(params.values())),
-                  (eq["t"], [t])]
+                  (eq["t"], [t]), (eq["x"], x)]
     terms = [eq["M"], eq["V"], eq["G"]]
     f = _function(terms, symbols_in)
     size = f.n_instructions()
@@ -309,7 +318,7 @@ def equations_sympy(system, simplified=None):
         mats, shared = function_to_sympy(f, [syms for _, syms in symbols_in], prefix="w")
     M, V, G = mats
     return {"M": M, "V": V, "G": G, "shared": shared, "q": q, "qd": qd, "params": params,
-            "t": t, "size": size, "simplified": simplified}
+            "t": t, "x": x, "size": size, "simplified": simplified}
 
 
 def _untranslatable(op):

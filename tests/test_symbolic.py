@@ -214,3 +214,16 @@ def test_to_sympy_shared_names_repeated_results():
     [(w, definition)] = shared
     assert definition == 2 * sp.sin(SX_)
     assert list(m) == [w + 1, w ** 2]
+
+
+def test_equations_of_a_model_with_controller_states_name_them():
+    # a PID's states enter V; in subsystems their symbols carry the instance path
+    import pathlib
+    root = pathlib.Path(__file__).resolve().parents[1] / "models"
+    eq = equations_sympy(kn.load(root / "robot" / "arm_axes.json").compile())
+    names = {s.name for s in eq["x"]}
+    assert names == {"x_shoulder_axis_pid_x_0", "x_shoulder_axis_pid_x_1",
+                     "x_elbow_axis_pid_x_0", "x_elbow_axis_pid_x_1"}
+    J_m, n = eq["params"]["J_m"], eq["params"]["n"]
+    assert sp.simplify(eq["M"][1, 1] - eq["M"][1, 1].subs(J_m, 0) - J_m * n**2) == 0
+    assert {s.name for s in eq["V"][0].free_symbols} >= {"x_shoulder_axis_pid_x_0"}

@@ -246,10 +246,15 @@ class System:
         return np.asarray(M), np.asarray(V).ravel(), np.asarray(G).ravel()
 
     def equations(self):
-        """Symbolic M, V, G (CasADi SX) with their symbols: q, qd, p (parameters), t."""
+        """Symbolic M, V, G (CasADi SX) with their symbols: q, qd, p (parameters), t, and
+        ``x``, the states of 1-D networks and signal blocks V depends on (a PID's
+        integral), named in ``x_names``."""
         a = self.asm
         M, V, G = a.terms()
+        known = {ca.SX(v).name() for v in (a.q, a.u, a.p, a.t) for v in ca.vertsplit(v)}
+        x = [v for v in ca.symvar(ca.veccat(M, V, G)) if v.name() not in known]
         return {"M": M, "V": V, "G": G, "q": a.q, "qd": a.u, "p": a.p, "t": a.t,
+                "x": ca.vertcat(*x) if x else ca.SX(0, 1), "x_names": [v.name() for v in x],
                 "param_names": list(a.param_names)}
 
     def outputs(self, t, x, params=None):

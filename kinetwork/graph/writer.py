@@ -8,7 +8,7 @@ import copy
 import json
 import os
 
-from ..components.base import REGISTRY
+from ..components.base import _NAME, REGISTRY
 from ..errors import ModelError
 from ..util import atomic_write, finite
 from .settings import check_setting
@@ -113,6 +113,11 @@ def _definitions(model, folder, problems):
                                     f"{d.name!r}; a file names a definition once (rename one)")
                 continue
             seen[d.name] = d
+            if not _NAME.fullmatch(d.name) or d.name in REGISTRY:
+                problems.append(f"definitions.{d.name}: a definition's name is the type its "
+                                f"instances have in a file: an identifier that names no "
+                                f"kinetwork type, got {d.name!r} (rename the model)")
+                continue
             entry = _reference(d, folder)
             if entry is None:
                 entry = _body(d, problems, f"definitions.{d.name}.")

@@ -251,3 +251,26 @@ def test_version_1_files_keep_their_keys(tmp_path, seed_model):
     data["definitions"] = {}
     path = write(tmp_path / "m.json", data)
     refused(path, "'definitions': unknown key", "need version 2")
+
+
+@pytest.mark.parametrize("name", ["my link", "Probe", "link.v2"])
+def test_a_definition_a_file_cannot_name_is_refused_at_saving(tmp_path, name):
+    link = link_model()
+    link.name = name
+    arm = kn.Model("arm")
+    arm.add(kn.Subsystem("upper", link))
+    with pytest.raises(kn.ModelError, match="a definition's name is the type its instances "
+                                            "have in a file"):
+        arm.save(tmp_path / "arm.json")
+    assert not (tmp_path / "arm.json").exists()
+
+
+def test_run_sets_a_subsystem_value_by_path(tmp_path, capsys):
+    path = tmp_path / "arm.json"
+    seed_of_links().save(path)
+    assert main(["run", str(path), "--t-end", "0.1", "-q", "--param", "upper.q0=0.3",
+                 "--param", "c=2", "--out", str(tmp_path / "out.csv")]) == 0
+    first = (tmp_path / "out.csv").read_text().splitlines()[1].split(",")
+    assert float(first[1]) == pytest.approx(0.3)
+    assert main(["run", str(path), "--t-end", "0.1", "-q", "--param", "nope.q0=0.3"]) == 1
+    assert "a path names a parameter of a subsystem placed in 'arm'" in capsys.readouterr().err
