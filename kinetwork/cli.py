@@ -168,7 +168,38 @@ def build_parser():
                      help="simplify into the paper's form, or print the Newton-Euler "
                           "expressions as built, with shared parts named (default: simplify "
                           "when that takes seconds, not hours)")
-    for command in (run, val, eqs):
+    anim = sub.add_parser(
+        "animate", help="write a 3-D animation of a model's motion",
+        description="Simulate MODEL.json and write its motion as a self-contained HTML file "
+                    "(three.js inlined: play, pause, scrub, speed, orbiting camera; opens "
+                    "without a network), and optionally a GIF or MP4.")
+    anim.add_argument("model", metavar="MODEL.json", help="model file")
+    anim.add_argument("--html", metavar="FILE.html", help="the animation page")
+    anim.add_argument("--gif", metavar="FILE.gif", help="also a GIF")
+    anim.add_argument("--mp4", metavar="FILE.mp4", help="also an MP4 video")
+    anim.add_argument("--t-end", type=float, metavar="T", help="end time [s]")
+    anim.add_argument("--fps", type=_positive(int), default=30, metavar="N",
+                      help="frames per second of the animation (default 30)")
+
+    dia = sub.add_parser(
+        "diagram", help="draw a model's wiring diagram as SVG",
+        description="Draw MODEL.json as blocks with their ports and wires, domains coloured "
+                    "as in Modelica, placed by the file's layout or an automatic layered "
+                    "layout where it has none.")
+    dia.add_argument("model", metavar="MODEL.json", help="model file")
+    dia.add_argument("-o", "--out", metavar="FILE.svg", required=True, help="the SVG file")
+
+    studio = sub.add_parser(
+        "studio", help="open the browser studio",
+        description="Start the studio on this machine (127.0.0.1, a free port, a token in the "
+                    "URL) and open it in the browser: place, wire, run and watch models. "
+                    "Files are read and written only inside the folder it was started in.")
+    studio.add_argument("model", nargs="?", metavar="MODEL.json", help="model to open")
+    studio.add_argument("--port", type=_positive(int), metavar="N",
+                        help="port (default: a free one)")
+    studio.add_argument("--no-browser", action="store_true",
+                        help="print the address, do not open a browser")
+    for command in (run, val, eqs, anim, dia, studio):
         command.add_argument("--library", action="append", default=[], metavar="DIR",
                              help="a folder of subsystem files (TYPE.json), searched after "
                                   "the model's own definitions and folder (repeat for "
@@ -181,7 +212,8 @@ def main(argv=None):
     args = build_parser().parse_args(argv)
     command = {"run": _run, "validate": _validate, "equations": _equations,
                "methods": _methods, "bench": _bench, "schema": _schema,
-               "cache": _cache}[args.command]
+               "cache": _cache, "animate": _animate, "diagram": _diagram,
+               "studio": _studio}[args.command]
     try:
         return command(args)
     except kn.ModelError as exc:
@@ -201,9 +233,9 @@ def _error(message):
     print(f"kinetwork: error: {message}", file=sys.stderr)
 
 
-def _load(path, library=None):
+def _load(path, library=None, validate=True):
     try:
-        return kn.load(path, library=library)
+        return kn.load(path, library=library, validate=validate)
     except OSError as exc:
         raise kn.ModelError(f"cannot read {path}: {exc.strerror or exc}") from None
 
@@ -466,6 +498,21 @@ def _compiled_summary(system, topo, loops):
         + ("articulated-body algorithm, O(N)" if system.formulation == "tree" else
            "mass matrix projected on the independent speeds") + ")",
     ]
+
+
+def _animate(args):
+    from .animation import cli_animate        # the faces load only when asked for
+    return cli_animate(args, _load(args.model, args.library))
+
+
+def _diagram(args):
+    from .diagram import cli_diagram
+    return cli_diagram(args, _load(args.model, args.library, validate=False))
+
+
+def _studio(args):
+    from .studio import cli_studio
+    return cli_studio(args)
 
 
 def _schema(args):
