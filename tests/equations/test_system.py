@@ -45,8 +45,9 @@ def test_rhs_mass_matrix_and_dynamics_terms_are_the_papers(params):
 def test_equations_are_the_symbolic_terms():
     system = double_pendulum().compile()
     eq = system.equations()
-    assert set(eq) == {"M", "V", "G", "q", "qd", "p", "t", "param_names"}
-    assert all(isinstance(eq[k], ca.SX) for k in ("M", "V", "G", "q", "qd", "p", "t"))
+    assert set(eq) == {"M", "V", "G", "q", "qd", "p", "t", "x", "param_names", "x_names"}
+    assert all(isinstance(eq[k], ca.SX) for k in ("M", "V", "G", "q", "qd", "p", "t", "x"))
+    assert eq["x_names"] == [] and eq["x"].numel() == 0    # no controller states here
     assert eq["M"].shape == (2, 2) and eq["V"].shape == eq["G"].shape == (2, 1)
     f = ca.Function("terms", [eq["t"], eq["q"], eq["qd"], eq["p"]], [eq["M"], eq["V"], eq["G"]])
     p = [PAPER[name] for name in eq["param_names"]]
