@@ -199,6 +199,18 @@ def build_parser():
                         help="port (default: a free one)")
     studio.add_argument("--no-browser", action="store_true",
                         help="print the address, do not open a browser")
+    imp = sub.add_parser(
+        "import", help="turn a URDF robot description into a kinetwork model file",
+        description="Read ROBOT.urdf (links, joints, inertials, limits, visuals) and write "
+                    "the kinetwork model of the robot: a Ground, its joints and bodies, and "
+                    "with --probes a probe on every joint.")
+    imp.add_argument("source", metavar="ROBOT.urdf", help="URDF file")
+    imp.add_argument("-o", "--out", metavar="MODEL.json", required=True, help="model file")
+    imp.add_argument("--probes", action="store_true", help="a probe on every joint")
+    imp.add_argument("--floating", action="store_true",
+                     help="a free-floating base (default: the root link fixed to the ground)")
+    imp.add_argument("--gravity", type=float, nargs=3, metavar=("GX", "GY", "GZ"),
+                     default=None, help="gravity of the ground (default 0 0 -9.81)")
     for command in (run, val, eqs, anim, dia, studio):
         command.add_argument("--library", action="append", default=[], metavar="DIR",
                              help="a folder of subsystem files (TYPE.json), searched after "
@@ -213,7 +225,7 @@ def main(argv=None):
     command = {"run": _run, "validate": _validate, "equations": _equations,
                "methods": _methods, "bench": _bench, "schema": _schema,
                "cache": _cache, "animate": _animate, "diagram": _diagram,
-               "studio": _studio}[args.command]
+               "studio": _studio, "import": _import}[args.command]
     try:
         return command(args)
     except kn.ModelError as exc:
@@ -513,6 +525,11 @@ def _diagram(args):
 def _studio(args):
     from .studio import cli_studio
     return cli_studio(args)
+
+
+def _import(args):
+    from .urdf import cli_import
+    return cli_import(args)
 
 
 def _schema(args):
