@@ -13,7 +13,7 @@ from . import plot as _plot  # noqa: F401  (installs Results.plot)
 from .components import multibody, rotational, signals, translational
 from .components.probe import Probe
 from .equations.system import System
-from .errors import ModelError, SimulationError
+from .errors import IdealisedInertiaWarning, ModelError, SimulationError
 from .graph.io import dumps, load, loads
 from .graph.model import Model
 from .graph.subsystem import Subsystem
@@ -24,6 +24,6 @@ from .simulation.results import Results
 
 __version__ = "0.1.0"
 
-__all__ = ["METHODS", "Model", "ModelError", "Probe", "Results", "SimulationError", "Subsystem", "System",
+__all__ = ["IdealisedInertiaWarning", "METHODS", "Model", "ModelError", "Probe", "Results", "SimulationError", "Subsystem", "System",
            "dumps", "load", "loads", "multibody", "rotational", "schema", "signals",
            "simulate", "translational"]

@@ -31,3 +31,10 @@ class SimulationError(RuntimeError):
         self.reason = reason
         #: the signal (SIGINT, SIGTERM) that stopped the run, or None
         self.signal = signal
+
+
+class IdealisedInertiaWarning(UserWarning):
+    """A body's inertia no rigid body has (principal moments breaking the triangle
+    inequality), accepted as an idealisation: MSL's examples give parts that only turn about
+    one axis inertias such as diag(2, 0, 0). The model simulates; a mass matrix made singular
+    by it is still refused, naming the joints."""

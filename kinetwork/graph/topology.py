@@ -8,13 +8,14 @@ Spherical joints) is walked breadth-first from the ground to order the Newton-Eu
 recursion; every edge left out is a cut joint that closes one independent kinematic loop.
 """
 
+import warnings
 from dataclasses import dataclass, field
 
 import networkx as nx
 import numpy as np
 
 from ..components.probe import QUANTITIES
-from ..errors import ModelError
+from ..errors import IdealisedInertiaWarning, ModelError
 
 ONED_DOMAINS = ("rotational", "translational")
 SIGNAL_DOMAINS = ("signal_in", "signal_out")
@@ -329,11 +330,14 @@ def _oned(model, topo, values, problems):
 
 
 def _inertias(model, bodies, values, problems):
-    """A body's inertia about its centre of mass must be a physical one: symmetric, positive
-    semi-definite, and its principal moments must satisfy the triangle inequality (no moment
-    exceeds the sum of the other two). A tensor with a zero principal moment is taken as an
-    idealisation (planar models often give a link only its moment about the joint axis) and
-    is not held to the inequality."""
+    """A body's inertia about its centre of mass must be symmetric and positive
+    semi-definite: nothing else is possible for any use. Principal moments that break the
+    triangle inequality (no rigid body has them) are an idealisation MSL's own examples use
+    for parts that turn about one axis only (ActuatedDrive's diag(2, 0, 0), RobotR3's
+    diag(0.001, 1.16, 0.001)): warned once per body, and simulated; a mass matrix they make
+    singular is refused later, naming the joints. A tensor with a zero principal moment (a
+    planar link given only its moment about the joint axis) is an idealisation too common to
+    warn about."""
     for body in bodies:
         inertia = np.asarray(values[body.name]["inertia"], dtype=float)
         where = model.place(body, "inertia")
@@ -347,9 +351,10 @@ def _inertias(model, bodies, values, problems):
             problems.append(f"{where}: must be positive semi-definite; its principal moments "
                             f"are {listed}")
         elif moments[0] > 1e-12 * scale and moments[0] + moments[1] < moments[2] - 1e-9 * scale:
-            problems.append(f"{where}: its principal moments {listed} break the triangle "
-                            f"inequality (the largest exceeds the sum of the other two): no "
-                            f"rigid body has them")
+            warnings.warn(f"{where}: its principal moments {listed} break the triangle "
+                          f"inequality (the largest exceeds the sum of the other two): no "
+                          f"rigid body has them; simulated as an idealisation",
+                          IdealisedInertiaWarning, stacklevel=2)
 
 
 def _domain(ports):
