@@ -50,6 +50,8 @@ PROJECTION_PULL = 1.0
 BAUMGARTE_RATE = 10.0
 #: a closure residual below this (m, and rotation-matrix entries) counts as closed
 CLOSED = 1e-10
+#: starts of the assembly search where Gauss-Newton stalls: the guesses, then perturbed ones
+SEARCH_STARTS = 24
 #: singular values below this fraction of the largest mark redundant closure equations
 RANK_TOL = 1e-8
 
@@ -192,40 +194,128 @@ class _Loops:
 
     # -- consistent initial configuration ---------------------------------------------------
     def close(self, p):
-        """Coordinates that close every loop, holding the given ones: Gauss-Newton with
-        least-squares steps from q0 (given) and q0_guess (not given)."""
+        """Coordinates that close every loop, holding the given ones.
+
+        Gauss-Newton with least-squares steps from q0 (given) and q0_guess (not given). Where
+        that stalls, as at a dead centre (a slider-crank started with its crank at pi: the
+        closure's Jacobian is singular there and the start sits in a local minimum of the
+        residual), a Levenberg-Marquardt search from the guesses and from a fixed set of
+        perturbed starts; of the assemblies found, the one nearest the guesses (the branch
+        they choose). A loop is named as unable to close only when it cannot close by
+        itself."""
         q0, _ = self.f_start(p)
-        q = np.asarray(q0, dtype=float).ravel()
-        r = np.asarray(self.f_phi(q, p)).ravel()
-        for _ in range(100):
-            if np.max(np.abs(r), initial=0.0) < CLOSED * 1e-2:
-                break
-            J = np.asarray(self.f_jac(q, p))
-            step = np.linalg.lstsq(J, -r, rcond=None)[0] if self.free else np.zeros(0)
-            for scale in (1.0, 0.5, 0.25, 0.1, 0.01):        # backtrack on |residual|
-                trial = q.copy()
-                trial[self.free] += scale * step
-                r_trial = np.asarray(self.f_phi(trial, p)).ravel()
-                if np.linalg.norm(r_trial) < np.linalg.norm(r):
-                    q, r = trial, r_trial
-                    break
-            else:
-                break
+        start = np.asarray(q0, dtype=float).ravel()
+        q, r = self._gauss_newton(start, p)
+        if not self._closed(r):
+            q, r = self._search(start, p, q, r)
         worst = np.max(np.abs(r), initial=0.0)
         if not np.isfinite(worst) or worst > CLOSED:
             by_loop = {}
             for i, v in zip(self.owner, np.abs(r)):
                 by_loop[i] = max(by_loop.get(i, 0.0), v)
-            bad = [i for i, v in by_loop.items() if v > CLOSED]
-            held = [n for n, g in zip(self.asm.coordinate_names, self.asm.given) if g]
-            msgs = [f"kinematic loop through {', '.join(self.asm.cuts[i][0].loop)} cannot "
+            # a loop stalled with a failing one is not blamed: only those that cannot
+            # close even alone (or, if each closes alone, those left open together)
+            alone = {i: self._alone(i, start, p) for i, v in by_loop.items() if v > CLOSED}
+            bad = [i for i, ok in alone.items() if not ok] or list(alone)
+            # the coordinates each loop's closure depends on, for the given ones it names
+            uses = np.asarray(ca.DM(ca.jacobian(self.phi, self.asm.q).sparsity(), 1))
+            msgs = []
+            for i in bad:
+                rows = [k for k, owner in enumerate(self.owner) if owner == i]
+                held = [n for k, (n, g) in enumerate(zip(self.asm.coordinate_names,
+                                                          self.asm.given))
+                        if g and uses[rows, k].any()]
+                msgs.append(
+                    f"kinematic loop through {', '.join(self.asm.cuts[i][0].loop)} cannot "
                     f"close: at the best fit found its closure is off by {by_loop[i]:.3g} "
                     f"(m, or rotation-matrix entries); check the link lengths and axes"
                     + (f", the given q0 ({', '.join(held)})" if held else "")
-                    + ", or start the search nearer an assembly with q0_guess"
-                    for i in bad]
+                    + ", or start the search nearer an assembly with q0_guess")
             raise ModelError(msgs)
         return q
+
+    def _closed(self, r):
+        return bool(np.isfinite(r).all()) and np.max(np.abs(r), initial=0.0) < CLOSED * 1e-2
+
+    def _gauss_newton(self, q, p, rows=None, free=None):
+        free = self.free if free is None else free
+        pick = (lambda r: r) if rows is None else (lambda r: r[rows])
+        q = q.copy()
+        r = pick(np.asarray(self.f_phi(q, p)).ravel())
+        for _ in range(100):
+            if self._closed(r):
+                break
+            J = np.asarray(self.f_jac(q, p))
+            J = J[:, [self.free.index(i) for i in free]]
+            J = J if rows is None else J[rows]
+            step = np.linalg.lstsq(J, -r, rcond=None)[0] if free else np.zeros(0)
+            for scale in (1.0, 0.5, 0.25, 0.1, 0.01):        # backtrack on |residual|
+                trial = q.copy()
+                trial[free] += scale * step
+                r_trial = pick(np.asarray(self.f_phi(trial, p)).ravel())
+                if np.linalg.norm(r_trial) < np.linalg.norm(r):
+                    q, r = trial, r_trial
+                    break
+            else:
+                break
+        return q, r
+
+    def _search(self, start, p, q_best, r_best, rows=None, free=None):
+        """Levenberg-Marquardt from the start and from SEARCH_STARTS perturbed starts
+        (deterministic); the closing assembly nearest the start, else the best fit."""
+        from scipy.optimize import least_squares
+        free = self.free if free is None else free
+        if not free:
+            return q_best, r_best
+        pick = (lambda r: r) if rows is None else (lambda r: r[rows])
+        cols = [self.free.index(i) for i in free]
+
+        def residual(z):
+            q = start.copy()
+            q[free] = z
+            return pick(np.asarray(self.f_phi(q, p)).ravel())
+
+        def jacobian(z):
+            q = start.copy()
+            q[free] = z
+            J = np.asarray(self.f_jac(q, p))[:, cols]
+            return J if rows is None else J[rows]
+        rng = np.random.default_rng(0)
+        scale = np.where(np.array(self.asm.coordinate_units)[free] == "m",
+                         max(1.0, np.max(np.abs(start[free]), initial=0.0)), np.pi)
+        found = []
+        for k in range(SEARCH_STARTS):
+            z0 = start[free] + (0 if k == 0 else rng.uniform(-1, 1, len(free)) * scale)
+            try:
+                fit = least_squares(residual, z0, jac=jacobian, method="lm", xtol=1e-15,
+                                    ftol=1e-15, gtol=1e-15, max_nfev=200 * (len(free) + 1))
+            except (ValueError, np.linalg.LinAlgError):
+                continue
+            q = start.copy()
+            q[free] = fit.x
+            q, r = self._gauss_newton(q, p, rows, free)          # polish to round-off
+            if self._closed(r):
+                # an angle as the turn nearest its guess (q0_guess 0: in (-pi, pi])
+                q[free] = start[free] + _wrapped(q[free] - start[free], scale)
+                found.append((np.linalg.norm(q[free] - start[free]), k, q, r))
+                if k == 0:
+                    break
+            elif np.linalg.norm(r) < np.linalg.norm(r_best):
+                q_best, r_best = q, r
+        if found:
+            _, _, q, r = min(found, key=lambda f: f[:2])
+            return q, r
+        return q_best, r_best
+
+    def _alone(self, loop, start, p):
+        """Whether loop ``loop`` closes by itself (its rows, the free coordinates in it)."""
+        rows = [k for k, i in enumerate(self.owner) if i == loop]
+        pattern = np.asarray(ca.DM(self.f_jac.sparsity_out(0), 1))[rows]
+        free = [i for c, i in enumerate(self.free) if pattern[:, c].any()]
+        q, r = self._gauss_newton(start, p, rows, free)
+        if not self._closed(r):
+            q, r = self._search(start, p, q, r, rows, free)
+        return self._closed(r)
 
     # -- independent equations and the speed partition ------------------------------------------
     def _partition(self, J, loop_coords):
@@ -409,6 +499,12 @@ class _Loops:
                          dependent_jacobian=JD if dep else None,
                          dependent_names=[unames[k] for k in dep])
 
+
+
+def _wrapped(d, scale):
+    """Differences of coordinates, angles (scale pi) taken modulo 2 pi."""
+    angle = scale == np.pi
+    return np.where(angle, (d + np.pi) % (2 * np.pi) - np.pi, d)
 
 
 def newton(residual, z, steps=PROJECTION_STEPS):

@@ -3,6 +3,8 @@ one-degree-of-freedom Lagrange equation of ``tests/scenes/reference_loops.py``, 
 wrench balance of each link for the cut forces."""
 
 import json
+import math
+import pathlib
 
 import numpy as np
 import pytest
@@ -11,6 +13,8 @@ import kinetwork as kn
 import scenes
 from scenes import double_pendulum
 from scenes import reference_loops as ref
+
+ROOT = pathlib.Path(__file__).resolve().parents[2]
 
 mb = kn.multibody
 T = np.linspace(0.0, 10.0, 1001)
@@ -341,3 +345,54 @@ def test_cut_flag_on_a_joint_outside_any_loop_is_refused():
     pendulum.components["elbow"].cut = True
     with pytest.raises(kn.ModelError, match="elbow is marked cut but closes no kinematic loop"):
         pendulum.compile()
+
+
+def _slider_crank_definition():
+    """models/slider_crank.json as a subsystem: its two ground attachments joined and exposed
+    as ``base``; the crank angle ``theta0`` and the rod length ``l`` as parameters."""
+    crank = kn.load(ROOT / "models" / "slider_crank.json")
+    ground = crank.components.pop("ground")
+    crank.connections = [(a, b) for a, b in crank.connections
+                         if ground not in (a.component, b.component)]
+    crank.connect("O.frame_a", "slider.frame_a")
+    crank.expose("base", "O.frame_a")
+    crank.set_parameter("theta0", 0.5)
+    crank.components["O"].q0 = "theta0"
+    for joint in ("A", "slider", "B"):              # no help: start from zero
+        crank.components[joint].q0_guess = 0.0
+    return crank
+
+
+@pytest.mark.parametrize("theta0", [math.pi, -math.pi, 0.0, 2.5])
+def test_a_slider_crank_assembles_at_its_dead_centres_from_zero_guesses(theta0):
+    """MSL Engine1a starts its crank at pi: the closure's Jacobian is singular there and the
+    zero guesses sit in a local minimum of the residual. The assembly is the closed form's
+    (reference_loops.slider_crank_closure: slider at r cos(theta) + sqrt(l^2 - r^2 sin^2))."""
+    scene = kn.Model("engine1a")
+    scene.add(kn.multibody.Ground("ground", gravity=[0, -9.81, 0]))
+    scene.add(kn.Subsystem("sc", _slider_crank_definition(), params={"theta0": theta0}))
+    scene.connect("ground.frame", "sc.base")
+    system = scene.compile()
+    _, z = system.initial_full_p(system.param_vector())
+    slider = z[system.algebraic_names.index("sc.slider.q")]
+    r, l = 0.2, 0.6
+    assert slider == pytest.approx(r * math.cos(theta0)
+                                   + math.sqrt(l**2 - (r * math.sin(theta0))**2), abs=1e-12)
+    res = kn.simulate(system, t_end=0.5, n_points=6)
+    assert np.all(np.isfinite(res.states))
+
+
+def test_only_the_loop_that_cannot_close_is_named():
+    """Two slider-cranks on one ground: one at its dead centre (closes), one whose rod cannot
+    reach the slider's axis (0.05 < r sin(0.5) = 0.096): only that one is named."""
+    bad = _slider_crank_definition()
+    bad.set_parameter("l", 0.05)
+    scene = kn.Model("two")
+    scene.add(kn.multibody.Ground("ground", gravity=[0, -9.81, 0]))
+    scene.add(kn.Subsystem("good", _slider_crank_definition(), params={"theta0": math.pi}))
+    scene.add(kn.Subsystem("bad", bad))
+    scene.connect("ground.frame", "good.base")
+    scene.connect("ground.frame", "bad.base")
+    with pytest.raises(kn.ModelError, match="cannot close") as err:
+        scene.compile()
+    assert "bad.rod" in str(err.value) and "good." not in str(err.value)
