@@ -18,6 +18,7 @@ NUMBER = {"type": "number"}
 EXPRESSION = {"type": "string", "minLength": 1,
               "description": "arithmetic in model parameters (and t where allowed)"}
 SCALAR = {"anyOf": [NUMBER, EXPRESSION]}
+COLOR = "^#[0-9A-Fa-f]{6}$"
 
 
 PORT_PATH = {"type": "string", "pattern": IDENT[:-1] + r"\.[A-Za-z_][A-Za-z0-9_]*$"}
@@ -116,6 +117,10 @@ def _param(spec):
         out = {"type": "boolean"}
     elif spec.kind == "name":
         out = {"type": "string", "pattern": IDENT}
+    elif spec.kind == "choice":
+        out = {"enum": list(spec.choices)}
+    elif spec.kind == "color":
+        out = {"type": "string", "pattern": COLOR}
     elif spec.kind == "names":
         items = {"enum": list(spec.choices)} if spec.choices else {"type": "string"}
         out = {"type": "array", "items": items, "uniqueItems": True}
