@@ -1,0 +1,176 @@
+"""What the studio tells the page about models: the palette, the checks of ``kn.load`` with
+each problem placed on its block, and a layout for a diagram without one.
+
+Nothing here is new judgement: the palette is read from the component declarations, and a
+model is checked by ``kinetwork.graph.io.model_from_dict``, the checker behind ``kn.load``.
+"""
+
+import collections
+import logging
+import math
+import os
+import re
+
+import numpy as np
+
+from ..components.base import REGISTRY
+from ..errors import ModelError
+from ..graph.io import Context, model_from_dict
+
+log = logging.getLogger("kinetwork.studio")
+
+#: the order of the libraries in the palette; any other follows, alphabetically
+LIBRARY_ORDER = ("multibody", "rotational", "translational", "signals", "electrical", "probe")
+#: a model is compiled to list its states only up to this many flat components: the
+#: symbolic build takes about 50 ms for the seed and grows with the model
+COMPILE_LIMIT = 400
+#: where a problem is: components[i] "name" params.key, connections[i], or comp.port
+_PLACE = re.compile(r'components\[(?P<index>\d+)\](?: "(?P<name>[^"]*)")?'
+                    r'(?: params\.(?P<param>[A-Za-z_][A-Za-z0-9_]*))?'
+                    r'|connections\[(?P<wire>\d+)\]'
+                    r'|(?P<ref>[A-Za-z_][A-Za-z0-9_]*)\.[A-Za-z_][A-Za-z0-9_]*(?=[:\s])')
+GRID_COLUMNS, GRID_DX, GRID_DY = 4, 220, 140
+
+
+# -- the palette -------------------------------------------------------------------------------
+def palette():
+    """Every type of the component REGISTRY, grouped by library (the part of the type name
+    before the dot; ``Probe`` is in ``probe``), in declaration order."""
+    groups = collections.defaultdict(list)
+    for type_name, cls in REGISTRY.items():
+        library = type_name.split(".")[0] if "." in type_name else type_name.lower()
+        groups[library].append(type_info(type_name, cls))
+    order = sorted(groups, key=lambda n: (LIBRARY_ORDER.index(n) if n in LIBRARY_ORDER
+                                          else len(LIBRARY_ORDER), n))
+    return {"libraries": [{"name": name, "types": groups[name]} for name in order]}
+
+
+def type_info(type_name, cls):
+    doc = (cls.__doc__ or "").strip().split("\n\n")[0]
+    return {
+        "type": type_name,
+        "doc": " ".join(doc.split()),
+        "ports": [{"name": name, "domain": port.domain, "doc": port.doc,
+                   "optional": bool(port.optional)} for name, port in cls.ports.items()],
+        "params": [{"name": name, "unit": spec.unit,
+                    "default": None if spec.required else plain(spec.default),
+                    "min": plain(spec.min), "max": plain(spec.max), "shape": list(spec.shape),
+                    "kind": spec.kind,
+                    "choices": None if spec.choices is None else plain(list(spec.choices)),
+                    "doc": spec.doc, "required": spec.required, "time": bool(spec.time)}
+                   for name, spec in cls.params.items()],
+    }
+
+
+def plain(value):
+    """A declaration's value as JSON: tuples and arrays as lists, non-finite numbers null."""
+    if isinstance(value, np.ndarray):
+        value = value.tolist()
+    if isinstance(value, dict):
+        return {str(k): plain(v) for k, v in value.items()}
+    if isinstance(value, (list, tuple)):
+        return [plain(v) for v in value]
+    if isinstance(value, np.generic):
+        value = value.item()
+    if isinstance(value, float) and not math.isfinite(value):
+        return None
+    if value is None or isinstance(value, (bool, int, float, str)):
+        return value
+    return str(value)
+
+
+# -- checking a model --------------------------------------------------------------------------
+def context(folder, library):
+    """Where a model's subsystem definitions are found, as ``kn.load`` of a file in
+    ``folder`` finds them: its own ``definitions``, files in ``folder`` (references may not
+    leave it), then the library folders."""
+    return Context.top(folder, library)
+
+
+def build(data, ctx, validate):
+    """The Model of a file's top-level object, through the checker of ``kn.load``."""
+    return model_from_dict(data, validate=validate, context=ctx)
+
+
+def validate(data, ctx):
+    """``{"ok", "problems", "summary"}`` of a model file's top-level object.
+
+    The model is checked as ``kn.load`` checks it; then compiled (up to COMPILE_LIMIT flat
+    components) to count its degrees of freedom and name its states, so what would refuse
+    to run (a mass matrix singular at the start) is a problem here too.
+    """
+    components = data.get("components")
+    summary = {"dof": None, "states": None,
+               "components": len(components) if isinstance(components, list) else 0}
+    try:
+        model = build(data, ctx, validate=True)
+    except ModelError as exc:
+        return {"ok": False, "problems": problems_of(exc, data), "summary": summary}
+    summary["components"] = len(model.components)
+    if model.exposed:      # a definition: wired where it is placed, nothing to count alone
+        return {"ok": True, "problems": [], "summary": summary}
+    try:
+        flat = model.flat()
+        topo = flat.validate()
+        if len(flat.components) <= COMPILE_LIMIT:
+            system = model.compile()
+            summary["dof"], summary["states"] = int(system.dof), list(system.state_names)
+        elif not topo.loops:
+            free = sum(1 for group in topo.oned if group.kind == "free")
+            summary["dof"] = int(topo.dof + free)
+    except ModelError as exc:
+        return {"ok": False, "problems": problems_of(exc, data), "summary": summary}
+    return {"ok": True, "problems": [], "summary": summary}
+
+
+def problems_of(exc, data=None):
+    """The problems of a ModelError, each with the component, parameter and connection its
+    place names, so the page can show it on the block or the wire."""
+    names = []
+    if isinstance(data, dict) and isinstance(data.get("components"), list):
+        names = [c.get("name") if isinstance(c, dict) else None for c in data["components"]]
+    return [problem(message, names) for message in exc.problems]
+
+
+def problem(message, names=()):
+    """``{"message", "component", "param", "connection"}`` of one problem's message."""
+    out = {"message": message, "component": None, "param": None, "connection": None}
+    match = _PLACE.match(message)
+    if match is None:
+        return out
+    if match["index"] is not None:
+        i = int(match["index"])
+        name = match["name"]
+        if name is None or name.endswith("..."):      # not quoted, or cut: the file's own
+            name = names[i] if i < len(names) and isinstance(names[i], str) else name
+        out["component"], out["param"] = name, match["param"]
+    elif match["wire"] is not None:
+        out["connection"] = int(match["wire"])
+    elif match["ref"] in names:
+        out["component"] = match["ref"]
+    return out
+
+
+# -- layout ------------------------------------------------------------------------------------
+def layout(model):
+    """Diagram positions for every component: ``kinetwork.diagram.auto_layout`` when that
+    module is there, else a plain grid in file order."""
+    try:
+        from ..diagram import auto_layout
+    except ImportError:
+        auto_layout = None
+    if auto_layout is not None:
+        return {str(name): _position(value) for name, value in auto_layout(model).items()}
+    return {name: {"x": GRID_DX * (i % GRID_COLUMNS), "y": GRID_DY * (i // GRID_COLUMNS)}
+            for i, name in enumerate(model.components)}
+
+
+def _position(value):
+    if isinstance(value, (list, tuple)) and len(value) == 2:
+        return {"x": plain(value[0]), "y": plain(value[1])}
+    return plain(value)
+
+
+def folder_of(root, real_path):
+    """The folder definitions of a model at ``real_path`` (or of an unsaved one) are found in."""
+    return os.path.dirname(real_path) if real_path else root

@@ -1,0 +1,586 @@
+"""The studio's server against its contract (kinetwork/studio/API.md): the token, the palette,
+files confined to the root, the checks of kn.load placed on their blocks, saves that keep
+files byte for byte, and runs that end as kn.simulate ends (done, failed, cancelled)."""
+
+import importlib.util
+import json
+import os
+import pathlib
+import shutil
+import sys
+import threading
+import time
+import types
+import warnings
+
+import numpy as np
+import pytest
+
+pytest.importorskip("fastapi")
+httpx = pytest.importorskip("httpx")
+uvicorn = pytest.importorskip("uvicorn")
+with warnings.catch_warnings():
+    # starlette asks for httpx2 now and says so on import; httpx still does the job
+    warnings.filterwarnings("ignore", message="Using `httpx` with `starlette.testclient`")
+    from fastapi.testclient import TestClient
+
+import kinetwork as kn
+from kinetwork.components.base import REGISTRY
+from kinetwork.studio import launch, runs
+from kinetwork.studio.server import TOKEN_HEADER, create_app
+
+MODELS = pathlib.Path(__file__).resolve().parents[2] / "models"
+MODEL_FILES = sorted(p.relative_to(MODELS).as_posix() for p in MODELS.rglob("*.json"))
+TOKEN = "test-token-0123456789"
+SEED = "models/double_pendulum.json"
+
+
+@pytest.fixture
+def root(tmp_path):
+    """A studio folder holding a copy of the example models."""
+    shutil.copytree(MODELS, tmp_path / "models")
+    return tmp_path
+
+
+@pytest.fixture
+def client(root):
+    with TestClient(create_app(root, TOKEN), headers={TOKEN_HEADER: TOKEN}) as c:
+        yield c
+
+
+def seed(client):
+    return client.get("/api/open", params={"path": SEED}).json()["model"]
+
+
+def with_params(data, component, **params):
+    data = json.loads(json.dumps(data))
+    next(c for c in data["components"] if c["name"] == component)["params"].update(params)
+    return data
+
+
+def wait(client, run_id, timeout=120.0):
+    end = time.monotonic() + timeout
+    while time.monotonic() < end:
+        answer = client.get(f"/api/run/{run_id}").json()
+        if answer["state"] != "running":
+            return answer
+        time.sleep(0.05)
+    raise AssertionError(f"run {run_id} still going after {timeout} s")
+
+
+# -- the token ---------------------------------------------------------------------------------
+API_GETS = ["/api/palette", "/api/schema", "/api/files", "/api/examples",
+            f"/api/open?path={SEED}", "/api/run/r1"]
+API_POSTS = ["/api/validate", "/api/save", "/api/layout", "/api/run", "/api/run/r1/cancel"]
+
+
+@pytest.mark.parametrize("route", API_GETS + API_POSTS)
+@pytest.mark.parametrize("headers", [{}, {TOKEN_HEADER: "wrong"}, {TOKEN_HEADER: ""},
+                                     {TOKEN_HEADER: TOKEN + "x"}])
+def test_api_refuses_a_missing_or_wrong_token(root, route, headers):
+    c = TestClient(create_app(root, TOKEN))
+    answer = c.get(route, headers=headers) if route in API_GETS else \
+        c.post(route, headers=headers, json={})
+    assert answer.status_code == 403
+    assert "token" in answer.json()["error"]
+
+
+def test_token_in_the_query_or_the_header(root):
+    c = TestClient(create_app(root, TOKEN))
+    assert c.get("/api/examples", params={"token": TOKEN}).status_code == 200
+    assert c.get("/api/examples", headers={TOKEN_HEADER: TOKEN}).status_code == 200
+    assert c.get("/api/examples", params={"token": "nope"}).status_code == 403
+
+
+def test_the_page_needs_the_token_and_assets_do_not(root):
+    c = TestClient(create_app(root, TOKEN))
+    assert c.get("/").status_code == 403
+    page = c.get("/", params={"token": TOKEN})
+    assert page.status_code == 200 and "<html" in page.text.lower()
+    # no token asked of assets: a missing one is a 404, never a 403
+    assert c.get("/assets/missing.js").status_code == 404
+    assert c.get("/assets/../server.py").status_code == 404
+
+
+# -- palette, schema, files, examples ------------------------------------------------------------
+def test_palette_lists_every_registry_type_with_its_params_and_units(client):
+    libraries = client.get("/api/palette").json()["libraries"]
+    found = {t["type"]: (lib["name"], t) for lib in libraries for t in lib["types"]}
+    assert set(found) == set(REGISTRY)
+    for type_name, cls in REGISTRY.items():
+        library, info = found[type_name]
+        assert library == (type_name.split(".")[0] if "." in type_name else "probe")
+        assert [p["name"] for p in info["params"]] == list(cls.params)
+        assert [p["unit"] for p in info["params"]] == [s.unit for s in cls.params.values()]
+        assert [p["required"] for p in info["params"]] == \
+            [s.required for s in cls.params.values()]
+        assert [(p["name"], p["domain"]) for p in info["ports"]] == \
+            [(name, port.domain) for name, port in cls.ports.items()]
+    mass = next(p for p in found["multibody.RigidBody"][1]["params"] if p["name"] == "mass")
+    assert mass["unit"] == "kg" and mass["min"] == 0
+
+
+def test_schema_is_kn_schema(client):
+    assert client.get("/api/schema").json() == json.loads(json.dumps(kn.schema()))
+
+
+def test_files_lists_the_models_under_the_root(client, root):
+    (root / "deep" / "a" / "b" / "c" / "d").mkdir(parents=True)
+    (root / "deep" / "a" / "b" / "c" / "d" / "too_deep.json").write_text("{}")
+    (root / "deep" / "a" / "b" / "c" / "ok.json").write_text("{}")
+    (root / ".hidden").mkdir()
+    (root / ".hidden" / "x.json").write_text("{}")
+    answer = client.get("/api/files").json()
+    assert answer["root"] == os.path.realpath(root)
+    assert {f"models/{f}" for f in MODEL_FILES} <= set(answer["files"])
+    assert "deep/a/b/c/ok.json" in answer["files"]
+    assert "deep/a/b/c/d/too_deep.json" not in answer["files"]
+    assert not any(".hidden" in f for f in answer["files"])
+
+
+def test_examples_come_from_the_models_folder(client):
+    names = client.get("/api/examples").json()["examples"]
+    assert "double_pendulum" in names and "engine_v6/EngineV6" in names
+    assert "engine_v6/Cylinder" not in names        # a definition, part of an example
+    opened = client.get("/api/open", params={"example": "double_pendulum"}).json()
+    assert opened["path"] is None
+    assert opened["text"] == (MODELS / "double_pendulum.json").read_text()
+    assert client.get("/api/open", params={"example": "nope"}).status_code == 404
+
+
+def test_an_example_of_subsystem_files_opens_self_contained(client):
+    """Its definitions come inline (their files stay in the examples' folder), so it
+    validates, runs and saves anywhere."""
+    opened = client.get("/api/open", params={"example": "engine_v6/EngineV6"}).json()
+    assert "file" not in json.dumps(opened["model"]["definitions"])
+    answer = client.post("/api/validate", json={"model": opened["model"]}).json()
+    assert answer["ok"] and answer["summary"]["dof"] == 1
+
+
+# -- open and save -------------------------------------------------------------------------------
+@pytest.mark.parametrize("verbatim", [True, False], ids=["text", "model"])
+@pytest.mark.parametrize("name", MODEL_FILES)
+def test_open_then_save_unchanged_is_byte_identical(client, root, name, verbatim):
+    path = f"models/{name}"
+    before = (root / path).read_bytes()
+    opened = client.get("/api/open", params={"path": path}).json()
+    assert opened["path"] == path and opened["text"] == before.decode()
+    model = json.loads(json.dumps(opened["model"]))       # as the page holds it
+    answer = client.post("/api/save", json={"path": path, "model": model,
+                                            "text": opened["text"] if verbatim else None})
+    assert answer.status_code == 200, answer.json()
+    assert answer.json() == {"ok": True, "bytes": len(before), "text": before.decode()}
+    assert (root / path).read_bytes() == before
+
+
+def test_save_of_a_changed_model_writes_kinetworks_text(client, root):
+    opened = client.get("/api/open", params={"path": SEED}).json()
+    changed = with_params(opened["model"], "mass1", mass=2.5)
+    changed["layout"] = {"mass1": {"x": 10, "y": 20}}
+    answer = client.post("/api/save", json={"path": "models/new.json", "model": changed,
+                                            "text": opened["text"]}).json()
+    model = kn.load(root / "models" / "new.json")
+    assert model.components["mass1"].given["mass"] == 2.5
+    assert model.layout == {"mass1": {"x": 10, "y": 20}}
+    assert answer["text"] == kn.dumps(model) == (root / "models" / "new.json").read_text()
+
+
+def test_save_keeps_a_half_built_model(client, root):
+    """Work in progress (a body wired to nothing) saves: kn.load(validate=False) reads it."""
+    data = seed(client)
+    data["connections"] = []
+    assert client.post("/api/save", json={"path": "wip.json", "model": data}).status_code == 200
+    assert kn.load(root / "wip.json", validate=False).connections == []
+
+
+@pytest.mark.parametrize("change", [
+    lambda d: d["components"].append({"name": "x", "type": "multibody.Nope"}),
+    lambda d: d.__setitem__("version", 99),
+    lambda d: d.__setitem__("layout", {"nobody": {"x": 0}}),
+    lambda d: d.__setitem__("simulation", {"t_end": -1}),
+], ids=["unknown type", "version", "layout", "settings"])
+def test_save_never_writes_what_is_not_a_model(client, root, change):
+    before = (root / SEED).read_bytes()
+    data = seed(client)
+    change(data)
+    for text in (None, json.dumps(data)):
+        answer = client.post("/api/save", json={"path": SEED, "model": data, "text": text})
+        assert answer.status_code == 400 and answer.json()["problems"]
+        assert (root / SEED).read_bytes() == before
+    assert not [p for p in (root / "models").iterdir() if p.name.endswith(".tmp")]
+
+
+def test_save_does_not_overwrite_other_json_files(client, root):
+    (root / "package.json").write_text('{"name": "not a model"}')
+    answer = client.post("/api/save", json={"path": "package.json", "model": seed(client)})
+    assert answer.status_code == 409
+    assert (root / "package.json").read_text() == '{"name": "not a model"}'
+    answer = client.post("/api/save", json={"path": "models", "model": seed(client)})
+    assert answer.status_code == 400
+    answer = client.post("/api/save", json={"path": "new/a.json", "model": seed(client)})
+    assert answer.status_code == 400 and "does not exist" in answer.json()["error"]
+
+
+@pytest.fixture
+def outside(tmp_path_factory):
+    folder = tmp_path_factory.mktemp("outside")
+    (folder / "secret.json").write_text('{"format": "kinetwork.model"}')
+    return folder
+
+
+@pytest.mark.parametrize("path", [
+    "../x.json", "models/../../x.json", "..\\x.json", "/etc/passwd", "/tmp/x.json",
+    "C:/x.json", "file:///etc/x.json", "~/x.json", "", "models", "models/a.txt", "a\x00.json",
+    "LINK/secret.json", "link.json",
+])
+def test_paths_leaving_the_root_are_refused(client, root, outside, path):
+    (root / "LINK").symlink_to(outside, target_is_directory=True)
+    (root / "link.json").symlink_to(outside / "secret.json")
+    data = seed(client)
+    for answer in (client.get("/api/open", params={"path": path}),
+                   client.post("/api/save", json={"path": path, "model": data}),
+                   client.post("/api/validate", json={"model": data, "path": path}),
+                   client.post("/api/run", json={"model": data, "path": path})):
+        assert answer.status_code == 400, (path, answer.json())
+        assert answer.json()["error"]
+    assert (outside / "secret.json").read_text() == '{"format": "kinetwork.model"}'
+    assert not (root.parent / "x.json").exists()
+
+
+def test_open_of_a_missing_or_broken_file(client, root):
+    assert client.get("/api/open", params={"path": "nope.json"}).status_code == 404
+    (root / "broken.json").write_text('{"format": ')
+    answer = client.get("/api/open", params={"path": "broken.json"})
+    assert answer.status_code == 400 and "invalid JSON" in answer.json()["error"]
+    assert client.get("/api/open").status_code == 400
+
+
+# -- validate ----------------------------------------------------------------------------------
+def test_validate_the_seed(client):
+    answer = client.post("/api/validate", json={"model": seed(client)}).json()
+    assert answer["ok"] and answer["problems"] == []
+    assert answer["summary"]["dof"] == 2 and answer["summary"]["components"] == 9
+    assert answer["summary"]["states"] == ["shoulder.q", "elbow.q", "shoulder.qd", "elbow.qd"]
+
+
+def test_validate_places_a_bad_value_on_its_block(client):
+    answer = client.post("/api/validate",
+                         json={"model": with_params(seed(client), "mass1", mass=-1)}).json()
+    assert not answer["ok"]
+    [problem] = answer["problems"]
+    assert (problem["component"], problem["param"], problem["connection"]) == \
+        ("mass1", "mass", None)
+    assert "must be >= 0" in problem["message"]
+
+
+@pytest.mark.parametrize("pair", [["ground.frame", "spring.flange_a"],
+                                  ["ground.frame", "nobody.frame"],
+                                  ["ground.frame", "mass1.nope"]],
+                         ids=["domains", "component", "port"])
+def test_validate_places_a_wrong_wire_on_its_connection(client, pair):
+    data = seed(client)
+    data["connections"][3] = pair
+    problems = client.post("/api/validate", json={"model": data}).json()["problems"]
+    assert any(p["connection"] == 3 and p["component"] is None for p in problems), problems
+
+
+def test_validate_names_the_component_of_a_port_problem(client):
+    data = seed(client)
+    data["connections"] = [c for c in data["connections"] if "shoulder.frame_a" not in c]
+    problems = client.post("/api/validate", json={"model": data}).json()["problems"]
+    assert {"shoulder", "mass1"} <= {p["component"] for p in problems}
+
+
+def test_validate_finds_subsystem_files_next_to_the_model(client):
+    path = "models/robot/arm_axes.json"
+    data = client.get("/api/open", params={"path": path}).json()["model"]
+    assert client.post("/api/validate", json={"model": data, "path": path}).json()["ok"]
+    unsaved = client.post("/api/validate", json={"model": data}).json()   # found in the root?
+    assert not unsaved["ok"] and "Axis" in unsaved["problems"][0]["message"]
+
+
+def test_layout_places_every_component(client):
+    data = seed(client)
+    layout = client.post("/api/layout", json={"model": data}).json()["layout"]
+    assert set(layout) == {c["name"] for c in data["components"]}
+    assert all(isinstance(p["x"], (int, float)) and isinstance(p["y"], (int, float))
+               for p in layout.values())
+    answer = client.post("/api/layout", json={"model": {"components": 3}})
+    assert answer.status_code == 400 and answer.json()["problems"]
+
+
+# -- runs --------------------------------------------------------------------------------------
+def test_a_run_gives_what_kn_simulate_gives(client, root):
+    run_id = client.post("/api/run", json={"model": seed(client)}).json()["run"]
+    answer = wait(client, run_id)
+    assert answer["state"] == "done", answer["error"]
+    assert answer["progress"] == 1.0 and answer["error"] is None
+    expected = kn.simulate(kn.load(root / SEED))
+    results = answer["results"]
+    np.testing.assert_allclose(results["t"], expected.t, rtol=0, atol=1e-12)
+    assert [s["name"] for s in results["signals"]] == expected.signal_names
+    for signal in results["signals"]:
+        assert signal["unit"] == expected.units[signal["name"]]
+        assert tuple(signal["shape"]) == expected[signal["name"]].shape[1:]
+        np.testing.assert_allclose(signal["values"], expected[signal["name"]], rtol=0,
+                                   atol=1e-12)
+    assert results["partial"] is None
+
+
+def test_results_carry_the_animation_or_null_without_its_module(client, monkeypatch):
+    settings = {"t_end": 0.5, "n_points": 6}
+    answer = wait(client, client.post("/api/run", json={"model": seed(client),
+                                                        "settings": settings}).json()["run"])
+    animation = answer["results"]["animation"]
+    if importlib.util.find_spec("kinetwork.animation") is not None:
+        assert animation["format"] == "kinetwork.animation" and animation["frames"]
+        assert len(animation["t"]) == 6
+    else:
+        assert animation is None
+    monkeypatch.setitem(sys.modules, "kinetwork.animation", None)     # not importable
+    answer = wait(client, client.post("/api/run", json={"model": seed(client),
+                                                        "settings": settings}).json()["run"])
+    assert answer["state"] == "done" and answer["results"]["animation"] is None
+
+
+@pytest.mark.skipif(importlib.util.find_spec("kinetwork.animation") is None,
+                    reason="kinetwork.animation is not there yet")
+def test_a_dense_run_is_resampled_for_the_animation(client, monkeypatch):
+    monkeypatch.setattr(runs, "MAX_FRAMES", 50)
+    answer = wait(client, client.post("/api/run", json={"model": seed(client), "settings": {
+        "t_end": 2.0, "n_points": 201}}).json()["run"])
+    assert len(answer["results"]["t"]) == 201
+    assert len(answer["results"]["animation"]["t"]) == 50
+
+
+def test_layout_without_the_diagram_module_is_a_grid(client, monkeypatch):
+    monkeypatch.setitem(sys.modules, "kinetwork.diagram", None)
+    layout = client.post("/api/layout", json={"model": seed(client)}).json()["layout"]
+    assert len({(p["x"], p["y"]) for p in layout.values()}) == len(layout) == 9
+
+
+def test_run_settings_override_the_models(client):
+    settings = {"t_end": 0.5, "n_points": 11, "method": "rk", "step": 0.01}
+    answer = wait(client, client.post("/api/run", json={"model": seed(client),
+                                                        "settings": settings}).json()["run"])
+    assert answer["state"] == "done"
+    assert answer["results"]["t"] == pytest.approx(np.linspace(0, 0.5, 11).tolist())
+
+
+def test_cancel_ends_a_long_run_cancelled_with_partial_results(client):
+    settings = {"t_end": 1e6, "n_points": 100001, "rtol": 1e-12, "atol": 1e-14}
+    run_id = client.post("/api/run", json={"model": seed(client),
+                                           "settings": settings}).json()["run"]
+    end = time.monotonic() + 60
+    while client.get(f"/api/run/{run_id}").json()["progress"] == 0 and time.monotonic() < end:
+        time.sleep(0.05)
+    assert client.post(f"/api/run/{run_id}/cancel").json() == {"ok": True}
+    answer = wait(client, run_id, timeout=30)
+    assert answer["state"] == "cancelled" and answer["error"] is None
+    partial = answer["results"]
+    assert 1 < len(partial["t"]) < 100001 and partial["partial"]["reason"] == "cancelled"
+    assert len(partial["signals"][0]["values"]) == len(partial["t"])
+
+
+def test_a_failed_integration_ends_failed_with_its_message_and_partial_results(client):
+    stiff = seed(client)
+    stiff["parameters"]["c"] = 1e9
+    run_id = client.post("/api/run", json={"model": stiff, "settings": {
+        "method": "rk", "step": 0.01}}).json()["run"]
+    answer = wait(client, run_id)
+    assert answer["state"] == "failed" and "non-finite" in answer["error"]
+    assert answer["results"]["partial"]["t_reached"] < 10
+    json.dumps(answer, allow_nan=False)
+
+
+def test_a_time_limit_ends_a_run_failed(client):
+    answer = wait(client, client.post("/api/run", json={
+        "model": seed(client), "settings": {"time_limit": 1e-6}}).json()["run"])
+    assert answer["state"] == "failed" and "time limit" in answer["error"]
+
+
+def test_a_bad_model_fails_its_run_with_problems(client):
+    answer = wait(client, client.post("/api/run", json={
+        "model": with_params(seed(client), "mass1", mass=-1)}).json()["run"])
+    assert answer["state"] == "failed" and answer["results"] is None
+    assert [(p["component"], p["param"]) for p in answer["problems"]] == [("mass1", "mass")]
+    answer = wait(client, client.post("/api/run", json={
+        "model": seed(client), "settings": {"t_end": "soon"}}).json()["run"])
+    assert answer["state"] == "failed" and "t_end" in answer["error"]
+
+
+def test_concurrent_runs(client, root):
+    starts = [0.05, 0.3, 1.0]
+    settings = {"t_end": 2.0, "n_points": 201}
+    ids = [client.post("/api/run", json={"model": with_params(seed(client), "shoulder", q0=q0),
+                                         "settings": settings}).json()["run"]
+           for q0 in starts]
+    assert len(set(ids)) == 3
+    for run_id, q0 in zip(ids, starts):
+        answer = wait(client, run_id)
+        assert answer["state"] == "done", answer["error"]
+        model = kn.load(root / SEED)
+        model.components["shoulder"].q0 = q0
+        angle = next(s for s in answer["results"]["signals"] if s["name"] == "probe1.angle")
+        np.testing.assert_allclose(angle["values"], kn.simulate(model, **settings)
+                                   ["probe1.angle"], rtol=0, atol=1e-12)
+
+
+def test_runs_unknown_are_404(client):
+    assert client.get("/api/run/r999").status_code == 404
+    assert client.post("/api/run/r999/cancel").status_code == 404
+
+
+def test_only_the_last_finished_runs_are_kept(client):
+    client.app.state.studio.runs.keep = 2
+    body = {"model": seed(client), "settings": {"t_end": 0.1, "n_points": 3}}
+    ids = []
+    for _ in range(4):
+        ids.append(client.post("/api/run", json=body).json()["run"])
+        wait(client, ids[-1])
+    assert [client.get(f"/api/run/{i}").status_code for i in ids] == [404, 404, 200, 200]
+
+
+def test_runs_going_at_once_are_limited(client):
+    client.app.state.studio.runs.max_running = 1
+    long = {"model": seed(client), "settings": {"t_end": 1e6, "n_points": 100001}}
+    first = client.post("/api/run", json=long).json()["run"]
+    answer = client.post("/api/run", json=long)
+    assert answer.status_code == 409 and "going" in answer.json()["error"]
+    client.post(f"/api/run/{first}/cancel")
+    assert wait(client, first, timeout=30)["state"] == "cancelled"
+    assert client.post("/api/run", json={**long, "settings": {"t_end": 0.1}}).status_code == 200
+
+
+# -- malformed requests --------------------------------------------------------------------------
+BIG = "1" + "0" * 400
+MALFORMED = [
+    ("/api/validate", b"not json"), ("/api/validate", b"[1, 2]"), ("/api/validate", b"{}"),
+    ("/api/validate", b'{"model": 1}'), ("/api/validate", b'{"model": {}, "extra": 1}'),
+    ("/api/validate", b'{"model": {"components": "x"}}'),
+    ("/api/validate", b'{"model": {"format": "kinetwork.model", "version": 1, "name": "m", '
+                      b'"components": [{"name": "g", "type": "multibody.Ground", "params": '
+                      b'{"gravity": [0, 1e308, 1e308]}}]}}'),
+    ("/api/validate", ('{"model": {"format": "kinetwork.model", "version": 1, "name": "m", '
+                       '"components": [], "parameters": {"a": ' + BIG + '}}}').encode()),
+    ("/api/validate", b'{"model": {"version": NaN}}'),
+    ("/api/validate", b"[" * 100000 + b"]" * 100000),
+    ("/api/validate", b'{"model": {"format": "kinetwork.model", "version": 1, "name": "m", '
+                      b'"components": [null, 1, {"name": []}], "connections": [[1, 2], "a"]}}'),
+    ("/api/validate", b'{"model": {}, "path": 5}'),
+    ("/api/save", b'{"path": "a.json"}'), ("/api/save", b'{"path": 1, "model": {}}'),
+    ("/api/save", b'{"path": "a.json", "model": {}, "text": 5}'),
+    ("/api/save", b'{"path": "a.json", "model": [], "text": null}'),
+    ("/api/layout", b'{"model": "x"}'),
+    ("/api/run", b'{"model": {}, "settings": []}'),
+    ("/api/run", b'{"model": {}, "settings": {"speed": 1}}'),
+    ("/api/run", b'{"settings": {}}'),
+    ("/api/open?path=", b""), ("/api/open?path=a.json&example=x", b""),
+]
+
+
+@pytest.mark.parametrize("route, body", MALFORMED,
+                         ids=[f"{i}-{r}" for i, (r, _) in enumerate(MALFORMED)])
+def test_malformed_requests_are_refused_not_crashed(client, route, body):
+    if route.startswith("/api/open"):
+        answer = client.get(route)
+    else:
+        answer = client.post(route, content=body, headers={"content-type": "application/json"})
+    assert answer.status_code in (200, 400, 404, 409), answer.text
+    data = answer.json()
+    if answer.status_code != 200:
+        assert isinstance(data["error"], str) and isinstance(data["problems"], list)
+    else:
+        assert isinstance(data["ok"], bool)          # validate: said, not raised
+
+
+@pytest.mark.parametrize("settings", [
+    {"t_end": 1e308}, {"n_points": 10**15}, {"rtol": -1}, {"method": "nope"},
+    {"step": 1e-300, "method": "rk"}, {"max_steps": "x"}, {"n_points": 2.5},
+    {"time_limit": -1}, {"t_end": True},
+])
+def test_bad_settings_fail_the_run_with_a_message(client, settings):
+    answer = wait(client, client.post("/api/run", json={"model": seed(client),
+                                                        "settings": settings}).json()["run"])
+    assert answer["state"] == "failed" and answer["error"], answer
+
+
+# -- the real server and the command -------------------------------------------------------------
+def test_the_server_answers_over_http(root):
+    sock = launch._listen(None)
+    port = sock.getsockname()[1]
+    server = uvicorn.Server(uvicorn.Config(create_app(root, TOKEN), log_level="warning",
+                                           ws="none", lifespan="on"))
+    thread = threading.Thread(target=server.run, kwargs={"sockets": [sock]}, daemon=True)
+    thread.start()
+    try:
+        end = time.monotonic() + 20
+        while not server.started and time.monotonic() < end:
+            time.sleep(0.02)
+        base = f"http://127.0.0.1:{port}"
+        answer = httpx.get(f"{base}/api/palette", headers={TOKEN_HEADER: TOKEN}, timeout=20)
+        assert answer.status_code == 200
+        assert {t["type"] for lib in answer.json()["libraries"] for t in lib["types"]} == \
+            set(REGISTRY)
+        assert httpx.get(f"{base}/api/palette", timeout=20).status_code == 403
+    finally:
+        server.should_exit = True
+        thread.join(20)
+        sock.close()
+    assert not thread.is_alive()
+
+
+def test_cli_studio_prints_the_address_and_serves_the_folder(root, monkeypatch, capsys):
+    served = {}
+
+    def run(self, sockets):
+        served["app"], served["port"] = self.config.app, sockets[0].getsockname()[1]
+        raise KeyboardInterrupt           # as Ctrl-C ends uvicorn: exit 0
+    monkeypatch.setattr(uvicorn.Server, "run", run)
+    monkeypatch.setattr(launch.webbrowser, "open", lambda url: served.setdefault("url", url))
+    monkeypatch.setenv("DISPLAY", ":0")
+    monkeypatch.chdir(root)
+    args = types.SimpleNamespace(model=SEED, port=None, no_browser=False, library=[])
+    assert launch.cli_studio(args) == 0
+    out = capsys.readouterr().out
+    assert f"http://127.0.0.1:{served['port']}/?token=" in out
+    assert "&open=models%2Fdouble_pendulum.json" in out and served["url"] in out
+    token = served["url"].split("token=")[1].split("&")[0]
+    assert len(token) >= 40
+    c = TestClient(served["app"])
+    assert c.get("/api/files", params={"token": token}).json()["open"] == SEED
+
+
+def test_cli_studio_opens_no_text_browser_without_a_display(monkeypatch, capsys):
+    monkeypatch.setattr(launch.webbrowser, "open", lambda url: pytest.fail("opened"))
+    monkeypatch.setattr(launch.sys, "platform", "linux")
+    for name in ("DISPLAY", "WAYLAND_DISPLAY", "BROWSER"):
+        monkeypatch.delenv(name, raising=False)
+    launch._open_browser("http://127.0.0.1:1/")
+    assert "open the address" in capsys.readouterr().out
+
+
+def test_cli_studio_roots_a_model_outside_the_folder_at_its_own(root, tmp_path_factory,
+                                                                monkeypatch):
+    monkeypatch.chdir(tmp_path_factory.mktemp("elsewhere"))
+    assert launch._root_and_query(str(root / SEED)) == \
+        (os.path.realpath(root / "models"), {"open": "double_pendulum.json"})
+    assert launch._root_and_query("double_pendulum")[1] == {"example": "double_pendulum"}
+    with pytest.raises(kn.ModelError, match="no such file, nor an example"):
+        launch._root_and_query("nope.json")
+
+
+def test_cli_studio_without_its_extras_says_what_to_install(monkeypatch):
+    monkeypatch.setitem(sys.modules, "uvicorn", None)
+    args = types.SimpleNamespace(model=None, port=None, no_browser=True, library=[])
+    with pytest.raises(kn.ModelError, match=r"pip install 'kinetwork\[studio\]'"):
+        launch.cli_studio(args)
+
+
+def test_cli_studio_refuses_a_port_in_use():
+    sock = launch._listen(None)
+    try:
+        with pytest.raises(kn.ModelError, match="cannot listen"):
+            launch._listen(sock.getsockname()[1])
+    finally:
+        sock.close()
