@@ -21,9 +21,10 @@ from .schema import schema
 from .simulation.driver import simulate
 from .simulation.methods import METHODS
 from .simulation.results import Results
+from .urdf import from_urdf
 
 __version__ = "0.1.0"
 
 __all__ = ["IdealisedInertiaWarning", "METHODS", "Model", "ModelError", "Probe", "Results", "SimulationError", "Subsystem", "System",
-           "dumps", "load", "loads", "multibody", "rotational", "schema", "signals",
+           "dumps", "from_urdf", "load", "loads", "multibody", "rotational", "schema", "signals",
            "simulate", "translational"]
