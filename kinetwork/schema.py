@@ -8,7 +8,7 @@ completion and first checks; ``kinetwork.load`` remains the judge (it also check
 schema cannot: wiring, units of expressions, physical sense).
 """
 
-from .components.base import REGISTRY
+from .components.base import COLOR, REGISTRY
 from .graph.io import DEFINITION_KEYS, FORMAT, KEYS, KEYS_V2, VERSION
 from .graph.settings import SIMULATION_KEYS
 from .simulation.methods import METHODS
@@ -18,7 +18,6 @@ NUMBER = {"type": "number"}
 EXPRESSION = {"type": "string", "minLength": 1,
               "description": "arithmetic in model parameters (and t where allowed)"}
 SCALAR = {"anyOf": [NUMBER, EXPRESSION]}
-COLOR = "^#[0-9A-Fa-f]{6}$"
 
 
 PORT_PATH = {"type": "string", "pattern": IDENT[:-1] + r"\.[A-Za-z_][A-Za-z0-9_]*$"}
@@ -120,7 +119,7 @@ def _param(spec):
     elif spec.kind == "choice":
         out = {"enum": list(spec.choices)}
     elif spec.kind == "color":
-        out = {"type": "string", "pattern": COLOR}
+        out = {"type": "string", "pattern": f"^{COLOR.pattern}$"}
     elif spec.kind == "names":
         items = {"enum": list(spec.choices)} if spec.choices else {"type": "string"}
         out = {"type": "array", "items": items, "uniqueItems": True}

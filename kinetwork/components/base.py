@@ -23,6 +23,8 @@ ONED, ANY = "1d", "any"
 #: "mass1\n" is refused, not matched up to its newline)
 NAME_LIMIT = 200
 _NAME = re.compile(rf"[A-Za-z_][A-Za-z0-9_]{{0,{NAME_LIMIT - 1}}}")
+#: a colour, as a parameter of kind "color" takes it
+COLOR = re.compile(r"#[0-9A-Fa-f]{6}")
 #: rows a signals.Table may have: a table is data for interpolation, not a data set
 TABLE_ROWS_LIMIT = 100_000
 
@@ -83,7 +85,7 @@ class Param:
     A value is a number, or a string expression in model parameters (and in time ``t`` where
     ``time=True``); ``shape`` (3,) takes three of those, (3, 3) a matrix or its diagonal.
     ``kind`` "bool", "name" and "names" take a flag, a component name and a list of strings,
-    "table" rows [x, y].
+    "table" rows [x, y], "choice" one string of ``choices``, "color" a colour "#rrggbb".
     """
 
     def __init__(self, default=REQUIRED, *, unit="", min=None, max=None, shape=(), doc="",
@@ -134,6 +136,15 @@ class Param:
         if self.kind == "name":
             if not isinstance(value, str) or not _NAME.fullmatch(value):
                 raise ModelError(f"{where}: must be a component name, got {quote(value)}")
+            return value
+        if self.kind == "choice":
+            if not isinstance(value, str) or value not in self.choices:
+                raise ModelError(f"{where}: must be one of {', '.join(self.choices)}, got "
+                                 f"{quote(value)}{suggest(value, self.choices)}")
+            return value
+        if self.kind == "color":
+            if not isinstance(value, str) or not COLOR.fullmatch(value):
+                raise ModelError(f"{where}: must be a colour '#rrggbb', got {quote(value)}")
             return value
         if self.kind == "names":
             if not isinstance(value, (list, tuple)) or not all(isinstance(v, str) for v in value):
@@ -319,6 +330,11 @@ class Component:
                 problems.extend(exc.problems)
         if problems:
             raise ModelError(problems)
+
+    def check_values(self, values, place):
+        """Problems of the evaluated parameters ``values`` taken together (a hole no wider than
+        its body), as messages naming ``place(key)``; the validation calls it. None here."""
+        return []
 
     def set_param(self, key, value):
         """Change parameter ``key`` (its file name) to ``value``, checked as at construction.

@@ -3,7 +3,9 @@
 The flow into a component through one of its frame ports (Modelica's sign: positive into
 the component) is what the rest of the model exerts on it there:
 
-- a rigid body takes its inertial wrench, m (a_c - g) and I alpha + w x I w;
+- a rigid body takes its inertial wrench, m (a_c - g) and I alpha + w x I w; a joint or
+  rigid part with mass (a body with a shape) takes its own at frame_a, besides what it passes
+  on;
 - a force element (line force, world force) takes minus the force it applies;
 - a cut joint takes minus the constraint wrench it applies, from the loops' multipliers;
 - a joint or rigid part of the spanning tree passes on everything behind it: through its
@@ -47,6 +49,14 @@ class _Balance:
             start += r.shape[0]
 
     def flow(self, comp, port):
+        f, m = self._flow(comp, port)
+        if _massive(comp) and port == "frame_a":
+            df, dm = self._inertial(comp)
+            f, m = f + df, m + dm
+        return f, m
+
+    def _flow(self, comp, port):
+        """The flow into ``comp`` at ``port``, less the inertia of a part with mass."""
         name = comp.name
         set_ = self.topo.set_of[comp.port_ref(port)]
         if comp.role == "body":
@@ -92,7 +102,10 @@ class _Balance:
             for ref in self.topo.sets[s]:
                 comp = ref.component
                 if comp.role in ("body", "frame_force") or comp.name in self.cut_of:
-                    df, dm = self.flow(comp, ref.name)
+                    df, dm = self._flow(comp, ref.name)
+                    f, m = f + df, m + dm
+                if _massive(comp) and ref.name == "frame_a":
+                    df, dm = self._inertial(comp)
                     f, m = f + df, m + dm
                 if comp.role == "joint" and ref.name == "frame_b" and comp.name != skip \
                         and comp.name not in self.cut_of:
@@ -171,3 +184,8 @@ class _Balance:
         wrench = G.T @ asm.lam[lo:hi]
         # the dual of (w, v) is (moment about the world origin, force)
         return wrench[3:], wrench[:3]
+
+
+def _massive(comp):
+    """A joint or rigid part with mass: a body on its frame_a as well."""
+    return comp.role in ("joint", "part") and comp.has_mass

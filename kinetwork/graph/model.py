@@ -298,7 +298,7 @@ class Model:
 
 def evaluate(value, spec, env, where):
     """A normalized parameter value evaluated with numbers; bounds checked."""
-    if value is None or spec.kind in ("bool", "name", "names", "table"):
+    if value is None or spec.kind != "real":
         return value
     if spec.shape == ():
         return _scalar(value, spec, env, where)

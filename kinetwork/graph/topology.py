@@ -67,7 +67,7 @@ class Topology:
     root: int                           # frame set of the ground
     tree: list = field(default_factory=list)      # Edge, parents before children
     joints: list = field(default_factory=list)    # joints with coordinates, model order
-    bodies: list = field(default_factory=list)    # (RigidBody, frame set)
+    bodies: list = field(default_factory=list)    # (body or part with mass, frame_a set)
     oned: list = field(default_factory=list)      # OneDGroup
     probes: list = field(default_factory=list)    # (Probe, target PortRef)
     loops: list = field(default_factory=list)     # lists of component names
@@ -142,6 +142,9 @@ def analyze(model):
     _signals(topo, problems)
     if values is not None:
         _inertias(model, roles.get("body", []), values, problems)
+        for comp in model.components.values():
+            problems.extend(comp.check_values(values[comp.name],
+                                              lambda key, c=comp: model.place(c, key)))
     if problems:
         raise ModelError(problems)
     return topo
@@ -249,7 +252,10 @@ def _tree(model, topo, roles, problems):
     coordinated += [c.component for c in topo.cuts
                     if c.component.dof > 0 and c.component.regular]
     topo.joints = sorted(coordinated, key=lambda c: rank[c.name])
-    topo.bodies = [(b, topo.set_of[b.port_ref("frame_a")]) for b in roles.get("body", [])
+    # a joint or rigid part with mass (a body with a shape) is a body on its frame_a too
+    massive = [c for c in model.components.values()
+               if c.role == "body" or (c.role in ("joint", "part") and c.has_mass)]
+    topo.bodies = [(b, topo.set_of[b.port_ref("frame_a")]) for b in massive
                    if topo.set_of[b.port_ref("frame_a")] in reached]
     topo.forces = [f for f in roles.get("frame_force", [])
                    if all(topo.set_of[f.port_ref(pn)] in reached for pn in f.ports)]
@@ -339,6 +345,8 @@ def _inertias(model, bodies, values, problems):
     planar link given only its moment about the joint axis) is an idealisation too common to
     warn about."""
     for body in bodies:
+        if "inertia" not in body.params:
+            continue        # computed from a shape: physical by construction
         inertia = np.asarray(values[body.name]["inertia"], dtype=float)
         where = model.place(body, "inertia")
         scale = max(np.max(np.abs(inertia)), 1e-300)

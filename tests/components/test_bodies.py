@@ -21,10 +21,6 @@ from scenes.loops import fourbar_guesses
 
 mb = kn.multibody
 STEEL, ALUMINIUM = 7700.0, 2700.0
-#: what needs the issue 14 hooks outside components/ (the solver folding a part's mass into
-#: its body, the Param kinds "choice" and "color", parameters checked together when the model
-#: is validated) fails until they land, and must pass then (strict)
-PENDING = pytest.mark.xfail(strict=True, reason="needs the issue 14 hooks outside components/")
 
 
 def numbers(expr):
@@ -210,7 +206,6 @@ def compound_pendulum(t, L, width, g, q0):
     return sol.y.T
 
 
-@PENDING
 def test_box_pendulum_is_the_compound_pendulum():
     model = box_pendulum()
     system = model.compile()
@@ -223,7 +218,6 @@ def test_box_pendulum_is_the_compound_pendulum():
     assert model.compile() is system
 
 
-@PENDING
 def test_box_pendulum_is_a_fixed_translation_with_a_rigid_body():
     shape, parts = (kn.simulate(box_pendulum(kind), t_end=3.0, n_points=301, rtol=1e-12,
                                 atol=1e-12, jit=False) for kind in ("shape", "parts"))
@@ -295,7 +289,6 @@ def spatial_scene(kind, reversed_box):
     return m
 
 
-@PENDING
 @pytest.mark.parametrize("reversed_box", [False, True], ids=["box_forward", "box_reversed"])
 def test_shaped_bodies_move_as_a_fixed_translation_with_a_rigid_body(reversed_box):
     """The same states and the same cut forces and torques at every frame of the shaped
@@ -358,7 +351,6 @@ def fourbar_scene(kind):
     return m
 
 
-@PENDING
 def test_a_loop_of_boxes_moves_as_one_of_fixed_translations_with_rigid_bodies():
     shape, parts = (kn.simulate(fourbar_scene(kind), t_end=1.0, n_points=51, rtol=1e-12,
                                 atol=1e-12, jit=False) for kind in ("shape", "parts"))
@@ -377,7 +369,6 @@ def test_a_loop_of_boxes_moves_as_one_of_fixed_translations_with_rigid_bodies():
                                            atol=1e-6 * max(1.0, np.abs(expected).max()))
 
 
-@PENDING
 def test_rigid_body_looks_change_nothing():
     def scene(**looks):
         m = kn.Model("p")
@@ -413,7 +404,6 @@ def file_model():
     return m
 
 
-@PENDING
 def test_a_saved_model_loads_back_byte_identical(tmp_path):
     path, again = tmp_path / "bodies.json", tmp_path / "again.json"
     model = file_model()
@@ -428,7 +418,6 @@ def test_a_saved_model_loads_back_byte_identical(tmp_path):
     assert loaded.compile().state_names == ["j.q", "j.qd"]
 
 
-@PENDING
 def test_the_schema_validates_a_file_of_them(tmp_path):
     schema = kn.schema()
     jsonschema.Draft202012Validator.check_schema(schema)
@@ -480,9 +469,7 @@ REFUSALS = {
 }
 
 
-@pytest.mark.parametrize("build, message", [
-    pytest.param(*v, id=k, marks=[PENDING] if k in ("color", "shape", "shape_suggested") else [])
-    for k, v in REFUSALS.items()])
+@pytest.mark.parametrize("build, message", [pytest.param(*v, id=k) for k, v in REFUSALS.items()])
 def test_bad_values_are_refused_with_their_place(build, message):
     with pytest.raises(kn.ModelError, match=message):
         build()
@@ -500,7 +487,6 @@ def test_a_refused_assignment_leaves_the_body_as_it_was():
     assert box.given["width"] == 0.2
 
 
-@PENDING
 def test_sizes_of_expressions_are_checked_once_the_parameters_are_known():
     model = file_model()
     model.components["box"].inner_width = "2*W"             # accepted: W is not known here
@@ -515,7 +501,6 @@ def test_sizes_of_expressions_are_checked_once_the_parameters_are_known():
         model.validate()
 
 
-@PENDING
 def test_a_file_names_the_place_of_a_bad_size(tmp_path):
     path = tmp_path / "m.json"
     file_model().save(path)
