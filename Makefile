@@ -4,12 +4,12 @@ VENV   := .venv
 PY     := $(VENV)/bin/python
 OUT    := demo
 
-.PHONY: demo test bench clean
+.PHONY: demo test bench frontend clean
 
 $(VENV)/.installed: pyproject.toml
 	$(PYTHON) -m venv $(VENV)
 	$(PY) -m pip install --quiet --upgrade pip
-	$(PY) -m pip install --quiet -e ".[test,bench]"
+	$(PY) -m pip install --quiet -e ".[test,bench,studio]"
 	touch $@
 
 demo: $(VENV)/.installed
@@ -23,6 +23,11 @@ test: $(VENV)/.installed
 
 bench: $(VENV)/.installed
 	$(PY) bench/run.py
+
+# the browser faces (studio, animation player), built into the package from the lockfile;
+# the built assets are committed, so demo and test need no Node
+frontend:
+	cd frontend && npm ci && npm run build
 
 clean:
 	rm -rf $(VENV) $(OUT) .pytest_cache
