@@ -10,6 +10,7 @@ faces: ``plot``, ``schema``, ``symbolic``, ``cli``.
 """
 
 from . import plot as _plot  # noqa: F401  (installs Results.plot)
+from . import diagram as _diagram  # noqa: F401  (installs Model._repr_svg_ for Jupyter)
 from .components import multibody, rotational, signals, translational
 from .components.probe import Probe
 from .equations.system import System
