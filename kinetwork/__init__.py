@@ -9,6 +9,7 @@ Layers, each importing only those before it: ``errors``, ``util``, ``expr``, ``s
 faces: ``plot``, ``schema``, ``symbolic``, ``cli``.
 """
 
+from . import animation as _animation  # noqa: F401  (installs Results.animate)
 from . import plot as _plot  # noqa: F401  (installs Results.plot)
 from . import diagram as _diagram  # noqa: F401  (installs Model._repr_svg_ for Jupyter)
 from .components import multibody, rotational, signals, translational

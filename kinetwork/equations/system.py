@@ -270,6 +270,25 @@ class System:
         return np.asarray(mapped(f_out or self.f_out, len(t))(t[None, :], X.T, p)).T
 
     @functools.cached_property
+    def frame_sets(self):
+        """The frame connection sets placed by the kinematic tree (topology indices, in
+        order): the frames ``f_frames`` gives the poses of."""
+        return sorted(self.asm.place)
+
+    @functools.cached_property
+    def f_frames(self):
+        """World poses of every set of ``frame_sets`` from the full state: a Function of
+        (t, x, p) -> (12, n_sets), each column the origin (3) then the orientation R
+        row-major (9). The very kinematics frame probes read (``Assembly.pose``), so an
+        animation shows what the probes record."""
+        a, eq = self.asm, self.eq
+        columns = [ca.vertcat(pos, ca.vec(R.T)) for R, pos in map(a.pose, self.frame_sets)]
+        poses = ca.horzcat(*columns) if columns else ca.SX(12, 0)
+        coords = a.q if eq.q is None else eq.q
+        return ca.Function("frame_poses", [a.t, ca.vertcat(eq.x, eq.z), a.p],
+                           [ca.densify(ca.substitute(poses, a.q, ca.densify(coords)))])
+
+    @functools.cached_property
     def damped(self):
         """Whether a generalized force depends on the speeds (dampers): only then can the
         model be stiff in the sense of ``kinetwork.simulation.driver.stiffness``."""

@@ -20,7 +20,7 @@ class Results:
     """
 
     def __init__(self, t, states, state_names, values, signals, stats=None, state_units=None,
-                 settings=None, probe_targets=None):
+                 settings=None, probe_targets=None, system=None):
         self.t = np.asarray(t, dtype=float)
         self.states = np.asarray(states, dtype=float).reshape(len(self.t), len(state_names))
         self.state_names = list(state_names)
@@ -36,6 +36,8 @@ class Results:
         self.probe_targets = dict(probe_targets or {})
         #: None, or {"t_reached", "reason"} when the run stopped before t_end
         self.partial = None
+        #: the System that made these results, when known: what ``animate`` draws
+        self.system = system
         self._values = {}
         col = 0
         values = np.asarray(values, dtype=float).reshape(len(self.t), -1)
@@ -113,6 +115,14 @@ class Results:
             raise RuntimeError("no plotter installed: import kinetwork")
         return _plotter(self, probes=probes, **kwargs)
 
+    def animate(self, path=None, **kwargs):
+        """3-D animation of the run: a self-contained HTML page at ``path`` (the three.js
+        player inlined, opens without a network) and ``gif=``/``mp4=`` videos; returns the
+        Animation (see ``kinetwork.animation.animate`` for the options)."""
+        if _animator is None:
+            raise RuntimeError("no animator installed: import kinetwork")
+        return _animator(self, path, **kwargs)
+
     def __repr__(self):
         return (f"<Results {len(self.t)} points, t = {self.t[0]:g} .. {self.t[-1]:g}, "
                 f"{len(self.signals)} signals>")
@@ -128,3 +138,13 @@ def install_plotter(plot):
     ``Results.plot``."""
     global _plotter
     _plotter = plot
+
+
+#: what draws ``Results.animate``: installed by ``kinetwork.animation`` when it is imported
+_animator = None
+
+
+def install_animator(animate):
+    """Set the function ``animate(results, path=None, **kwargs)`` of ``Results.animate``."""
+    global _animator
+    _animator = animate

@@ -1,0 +1,447 @@
+// The 3-D viewer of a kinetwork Animation (kinetwork.animation.animation_data): the scene's
+// shapes on their frames, the frames moved along their poses in time.
+//
+//   const viewer = createViewer(element, animation, {controls: true, onTime: t => ...});
+//   viewer.setTime(1.5); viewer.play(); viewer.pause(); viewer.setSpeed(0.5); viewer.dispose();
+//
+// Options: controls (draw play/pause, scrub, time, speed, frames and view buttons; default
+// false), onTime(t) (called while playing and when the user scrubs; not on setTime), autoplay
+// (default false), loop (default true), speed (default 1), showFrames (the small axes on every
+// frame; default: when there are at most 24). Between samples positions are interpolated
+// linearly and orientations along the shorter arc, so any grid plays smoothly at any speed.
+// Besides: getTime(), isPlaying().
+import {
+  AmbientLight, BoxGeometry, Color, ConeGeometry, CylinderGeometry, DirectionalLight,
+  GridHelper, Group, Matrix4, Mesh, MeshBasicMaterial, MeshStandardMaterial, PerspectiveCamera,
+  Quaternion, Scene, SphereGeometry, TubeGeometry, Curve, Vector3, WebGLRenderer,
+} from "three";
+import { OrbitControls } from "three/examples/jsm/controls/OrbitControls.js";
+
+const SPEEDS = [0.1, 0.25, 0.5, 1, 2, 4];
+const FRAMES_SHOWN = 24;
+const AXIS_COLORS = [0xdc3232, 0x28a03c, 0x3250dc];
+const Y = new Vector3(0, 1, 0);
+
+export function createViewer(element, animation, options = {}) {
+  const data = prepare(animation);
+  const root = document.createElement("div");
+  root.className = "kn-viewer";
+  root.tabIndex = 0;
+  element.appendChild(root);
+  injectStyle();
+
+  const state = { time: data.t[0], playing: false, speed: options.speed || 1, last: null,
+                  frame: 0, pending: 0, disposed: false };
+  let renderer;
+  try {
+    renderer = new WebGLRenderer({ antialias: true });
+  } catch (err) {
+    const note = document.createElement("div");
+    note.className = "kn-viewer-note";
+    note.textContent = "This 3-D view needs WebGL, which this browser does not offer.";
+    root.appendChild(note);
+    console.warn("kinetwork viewer:", err);
+    return stub(root, data, state);
+  }
+  renderer.setPixelRatio(Math.min(window.devicePixelRatio || 1, 2));
+  root.appendChild(renderer.domElement);
+
+  const scene = new Scene();
+  scene.background = new Color(0xf4f5f7);
+  const camera = new PerspectiveCamera(animation.view.fov || 35, 1, 0.01, 1000);
+  camera.up.fromArray(animation.view.up);
+  camera.add(new DirectionalLight(0xffffff, 2.2).translateX(-0.4).translateY(0.6).translateZ(1));
+  scene.add(camera, new AmbientLight(0xffffff, 1.1));
+
+  const frames = data.frames.map(() => {
+    const group = new Group();
+    scene.add(group);
+    return group;
+  });
+  const links = [];      // shapes between two frames, rebuilt from their origins
+  const frameAxes = [];
+  const ground = animation.shapes.find(s => s.kind === "grid");
+  for (const shape of animation.shapes) {
+    const object = build(shape, data.scale);
+    if (!object) continue;
+    if (shape.kind === "rod" || shape.kind === "spring") {
+      scene.add(object);
+      links.push({ shape, object });
+    } else {
+      frames[shape.frame].add(object);
+      const small = shape.kind === "axes" && shape.component === null;
+      if (small && !(ground && shape.frame === ground.frame)) frameAxes.push(object);
+    }
+  }
+
+  const controls = new OrbitControls(camera, renderer.domElement);
+  controls.addEventListener("change", () => request());
+
+  const ui = options.controls ? buildControls() : null;
+  const resize = new ResizeObserver(() => layout());
+  resize.observe(root);
+  layout();
+  fitView();
+  // a scene of many frames (an engine) is clearer without them until asked for
+  setFramesVisible(options.showFrames ?? frameAxes.length <= FRAMES_SHOWN);
+  apply(state.time);
+  const onKey = event => {
+    if (event.code === "Space") { event.preventDefault(); state.playing ? pause() : play(); }
+  };
+  root.addEventListener("keydown", onKey);
+  if (options.autoplay) play(); else request();
+
+  // -- time ---------------------------------------------------------------------------------
+  function apply(time) {
+    const t = data.t, n = t.length;
+    let i = 0, w = 0;
+    if (n > 1) {
+      let lo = 0, hi = n - 1;
+      while (hi - lo > 1) {
+        const mid = (lo + hi) >> 1;
+        if (t[mid] <= time) lo = mid; else hi = mid;
+      }
+      i = lo;
+      w = t[hi] > t[lo] ? Math.min(Math.max((time - t[lo]) / (t[hi] - t[lo]), 0), 1) : 0;
+    }
+    data.frames.forEach((f, k) => pose(f, i, w, frames[k]));
+    for (const { shape, object } of links) stretch(object, frames[shape.frame].position,
+                                                   frames[shape.to].position);
+    if (ui) ui.show(time);
+  }
+
+  function setTime(time, fromUser = false) {
+    state.time = clampTime(time);
+    apply(state.time);
+    if (fromUser && options.onTime) options.onTime(state.time);
+    request();
+  }
+
+  function clampTime(time) {
+    const t = data.t;
+    return Math.min(Math.max(Number(time) || 0, t[0]), t[t.length - 1]);
+  }
+
+  function tick(now) {
+    state.frame = 0;
+    if (state.disposed) return;
+    if (state.playing) {
+      const t = data.t, span = t[t.length - 1] - t[0];
+      if (state.last !== null) state.time += (now - state.last) / 1000 * state.speed;
+      state.last = now;
+      if (state.time > t[t.length - 1]) {
+        if (options.loop === false || span <= 0) { state.time = t[t.length - 1]; pause(); }
+        else state.time = t[0] + (state.time - t[0]) % span;
+      }
+      apply(state.time);
+      if (options.onTime) options.onTime(state.time);
+    }
+    renderer.render(scene, camera);
+    if (state.playing) request();
+  }
+
+  function request() {
+    if (!state.frame && !state.disposed) state.frame = requestAnimationFrame(tick);
+  }
+
+  function play() {
+    const t = data.t;
+    if (state.time >= t[t.length - 1] && options.loop === false) state.time = t[0];
+    state.playing = true;
+    state.last = null;
+    if (ui) ui.playing(true);
+    request();
+  }
+
+  function pause() {
+    state.playing = false;
+    if (ui) ui.playing(false);
+    request();
+  }
+
+  function setSpeed(speed) {
+    if (!(speed > 0)) return;
+    state.speed = speed;
+    if (ui) ui.speed(speed);
+  }
+
+  // -- view ---------------------------------------------------------------------------------
+  function layout() {
+    const width = root.clientWidth || 640;
+    const height = Math.max((root.clientHeight || 480) - (ui ? ui.height() : 0), 50);
+    renderer.setSize(width, height);
+    camera.aspect = width / height;
+    camera.updateProjectionMatrix();
+    request();
+  }
+
+  function fitView() {
+    const view = animation.view;
+    const target = new Vector3().fromArray(view.target);
+    const forward = new Vector3().fromArray(view.direction).negate().normalize();
+    const up = new Vector3().fromArray(view.up);
+    const right = new Vector3().crossVectors(forward, up).normalize();
+    const camUp = new Vector3().crossVectors(right, forward);
+    const tan = Math.tan((view.fov || 35) * Math.PI / 360);
+    const aspect = Math.min(Math.max(camera.aspect || 1, 0.3), 3);
+    const margin = data.scale / 5;
+    const [lo, hi] = animation.bounds;
+    let distance = data.scale * 0.5;
+    for (const x of [lo[0] - margin, hi[0] + margin])
+      for (const y of [lo[1] - margin, hi[1] + margin])
+        for (const z of [lo[2] - margin, hi[2] + margin]) {
+          const c = new Vector3(x, y, z).sub(target);
+          const depth = c.dot(forward);
+          distance = Math.max(distance, Math.abs(c.dot(camUp)) / tan - depth,
+                              Math.abs(c.dot(right)) / (tan * aspect) - depth);
+        }
+    distance *= 1.08;
+    camera.position.copy(target).addScaledVector(forward, -distance);
+    camera.near = distance / 200;
+    camera.far = distance * 50;
+    camera.updateProjectionMatrix();
+    controls.target.copy(target);
+    controls.update();
+    request();
+  }
+
+  function setFramesVisible(visible) {
+    for (const object of frameAxes) object.visible = visible;
+    if (ui) ui.frames(visible);
+    request();
+  }
+
+  // -- the controls -------------------------------------------------------------------------
+  function buildControls() {
+    const bar = document.createElement("div");
+    bar.className = "kn-viewer-bar";
+    const button = (label, title, onClick) => {
+      const b = document.createElement("button");
+      b.type = "button";
+      b.textContent = label;
+      b.title = title;
+      b.addEventListener("click", onClick);
+      bar.appendChild(b);
+      return b;
+    };
+    const playButton = button("\u25B6", "Play (space)", () => (state.playing ? pause() : play()));
+    playButton.className = "kn-play";
+    const slider = document.createElement("input");
+    slider.type = "range";
+    slider.min = String(data.t[0]);
+    slider.max = String(data.t[data.t.length - 1]);
+    slider.step = "any";
+    slider.title = "Time";
+    slider.addEventListener("input", () => setTime(Number(slider.value), true));
+    bar.appendChild(slider);
+    const label = document.createElement("span");
+    label.className = "kn-time";
+    bar.appendChild(label);
+    const speed = document.createElement("select");
+    speed.title = "Speed";
+    for (const s of SPEEDS) {
+      const option = document.createElement("option");
+      option.value = String(s);
+      option.textContent = `${s}\u00D7`;
+      speed.appendChild(option);
+    }
+    speed.addEventListener("change", () => setSpeed(Number(speed.value)));
+    bar.appendChild(speed);
+    const framesButton = button("frames", "Show or hide the axes of every frame",
+                                () => setFramesVisible(!framesButton.classList.contains("kn-on")));
+    button("view", "Back to the first view", () => fitView());
+    const title = document.createElement("div");
+    title.className = "kn-viewer-title";
+    title.textContent = animation.name || "";
+    root.appendChild(title);
+    root.appendChild(bar);
+    const end = data.t[data.t.length - 1];
+    const digits = end - data.t[0] >= 100 ? 1 : 2;
+    return {
+      height: () => bar.offsetHeight,
+      show(time) {
+        slider.value = String(time);
+        label.textContent = `t = ${time.toFixed(digits)} / ${end.toFixed(digits)} s`;
+      },
+      playing(on) {
+        playButton.textContent = on ? "\u275A\u275A" : "\u25B6";
+        playButton.title = on ? "Pause (space)" : "Play (space)";
+      },
+      speed(s) {
+        if (SPEEDS.includes(s)) speed.value = String(s);
+      },
+      frames(on) { framesButton.classList.toggle("kn-on", on); },
+    };
+  }
+
+  function dispose() {
+    state.disposed = true;
+    state.playing = false;
+    if (state.frame) cancelAnimationFrame(state.frame);
+    resize.disconnect();
+    root.removeEventListener("keydown", onKey);
+    controls.dispose();
+    scene.traverse(object => {
+      if (object.geometry) object.geometry.dispose();
+      if (object.material) object.material.dispose();
+    });
+    renderer.dispose();
+    root.remove();
+  }
+
+  if (ui) { ui.speed(state.speed); ui.show(state.time); }
+  return {
+    setTime: time => setTime(time), play, pause, setSpeed, dispose,
+    getTime: () => state.time, isPlaying: () => state.playing,
+  };
+}
+
+// A viewer with nothing to draw on: time still moves, so a host's cursor still follows.
+function stub(root, data, state) {
+  return {
+    setTime(time) { state.time = Math.min(Math.max(time, data.t[0]), data.t[data.t.length - 1]); },
+    play() { state.playing = true; }, pause() { state.playing = false; }, setSpeed() {},
+    dispose() { root.remove(); }, getTime: () => state.time, isPlaying: () => state.playing,
+  };
+}
+
+// The poses as flat typed arrays: [x, y, z] and [w, x, y, z] per sample.
+function prepare(animation) {
+  const valid = animation && Array.isArray(animation.t) && animation.t.length > 0
+    && Array.isArray(animation.frames);
+  if (!valid)
+    throw new Error("kinetwork viewer: not an animation (kinetwork.animation_data)");
+  return {
+    t: Float64Array.from(animation.t),
+    scale: animation.scale || 1,
+    frames: animation.frames.map(f => ({
+      position: Float64Array.from(f.position.flat()),
+      quaternion: Float64Array.from(f.quaternion.flat()),
+      rows: f.position.length,
+    })),
+  };
+}
+
+const qa = new Quaternion(), qb = new Quaternion();
+
+function pose(frame, i, w, object) {
+  const p = frame.position, q = frame.quaternion;
+  if (frame.rows === 1) {
+    object.position.set(p[0], p[1], p[2]);
+    object.quaternion.set(q[1], q[2], q[3], q[0]);
+    return;
+  }
+  const j = Math.min(i + 1, frame.rows - 1);
+  const lerp = k => p[3 * i + k] + w * (p[3 * j + k] - p[3 * i + k]);
+  object.position.set(lerp(0), lerp(1), lerp(2));
+  qa.set(q[4 * i + 1], q[4 * i + 2], q[4 * i + 3], q[4 * i]);
+  qb.set(q[4 * j + 1], q[4 * j + 2], q[4 * j + 3], q[4 * j]);
+  object.quaternion.slerpQuaternions(qa, qb, w);
+}
+
+const direction = new Vector3();
+
+// A shape between two frame origins: its mesh is one unit long along y, from its origin.
+function stretch(object, a, b) {
+  direction.subVectors(b, a);
+  const length = direction.length();
+  object.visible = length > 1e-12;
+  if (!object.visible) return;
+  object.position.copy(a);
+  object.quaternion.setFromUnitVectors(Y, direction.divideScalar(length));
+  object.scale.set(1, length / (object.userData.length || 1), 1);
+}
+
+function material(color) {
+  return new MeshStandardMaterial({ color: new Color(color), roughness: 0.55, metalness: 0.1 });
+}
+
+// The three.js object of one shape, in the coordinates of its frame (or, between two
+// frames, a unit along y that `stretch` places).
+function build(shape, scale) {
+  const kind = shape.kind;
+  if (kind === "box" || kind === "cylinder" || kind === "sphere") {
+    const { length, width, height } = shape;
+    let geometry;
+    if (kind === "box") geometry = new BoxGeometry(length, width, height);
+    else if (kind === "cylinder")
+      geometry = new CylinderGeometry(width / 2, width / 2, length, 32).rotateZ(-Math.PI / 2);
+    else geometry = new SphereGeometry(length / 2, 32, 16);
+    geometry.translate(length / 2, 0, 0);
+    const mesh = new Mesh(geometry, material(shape.color));
+    const l = new Vector3().fromArray(shape.length_direction);
+    const w = new Vector3().fromArray(shape.width_direction);
+    const h = new Vector3().crossVectors(l, w);
+    const holder = new Group();
+    holder.quaternion.setFromRotationMatrix(new Matrix4().makeBasis(l, w, h));
+    holder.position.fromArray(shape.r_shape);
+    holder.add(mesh);
+    return holder;
+  }
+  if (kind === "rod") {
+    const r = shape.diameter / 2;
+    const geometry = new CylinderGeometry(r, r, 1, 20).translate(0, 0.5, 0);
+    return new Mesh(geometry, material(shape.color));
+  }
+  if (kind === "spring") {
+    const turns = shape.windings || 8, radius = shape.diameter / 2;
+    const helix = new Curve();
+    helix.getPoint = (s, target = new Vector3()) => {
+      const r = s > 0.04 && s < 0.96 ? radius : 0;
+      const a = 2 * Math.PI * turns * s;
+      return target.set(r * Math.cos(a), s, r * Math.sin(a));
+    };
+    const geometry = new TubeGeometry(helix, turns * 24, shape.wire / 2, 8, false);
+    const mesh = new Mesh(geometry, material(shape.color));
+    mesh.userData.length = 1;
+    return mesh;
+  }
+  if (kind === "axes") return axes(shape.length);
+  if (kind === "grid") {
+    const color = new Color(shape.color);
+    const grid = new GridHelper(shape.size, shape.divisions, color.clone().multiplyScalar(0.8), color);
+    grid.quaternion.setFromUnitVectors(Y, new Vector3().fromArray(shape.normal));
+    grid.position.fromArray(shape.r_shape);
+    return grid;
+  }
+  return null;
+}
+
+function axes(length) {
+  const group = new Group();
+  const radius = length / 30;
+  const directions = [new Vector3(1, 0, 0), Y, new Vector3(0, 0, 1)];
+  directions.forEach((d, k) => {
+    const paint = new MeshBasicMaterial({ color: AXIS_COLORS[k] });
+    const shaft = new CylinderGeometry(radius, radius, length * 0.8, 8).translate(0, length * 0.4, 0);
+    const head = new ConeGeometry(radius * 2.6, length * 0.2, 12).translate(0, length * 0.9, 0);
+    const arrow = new Group();
+    arrow.add(new Mesh(shaft, paint), new Mesh(head, paint.clone()));
+    arrow.quaternion.setFromUnitVectors(Y, d);
+    group.add(arrow);
+  });
+  return group;
+}
+
+function injectStyle() {
+  if (document.getElementById("kn-viewer-style")) return;
+  const style = document.createElement("style");
+  style.id = "kn-viewer-style";
+  style.textContent = `
+.kn-viewer{position:relative;width:100%;height:100%;overflow:hidden;outline:none;
+  font:13px system-ui,-apple-system,"Segoe UI",sans-serif;color:#333;background:#f4f5f7}
+.kn-viewer canvas{display:block}
+.kn-viewer-title{position:absolute;top:8px;left:12px;font-weight:600;color:#555;pointer-events:none}
+.kn-viewer-note{padding:2em;color:#a33}
+.kn-viewer-bar{position:absolute;left:0;right:0;bottom:0;display:flex;align-items:center;gap:8px;
+  padding:6px 10px;background:#fff;border-top:1px solid #dde0e4}
+.kn-viewer-bar button{font:inherit;padding:2px 8px;border:1px solid #c8ccd2;border-radius:4px;
+  background:#fff;cursor:pointer;min-width:2.2em}
+.kn-viewer-bar button.kn-play{width:2.8em}
+.kn-viewer-bar button:hover{background:#eef1f5}
+.kn-viewer-bar button.kn-on{background:#dbe8fb;border-color:#8fb3e6}
+.kn-viewer-bar input[type=range]{flex:1;min-width:80px}
+.kn-viewer-bar select{font:inherit}
+.kn-time{font-variant-numeric:tabular-nums;white-space:nowrap}`;
+  document.head.appendChild(style);
+}
