@@ -309,11 +309,14 @@ def _row(names, spots, boxes):
 def _satellites(names, boxes, links, fixed):
     """Parts wired only to the top or bottom ports of one other block: name -> (anchor,
     "top" or "bottom")."""
-    found = {}
+    found, meets = {}, {}
+    for a, pa, b, pb in links:
+        meets.setdefault(a, []).append((b, pb))
+        meets.setdefault(b, []).append((a, pa))
     for name in names:
         if name in fixed or isinstance(boxes[name].comp, Subsystem):
             continue
-        ends = [(b, pb) if a == name else (a, pa) for a, pa, b, pb in links if name in (a, b)]
+        ends = meets.get(name, [])
         others = {other for other, _ in ends}
         if len(others) == 1:
             anchor = ends[0][0]
@@ -328,10 +331,11 @@ def _layered(names, boxes, links, fixed, order):
     sats = _satellites(names, boxes, links, fixed)
     units = [n for n in names if n not in sats]
     # a unit is a block with the parts stacked above and below it
-    stack, size = {}, {}
+    stack, size, hung = {}, {}, {}
+    for n, anchor_side in sats.items():
+        hung.setdefault(anchor_side, []).append(n)
     for unit in units:
-        above = [n for n in names if sats.get(n) == (unit, "top")]
-        below = [n for n in names if sats.get(n) == (unit, "bottom")]
+        above, below = hung.get((unit, "top"), []), hung.get((unit, "bottom"), [])
         width = max(boxes[n].w for n in [unit, *above, *below])
         y, place = 0, {}
         for n in [*above, unit, *below]:
@@ -356,8 +360,64 @@ def _layered(names, boxes, links, fixed, order):
         signal = boxes[a].comp.ports[pa].domain in ("signal_in", "signal_out")
         wires.append((ua, ya, ub, yb, fa - fb, signal))
 
-    # direct the wires; break cycles by a depth-first walk from the sources (the inputs
-    # of a model: a reference signal, the ground), turning back the edges that close them
+    dag = _direct(units, wires, order)
+    layer = {}
+    topo = list(nx.lexicographical_topological_sort(dag, key=order.get))
+    for unit in topo:
+        layer[unit] = max((layer[p] + 1 for p in dag.predecessors(unit)), default=0)
+    for unit in reversed(topo):        # sources move up to just before what they feed
+        succ = [layer[s] for s in dag.successors(unit)]
+        if succ and not any(True for _ in dag.predecessors(unit)):
+            layer[unit] = min(succ) - 1
+
+    # placeholders where a wire passes a layer, so that nothing is put in its way
+    height, edges = dict(size), []        # edges: (node, y, node, y), layer to layer + 1
+    for k, (ua, ya, ub, yb, _, _) in enumerate(wires):
+        if layer[ua] > layer[ub]:
+            ua, ya, ub, yb = ub, yb, ua, ya
+        chain, ys = [ua], [ya]
+        for i in range(layer[ua] + 1, layer[ub]):
+            dummy = ("~", k, i)
+            layer[dummy], height[dummy] = i, (0, TRACK)
+            chain.append(dummy)
+            ys.append(TRACK / 2)
+        chain.append(ub)
+        ys.append(yb)
+        if layer[ua] != layer[ub]:
+            edges += [(chain[i], ys[i], chain[i + 1], ys[i + 1]) for i in range(len(chain) - 1)]
+    count = max(layer.values()) + 1
+    rank = {n: order.get(n, order.get(wires[n[1]][0]) if isinstance(n, tuple) else 0)
+            for n in layer}
+    layers = [[] for _ in range(count)]
+    for n in layer:
+        layers[layer[n]].append(n)
+    for members in layers:
+        members.sort(key=lambda n: (rank[n], str(n)))
+
+    layers, near, between = _order(layers, edges, layer, height)
+
+    # x: one column per layer, wider gaps where more wires cross
+    xs, x = [], 0.0
+    for i in range(count):
+        xs.append(x)
+        through = len(between[i])
+        x += max(height[n][0] for n in layers[i]) + LAYER_GAP + TRACK * min(through, 14)
+
+    top = _heights(layers, near, height)
+    out = {}
+    for unit in units:
+        i = layer[unit]
+        width = max(height[n][0] for n in layers[i])
+        ux = xs[i] + (width - size[unit][0]) / 2
+        for n, (dx, dy) in stack[unit].items():
+            out[n] = (ux + dx, top[unit] + dy)
+    return out
+
+
+def _direct(units, wires, order):
+    """The wires between units as a DAG: each from the flow's side to the other; cycles
+    broken by a depth-first walk from the sources (a model's inputs: a reference signal,
+    the ground), turning back the edges that close them (a measured feedback runs back)."""
     flows = {}
     for ua, _, ub, _, score, signal in wires:
         # mechanics first, then signals, then wires between like sides (frame_b to frame_b)
@@ -392,37 +452,14 @@ def _layered(names, boxes, links, fixed, order):
                 if nxt not in state:
                     state[nxt] = 1
                     path.append((nxt, iter(after[nxt])))
-    layer = {}
-    topo = list(nx.lexicographical_topological_sort(dag, key=order.get))
-    for unit in topo:
-        layer[unit] = max((layer[p] + 1 for p in dag.predecessors(unit)), default=0)
-    for unit in reversed(topo):        # sources move up to just before what they feed
-        succ = [layer[s] for s in dag.successors(unit)]
-        if succ and not any(True for _ in dag.predecessors(unit)):
-            layer[unit] = min(succ) - 1
+    return dag
 
-    # placeholders where a wire passes a layer, so that nothing is put in its way
-    height, edges = dict(size), []        # edges: (node, y, node, y), layer to layer + 1
-    for k, (ua, ya, ub, yb, _, _) in enumerate(wires):
-        if layer[ua] > layer[ub]:
-            ua, ya, ub, yb = ub, yb, ua, ya
-        chain, ys = [ua], [ya]
-        for i in range(layer[ua] + 1, layer[ub]):
-            dummy = ("~", k, i)
-            layer[dummy], height[dummy] = i, (0, TRACK)
-            chain.append(dummy)
-            ys.append(TRACK / 2)
-        chain.append(ub)
-        ys.append(yb)
-        if layer[ua] != layer[ub]:
-            edges += [(chain[i], ys[i], chain[i + 1], ys[i + 1]) for i in range(len(chain) - 1)]
-    count = max(layer.values()) + 1
-    rank = {n: order.get(n, order.get(wires[n[1]][0]) if isinstance(n, tuple) else 0)
-            for n in layer}
-    layers = [sorted((n for n in layer if layer[n] == i),
-                     key=lambda n: (rank[n], str(n))) for i in range(count)]
 
-    # order within layers: barycentre sweeps, keeping the order with the fewest crossings
+def _order(layers, edges, layer, height):
+    """The order within layers: barycentre sweeps on the ports' heights, keeping the order
+    with the fewest crossings, then swaps of neighbours while they remove crossings.
+    Returns the layers, each node's (left, right) neighbours and the edges by layer."""
+    count = len(layers)
     near = {n: ([], []) for n in layer}               # (left neighbours, right neighbours)
     for a, ya, b, yb in edges:
         near[b][0].append((a, ya, yb))
@@ -431,7 +468,9 @@ def _layered(names, boxes, links, fixed, order):
     def position(n, y):
         return pos[n] + y / max(height[n][1], 1)
 
-    between = [[e for e in edges if layer[e[0]] == i] for i in range(count - 1)]
+    between = [[] for _ in range(count)]
+    for e in edges:
+        between[layer[e[0]]].append(e)
 
     def crossings(gaps=None):
         total = 0
@@ -475,15 +514,14 @@ def _layered(names, boxes, links, fixed, order):
                 else:
                     members[j], members[j + 1] = members[j + 1], members[j]
                     pos[members[j]], pos[members[j + 1]] = j, j + 1
+    return layers, near, between
 
-    # x: one column per layer, wider gaps where more wires cross
-    xs, x = [], 0.0
-    for i in range(count):
-        xs.append(x)
-        through = sum(1 for a, _, _, _ in edges if layer[a] == i)
-        x += max(height[n][0] for n in layers[i]) + LAYER_GAP + TRACK * min(through, 14)
 
-    # y: stacked in order, then moved to straighten wires, the order kept
+def _heights(layers, near, height):
+    """The top of each node: stacked in its layer's order, then moved to straighten wires
+    with the order kept (an isotonic fit, layer by layer, sweeping both ways), and last
+    nearly straight wires made straight."""
+    count = len(layers)
     top = {}
     for members in layers:
         y = 0.0
@@ -539,14 +577,7 @@ def _layered(names, boxes, links, fixed, order):
                     top.update(new)
                     locked.add(n)
                     break
-    out = {}
-    for unit in units:
-        i = layer[unit]
-        width = max(height[n][0] for n in layers[i])
-        ux = xs[i] + (width - size[unit][0]) / 2
-        for n, (dx, dy) in stack[unit].items():
-            out[n] = (ux + dx, top[unit] + dy)
-    return out
+    return top
 
 
 def _gaps(members):
