@@ -223,7 +223,7 @@ def simulate(model, t_end=None, n_points=None, method=None, rtol=None, atol=None
                                 "step": settings["step"], "jit": stats["jit"],
                                 "max_steps": max_steps, "time_limit": time_limit,
                                 "restart": restart, "params": dict(params or {})},
-                      probe_targets=system.probe_targets)
+                      probe_targets=system.probe_targets, system=system)
     if failure is not None:
         reached = float(t[-1]) if len(t) else float(t_start)
         results.partial = {"t_reached": reached, "reason": failure}
