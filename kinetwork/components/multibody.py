@@ -731,3 +731,6 @@ class WorldTorque(Component, library=MB):
     role = "frame_force"
     frame_b = Port("frame", "Frame the torque acts on")
     torque = Param(unit="N*m", shape=(3,), time=True, doc="Torque, resolved in the world frame")
+
+
+from .loopjoints import JointRRR, SphericalSpherical, UniversalSpherical  # noqa: E402,F401

@@ -197,6 +197,7 @@ def assemble(model, topo, values):
         if n else ca.SX(0, 1)
     asm.cuts = [(cut, _closure(asm, cut, bound[cut.component.name], qindex))
                 for cut in topo.cuts]
+    _place_cut_frames(asm, topo, bound)
     asm.lam = ca.SX.sym("lambda", sum(r.shape[0] for _, r in asm.cuts))
     asm.qindex, asm.uindex, asm.Q_drive = qindex, uindex, net.axis_flow
     asm.signals = probe_signals(asm, topo, net, bound, model)
@@ -293,6 +294,19 @@ def _closure(asm, cut, comp, qindex):
     Ra, pa, Rb, pb = asm.relative_poses(cut.set_a, cut.set_b)
     qj = asm.q[qindex[comp.name]] if comp.dof and comp.regular else ca.SX(0, 1)
     return comp.closure(Ra.T @ Rb, Ra.T @ (pb - pa), qj)
+
+
+def _place_cut_frames(asm, topo, bound):
+    """Frames a cut joint places from where its two ends are (a rod's frame_ia), in the body
+    of its frame_a: for probes, as validation holds (nothing there bears a load)."""
+    for cut in topo.cuts:
+        comp = bound[cut.component.name]
+        if not getattr(type(comp), "placed_frames", ()):
+            continue
+        Ra, pa, Rb, pb = asm.relative_poses(cut.set_a, cut.set_b)
+        k, R, pos = asm.place[cut.set_a]
+        for port, (Rp, pp) in comp.frames(Ra.T @ Rb, Ra.T @ (pb - pa)).items():
+            asm.place[topo.set_of[cut.component.port_ref(port)]] = (k, R @ Rp, pos + R @ pp)
 
 
 def _symbolic(value, env, funcs):

@@ -67,6 +67,8 @@ class _Balance:
         if comp.role == "world":
             return self._minus_rest(set_, comp)
         if name in self.cut_of:
+            if port not in ("frame_a", "frame_b"):     # a frame it places: for probes only
+                return ca.SX.zeros(3), ca.SX.zeros(3)
             f, m = self._constraint(*self.cut_of[name], port)
             if port == "frame_b":              # a cut joint's drive acts there too
                 df, dm = self._drive(comp)

@@ -166,7 +166,14 @@ def check_placement(model, sub):
 
 
 def has_subsystems(model):
-    return any(isinstance(c, Subsystem) for c in model.components.values())
+    """Whether ``model`` places a subsystem or an aggregate (both flatten)."""
+    return any(isinstance(c, Subsystem) or _aggregate(c) for c in model.components.values())
+
+
+def _aggregate(comp):
+    """Whether ``comp`` is an aggregate: a component that stands for a chain of elementary
+    ones (its ``expand`` hook gives them, wired, and which of their ports are its own)."""
+    return getattr(type(comp), "expand", None) is not None
 
 
 class _Flat:
@@ -174,6 +181,15 @@ class _Flat:
 
     def __init__(self, model, flat):
         self.model, self.flat, self.problems = model, flat, []
+        self.expanded = {}           # id of an aggregate -> (it, its Expansion), made once
+
+    def expansion(self, comp):
+        """The Expansion of aggregate ``comp`` (the same object at every look), else None."""
+        if not _aggregate(comp):
+            return None
+        if id(comp) not in self.expanded:
+            self.expanded[id(comp)] = (comp, comp.expand())
+        return self.expanded[id(comp)][1]
 
     def walk(self, m, prefix, scope, display, depth):
         """Add ``m``'s components under ``prefix``; ``scope`` maps m's parameter names to
@@ -185,6 +201,9 @@ class _Flat:
             if isinstance(comp, Subsystem):
                 self.walk(comp.definition, path + ".", self.scope_of(m, comp, path, scope),
                           shown + "/", depth + 1)
+                continue
+            if _aggregate(comp):          # its parts take its parameters' own words
+                self.walk(self.expansion(comp), path + ".", scope, shown + "/", depth + 1)
                 continue
             twin = copy.copy(comp)
             object.__setattr__(twin, "name", path)
@@ -241,14 +260,15 @@ class _Flat:
                 self.problems.append(f"{prefix}{ref.path}: component {comp.name!r} is not in "
                                      f"model {m.name!r} any more (remove its connections too)")
                 return None
-            if not isinstance(comp, Subsystem):
+            inner = comp.definition if isinstance(comp, Subsystem) else self.expansion(comp)
+            if inner is None:
                 return PortRef(self.flat.components[prefix + comp.name], ref.name)
-            target = comp.definition.exposed.get(ref.name)
+            target = inner.exposed.get(ref.name)
             if target is None:
-                self.problems.append(f"{prefix}{ref.path}: {comp.definition.name!r} exposes no "
-                                     f"port {ref.name!r}{suggest(ref.name, comp.definition.exposed)}")
+                self.problems.append(f"{prefix}{ref.path}: {inner.name!r} exposes no "
+                                     f"port {ref.name!r}{suggest(ref.name, inner.exposed)}")
                 return None
-            m, prefix, ref = comp.definition, f"{prefix}{comp.name}.", target
+            m, prefix, ref = inner, f"{prefix}{comp.name}.", target
         raise ModelError(f"{prefix}{ref.path}: subsystems nested more than {DEPTH_LIMIT} deep")
 
 

@@ -218,8 +218,16 @@ def _tree(model, topo, roles, problems):
 
     reached = nx.node_connected_component(frames, topo.root)
     for comp in [*joints, *roles.get("body", []), *roles.get("frame_force", [])]:
+        # frames a cut joint places from where its ends are (a rod's frame_ia): for probes
+        placed = getattr(type(comp), "placed_frames", ())
+        for pname in placed:
+            stray = [p.path for p in topo.sets[topo.set_of[comp.port_ref(pname)]]
+                     if p.component is not comp and p.component.role != "probe"]
+            if stray:
+                problems.append(f"{model.place(comp)}: {comp.name}.{pname} is for probes "
+                                f"only, but {', '.join(stray)} is wired to it")
         for pname in comp.ports:
-            if comp.ports[pname].domain == "frame" and \
+            if comp.ports[pname].domain == "frame" and pname not in placed and \
                     topo.set_of[comp.port_ref(pname)] not in reached:
                 problems.append(f"{model.place(comp)}: {comp.name} is not connected to the "
                                 f"ground {topo.world.name!r} through joints or rigid parts")
@@ -238,7 +246,12 @@ def _tree(model, topo, roles, problems):
     for _, _, data in sub.edges(data=True):
         comp = data["component"]
         if comp.name in in_tree:
-            if comp._values.get("cut", False):
+            if getattr(type(comp), "loop_only", False):
+                problems.append(f"{model.place(comp)}: {comp.name} closes no kinematic loop "
+                                f"(or its loop has another such joint): a {comp.type_name} "
+                                f"holds only the distance of its frames, so it must be the "
+                                f"one joint that closes its loop")
+            elif comp._values.get("cut", False):
                 problems.append(f"{model.place(comp, 'cut')}: {comp.name} is marked cut but "
                                 f"closes no kinematic loop")
             continue
