@@ -1,0 +1,58 @@
+// The studio's HTTP client: every call carries the session token (X-Kinetwork-Token), read
+// once from the page's URL (?token=...). See kinetwork/studio/API.md for the contract.
+
+const params = new URLSearchParams(window.location.search);
+export const TOKEN = params.get("token") || "";
+export const OPEN = params.get("open");
+export const EXAMPLE = params.get("example");
+
+export class ApiError extends Error {
+  constructor(message, status, body) {
+    super(message);
+    this.status = status;
+    this.problems = (body && body.problems) || [];
+    this.body = body;
+  }
+}
+
+async function call(method, path, body) {
+  const init = { method, headers: { "X-Kinetwork-Token": TOKEN } };
+  if (body !== undefined) {
+    init.headers["Content-Type"] = "application/json";
+    init.body = JSON.stringify(body);
+  }
+  let res;
+  try {
+    res = await fetch(path, init);
+  } catch (err) {
+    throw new ApiError(`the studio server does not answer (${err.message}): is kinetwork studio still running?`, 0, null);
+  }
+  let data = null;
+  const text = await res.text();
+  try {
+    data = text ? JSON.parse(text) : null;
+  } catch {
+    data = null;
+  }
+  if (!res.ok) {
+    const msg = (data && (data.error || data.detail)) || `${method} ${path}: HTTP ${res.status}`;
+    throw new ApiError(typeof msg === "string" ? msg : JSON.stringify(msg), res.status, data);
+  }
+  return data;
+}
+
+const q = encodeURIComponent;
+
+export const api = {
+  palette: () => call("GET", "api/palette"),
+  files: () => call("GET", "api/files"),
+  examples: () => call("GET", "api/examples"),
+  openPath: (path) => call("GET", `api/open?path=${q(path)}`),
+  openExample: (name) => call("GET", `api/open?example=${q(name)}`),
+  validate: (model, path) => call("POST", "api/validate", { model, path: path || null }),
+  save: (path, model, text) => call("POST", "api/save", { path, model, text }),
+  run: (model, settings, path) => call("POST", "api/run", { model, settings, path: path || null }),
+  runStatus: (id) => call("GET", `api/run/${q(id)}`),
+  cancel: (id) => call("POST", `api/run/${q(id)}/cancel`),
+  layout: (model, path) => call("POST", "api/layout", { model, path: path || null }),
+};

@@ -1,0 +1,448 @@
+// The document model of the studio: a model file's top-level object (format
+// "kinetwork.model", version 1 or 2), edited immutably; scopes (the model itself, or one of
+// its subsystem definitions), the wiring rule of kn's Model.connect, names, layout.
+
+export const DOMAIN_COLORS = {
+  frame: "#5f5f5f",
+  rotational: "#404040",
+  translational: "#007f00",
+  signal_in: "#00007f",
+  signal_out: "#00007f",
+  any: "#a15c00",
+};
+
+// layout units (as written in files) -> screen pixels of the diagram at zoom 1
+export const SCALE = 1.5;
+export const GRID = 15; // snap grid in pixels (10 layout units)
+
+const SIGNALS = new Set(["signal_in", "signal_out"]);
+
+/** Why two ports cannot be wired (kn's Model.connect), or null when they can. */
+export function connectProblem(a, b, connections) {
+  if (a.path === b.path) return `cannot connect ${a.path} to itself`;
+  const da = a.domain;
+  const db = b.domain;
+  const signals = SIGNALS.has(da) && SIGNALS.has(db);
+  if (da !== db && da !== "any" && db !== "any" && !signals) {
+    return `cannot connect ${a.path} (${da}) to ${b.path} (${db}): ports of different domains`;
+  }
+  for (const [x, y] of connections || []) {
+    if ((x === a.path && y === b.path) || (x === b.path && y === a.path)) {
+      return `${a.path} and ${b.path} are already connected`;
+    }
+  }
+  return null;
+}
+
+/** Which side of a block a port sits on: left, right, top or bottom. */
+export function portSide(portName, domain, ports) {
+  if (/_a$/.test(portName) || domain === "signal_in") return "left";
+  if (/_b$/.test(portName) || domain === "signal_out") return "right";
+  // a joint's drive flanges: support above, axis below (where its probe usually hangs)
+  if (/^support/.test(portName)) return "top";
+  if (/^axis/.test(portName)) return "bottom";
+  if (portName === "port") return "top";
+  if (portName === "frame") return "right";
+  if (portName === "flange") {
+    // a sensor reads its flange (left) and puts out y (right); a source drives it (right)
+    const hasOut = (ports || []).some((p) => p.domain === "signal_out");
+    return hasOut ? "left" : "right";
+  }
+  return "top";
+}
+
+const SHORT = {
+  RigidBody: "mass",
+  FixedTranslation: "link",
+  FixedRotation: "rotation",
+  SpringDamper: "spring",
+  BodyBox: "box",
+  BodyCylinder: "cylinder",
+  BodySphere: "sphere",
+};
+
+/** The stem of fresh names of a type: "multibody.Revolute" -> "revolute". */
+export function nameStem(type) {
+  const cls = String(type).split(".").pop();
+  if (SHORT[cls]) return SHORT[cls];
+  const stem = cls.charAt(0).toLowerCase() + cls.slice(1);
+  return /^[A-Za-z_][A-Za-z0-9_]*$/.test(stem) ? stem : "part";
+}
+
+/** The first of stem1, stem2, ... not in ``taken`` (a Set). */
+export function freshName(stem, taken) {
+  const base = stem.replace(/\d+$/, "") || "part";
+  for (let i = 1; ; i++) {
+    const name = `${base}${i}`;
+    if (!taken.has(name)) return name;
+  }
+}
+
+export const IDENT = /^[A-Za-z_][A-Za-z0-9_]*$/;
+
+export function clone(x) {
+  return x === undefined ? undefined : JSON.parse(JSON.stringify(x));
+}
+
+/** A new, empty model. */
+export function emptyModel(name = "untitled") {
+  return {
+    format: "kinetwork.model",
+    version: 1,
+    name,
+    description: "",
+    parameters: {},
+    components: [],
+    connections: [],
+    simulation: { t_end: 10.0, n_points: 1001, method: "auto", rtol: 1e-8, atol: 1e-10 },
+    layout: {},
+  };
+}
+
+// -- paths ---------------------------------------------------------------------------------
+
+export function dirname(path) {
+  if (!path) return "";
+  const i = path.lastIndexOf("/");
+  return i < 0 ? "" : path.slice(0, i);
+}
+
+export function joinPath(folder, rel) {
+  const parts = (folder ? folder.split("/") : []).concat(rel.split("/"));
+  const out = [];
+  for (const p of parts) {
+    if (p === "" || p === ".") continue;
+    if (p === "..") out.pop();
+    else out.push(p);
+  }
+  return out.join("/");
+}
+
+export function relPath(from, to) {
+  const a = from ? from.split("/") : [];
+  const b = to.split("/");
+  let i = 0;
+  while (i < a.length && i < b.length - 1 && a[i] === b[i]) i++;
+  return [...a.slice(i).map(() => ".."), ...b.slice(i)].join("/");
+}
+
+// -- scopes: the model, or one of its definitions -----------------------------------------
+
+/**
+ * Where the definition of subsystem type ``type`` is, as seen from the doc at ``docPath``:
+ * {kind: "inline", body} | {kind: "file", key, folder} (key: the root-relative path of its
+ * file, in the definition cache) | null (not a definition: a registry type or unknown).
+ */
+export function definitionSource(doc, docPath, type, palette, folderOverride) {
+  if (!type || (palette && palette.types[type])) return null;
+  if (!IDENT.test(type)) return null;
+  const folder = folderOverride !== undefined ? folderOverride : dirname(docPath);
+  const entry = doc.definitions && doc.definitions[type];
+  if (entry && typeof entry === "object") {
+    if (typeof entry.file === "string") {
+      const key = joinPath(folder, entry.file);
+      return { kind: "file", key, folder: dirname(key) };
+    }
+    return { kind: "inline", body: entry };
+  }
+  const key = joinPath(folder, `${type}.json`);
+  return { kind: "file", key, folder: dirname(key), implicit: true };
+}
+
+/**
+ * Resolve subsystem type ``type`` as seen from ``ctx`` ({palette, doc, docPath, defCache}):
+ * {src, body, ctx: the context inside it} (body null while its file loads, or when it is
+ * missing), or null for a registry type or a name that cannot be a definition.
+ */
+export function resolveDef(type, ctx) {
+  const src = definitionSource(ctx.doc, ctx.docPath, type, ctx.palette);
+  if (!src) return null;
+  if (src.kind === "inline") return { src, body: src.body, ctx };
+  const hit = ctx.defCache[src.key];
+  if (!hit || hit.status !== "ok") return { src, body: null, ctx, missing: !!hit && hit.status === "missing" };
+  return { src, body: hit.model, ctx: { ...ctx, doc: hit.model, docPath: src.key } };
+}
+
+/** The scope at the end of a chain of definition names, from the root: {body, ctx, res}. */
+export function resolveScope(scopes, ctx) {
+  let cur = { body: ctx.doc, ctx, res: null };
+  for (const name of scopes) {
+    const r = resolveDef(name, cur.ctx);
+    if (!r || !r.body) return null;
+    cur = { body: r.body, ctx: r.ctx, res: r };
+  }
+  return cur;
+}
+
+const BODY_KEYS = ["description", "parameters", "ports", "components", "connections", "layout"];
+
+/**
+ * Replace the body of definition ``name`` (resolved as ``res``) by ``fn(body)``: it is
+ * written inline in the model's definitions (as kn's writer does for a changed definition);
+ * a definition read from a file brings its own definitions along, their file paths seen
+ * from the model's folder.
+ */
+export function updateDefinition(doc, docPath, name, res, fn) {
+  const body = {};
+  for (const k of BODY_KEYS) if (res.body[k] !== undefined) body[k] = res.body[k];
+  const defs = { ...(doc.definitions || {}) };
+  if (res.src.kind === "file") {
+    for (const [n, entry] of Object.entries(res.body.definitions || {})) {
+      if (defs[n] || n === name) continue;
+      defs[n] = entry && typeof entry.file === "string"
+        ? { file: relPath(dirname(docPath), joinPath(res.src.folder, entry.file)) }
+        : clone(entry);
+    }
+  }
+  defs[name] = fn(clone(body));
+  return orderKeys({ ...doc, version: 2, definitions: defs });
+}
+
+const KEY_ORDER = ["format", "version", "name", "description", "parameters", "ports", "components",
+  "connections", "simulation", "layout", "definitions"];
+
+export function orderKeys(doc) {
+  const out = {};
+  for (const k of KEY_ORDER) if (doc[k] !== undefined) out[k] = doc[k];
+  for (const k of Object.keys(doc)) if (!(k in out)) out[k] = doc[k];
+  return out;
+}
+
+// -- component and port information ---------------------------------------------------------
+
+/**
+ * TypeInfo of a component type: the palette's for a registry type, one made from the
+ * definition for a subsystem ({subsystem: true, ports with their domains}), or null.
+ */
+export function typeInfo(type, ctx, depth = 0) {
+  const { palette } = ctx;
+  if (palette && palette.types[type]) return palette.types[type];
+  if (depth > 16) return null;
+  const r = resolveDef(type, ctx);
+  if (!r || !r.body) return null;
+  const body = r.body;
+  const ports = Object.entries(body.ports || {}).map(([name, ref]) => ({
+    name,
+    domain: refDomain(body, ref, r.ctx, depth + 1),
+    doc: `${ref} of ${type}`,
+    optional: true,
+  }));
+  const params = Object.entries(body.parameters || {}).map(([name, value]) => ({
+    name,
+    unit: "",
+    default: value,
+    min: null,
+    max: null,
+    shape: [],
+    kind: "real",
+    choices: null,
+    doc: `parameter ${name} of ${type}`,
+    required: false,
+    time: false,
+  }));
+  return { type, doc: body.description || `subsystem ${type}`, ports, params, subsystem: true };
+}
+
+/** The domain of "comp.port" inside a body. */
+export function refDomain(body, ref, ctx, depth = 0) {
+  if (typeof ref !== "string") return "any";
+  const [cname, pname] = ref.split(".");
+  const comp = (body.components || []).find((c) => c.name === cname);
+  if (!comp) return "any";
+  const info = typeInfo(comp.type, ctx, depth + 1);
+  const port = info && info.ports.find((p) => p.name === pname);
+  return port ? port.domain : "any";
+}
+
+/** The domain of port "comp.port" of the scope, or null when there is no such port. */
+export function portDomain(body, path, ctx) {
+  const [cname, pname] = path.split(".");
+  const comp = (body.components || []).find((c) => c.name === cname);
+  if (!comp) return null;
+  const info = typeInfo(comp.type, ctx);
+  const port = info && info.ports.find((p) => p.name === pname);
+  return port ? port.domain : null;
+}
+
+// -- editing operations on a scope body -----------------------------------------------------
+
+export function takenNames(body) {
+  return new Set((body.components || []).map((c) => c.name));
+}
+
+export function addComponent(body, comp, pos) {
+  const layout = { ...(body.layout || {}) };
+  if (pos) layout[comp.name] = pos;
+  return { ...body, components: [...(body.components || []), comp], layout };
+}
+
+export function removeComponents(body, names) {
+  const gone = new Set(names);
+  const layout = { ...(body.layout || {}) };
+  for (const n of gone) delete layout[n];
+  const ports = {};
+  for (const [k, ref] of Object.entries(body.ports || {})) {
+    if (!gone.has(String(ref).split(".")[0])) ports[k] = ref;
+  }
+  const out = {
+    ...body,
+    components: (body.components || []).filter((c) => !gone.has(c.name)),
+    connections: (body.connections || []).filter(
+      ([a, b]) => !gone.has(String(a).split(".")[0]) && !gone.has(String(b).split(".")[0]),
+    ),
+    layout,
+  };
+  if (body.ports) out.ports = ports;
+  return out;
+}
+
+export function renameComponent(body, from, to) {
+  const re = (ref) => {
+    const [c, p] = String(ref).split(".");
+    return c === from ? `${to}.${p}` : ref;
+  };
+  const layout = {};
+  for (const [k, v] of Object.entries(body.layout || {})) layout[k === from ? to : k] = v;
+  const out = {
+    ...body,
+    components: body.components.map((c) => (c.name === from ? { ...c, name: to } : c)),
+    connections: (body.connections || []).map(([a, b]) => [re(a), re(b)]),
+    layout,
+  };
+  if (body.ports) {
+    out.ports = Object.fromEntries(Object.entries(body.ports).map(([k, v]) => [k, re(v)]));
+  }
+  return out;
+}
+
+export function setParam(body, cname, key, value) {
+  return {
+    ...body,
+    components: body.components.map((c) => {
+      if (c.name !== cname) return c;
+      const params = { ...(c.params || {}) };
+      if (value === undefined) delete params[key];
+      else params[key] = value;
+      return { ...c, params };
+    }),
+  };
+}
+
+// -- values: numbers, expressions, vectors ---------------------------------------------------
+
+/** A parameter value as text in an input: 1.5, "-L1/2" as -L1/2, [0, "-L1", 0] as [0, -L1, 0]. */
+export function formatValue(v) {
+  if (v === undefined || v === null) return "";
+  if (typeof v === "string") return v;
+  if (Array.isArray(v)) return `[${v.map(formatValue).join(", ")}]`;
+  if (typeof v === "number") return formatNumber(v);
+  return JSON.stringify(v);
+}
+
+export function formatNumber(x) {
+  if (!Number.isFinite(x)) return String(x);
+  if (Number.isInteger(x) && Math.abs(x) < 1e15) return String(x);
+  return String(x);
+}
+
+/**
+ * Text typed into a parameter field -> a file value: "" -> undefined (the default), a number,
+ * an expression string, or a (nested) list of those for "[a, b, c]".
+ */
+export function parseValue(text) {
+  const s = String(text).trim();
+  if (s === "") return undefined;
+  if (s.startsWith("[")) {
+    const items = splitList(s);
+    if (items) return items.map(parseValue).map((x) => (x === undefined ? 0 : x));
+  }
+  if (s === "true") return true;
+  if (s === "false") return false;
+  if (/^[-+]?(\d+\.?\d*|\.\d+)([eE][-+]?\d+)?$/.test(s)) return Number(s);
+  return s;
+}
+
+function splitList(s) {
+  if (!s.endsWith("]")) return null;
+  const inner = s.slice(1, -1);
+  const items = [];
+  let depth = 0;
+  let cur = "";
+  for (const ch of inner) {
+    if (ch === "[" || ch === "(") depth++;
+    if (ch === "]" || ch === ")") depth--;
+    if (ch === "," && depth === 0) {
+      items.push(cur);
+      cur = "";
+    } else cur += ch;
+  }
+  if (cur.trim() !== "" || items.length) items.push(cur);
+  return items.map((x) => x.trim());
+}
+
+/** The identifiers an expression (or a nested value) mentions. */
+export function identifiers(value, out = new Set()) {
+  if (typeof value === "string") {
+    for (const m of value.matchAll(/[A-Za-z_][A-Za-z0-9_]*/g)) out.add(m[0]);
+  } else if (Array.isArray(value)) {
+    for (const v of value) identifiers(v, out);
+  }
+  return out;
+}
+
+// -- layout ---------------------------------------------------------------------------------
+
+/**
+ * Positions (layout units) for the components of ``body`` that have none: a layered
+ * layout along the wiring from the grounds (or the first component), placed below what is
+ * already laid out.
+ */
+export function autoLayout(body, only) {
+  const comps = body.components || [];
+  const want = new Set(only || comps.map((c) => c.name));
+  if (!want.size) return {};
+  const adj = new Map(comps.map((c) => [c.name, []]));
+  for (const [a, b] of body.connections || []) {
+    const ca = String(a).split(".")[0];
+    const cb = String(b).split(".")[0];
+    const pa = String(a).split(".")[1] || "";
+    const pb = String(b).split(".")[1] || "";
+    if (!adj.has(ca) || !adj.has(cb)) continue;
+    adj.get(ca).push([cb, pa, pb]);
+    adj.get(cb).push([ca, pb, pa]);
+  }
+  const depth = new Map();
+  const order = [];
+  const roots = comps.filter((c) => /Ground$/.test(c.type)).map((c) => c.name);
+  const visit = (start) => {
+    depth.set(start, depth.has(start) ? depth.get(start) : 0);
+    const queue = [start];
+    while (queue.length) {
+      const n = queue.shift();
+      order.push(n);
+      for (const [m, , pm] of adj.get(n) || []) {
+        if (depth.has(m)) continue;
+        // a body, a probe or a sensor hangs below; a chain goes on to the right
+        const side = /^support|^axis|^port$|^y$|^u/.test(pm) || /^(port)$/.test(pm) ? 0 : 1;
+        depth.set(m, depth.get(n) + side);
+        queue.push(m);
+      }
+    }
+  };
+  for (const r of roots) if (!depth.has(r)) visit(r);
+  for (const c of comps) if (!depth.has(c.name)) visit(c.name);
+  const rows = new Map();
+  const pos = {};
+  let top = 0;
+  for (const [, p] of Object.entries(body.layout || {})) {
+    if (p && typeof p.y === "number") top = Math.max(top, p.y + 100);
+  }
+  for (const n of order) {
+    if (!want.has(n)) continue;
+    const col = depth.get(n);
+    const row = rows.get(col) || 0;
+    rows.set(col, row + 1);
+    pos[n] = { x: col * 130, y: top + row * 90 };
+  }
+  return pos;
+}

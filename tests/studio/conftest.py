@@ -1,0 +1,131 @@
+"""Fixtures of the studio's end-to-end tests: the real server (uvicorn in a thread, on a free
+port, over a copy of the example models) and Debian's Chromium driven by Playwright.
+
+Nothing here is autouse, so the server's own tests (test_server.py) are untouched. The
+fixtures skip, saying why, when Chromium, Playwright, FastAPI/uvicorn or the built front end
+is missing.
+"""
+
+import os
+import pathlib
+import shutil
+import socket
+import threading
+import time
+
+import pytest
+
+REPO = pathlib.Path(__file__).resolve().parents[2]
+CHROMIUM = "/usr/bin/chromium"
+STATIC_INDEX = REPO / "kinetwork" / "studio" / "static" / "index.html"
+E2E_TOKEN = "e2e-token-0123456789abcdef"
+CHROMIUM_ARGS = ["--headless", "--no-sandbox", "--disable-gpu", "--disable-background-networking",
+                 "--disable-component-update", "--disable-sync", "--no-first-run"]
+VIEWPORT = {"width": 1600, "height": 1000}
+
+
+def _why_not():
+    """Why the end-to-end tests cannot run here, or None."""
+    if not os.path.exists(CHROMIUM):
+        return f"{CHROMIUM} is missing (as root: apt-get install -y chromium chromium-driver)"
+    for module, what in (("playwright.sync_api", "playwright"), ("fastapi", "fastapi"),
+                         ("uvicorn", "uvicorn")):
+        try:
+            __import__(module)
+        except ImportError:
+            return f"{what} is not installed (the studio extras: pip install fastapi uvicorn " \
+                   f"playwright)"
+    if not STATIC_INDEX.exists():
+        return "the studio's front end is not built (cd frontend && npm ci && npm run " \
+               "build:studio)"
+    return None
+
+
+class Studio:
+    """A running studio: its folder, address and token."""
+
+    def __init__(self, root, port):
+        self.root, self.port, self.token = root, port, E2E_TOKEN
+        self.base = f"http://127.0.0.1:{port}"
+
+    def url(self, **query):
+        from urllib.parse import urlencode
+        return f"{self.base}/?" + urlencode({"token": self.token, **query})
+
+
+@pytest.fixture
+def studio(tmp_path):
+    """The studio's server over a folder holding a copy of models/ (so saving touches no
+    file of the repository)."""
+    why = _why_not()
+    if why:
+        pytest.skip(why)
+    import uvicorn
+
+    from kinetwork.studio.server import create_app
+
+    shutil.copytree(REPO / "models", tmp_path / "models")
+    sock = socket.socket(socket.AF_INET, socket.SOCK_STREAM)
+    sock.setsockopt(socket.SOL_SOCKET, socket.SO_REUSEADDR, 1)
+    sock.bind(("127.0.0.1", 0))
+    sock.listen(64)
+    port = sock.getsockname()[1]
+    server = uvicorn.Server(uvicorn.Config(create_app(tmp_path, E2E_TOKEN), log_level="warning",
+                                           ws="none", lifespan="on"))
+    thread = threading.Thread(target=server.run, kwargs={"sockets": [sock]}, daemon=True)
+    thread.start()
+    end = time.monotonic() + 30
+    while not server.started and time.monotonic() < end:
+        time.sleep(0.02)
+    assert server.started, "the studio's server did not start"
+    try:
+        yield Studio(tmp_path, port)
+    finally:
+        server.should_exit = True
+        thread.join(30)
+        sock.close()
+
+
+@pytest.fixture(scope="session")
+def browser():
+    """Debian's Chromium, headless, for the whole session."""
+    why = _why_not()
+    if why:
+        pytest.skip(why)
+    from playwright.sync_api import sync_playwright
+
+    with sync_playwright() as p:
+        b = p.chromium.launch(executable_path=CHROMIUM, args=CHROMIUM_ARGS)
+        try:
+            yield b
+        finally:
+            b.close()
+
+
+@pytest.hookimpl(hookwrapper=True)
+def pytest_runtest_makereport(item, call):
+    """Keep each phase's report on the test item, so ``page`` can tell a failure."""
+    outcome = yield
+    setattr(item, f"report_{call.when}", outcome.get_result())
+
+
+@pytest.fixture
+def page(browser, request):
+    """A fresh page (its own context) that records console errors and uncaught exceptions in
+    ``page.errors``; when the test fails, a screenshot goes to $KINETWORK_E2E_SHOTS (if
+    set) to show why."""
+    context = browser.new_context(viewport=VIEWPORT)
+    pg = context.new_page()
+    pg.errors = []
+    pg.on("console", lambda m: m.type == "error" and pg.errors.append(f"console: {m.text}"))
+    pg.on("pageerror", lambda e: pg.errors.append(f"uncaught: {e}"))
+    pg.set_default_timeout(30_000)
+    try:
+        yield pg
+    finally:
+        report = getattr(request.node, "report_call", None)
+        shots = os.environ.get("KINETWORK_E2E_SHOTS")
+        if shots and report is not None and report.failed:
+            os.makedirs(shots, exist_ok=True)
+            pg.screenshot(path=os.path.join(shots, f"{request.node.name}.png"))
+        context.close()

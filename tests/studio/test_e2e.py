@@ -1,0 +1,433 @@
+"""The studio in a browser (headless Chromium driven by Playwright, the real server over a
+copy of models/): build the seed by mouse and run it to kn.simulate's numbers, open and run
+every example, refusals shown where they belong, saves byte for byte, subsystems, the
+editing keys; the screenshots of the docs are taken here too.
+
+Fixtures (server, browser, page) are in conftest.py; they skip when Chromium, Playwright or
+the studio's extras are missing.
+"""
+
+import json
+import os
+import pathlib
+import time
+
+import numpy as np
+import pytest
+
+import kinetwork as kn
+
+REPO = pathlib.Path(__file__).resolve().parents[2]
+SEED = "models/double_pendulum.json"
+MODEL_FILES = sorted(p.relative_to(REPO).as_posix() for p in (REPO / "models").rglob("*.json"))
+IMAGES = REPO / "docs" / "images"
+RUN_TIMEOUT = 240_000          # ms: EngineV6 compiles for ~30 s on a busy 2-core machine
+
+
+# -- helpers -----------------------------------------------------------------------------------
+def tid(name):
+    return f'[data-testid="{name}"]'
+
+
+def K(page, expr):
+    """Evaluate ``expr`` on the studio's testing hook (window.__kinetwork as K)."""
+    return page.evaluate(f"() => {{ const K = window.__kinetwork; return ({expr}); }}")
+
+
+def open_studio(page, studio, **query):
+    """Load the page; the seconds from navigation to the palette being ready."""
+    t0 = time.perf_counter()
+    page.goto(studio.url(**query))
+    page.wait_for_selector(f'{tid("palette")}[data-ready="1"]')
+    return time.perf_counter() - t0
+
+
+def wait_validated(page):
+    """Wait for the debounced validation of the current document to answer."""
+    page.wait_for_function("() => window.__kinetwork.validated")
+
+
+def center(page, selector):
+    box = page.locator(selector).bounding_box()
+    assert box, f"{selector} is not on screen"
+    return box["x"] + box["width"] / 2, box["y"] + box["height"] / 2
+
+
+def place(page, type_, name, x, y):
+    """Drag ``type_`` from the palette onto the canvas, its block's top-left corner at
+    (x, y) of the canvas (screen pixels), and name it ``name`` in the parameter panel."""
+    before = K(page, "K.doc.components.length")
+    page.locator(tid(f"palette-{type_}")).scroll_into_view_if_needed()
+    page.drag_and_drop(tid(f"palette-{type_}"), tid("canvas"),
+                       target_position={"x": x + 58, "y": y + 32})
+    page.wait_for_function(f"() => window.__kinetwork.doc.components.length === {before + 1}")
+    fresh = K(page, "K.doc.components[K.doc.components.length - 1].name")
+    page.wait_for_function(f"() => window.__kinetwork.selection.join() === {json.dumps(fresh)}")
+    if fresh != name:
+        field = page.locator(tid("param-name"))
+        field.fill(name)
+        field.press("Enter")
+    page.wait_for_selector(tid(f"node-{name}"))
+    return fresh
+
+
+def wire(page, a, b):
+    """Drag with the mouse from port ``a`` ("comp.port") to port ``b``."""
+    (ca, pa), (cb, pb) = a.split("."), b.split(".")
+    x1, y1 = center(page, tid(f"handle-{ca}-{pa}"))
+    x2, y2 = center(page, tid(f"handle-{cb}-{pb}"))
+    page.mouse.move(x1, y1)
+    page.mouse.down()
+    page.mouse.move((x1 + x2) / 2, (y1 + y2) / 2 + 7, steps=6)
+    page.mouse.move(x2, y2, steps=6)
+    page.mouse.up()
+
+
+def select(page, name):
+    """Select one block by clicking its name."""
+    page.locator(f'{tid(f"node-{name}")} .kn-block-name').click()
+    page.wait_for_function(f"() => window.__kinetwork.selection.join() === {json.dumps(name)}")
+
+
+def deselect(page):
+    box = page.locator(tid("canvas")).bounding_box()
+    page.mouse.click(box["x"] + box["width"] - 60, box["y"] + 20)
+    page.wait_for_function("() => window.__kinetwork.selection.length === 0")
+
+
+def set_field(page, testid, text):
+    field = page.locator(tid(testid))
+    field.fill(text)
+    field.press("Enter")
+
+
+def open_file(page, path):
+    """Open ``path`` through the Open dialog's file list; wait for its blocks."""
+    page.click(tid("open"))
+    page.click(tid(f"file-{path}"))
+    page.wait_for_selector(tid("open-dialog"), state="detached")
+    page.wait_for_function(f"() => window.__kinetwork.file.path === {json.dumps(path)}")
+    for comp in K(page, "K.doc.components.map(c => c.name)"):
+        page.wait_for_selector(tid(f"node-{comp}"))
+
+
+def run(page, timeout=RUN_TIMEOUT):
+    """Press Run, wait for the run to end; its final state."""
+    n = K(page, "(K.runs || []).length ? K.runs[0].n : 0")
+    page.click(tid("run"))
+    page.wait_for_function(
+        "() => { const s = window.__kinetwork.runState; return s && s.state !== 'running' "
+        "&& s.state !== 'starting'; }", timeout=timeout)
+    state = K(page, "K.runState.state")
+    if state == "done":
+        page.wait_for_function(f"() => window.__kinetwork.runs.length && "
+                               f"window.__kinetwork.runs[0].n > {n}")
+    return state
+
+
+def seed_results():
+    return kn.simulate(kn.load(REPO / SEED), t_end=10.0, n_points=1001, method="auto",
+                       rtol=1e-8, atol=1e-10)
+
+
+def assert_signals_match(run_results, reference, atol=1e-9):
+    t = np.asarray(run_results["t"], dtype=float)
+    np.testing.assert_allclose(t, reference.t, rtol=0, atol=1e-12)
+    names = [s["name"] for s in run_results["signals"]]
+    assert sorted(names) == sorted(f"probe{i}.{q}" for i in (1, 2)
+                                   for q in ("angle", "speed", "acceleration", "torque"))
+    for s in run_results["signals"]:
+        np.testing.assert_allclose(np.asarray(s["values"], dtype=float), reference[s["name"]],
+                                   rtol=0, atol=atol, err_msg=s["name"])
+
+
+# -- 1. the seed, built by mouse -----------------------------------------------------------------
+SEED_LAYOUT = {          # the seed file's layout (x 1.5 on screen), moved into view
+    "ground": (0, 0), "shoulder": (120, 0), "elbow": (360, 0), "link1": (240, 0),
+    "mass1": (240, 70), "mass2": (480, 0), "spring": (120, -80), "probe1": (120, 80),
+    "probe2": (360, 80),
+}
+SEED_TYPES = {
+    "ground": "multibody.Ground", "shoulder": "multibody.Revolute",
+    "elbow": "multibody.Revolute", "link1": "multibody.FixedTranslation",
+    "mass1": "multibody.RigidBody", "mass2": "multibody.RigidBody",
+    "spring": "rotational.SpringDamper", "probe1": "Probe", "probe2": "Probe",
+}
+SEED_PARAMS = {
+    "ground": {"gravity": "[0, -g, 0]"},
+    "shoulder": {"axis": "[0, 0, 1]", "q0": "0.05"},
+    "elbow": {"axis": "[0, 0, 1]", "q0": "0.05"},
+    "link1": {"r": "[0, -L1, 0]"},
+    "mass1": {"mass": "m1", "r_cm": "[0, -L1/2, 0]"},
+    "mass2": {"mass": "m2", "r_cm": "[0, -L2/2, 0]"},
+    "spring": {"c": "c", "d": "d"},
+}
+SEED_WIRES = [
+    ("ground.frame", "shoulder.frame_a"), ("shoulder.frame_b", "mass1.frame_a"),
+    ("shoulder.frame_b", "link1.frame_a"), ("link1.frame_b", "elbow.frame_a"),
+    ("elbow.frame_b", "mass2.frame_a"), ("spring.flange_a", "shoulder.support"),
+    ("spring.flange_b", "shoulder.axis"), ("probe1.port", "shoulder.axis"),
+    ("probe2.port", "elbow.axis"),
+]
+
+
+def build_seed(page):
+    """Build the seed scene on an empty canvas with the mouse and the panels."""
+    for name in SEED_TYPES:                       # the seed file's order
+        x, y = SEED_LAYOUT[name]
+        place(page, SEED_TYPES[name], name, 60 + 1.5 * x, 150 + 1.5 * y)
+    for name, params in SEED_PARAMS.items():
+        select(page, name)
+        for key, text in params.items():
+            set_field(page, f"param-{key}", text)
+    for name in ("probe1", "probe2"):
+        select(page, name)
+        for q in ("angle", "speed", "acceleration", "torque"):
+            page.check(tid(f"param-quantities-{q}"))
+    for i, (a, b) in enumerate(SEED_WIRES):
+        wire(page, a, b)
+        page.wait_for_function(f"() => window.__kinetwork.doc.connections.length === {i + 1}")
+    deselect(page)
+    for key, value in {"L1": "1", "L2": "1", "m1": "1", "m2": "1", "c": "1", "d": "1",
+                       "g": "9.8"}.items():
+        page.fill(tid("mparam-new-name"), key)
+        page.fill(tid("mparam-new-value"), value)
+        page.press(tid("mparam-new-value"), "Enter")
+        page.wait_for_selector(tid(f"mparam-{key}"))
+
+
+def test_build_the_seed_by_mouse_and_run_it_as_kn_simulate(page, studio):
+    open_studio(page, studio)
+    assert K(page, "K.doc.components.length") == 0
+    build_seed(page)
+    doc = K(page, "K.doc")
+    seed = json.loads((REPO / SEED).read_text())
+    assert [c["name"] for c in doc["components"]] == [c["name"] for c in seed["components"]]
+    assert {c["name"]: c["type"] for c in doc["components"]} == \
+        {c["name"]: c["type"] for c in seed["components"]}
+    assert {frozenset(c) for c in doc["connections"]} == \
+        {frozenset(c) for c in seed["connections"]}
+    assert doc["parameters"] == seed["parameters"]
+    assert doc["simulation"] == {k: v for k, v in seed["simulation"].items()}
+    # the model built is the seed: same components, parameters given the same way
+    built = kn.loads(json.dumps(doc))
+    assert {n: c.given for n, c in built.components.items()} == \
+        {n: c.given for n, c in kn.load(REPO / SEED).components.items()}
+    wait_validated(page)
+    assert K(page, "K.validation.ok"), K(page, "K.validation.problems")
+    assert run(page) == "done"
+    reference = seed_results()
+    assert_signals_match(K(page, "K.lastRun"), reference)
+    # what the plots draw is that data: one panel per probe quantity
+    plotted = K(page, "K.plotted")
+    assert sorted(plotted) == sorted(s["name"] for s in K(page, "K.lastRun.signals"))
+    for name, (t, y) in plotted.items():
+        np.testing.assert_allclose(np.asarray(t, float), reference.t, rtol=0, atol=1e-12)
+        np.testing.assert_allclose(np.asarray(y, float), reference[name], rtol=0, atol=1e-9)
+    for quantity in ("angle", "speed", "acceleration", "torque"):   # both probes in each
+        assert page.locator(tid(f"plot-{quantity}")).is_visible()
+    assert not page.errors, page.errors
+
+
+# -- 2. every example: render and run ------------------------------------------------------------
+def test_every_example_model_opens_renders_and_runs(page, studio):
+    open_studio(page, studio)
+    page.click(tid("open"))
+    page.wait_for_selector('[data-testid^="file-"]')
+    listed = [el.get_attribute("data-testid")[len("file-"):]
+              for el in page.locator('[data-testid^="file-"]').all()]
+    page.keyboard.press("Escape")
+    assert listed == MODEL_FILES
+    for path in MODEL_FILES:
+        open_file(page, path)
+        wait_validated(page)
+        assert K(page, "K.validation.ok"), (path, K(page, "K.validation.problems"))
+        data = json.loads((studio.root / path).read_text())
+        state = run(page)
+        if "ports" in data:          # a subsystem definition: placed in a model, it runs
+            assert state == "failed"
+            assert "subsystem definition" in K(page, "K.runState.error")
+            page.wait_for_selector(f'{tid("toast")}:has-text("subsystem definition")')
+        else:
+            assert state == "done", (path, K(page, "K.runState"))
+            assert page.locator('[data-testid^="plot-"]').count() > 0 or \
+                not K(page, "K.lastRun.signals.length")
+        assert not page.errors, (path, page.errors)
+
+
+def test_a_subsystem_opens_to_its_definition_and_back(page, studio):
+    open_studio(page, studio, open="models/robot/arm_axes.json")
+    page.wait_for_selector(tid("node-shoulder_axis"))
+    node = page.locator(tid("node-shoulder_axis"))
+    assert "subsystem" in node.get_attribute("class")
+    for port in ("flange", "reference"):          # the definition's exposed ports
+        assert page.locator(tid(f"handle-shoulder_axis-{port}")).count() == 1
+    node.locator(".kn-block-name").dblclick()
+    page.wait_for_selector(tid("crumb-1"))
+    assert page.locator(tid("crumb-1")).inner_text() == "Axis"
+    for comp in ("motor", "rotor", "gear", "angle", "pid"):
+        page.wait_for_selector(tid(f"node-{comp}"))
+    assert not K(page, "K.dirty")                 # looking changes nothing
+    page.click(tid("crumb-0"))
+    page.wait_for_selector(tid("node-shoulder_axis"))
+    assert not page.errors, page.errors
+
+
+def test_make_subsystem_runs_as_the_flat_model(page, studio):
+    open_studio(page, studio, open=SEED)
+    page.wait_for_selector(tid("node-elbow"))
+    select(page, "link1")
+    for name in ("elbow", "mass2"):
+        page.locator(f'{tid(f"node-{name}")} .kn-block-name').click(modifiers=["Control"])
+    page.wait_for_function("() => window.__kinetwork.selection.length === 3")
+    page.click(tid("make-subsystem"))
+    set_field(page, "subsystem-name", "Forearm")
+    page.wait_for_selector(tid("node-forearm1"))
+    doc = K(page, "K.doc")
+    assert doc["version"] == 2
+    definition = doc["definitions"]["Forearm"]
+    assert sorted(c["name"] for c in definition["components"]) == ["elbow", "link1", "mass2"]
+    assert set(definition["ports"]) == {"link1_frame_a", "elbow_axis"}
+    assert {frozenset(c) for c in doc["connections"]} >= {
+        frozenset(("shoulder.frame_b", "forearm1.link1_frame_a")),
+        frozenset(("probe2.port", "forearm1.elbow_axis"))}
+    wait_validated(page)
+    assert K(page, "K.validation.ok"), K(page, "K.validation.problems")
+    assert run(page) == "done"
+    assert_signals_match(K(page, "K.lastRun"), seed_results(), atol=1e-8)
+    # undo gives the flat model back
+    page.keyboard.press("Control+z")
+    page.wait_for_selector(tid("node-elbow"))
+    assert "definitions" not in K(page, "K.doc")
+    assert not page.errors, page.errors
+
+
+def test_editing_keys_copy_paste_delete_undo_redo(page, studio):
+    open_studio(page, studio, open=SEED)
+    page.wait_for_selector(tid("node-mass2"))
+    select(page, "mass2")
+    page.keyboard.press("Control+c")
+    page.keyboard.press("Control+v")
+    page.wait_for_selector(tid("node-mass3"))
+    assert K(page, "K.doc.components.find(c => c.name === 'mass3').params") == \
+        {"mass": "m2", "r_cm": [0, "-L2/2", 0]}
+    page.keyboard.press("Delete")
+    page.wait_for_selector(tid("node-mass3"), state="detached")
+    page.keyboard.press("Control+z")
+    page.wait_for_selector(tid("node-mass3"))
+    page.keyboard.press("Control+z")
+    page.wait_for_selector(tid("node-mass3"), state="detached")
+    assert not K(page, "K.dirty")
+    page.keyboard.press("Control+y")
+    page.wait_for_selector(tid("node-mass3"))
+    # a box drawn around blocks selects them; Delete removes them and their wires
+    deselect(page)
+    box = page.locator(tid("node-probe1")).bounding_box()
+    page.mouse.move(box["x"] - 15, box["y"] - 15)
+    page.mouse.down()
+    page.mouse.move(box["x"] + box["width"] + 15, box["y"] + box["height"] + 15, steps=8)
+    page.mouse.up()
+    page.wait_for_function("() => window.__kinetwork.selection.join() === 'probe1'")
+    page.keyboard.press("Delete")
+    page.wait_for_selector(tid("node-probe1"), state="detached")
+    assert not any("probe1" in a or "probe1" in b for a, b in K(page, "K.doc.connections"))
+    assert not page.errors, page.errors
+
+
+# -- 3. refusals on the spot and on their block ------------------------------------------------------
+def test_a_wrong_wire_and_a_bad_parameter_show_their_message(page, studio):
+    open_studio(page, studio, open=SEED)
+    page.wait_for_selector(tid("node-link1"))
+    before = K(page, "K.doc.connections.length")
+    wire(page, "shoulder.axis", "link1.frame_a")
+    toast = page.locator(tid("toast")).filter(has_text="cannot connect")
+    toast.wait_for()
+    assert "cannot connect shoulder.axis (rotational) to link1.frame_a (frame)" in \
+        toast.inner_text()
+    assert K(page, "K.doc.connections.length") == before
+    select(page, "mass1")
+    set_field(page, "param-mass", "-1")
+    message = page.locator(tid("node-msg-mass1"))
+    message.wait_for()
+    assert "mass" in message.inner_text() and ">= 0" in message.inner_text()
+    assert "bad" in page.locator(tid("node-mass1")).get_attribute("class")
+    problems = page.locator(tid("problems"))
+    assert "mass1" in problems.inner_text() and ">= 0" in problems.inner_text()
+    assert "bad" not in page.locator(tid("node-mass2")).get_attribute("class")
+    # fixed: the message goes
+    set_field(page, "param-mass", "m1")
+    message.wait_for(state="detached")
+    assert not page.errors, page.errors
+
+
+# -- 4. files: saved byte for byte ---------------------------------------------------------------------
+def test_save_and_reload_are_byte_identical(page, studio):
+    original = (studio.root / SEED).read_bytes()
+    open_studio(page, studio)
+    open_file(page, SEED)
+    page.click(tid("save"))
+    page.wait_for_function("() => window.__kinetwork.lastSave")
+    assert K(page, "K.lastSave.unchanged")
+    assert (studio.root / SEED).read_bytes() == original
+    page.reload()
+    page.wait_for_selector(tid("node-mass1"))          # reopened from the URL (&open=...)
+    assert K(page, "K.file.path") == SEED
+    page.evaluate("() => { window.__kinetwork.lastSave = null; }")
+    page.keyboard.press("Control+s")
+    page.wait_for_function("() => window.__kinetwork.lastSave")
+    assert (studio.root / SEED).read_bytes() == original
+    # a change is saved canonically, and read back as it was made
+    select(page, "spring")
+    set_field(page, "param-c", "2.5")
+    page.evaluate("() => { window.__kinetwork.lastSave = null; }")
+    page.click(tid("save-as"))
+    set_field(page, "save-path", "models/changed.json")
+    page.wait_for_function("() => window.__kinetwork.lastSave")
+    changed = (studio.root / "models" / "changed.json").read_bytes()
+    model = kn.load(studio.root / "models" / "changed.json")
+    assert model.components["spring"].given == {"c": 2.5, "d": "d"}
+    assert model.layout == json.loads(original)["layout"]
+    page.goto(studio.url(open="models/changed.json"))
+    page.wait_for_selector(tid("node-spring"))
+    page.click(tid("save"))
+    page.wait_for_function("() => window.__kinetwork.lastSave && "
+                           "window.__kinetwork.lastSave.unchanged")
+    assert (studio.root / "models" / "changed.json").read_bytes() == changed
+    assert not page.errors, page.errors
+
+
+def test_a_model_without_layout_is_laid_out_and_saved_with_it(page, studio):
+    open_studio(page, studio, open="models/fourbar.json")
+    names = K(page, "K.doc.components.map(c => c.name)")
+    boxes = [page.locator(tid(f"node-{n}")).bounding_box() for n in names]
+    for i, a in enumerate(boxes):                   # no two blocks on top of each other
+        for b in boxes[:i]:
+            assert abs(a["x"] - b["x"]) > 20 or abs(a["y"] - b["y"]) > 20
+    assert not K(page, "K.dirty")
+    select(page, names[0])
+    page.locator(tid(f"node-{names[0]}")).hover()
+    page.mouse.down()
+    page.mouse.move(*[c + 45 for c in center(page, tid(f"node-{names[0]}"))], steps=5)
+    page.mouse.up()
+    page.wait_for_function("() => window.__kinetwork.dirty")
+    page.click(tid("save"))
+    page.wait_for_function("() => window.__kinetwork.lastSave")
+    saved = json.loads((studio.root / "models" / "fourbar.json").read_text())
+    assert set(saved["layout"]) == set(names)
+    assert not page.errors, page.errors
+
+
+# -- 5. screenshots and measurements -------------------------------------------------------------------
+def test_screenshot_of_the_seed_with_plots_and_3d_view(page, studio):
+    load = open_studio(page, studio, open=SEED)
+    page.wait_for_selector(tid("node-probe2"))
+    wait_validated(page)
+    assert run(page) == "done"
+    page.wait_for_selector(f'{tid("viewer")}[data-ready="1"]')
+    page.evaluate("() => window.__kinetwork.setTime(2.6)")
+    page.wait_for_timeout(600)
+    IMAGES.mkdir(parents=True, exist_ok=True)
+    page.screenshot(path=str(IMAGES / "studio.png"))
+    print(f"\nstudio load (navigation to palette ready): {load:.2f} s; Run to plotted "
+          f"results: {K(page, 'K.timings.runToPlot'):.2f} s")
+    assert not page.errors, page.errors
