@@ -101,8 +101,9 @@ class UniversalSpherical(PartialRod, library=MB):
     def check_values(self, values, place):
         n, r = (np.asarray(values[k], dtype=float) for k in ("n_a", "r_rod"))
         if np.linalg.norm(np.cross(n, r)) <= 1e-9 * np.linalg.norm(n) * np.linalg.norm(r):
-            return [f"{place('n_a')} = {list(n)}: lies along the rod r_rod = {list(r)}, where "
-                    f"the universal joint is singular; choose an axis normal to the rod"]
+            return [f"{place('n_a')} = {n.tolist()}: lies along the rod r_rod = "
+                    f"{r.tolist()} m, where the universal joint is singular; choose an axis "
+                    f"normal to the rod"]
         return []
 
 
