@@ -131,6 +131,31 @@ def test_the_rod_force_is_along_the_rod_and_balances_the_rocker():
     np.testing.assert_allclose(J_D * psidd, moment, atol=1e-9 * scale)
 
 
+def test_a_pressed_rod_reads_a_positive_rod_force():
+    """A 2 kg bob on a horizontal arm propped from below by a rod: a structure (no degree of
+    freedom left) whose rod carries the weight, f_rod = -force . e = m g (MSL's sign:
+    positive when the rod is pressed)."""
+    m = kn.Model("prop")
+    m.add(mb.Ground("ground"))
+    m.add(mb.Revolute("A"))
+    m.add(mb.FixedTranslation("arm", r=[1, 0, 0]))
+    m.add(mb.RigidBody("bob", mass=2.0, r_cm=[1, 0, 0]))
+    m.add(mb.FixedTranslation("foot", r=[1, -1, 0]))
+    m.add(mb.SphericalSpherical("prop", length=1.0))
+    m.add(kn.Probe("p", quantities=["force"]))
+    for a, b in [("ground.frame", "A.frame_a"), ("A.frame_b", "arm.frame_a"),
+                 ("A.frame_b", "bob.frame_a"), ("ground.frame", "foot.frame_a"),
+                 ("foot.frame_b", "prop.frame_a"), ("prop.frame_b", "arm.frame_b"),
+                 ("p.port", "prop.frame_b")]:
+        m.connect(a, b)
+    system = m.compile()
+    assert system.state_names == [] and system.algebraic_names == ["A.q"]
+    force = kn.simulate(system, t_end=1.0, n_points=11)["p.force"]
+    e = np.array([0.0, 1.0, 0.0])                     # from the foot (frame_a) up to the arm
+    np.testing.assert_allclose(-force @ e, 2.0 * 9.81, rtol=1e-12)
+    np.testing.assert_allclose(force[:, [0, 2]], 0, atol=1e-12)
+
+
 def rot(n, angle):
     """Rodrigues' rotation by ``angle`` about ``n`` (numpy)."""
     n = np.asarray(n, dtype=float) / np.linalg.norm(n)
