@@ -5,7 +5,13 @@ parameters with its own names and units (``rel0`` is ``phi_rel0`` in rotational 
 ``s_rel0`` in translational). Flows are positive into the component, as in Modelica.
 """
 
+import math
+
 from .base import ONED, Component, Port
+
+#: Modelica's second-order Bessel filter of a position source (Rotational.Sources.Position):
+#: the coefficients af, bf of phi_ref / (1 + af s / w_crit + bf s^2 / w_crit^2)
+BESSEL = (1.3617, 0.6180)
 
 
 class PartialCompliant(Component):
@@ -117,11 +123,53 @@ class PartialFlowSensor(PartialRigid):
 
 
 class PartialMotion(Component):
-    """Prescribes the motion of its flange as a function of time (the reaction, through
-    the optional support, rests in the world): ``reference`` is the ``derivative``-th time
-    derivative of the flange's position (0: the position, 1: the speed, integrated from
-    ``position0``)."""
+    """Prescribes the motion of its flange: ``reference`` (or the signal at ``u``, when wired)
+    is the ``derivative``-th time derivative of the flange's position (0: the position, 1: the
+    speed, 2: the acceleration), as Modelica's Position, Speed and Accelerate.
+
+    The flange follows it rigidly, whatever it drives: a rotor, or a joint's axis (then the
+    joint's coordinate is a known function of time and the torque the motion needs is its
+    flow). With ``exact`` the reference is differentiated exactly (CasADi's derivatives of
+    its expression and of the signal blocks feeding it); otherwise it is filtered, with the
+    filter's states giving the position, speed and acceleration: Modelica's second-order
+    Bessel filter of cut-off ``f_crit`` for a position, first-order for a speed. The
+    reaction, through the optional support, rests in the world.
+    """
     role = "prescribed"
     derivative = 0
+    exact = True
     flange = Port(ONED, "Flange moved")
     support = Port(ONED, "Reaction flange (unwired: the world)", optional=True)
+    u = Port("signal_in", "Reference signal (instead of the parameter)", optional=True)
+
+    @property
+    def n_states(self):
+        """States of the motion: its position (and speed), integrated or filtered."""
+        return self.derivative if self.exact else 2
+
+    def motion(self, r, x, der):
+        """(position, speed, acceleration, rates of the states ``x``) for the reference
+        ``r``; ``der(e)`` is the exact time derivative of an expression."""
+        if self.exact:
+            chain = [*x, r]              # Position [r], Speed [phi, r], Accelerate [phi, w, r]
+            while len(chain) < 3:
+                chain.append(der(chain[-1]))
+            pos, vel, acc = chain
+            return pos, vel, acc, [vel, acc][:len(x)]
+        pos, vel = x
+        w_crit = 2 * math.pi * self.f_crit
+        if self.derivative == 0:
+            af, bf = BESSEL
+            acc = ((r - pos) * w_crit - af * vel) * w_crit / bf
+        else:
+            acc = (r - vel) * w_crit
+        return pos, vel, acc, [vel, acc]
+
+    def initial(self, r0):
+        """Initial values of the states, ``r0`` the reference at the start: a filter starts
+        at rest on the reference (a Position) or at its speed (a Speed)."""
+        if self.exact and self.derivative == 0:
+            return []
+        if self.exact:
+            return [self.position0, self.speed0] if self.derivative == 2 else [self.position0]
+        return [r0, 0.0] if self.derivative == 0 else [self.position0, r0]

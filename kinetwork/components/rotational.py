@@ -83,17 +83,36 @@ class TorqueSensor(PartialFlowSensor, library=LIB):
 
 
 class Position(PartialMotion, library=LIB):
-    """Moves its flange to phi_ref(t), an expression in time and model parameters."""
+    """Moves its flange to phi_ref: an expression in time and model parameters, or the signal at
+    u; exact (differentiated exactly) or filtered (second-order Bessel filter, f_crit)."""
     domain = LIB
-    reference = Param(unit="rad", time=True, name="phi_ref", doc="Prescribed angle")
+    reference = Param(None, optional=True, unit="rad", time=True, name="phi_ref",
+                      doc="Prescribed angle (when u is not wired)")
+    exact = Param(True, kind="bool", doc="Differentiate the reference exactly (else filter it)")
+    f_crit = Param(50.0, unit="Hz", positive=True, doc="Cut-off frequency of the filter")
 
 
 class Speed(PartialMotion, library=LIB):
-    """Moves its flange at w_ref(t) from phi0 (the angle is integrated)."""
+    """Moves its flange at w_ref (an expression in time and model parameters, or the signal
+    at u) from phi0: the angle is integrated; exact or filtered (first order, f_crit)."""
     domain = LIB
     derivative = 1
-    reference = Param(unit="rad/s", time=True, name="w_ref", doc="Prescribed speed")
+    reference = Param(None, optional=True, unit="rad/s", time=True, name="w_ref",
+                      doc="Prescribed speed (when u is not wired)")
+    exact = Param(True, kind="bool", doc="Differentiate the reference exactly (else filter it)")
+    f_crit = Param(50.0, unit="Hz", positive=True, doc="Cut-off frequency of the filter")
     position0 = Param(0.0, unit="rad", name="phi0", doc="Initial angle")
+
+
+class Accelerate(PartialMotion, library=LIB):
+    """Moves its flange with acceleration a_ref (an expression in time and model parameters,
+    or the signal at u) from phi0 at w0: speed and angle are integrated."""
+    domain = LIB
+    derivative = 2
+    reference = Param(None, optional=True, unit="rad/s^2", time=True, name="a_ref",
+                      doc="Prescribed acceleration (when u is not wired)")
+    position0 = Param(0.0, unit="rad", name="phi0", doc="Initial angle")
+    speed0 = Param(0.0, unit="rad/s", name="w0", doc="Initial speed")
 
 
 class IdealGear(PartialRigid, library=LIB):

@@ -83,14 +83,33 @@ class ForceSensor(PartialFlowSensor, library=LIB):
 
 
 class Position(PartialMotion, library=LIB):
-    """Moves its flange to s_ref(t), an expression in time and model parameters."""
+    """Moves its flange to s_ref: an expression in time and model parameters, or the signal at
+    u; exact (differentiated exactly) or filtered (second-order Bessel filter, f_crit)."""
     domain = LIB
-    reference = Param(unit="m", time=True, name="s_ref", doc="Prescribed position")
+    reference = Param(None, optional=True, unit="m", time=True, name="s_ref",
+                      doc="Prescribed position (when u is not wired)")
+    exact = Param(True, kind="bool", doc="Differentiate the reference exactly (else filter it)")
+    f_crit = Param(50.0, unit="Hz", positive=True, doc="Cut-off frequency of the filter")
 
 
 class Speed(PartialMotion, library=LIB):
-    """Moves its flange at v_ref(t) from s0 (the position is integrated)."""
+    """Moves its flange at v_ref (an expression in time and model parameters, or the signal
+    at u) from s0: the position is integrated; exact or filtered (first order, f_crit)."""
     domain = LIB
     derivative = 1
-    reference = Param(unit="m/s", time=True, name="v_ref", doc="Prescribed speed")
+    reference = Param(None, optional=True, unit="m/s", time=True, name="v_ref",
+                      doc="Prescribed speed (when u is not wired)")
+    exact = Param(True, kind="bool", doc="Differentiate the reference exactly (else filter it)")
+    f_crit = Param(50.0, unit="Hz", positive=True, doc="Cut-off frequency of the filter")
     position0 = Param(0.0, unit="m", name="s0", doc="Initial position")
+
+
+class Accelerate(PartialMotion, library=LIB):
+    """Moves its flange with acceleration a_ref (an expression in time and model parameters,
+    or the signal at u) from s0 at v0: speed and position are integrated."""
+    domain = LIB
+    derivative = 2
+    reference = Param(None, optional=True, unit="m/s^2", time=True, name="a_ref",
+                      doc="Prescribed acceleration (when u is not wired)")
+    position0 = Param(0.0, unit="m", name="s0", doc="Initial position")
+    speed0 = Param(0.0, unit="m/s", name="v0", doc="Initial speed")

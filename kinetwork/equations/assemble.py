@@ -10,7 +10,9 @@ become output expressions.
 from dataclasses import dataclass, field
 
 import casadi as ca
+import numpy as np
 
+from ..errors import ModelError
 from ..expr import casadi_functions, parse
 from ..spatial import line_length, vec3, vee
 from . import network
@@ -53,12 +55,15 @@ class Assembly:
     place: dict = field(default_factory=dict)     # frame set -> (body, R, p) in the body
     cuts: list = field(default_factory=list)      # (Cut, residual SX in q)
     signals: list = field(default_factory=list)   # Signal descriptors, in (t, q, u, udot, lam, p)
-    lam: ca.SX = None          # symbol: the loops' multipliers (one per closure row)
+    lam: ca.SX = None          # symbol: the loops' multipliers (one per closure row), then
+    #                            the drives of the prescribed joints (one per prescribed speed)
     armature: ca.SX = None     # 1-D inertia geared rigidly to each speed
     net: object = None         # the 1-D network and signal blocks (network.Network)
     qindex: dict = None        # joint name -> indices of its coordinates in q
     uindex: dict = None        # joint name -> indices of its speeds in u
     Q_drive: ca.SX = None      # the part of Q that 1-D flanges apply (drives, springs)
+    #: speed index -> network.Prescribed: joint coordinates that motion sources give
+    prescribed: dict = field(default_factory=dict)
     _poses: dict = field(default_factory=dict)
     base: tuple = None         # world pose of the body of the last ``relative_poses``
 
@@ -187,6 +192,9 @@ def assemble(model, topo, values):
         given += [v is not None for v in q0]
         u_start += [0 if v is None else v for v in u0]
         u_given += [v is not None for v in u0]
+    if net.prescribed:
+        starts, u_start = _prescribed_starts(model, net, t, q, u, starts, u_start, given,
+                                             u_given, p, [values[k] for k in names])
     asm = Assembly(t, q, u, p, names, coord_names, coord_units, speed_names, speed_units,
                    bodies, ca.vertcat(*starts) if starts else ca.SX(0, 1),
                    ca.vertcat(*u_start) if u_start else ca.SX(0, 1), given, u_given, regular,
@@ -198,10 +206,58 @@ def assemble(model, topo, values):
     asm.cuts = [(cut, _closure(asm, cut, bound[cut.component.name], qindex))
                 for cut in topo.cuts]
     _place_cut_frames(asm, topo, bound)
-    asm.lam = ca.SX.sym("lambda", sum(r.shape[0] for _, r in asm.cuts))
+    asm.prescribed = dict(sorted(net.prescribed.items()))
+    asm.lam = ca.vertcat(ca.SX.sym("lambda", sum(r.shape[0] for _, r in asm.cuts)),
+                         *[m.drive for m in asm.prescribed.values()])
     asm.qindex, asm.uindex, asm.Q_drive = qindex, uindex, net.axis_flow
     asm.signals = probe_signals(asm, topo, net, bound, model)
     return asm
+
+
+def _prescribed_starts(model, net, t, q, u, starts, u_start, given, u_given, p, p_values):
+    """Initial coordinates and speeds with those of prescribed joints from their motions
+    (at t = 0), and the network's initial states as expressions in the parameters alone (a
+    filter starts on its reference, which may read the mechanism's initial state).
+
+    A joint's own q0 or qd0 that contradicts its motion is refused: the motion decides."""
+    held = []                  # (joint, label, what, the joint's value, index in values)
+    nq = len(starts)
+    for speed, m in net.prescribed.items():
+        for flag, i, label, what, value in (
+                (given, m.coordinate, "q0", "coordinate", starts[m.coordinate]),
+                (u_given, speed, "qd0", "speed", u_start[speed])):
+            if flag[i]:
+                held.append((m, label, what, value, i + (0 if label == "q0" else nq)))
+            flag[i] = True
+        starts[m.coordinate], u_start[speed] = m.pos, m.vel
+    unknown = ca.vertcat(q, u, *net.x)
+    values = ca.substitute(ca.vertcat(*[ca.SX(v) for v in [*starts, *u_start, *net.start]]),
+                           t, ca.SX(0))
+    for _ in range(unknown.shape[0] + 1):
+        if not ca.depends_on(values, unknown):
+            break
+        values = ca.substitute(values, unknown, values)
+    if ca.depends_on(values, unknown) or any(not ca.depends_on(p, v)
+                                             for v in ca.symvar(values)):
+        names = ", ".join(m.source for m in net.prescribed.values())
+        raise ModelError(f"the initial state of the prescribed motion(s) {names} is not "
+                         f"determined: their reference at t = 0 depends on itself (or on an "
+                         f"algebraic loop); give it in time, or filter a reference that does "
+                         f"not read the joint it moves")
+    nu = len(u_start)
+    numbers = np.asarray(ca.Function("starts", [p], [values])(p_values), dtype=float).ravel()
+    problems = []
+    for m, label, what, value, k in held:
+        mine = float(ca.Function("held", [p], [ca.SX(value)])(p_values))
+        if abs(mine - numbers[k]) > 1e-9 * (1 + abs(numbers[k])):
+            joint = model.components[m.joint]
+            problems.append(f"{model.place(joint, label)} = {mine:.12g}: {joint.name} is "
+                            f"moved by {m.source}, which gives its {what} at t = 0 as "
+                            f"{numbers[k]:.12g}: leave {label} unset (the motion decides)")
+    if problems:
+        raise ModelError(problems)
+    net.start = ca.vertsplit(values[nq + nu:])
+    return ca.vertsplit(values[:nq]), ca.vertsplit(values[nq:nq + nu])
 
 
 def _symbols(names, suffix):

@@ -29,6 +29,22 @@ loops has more coordinates than degrees of freedom; three formulations are offer
     level with Baumgarte stabilisation J udot + (dJ/dt) u + 2 a J u + a^2 Phi = 0. Any ODE
     method integrates it, but it has more states and the residual is only kept small, not
     zero; it is there to compare with.
+
+Prescribed joints (a Position, Speed or Accelerate source on a joint's axis: a rheonomic
+constraint q_P = phi(t)) are eliminated, not constrained: their coordinates, speeds and
+accelerations are known functions of time (and of the sources' filter states), so they are
+no states. A tree becomes Featherstone's hybrid dynamics (``hybrid``): the articulated-body
+algorithm with the prescribed accelerations given, M_ff udot_f = Q_f - M_fp udot_p - h_f in
+O(n), and the drives by inverse dynamics, tau_p = [M udot + h - Q]_p. With loops the
+prescribed speeds are neither independent nor dependent: u = T u_I + s(t), udot = T udot_I +
+g with the prescribed motion in s and g, and the multipliers and the drives together solve
+J^T lam + E_P tau_p = M udot + h - Q. The drives stand in the network for the sources'
+torques (``Assembly.lam`` after the multipliers), so probes, sensors and cut forces read them.
+Where a loop's closure then depends on time explicitly (an exact Position in a loop), time
+becomes a state (``time``, rate 1): the closure, its Jacobian and the polish of the outputs
+are functions of the states alone, and a mechanism left with no degree of freedom (a
+four-bar whose crank is driven) is still integrated by IDAS, which solves its other joints
+at every step.
 """
 
 from dataclasses import dataclass
@@ -38,7 +54,7 @@ import numpy as np
 import scipy.linalg
 
 from ..errors import ModelError
-from .newton_euler import crba, rnea
+from .newton_euler import aba, crba, rnea
 
 FORMULATIONS = ("partition", "projected", "baumgarte")
 #: Newton steps of the projected formulation (from a start within the integrator's tolerance
@@ -82,6 +98,8 @@ class Equations:
     #: regular; where it turns singular the mechanism folds flat or locks
     dependent_jacobian: ca.SX = None
     dependent_names: list = None    # the dependent speeds, by name
+    prescribed: int = 0             # joint speeds a motion source gives (no states)
+    clock: int = None               # index of the state ``time``, when there is one
 
 
 def formulate(asm, topo, values, formulation="partition", rate=BAUMGARTE_RATE):
@@ -96,8 +114,8 @@ def formulate(asm, topo, values, formulation="partition", rate=BAUMGARTE_RATE):
     q = asm.q if eq.q is None else eq.q
 
     def in_states(exprs):
-        return ca.substitute(ca.vertcat(*exprs), ca.vertcat(asm.q, asm.u, asm.udot),
-                             ca.densify(ca.vertcat(q, eq.u, eq.udot)))
+        return ca.substitute(ca.vertcat(*exprs), ca.vertcat(asm.q, asm.u, asm.udot, asm.lam),
+                             ca.densify(ca.vertcat(q, eq.u, eq.udot, eq.lam)))
     z_mech = eq.z
     eq.x, eq.ode = ca.vertcat(eq.x, *net.x), ca.vertcat(eq.ode, in_states(net.rate))
     eq.state_names = eq.state_names + net.names
@@ -142,6 +160,8 @@ def _mechanism(asm, topo, values, formulation, rate):
     names = asm.coordinate_names + asm.speed_names
     units = asm.coordinate_units + asm.speed_units
     given = np.array(asm.given, dtype=bool)
+    if not asm.cuts and asm.prescribed:
+        return _hybrid(asm, given)
     if not asm.cuts:
         start = asm.start_function()
 
@@ -155,7 +175,85 @@ def _mechanism(asm, topo, values, formulation, rate):
         return Equations(ca.vertcat(q, u), ca.SX(0, 1), ca.vertcat(asm.qdot, asm.udot_tree),
                          ca.SX(0, 1), names, units, [], [], u, asm.udot_tree, "tree", note,
                          initial=initial, lam=ca.SX(0, 1))
-    return _Loops(asm, topo, values).equations(formulation, rate)
+    eq = _Loops(asm, topo, values).equations(formulation, rate)
+    return _prescribe(asm, eq, loops=True) if asm.prescribed else eq
+
+
+def _hybrid(asm, given):
+    """A tree with prescribed joints: Featherstone's hybrid dynamics (the articulated-body
+    algorithm with the prescribed accelerations given), the drives by inverse dynamics."""
+    q, u = asm.q, asm.u
+    P = list(asm.prescribed)
+    Pq = {m.coordinate for m in asm.prescribed.values()}
+    keep_q = [k for k in range(q.shape[0]) if k not in Pq]
+    ind = [k for k in range(u.shape[0]) if k not in set(P)]
+    a_grav = ca.vertcat(ca.SX.zeros(3), -asm.gravity)
+    acc = {s: m.acc for s, m in asm.prescribed.items()}
+    extra = getattr(asm, "applied", None)
+    if extra is not None and extra.masses:
+        # point masses of force elements are no bodies of the tree: the mass matrix they
+        # add is dense, so the free speeds are solved from it, M_ff udot_f = -(h + M_fp a_p)_f
+        M = asm.mass_matrix()
+        bias = rnea(asm.bodies, u, ca.SX.zeros(u.shape[0]), a_grav) - asm.Q
+        udot = ca.SX.zeros(u.shape[0])
+        udot[P] = ca.vertcat(*acc.values())
+        if ind:
+            udot[ind] = ca.solve(M[ind, ind], -(bias + M @ udot)[ind])
+        drive = (M @ udot + bias)[P]
+    else:
+        udot = aba(asm.bodies, u, asm.Q, a_grav, asm.armature, acc)
+        drive = (rnea(asm.bodies, u, udot, a_grav, asm.armature) - asm.Q)[P]
+    start = asm.start_function()
+
+    def initial(p):
+        q0, u0 = (np.asarray(v, dtype=float).ravel() for v in start(p))
+        return np.concatenate([np.where(given, q0, 0.0)[keep_q], u0[ind]]), np.zeros(0)
+    names = [asm.coordinate_names[k] for k in keep_q] + [asm.speed_names[k] for k in ind]
+    units = [asm.coordinate_units[k] for k in keep_q] + [asm.speed_units[k] for k in ind]
+    eq = Equations(ca.vertcat(_rows(q, keep_q), _rows(u, ind)), ca.SX(0, 1),
+                   ca.vertcat(_rows(asm.qdot, keep_q), _rows(udot, ind)), ca.SX(0, 1), names,
+                   units, [], [], u, udot, "hybrid",
+                   "hybrid dynamics (the articulated-body algorithm with the prescribed "
+                   "accelerations given)", initial=initial, lam=drive)
+    return _prescribe(asm, eq, loops=False)
+
+
+def _prescribe(asm, eq, loops):
+    """The prescribed coordinates and speeds put in the formulation's equations as the
+    motions give them; with a loop whose closure then reads time, time as a state."""
+    recs = list(asm.prescribed.values())
+    known = ca.vertcat(*[asm.q[m.coordinate] for m in recs], asm.u[list(asm.prescribed)])
+    pos = ca.vertcat(*[m.pos for m in recs])
+    vel = ca.vertcat(*[m.vel for m in recs])
+    clock = None
+    if loops and ca.depends_on(ca.substitute(eq.residual, known[:len(recs)], pos), asm.t):
+        clock = ca.SX.sym("time")
+        pos = ca.substitute(pos, asm.t, clock)
+
+    def sub(e):
+        return None if e is None else ca.substitute(e, known, ca.vertcat(pos, vel))
+    eq.ode, eq.alg, eq.u, eq.udot = sub(eq.ode), sub(eq.alg), sub(eq.u), sub(eq.udot)
+    eq.q = sub(asm.q if eq.q is None else eq.q)
+    eq.residual, eq.dependent_jacobian = sub(eq.residual), sub(eq.dependent_jacobian)
+    lam = eq.lam if eq.lam is not None else ca.SX(0, 1)
+    eq.lam = sub(lam)
+    eq.prescribed = len(recs)
+    which = ", ".join(f"{m.joint} by {m.source}" for m in recs)
+    eq.note = (f"{len(recs)} joint coordinate(s) prescribed ({which}): known functions of "
+               f"time, not states; " + eq.note)
+    if clock is not None:
+        eq.clock = eq.x.shape[0]
+        eq.x, eq.ode = ca.vertcat(eq.x, clock), ca.vertcat(eq.ode, 1)
+        eq.state_names, eq.state_units = eq.state_names + ["time"], eq.state_units + ["s"]
+        mechanism = eq.initial
+
+        def initial(p):
+            x0, z0 = mechanism(p)
+            return np.concatenate([x0, [0.0]]), z0
+        eq.initial = initial
+        eq.note += ("; time is a state (rate 1, from 0 at the start) because the loop "
+                    "closure follows the prescribed angle in time")
+    return eq
 
 
 class _Loops:
@@ -335,6 +433,8 @@ class _Loops:
             if not asm.regular[k]:
                 continue
             speed = asm.speed_of[k]
+            if speed in asm.prescribed:      # its motion is given: neither kind
+                continue
             if asm.given[k] or asm.u_given[speed]:
                 tiers[2].append(speed)
             elif names[k].rsplit(".", 1)[0] in cut_joints:
@@ -361,12 +461,17 @@ class _Loops:
             quaternion = sorted({n.rsplit(".", 1)[0] for k, n in enumerate(names)
                                  if k in loop_coords and not asm.regular[k]})
             loops = "; ".join(", ".join(c.loop) for c, _ in asm.cuts)
+            driven = sorted({f"{m.joint} (by {m.source})" for m in asm.prescribed.values()
+                             if m.coordinate in loop_coords})
             raise ModelError(
                 f"kinematic loop through {loops}: its closure fixes {rank} speeds but only "
                 f"{len(dep)} joint angles or distances on the loop can follow it"
                 + (f"; the ball or free joint(s) {', '.join(quaternion)} on the loop must be "
                    f"the cut joint (mark one cut=True), or be replaced by a Universal joint"
-                   if quaternion else ""))
+                   if quaternion else "")
+                + (f"; the prescribed joint(s) {', '.join(driven)} cannot follow it: "
+                   f"their motions fight each other through the loop (drive fewer joints)"
+                   if driven else ""))
         return rows, sorted(dep)
 
     # -- the equations --------------------------------------------------------------------------
@@ -406,32 +511,54 @@ class _Loops:
         q, u = asm.q, asm.u
         nv = u.shape[0]
         dep = self.dep
-        ind = [k for k in range(nv) if k not in set(dep)]
+        # prescribed speeds P are neither independent nor dependent: their motion is given
+        P = list(asm.prescribed)
+        ind = [k for k in range(nv) if k not in set(dep) | set(P)]
         phi = _rows(self.phi, self.rows)
         J = _rows(self.J, self.rows)
-        JD, JI = _cols(J, dep), _cols(J, ind)
+        JD, JI, JP = _cols(J, dep), _cols(J, ind), _cols(J, P)
         self.JD = JD
         T = ca.SX.zeros(nv, len(ind))
         T[ind, :] = ca.SX.eye(len(ind))
         if dep:
             T[dep, :] = -ca.solve(JD, JI)
+        # u = T u_I + s: the prescribed speeds (symbols until ``_prescribe``) and what the
+        # dependent ones do to follow them
+        s_vel = ca.SX.zeros(nv)
+        acc_P = ca.vertcat(*[m.acc for m in asm.prescribed.values()])
+        if P:
+            s_vel[P] = u[P]
+            if dep:
+                s_vel[dep] = -ca.solve(JD, JP @ u[P])
         c = ca.jtimes(J @ u, q, asm.qdot)             # (dJ/dt) u
         if formulation == "baumgarte":
             c = c + 2 * rate * (J @ u) + rate ** 2 * phi
         g = ca.SX.zeros(nv)
+        if P:
+            g[P] = acc_P
         if dep:
-            g[dep] = -ca.solve(JD, c)
+            g[dep] = -ca.solve(JD, c + JP @ acc_P if P else c)
         a_grav = ca.vertcat(ca.SX.zeros(3), -asm.gravity)
         M = crba(asm.bodies, nv, asm.armature)
         bias = rnea(asm.bodies, u, ca.SX.zeros(nv), a_grav) - asm.Q
         Mr = T.T @ M @ T
         udot_i = ca.solve(Mr, -T.T @ (bias + M @ g))
         udot = T @ udot_i + g
-        # multipliers: J^T lam = M udot + bias, exactly solvable as J has independent rows
+        # multipliers: J^T lam = M udot + bias, exactly solvable as J has independent rows;
+        # with prescribed speeds, J^T lam + E_P drive = M udot + bias (E_P: their columns of
+        # the identity), as exactly: no combination of closure rows acts on them alone, or
+        # the partition would have failed
         lam = ca.SX.zeros(self.phi.shape[0])
-        if self.rows:
+        if P:
+            A = ca.horzcat(J.T, ca.SX.eye(nv)[:, P])
+            both = ca.solve(A.T @ A, A.T @ (M @ udot + bias))
+            if self.rows:
+                lam[self.rows] = both[:len(self.rows)]
+            lam = ca.vertcat(lam, both[len(self.rows):])
+        elif self.rows:
             lam[self.rows] = ca.solve(J @ J.T, J @ (M @ udot + bias))
         dep_q = [k for k, v in asm.speed_of.items() if v in set(dep)]
+        Pq = {m.coordinate for m in asm.prescribed.values()}
         qnames, unames = asm.coordinate_names, asm.speed_names
         qunits, uunits = asm.coordinate_units, asm.speed_units
         note_rows = (f"{len(self.rows)} independent closure equations"
@@ -440,24 +567,29 @@ class _Loops:
         start = self.f_start
         rows = self.rows
         if formulation == "baumgarte":
-
-            f_T = ca.Function("T", [q, asm.p], [T])
+            u_i = ca.SX.sym("u_i", len(ind))
+            f_u = ca.Function("u_start", [q, u_i, asm.p], [ca.substitute(
+                T @ u_i + s_vel, _rows(u, P), _rows(asm.u_start, P))])
+            all_q = [k for k in range(q.shape[0]) if k not in Pq]
+            all_u = [k for k in range(nv) if k not in set(P)]
 
             def initial(p):
                 qc = self.close(p)
                 _, u0 = start(p)
-                un = np.asarray(f_T(qc, p)) @ np.asarray(u0, dtype=float).ravel()[ind]
-                return np.concatenate([qc, un]), np.zeros(0)
-            note = (f"kinematic loops, Baumgarte formulation: all {q.shape[0]} coordinates and "
-                    f"{nv} speeds are states ({nv - len(dep)} degrees of freedom; "
+                un = np.asarray(f_u(qc, np.asarray(u0, dtype=float).ravel()[ind], p))
+                return np.concatenate([qc[all_q], un.ravel()[all_u]]), np.zeros(0)
+            note = (f"kinematic loops, Baumgarte formulation: all {len(all_q)} coordinates "
+                    f"and {len(all_u)} speeds are states ({len(ind)} degrees of freedom; "
                     f"{note_rows}, stabilised at rate {rate:g}/s)")
-            return Equations(ca.vertcat(q, u), ca.SX(0, 1), ca.vertcat(asm.qdot, udot),
-                             ca.SX(0, 1), qnames + unames, qunits + uunits, [], [], u, udot,
-                             "baumgarte", note, len(rows), self.phi.shape[0] - len(rows),
+            return Equations(ca.vertcat(_rows(q, all_q), _rows(u, all_u)), ca.SX(0, 1),
+                             ca.vertcat(_rows(asm.qdot, all_q), _rows(udot, all_u)),
+                             ca.SX(0, 1), [qnames[k] for k in all_q] + [unames[k] for k in all_u],
+                             [qunits[k] for k in all_q] + [uunits[k] for k in all_u], [], [], u,
+                             udot, "baumgarte", note, len(rows), self.phi.shape[0] - len(rows),
                              initial, phi, lam, dependent_jacobian=JD,
                              dependent_names=[unames[k] for k in dep])
-        keep_q = [k for k in range(q.shape[0]) if k not in set(dep_q)]
-        u_full = ca.densify(T @ _rows(u, ind))
+        keep_q = [k for k in range(q.shape[0]) if k not in set(dep_q) | Pq]
+        u_full = ca.densify(T @ _rows(u, ind) + s_vel)
         sub = lambda e: ca.substitute(e, u, u_full)     # noqa: E731
         x = ca.vertcat(_rows(q, keep_q), _rows(u, ind))
         z = _rows(q, dep_q)

@@ -7,8 +7,14 @@ flanges a rigid chain ties together). What the group's coordinate is follows fro
 
 - "joint": the joint coordinate; the group's inertia sum(J k^2) is added to the joint's
   diagonal of the mass matrix (its armature): exact, and no state;
-- "fixed" / "world": a constant; "prescribed": a function of time (Position), or its
-  integral (Speed, one state);
+- "fixed" / "world": a constant; "prescribed": what its motion source gives (a Position,
+  Speed or Accelerate: its reference differentiated exactly, integrated or filtered, with the
+  states that takes);
+- a "joint" group with a motion source in it: the joint's coordinate, speed and acceleration
+  are those of the motion (divided by the group's ratio at the source), recorded in
+  ``Network.prescribed`` for the formulation, which eliminates them (``loops.py``); the
+  torque the source applies is a symbol, the generalized force the formulation finds the
+  joint needs;
 - "free": a coordinate and a speed of its own (a rotor behind a flexible coupling):
   J theta'' = the generalized force of the elements on it;
 - "massless": no inertia, so the flows on it balance at every instant: solved symbolically
@@ -58,15 +64,19 @@ class Network:
     alg_names: list = field(default_factory=list)
     block_states: int = 0
     no_acceleration: set = field(default_factory=set)  # sets of massless groups
+    #: speed index -> Prescribed, for joints whose coordinate a motion source gives
+    prescribed: dict = field(default_factory=dict)
 
     def summary(self, topo):
         """A line on what structural analysis made of the 1-D network and the blocks."""
         kinds = {}
         for g in topo.oned:
-            kinds[g.kind] = kinds.get(g.kind, 0) + 1
+            kind = "driven" if g.motion else g.kind
+            kinds[kind] = kinds.get(kind, 0) + 1
         blocks = self.block_states
         parts = [f"{kinds[k]} {what}" for k, what in (
             ("joint", "on joint axes (no state: any inertia adds to the joint's)"),
+            ("driven", "moving a joint by a prescribed motion (its coordinate is no state)"),
             ("free", "free (an angle and a speed each)"),
             ("massless", "massless (solved from their balance)"),
             ("prescribed", "prescribed"), ("fixed", "fixed")) if kinds.get(k)]
@@ -92,6 +102,33 @@ def build(model, topo, bound, q, u, udot, qindex, uindex, t, inverse=None, p=Non
                     p_values).run()
 
 
+@dataclass
+class Prescribed:
+    """A joint coordinate a motion source gives: its value, speed and acceleration (in t,
+    p, the network's states and, for a filtered reference, the mechanism's q and u), and
+    ``drive``, the symbol of the generalized force the source applies to the joint."""
+    coordinate: int
+    pos: ca.SX
+    vel: ca.SX
+    acc: ca.SX
+    drive: ca.SX
+    source: str
+    joint: str
+
+
+@dataclass
+class _Motion:
+    """A motion source while the network is built: its group, ratio, states, reference."""
+    comp: object                     # bound to the parameters' symbols
+    source: object                   # the model's component, whose ports are wired
+    group: object
+    k: ca.SX
+    x: list
+    coord: tuple                     # placeholders (or the joint's q, u, udot)
+    reference: ca.SX = None
+    drive: ca.SX = None              # on a joint: the symbol of the generalized force
+
+
 class _Builder:
     def __init__(self, model, topo, bound, q, u, udot, qindex, uindex, t, inverse, p,
                  p_values):
@@ -107,6 +144,7 @@ class _Builder:
         self.pending = {}            # placeholder symbol -> expression, substituted at the end
         self.block_x = {}
         self.inertia = {}            # group index -> sum of J k^2
+        self.motions = []            # _Motion, in group order
 
     # -- the steps ------------------------------------------------------------------------
     def run(self):
@@ -147,27 +185,25 @@ class _Builder:
             self.k[s] = self.k[parent] * r if a_here else self.k[parent] / r
 
     def _coordinate(self, group):
-        kind, t = group.kind, self.t
+        kind = group.kind
         zero = (ca.SX(0), ca.SX(0), ca.SX(0))
         if kind == "joint":
             joint = group.definer.component
             j = joint.coordinate_ports[group.definer.name]
             i, u = self.qindex[joint.name][j], self.uindex[joint.name][j]
             self.coord[group.index] = (self.q[i], self.u[u], self.udot[u])
+            if group.motion is not None:
+                self._motion(group, group.motion, self.coord[group.index])
         elif kind == "fixed":
             comp = self.bound[group.definer.component.name]
             position = comp.position() if comp.role == "fixed" else 0
             self.coord[group.index] = (ca.SX(position), ca.SX(0), ca.SX(0))
         elif kind == "prescribed":
-            comp = self.bound[group.definer.component.name]
-            ref = ca.SX(comp.reference)
-            if comp.derivative == 1:             # a speed: the position is integrated
-                theta = self._state(f"{comp.name}.{_pos(group)}", _units(group)[0],
-                                    comp.position0, ref)
-                self.coord[group.index] = (theta, ref, ca.jacobian(ref, t))
-            else:
-                w = ca.jacobian(ref, t)
-                self.coord[group.index] = (ref, w, ca.jacobian(w, t))
+            # placeholders until the reference (perhaps a signal) is known: ``_finish``
+            placeholders = tuple(ca.SX.sym(f"g{group.index}_{what}")
+                                 for what in ("pos", "vel", "acc"))
+            self.coord[group.index] = placeholders
+            self._motion(group, group.definer, placeholders)
         elif kind == "free":
             self._free(group)
         elif kind == "massless":
@@ -176,6 +212,16 @@ class _Builder:
             self.coord[group.index] = (theta, w, a)
         else:
             self.coord[group.index] = zero
+
+    def _motion(self, group, flange, coord):
+        """A motion source on ``group``: its states (position, then speed), named as the
+        source's (``drive.phi``, ``drive.w``)."""
+        comp = self.bound[flange.component.name]
+        units = _units(group)
+        labels = list(zip((_pos(group), _vel(group)), units))[:comp.n_states]
+        x = [self._state(f"{comp.name}.{label}", unit, 0, 0) for label, unit in labels]
+        self.motions.append(_Motion(comp, flange.component, group,
+                                    self.k[self.topo.set_of[flange]], x, coord))
 
     def _free(self, group):
         inertias = [e for e in group.rigid if e.has_inertia]
@@ -317,7 +363,7 @@ class _Builder:
                 source = self.topo.signal_source[s].component.name
                 if comp.role == "block" and comp.feedthrough:
                     g.add_edge(source, comp.name)
-                elif comp.role == "source":
+                elif comp.role in ("source", "prescribed"):
                     g.add_edge(source, MECHANICS)
         # block-lower-triangular order: the strongly connected components (Tarjan) of the
         # graph, each solved as one block, in topological order of the condensation
@@ -337,8 +383,27 @@ class _Builder:
     # -- the mechanics ------------------------------------------------------------------
     def _mechanics(self):
         self._flows("source")
-        for group in self.topo.oned:
+        for m in self.motions:
+            u = self._inputs(m.source).get("u")
+            m.reference = ca.SX(m.comp.reference if u is None else u)
+            if m.group.kind == "joint":
+                # the torque (force) the source applies: the generalized force the joint
+                # needs, found by the formulation, through the group's ratio at the source
+                drive = ca.SX.sym(f"drive_{m.comp.name}")
+                self._drive(m, drive / m.k)
+                m.drive = drive
+        # motions of free flanges first: the flow into their source is then known, and so
+        # the reaction on their support, before the fixed groups take it
+        for group in sorted(self.topo.oned, key=lambda g: g.kind != "prescribed"):
             self._balance(group)
+            if group.kind == "prescribed":
+                m = next(m for m in self.motions if m.group is group)
+                self._drive(m, -self.net.flow[group.definer])
+
+    def _drive(self, motion, torque):
+        """The source applies ``torque`` to its flange, and its reaction to its support."""
+        self.net.flow[motion.source.port_ref("flange")] = -torque
+        self.net.flow[motion.source.port_ref("support")] = torque
 
     def _flows(self, role):
         net = self.net
@@ -357,7 +422,8 @@ class _Builder:
                 flow[refs[pn]] = f
 
     def _applied(self, s, roles=("compliant", "source")):
-        """Flows into the non-rigid elements at a connection set (compliant, sources)."""
+        """Flows into the non-rigid elements at a connection set (compliant, sources; with
+        ``prescribed`` in ``roles``, motion sources too)."""
         return sum((self.net.flow.get(r, 0) for r in self.topo.sets[s]
                     if r.component.role in roles), ca.SX(0))
 
@@ -421,7 +487,8 @@ class _Builder:
         its far side balances what is beyond; its law gives the near side."""
         flow, k = self.net.flow, self.k
         theta, w, a = self.coord[group.index]
-        beyond = {s: self._applied(s) for s, _, _ in group.sets}
+        beyond = {s: self._applied(s, ("compliant", "source", "prescribed"))
+                  for s, _, _ in group.sets}
         for s, parent, element in reversed(group.sets):
             if parent is None:
                 if group.definer is not None:
@@ -445,8 +512,24 @@ class _Builder:
         for joint_ports in self._axis_ports():
             ref, u = joint_ports
             net.axis_flow[u] += net.flow.get(ref, 0)
+        self._motion_laws()
         if not self.pending:
             return
+        sub = self._substitution()
+        for d in (net.pos, net.vel, net.acc, net.flow, net.signal):
+            for key in d:
+                d[key] = sub(d[key])
+        net.Q, net.armature, net.axis_flow = sub(net.Q), sub(net.armature), sub(net.axis_flow)
+        net.rate = [sub(r) for r in net.rate]
+        net.start = [sub(r) for r in net.start]
+        net.alg_res = [sub(r) for r in net.alg_res]
+        for rec in net.prescribed.values():
+            rec.pos, rec.vel, rec.acc = sub(rec.pos), sub(rec.vel), sub(rec.acc)
+
+    def _substitution(self):
+        """The function putting every placeholder's expression in its place."""
+        if not self.pending:
+            return lambda e: ca.SX(e)
         keys = list(self.pending)
         old, new = ca.vertcat(*keys), ca.vertcat(*[ca.SX(self.pending[k]) for k in keys])
         # placeholders may refer to each other (a free rotor's acceleration to a massless
@@ -455,15 +538,53 @@ class _Builder:
             if not ca.depends_on(new, old):
                 break
             new = ca.substitute(new, old, new)
+        return lambda e: ca.substitute(ca.SX(e), old, new)
 
-        def sub(e):
-            return ca.substitute(ca.SX(e), old, new)
-        for d in (net.pos, net.vel, net.acc, net.flow, net.signal):
-            for key in d:
-                d[key] = sub(d[key])
-        net.Q, net.armature, net.axis_flow = sub(net.Q), sub(net.armature), sub(net.axis_flow)
-        net.rate = [sub(r) for r in net.rate]
-        net.alg_res = [sub(r) for r in net.alg_res]
+    def _motion_laws(self):
+        """Each motion's position, speed and acceleration from its reference, once every
+        signal and every state's rate is known (an exact derivative needs the rates of the
+        blocks the reference comes from); in the order they were placed, so a motion read by
+        a sensor feeding another is known first."""
+        drives = [m.drive for m in self.motions if m.drive is not None]
+        moving = ca.vertcat(self.q, self.u, self.udot, *drives,
+                            *[c for m in self.motions if m.drive is None for c in m.coord])
+        for m in self.motions:
+            sub = self._substitution()
+            where = self.model.place(m.source)
+
+            def der(e, sub=sub, where=where, m=m):
+                e = sub(e)
+                if ca.depends_on(e, moving):
+                    raise ModelError(
+                        f"{where}: exact=True differentiates the reference exactly, so it "
+                        f"must follow time only (an expression in t, or signal blocks fed "
+                        f"by time); the reference of {m.comp.name} depends on the motion of "
+                        f"the model: set exact=False to follow it through its filter "
+                        f"(f_crit)")
+                states = [x for x in self.net.x if ca.depends_on(e, x)]
+                out = ca.jacobian(e, self.t)
+                if states:
+                    rates = sub(ca.vertcat(*[self.net.rate[self._at(x)] for x in states]))
+                    out += ca.jtimes(e, ca.vertcat(*states), rates)
+                return out
+            pos, vel, acc, rates = m.comp.motion(m.reference, m.x, der)
+            if ca.depends_on(sub(acc), ca.vertcat(self.udot, *drives)):
+                raise ModelError(f"{where}: the acceleration {m.comp.name} prescribes depends "
+                                 f"on accelerations of the model at the same instant (an "
+                                 f"algebraic loop through the mechanics): break it with a "
+                                 f"state (exact=False, a FirstOrder)")
+            r0 = ca.substitute(sub(m.reference), self.t, ca.SX(0))
+            for x, rate, start in zip(m.x, rates, m.comp.initial(r0)):
+                self.net.rate[self._at(x)] = rate
+                self.net.start[self._at(x)] = start
+            if m.group.kind == "joint":
+                joint = m.group.definer.component
+                j = joint.coordinate_ports[m.group.definer.name]
+                self.net.prescribed[self.uindex[joint.name][j]] = Prescribed(
+                    self.qindex[joint.name][j], pos / m.k, vel / m.k, acc / m.k, m.drive,
+                    m.comp.name, joint.name)
+            else:
+                self.pending.update(zip(m.coord, (pos, vel, acc)))
 
     def _axis_ports(self):
         for joint in self.topo.joints:

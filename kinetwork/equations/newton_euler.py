@@ -62,41 +62,62 @@ def _solve(D, b):
     return b / D if D.shape == (1, 1) else ca.solve(D, b)
 
 
-def aba(bodies, qd, tau, a0, armature=None):
+def aba(bodies, qd, tau, a0, armature=None, known=None):
     """Articulated-body algorithm: joint accelerations qdd, O(n) in the number of bodies.
 
     ``armature`` (one per speed) is 1-D inertia rigidly geared to a joint coordinate (a
     motor's rotor): it adds to D, the joint-space inertia of its joint, and nowhere else.
+    ``known`` (speed index -> acceleration) makes it Featherstone's hybrid dynamics: those
+    speeds' rates are given (prescribed motions) and pass their bodies' articulated inertia
+    whole to the parent; ``tau`` of them is not used.
     """
+    known = known or {}
     n = len(bodies)
     X = [b.X for b in bodies]
     v, c, IA, pA = [None] * n, [None] * n, [None] * n, [None] * n
+    free, S, given = [None] * n, [None] * n, [None] * n
     for k, b in enumerate(bodies):
         vJ = b.S @ qd[b.speeds]
         v[k] = (X[k] @ v[b.parent] if b.parent >= 0 else ZERO6) + vJ
         c[k] = crm(v[k]) @ vJ + b.cJ
+        free[k] = [s for s in b.speeds if s not in known]
+        cols = [b.speeds.index(s) for s in free[k]]
+        S[k] = b.S if len(cols) == len(b.speeds) else (b.S[:, cols] if cols
+                                                           else ca.SX(6, 0))
+        given[k] = [b.speeds.index(s) for s in b.speeds if s in known]
+        if given[k]:             # the prescribed part of the joint's motion acts as a bias
+            c[k] = c[k] + b.S[:, given[k]] @ ca.vertcat(*[known[b.speeds[i]]
+                                                          for i in given[k]])
         IA[k] = b.inertia
         pA[k] = crf(v[k]) @ (b.inertia @ v[k])
     U, D, u = [None] * n, [None] * n, [None] * n
     for k in reversed(range(n)):
         b = bodies[k]
-        U[k] = IA[k] @ b.S
-        D[k] = b.S.T @ U[k]
-        if armature is not None:
-            D[k] = D[k] + ca.diag(armature[b.speeds])
-        u[k] = tau[b.speeds] - b.S.T @ pA[k]
+        if free[k]:
+            U[k] = IA[k] @ S[k]
+            D[k] = S[k].T @ U[k]
+            if armature is not None:
+                D[k] = D[k] + ca.diag(armature[free[k]])
+            u[k] = tau[free[k]] - S[k].T @ pA[k]
         if b.parent >= 0:
-            Ia = IA[k] - U[k] @ _solve(D[k], U[k].T)
-            pa = pA[k] + Ia @ c[k] + U[k] @ _solve(D[k], u[k])
+            if free[k]:
+                Ia = IA[k] - U[k] @ _solve(D[k], U[k].T)
+                pa = pA[k] + Ia @ c[k] + U[k] @ _solve(D[k], u[k])
+            else:
+                Ia, pa = IA[k], pA[k] + IA[k] @ c[k]
             IA[b.parent] = IA[b.parent] + X[k].T @ Ia @ X[k]
             pA[b.parent] = pA[b.parent] + X[k].T @ pa
     qdd = ca.SX.zeros(qd.shape[0], 1)
     a = [None] * n
     for k, b in enumerate(bodies):
         ap = X[k] @ (a[b.parent] if b.parent >= 0 else a0) + c[k]
-        qdd_k = _solve(D[k], u[k] - U[k].T @ ap)
-        qdd[b.speeds] = qdd_k
-        a[k] = ap + b.S @ qdd_k
+        a[k] = ap
+        if free[k]:
+            qdd_k = _solve(D[k], u[k] - U[k].T @ ap)
+            qdd[free[k]] = qdd_k
+            a[k] = ap + S[k] @ qdd_k
+    for s, value in known.items():
+        qdd[s] = value
     return qdd
 
 

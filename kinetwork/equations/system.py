@@ -68,7 +68,8 @@ class System:
             "dependent_jacobian", [ca.vertcat(eq.x, eq.z), asm.p],
             [ca.densify(ca.substitute(jd, asm.q, ca.densify(coords)))])
         self.dependent_names = eq.dependent_names or []
-        if self.formulation == "tree" and self.speed_names and not self.n_algebraic:
+        if self.formulation in ("tree", "hybrid") and self.speed_names and \
+                not self.n_algebraic:
             self._check_mass_matrix()
         else:                  # initial values that contradict the loops: refused now
             self.initial_full_p(self.param_vector())
@@ -82,7 +83,8 @@ class System:
         """Refuse a mass matrix that is singular at the initial state (a joint that moves no
         mass or inertia: a chain of bodies with zero mass, a slider carrying nothing, a free
         body with no inertia about an axis), naming the joints it cannot accelerate, rather
-        than integrating NaNs or, worse, zeros."""
+        than integrating NaNs or, worse, zeros. Of a model with prescribed joints, the
+        mass matrix of the others."""
         p = self.param_vector()
         x0 = self.initial_full_p(p)[0]
         # M column by column as inverse dynamics of unit accelerations (no speed, no
@@ -90,7 +92,12 @@ class System:
         a, n = self.asm, len(self.speed_names)
         acc = ca.SX.sym("acc", n)
         f = ca.Function("M_columns", [a.q, acc, a.p], [a.mass_times(acc)])
-        M = np.asarray(f.map(n)(x0[:len(self.coordinate_names)], np.eye(n), p))
+        q0 = x0[:len(self.coordinate_names)] if self.eq.q is None else \
+            np.asarray(ca.Function("q0", [a.t, self._x, a.p], [self.eq.q])(0, x0, p)).ravel()
+        free = [k for k in range(n) if k not in a.prescribed]
+        M = np.asarray(f.map(n)(q0, np.eye(n), p))[np.ix_(free, free)]
+        if not free:
+            return
         if not np.all(np.isfinite(M)):
             raise ModelError(overflow_message(self.model, "the mass matrix", p,
                                               self.param_names))
@@ -99,7 +106,7 @@ class System:
         if values[0] > 1e-12 * scale:
             return
         null = vectors[:, values <= 1e-12 * scale]
-        involved = [self.speed_names[i] for i in range(len(self.speed_names))
+        involved = [self.speed_names[k] for i, k in enumerate(free)
                     if np.max(np.abs(null[i])) > 1e-3]
         joints = list(dict.fromkeys(n.rsplit(".", 1)[0] for n in involved))
         raise ModelError(f"the mass matrix is singular at the initial state: "
@@ -126,10 +133,10 @@ class System:
 
     @property
     def dof(self):
-        """Degrees of freedom: speeds less the independent loop-closure equations, plus the
-        free rotors and sliding masses of the 1-D network."""
+        """Degrees of freedom: speeds less the independent loop-closure equations and the
+        prescribed joint speeds, plus the free rotors and sliding masses of the 1-D network."""
         free = sum(1 for g in self.topology.oned if g.kind == "free")
-        return len(self.speed_names) - self.eq.loop_rows + free
+        return len(self.speed_names) - self.eq.loop_rows - self.eq.prescribed + free
 
     @property
     def n_algebraic(self):
@@ -267,6 +274,13 @@ class System:
         ``f_out`` replaces the output Function (its compiled twin)."""
         t = np.atleast_1d(np.asarray(t, dtype=float))
         X = np.atleast_2d(np.asarray(x, dtype=float))
+        clock = self.eq.clock
+        if clock is not None and len(t) and \
+                np.max(np.abs(X[:, clock] - t)) > 1e-6 * (1 + np.max(np.abs(t))):
+            # the state "time" starts at 0: a loop driven in time must start there too
+            raise ModelError(f"{self.model.name!r}: a kinematic loop follows a prescribed "
+                             f"motion in time, whose clock (the state 'time') starts at 0; "
+                             f"simulate from t_start = 0")
         return np.asarray(mapped(f_out or self.f_out, len(t))(t[None, :], X.T, p)).T
 
     @functools.cached_property

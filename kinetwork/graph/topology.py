@@ -47,7 +47,9 @@ class OneDGroup:
     the ``definer`` when there is one. ``kind`` says what gives the group its position:
     "joint" (a joint's coordinate), "fixed" (a Fixed or a support), "prescribed" (a motion
     source), "free" (nothing: it has inertia, so its own coordinate and speed) or
-    "massless" (nothing, and no inertia: solved from the balance of its flows).
+    "massless" (nothing, and no inertia: solved from the balance of its flows). A "joint"
+    group may hold one motion source too (``motion``, the source's flange): the joint's
+    coordinate then follows it.
     """
     index: int
     domain: str
@@ -56,6 +58,7 @@ class OneDGroup:
     definer: object = None
     kind: str = "massless"
     rigid: list = field(default_factory=list)
+    motion: object = None
 
 
 @dataclass
@@ -77,7 +80,8 @@ class Topology:
 
     @property
     def dof(self):
-        return sum(j.dof for j in self.joints)
+        """Degrees of freedom of the joints, less the coordinates prescribed by motions."""
+        return sum(j.dof for j in self.joints) - sum(1 for g in self.oned if g.motion)
 
 
 def analyze(model):
@@ -140,6 +144,7 @@ def analyze(model):
         _tree(model, topo, roles, problems)
     _oned(model, topo, values, problems)
     _signals(topo, problems)
+    _motions(model, topo, problems)
     if values is not None:
         _inertias(model, roles.get("body", []), values, problems)
         for comp in model.components.values():
@@ -296,24 +301,36 @@ def _oned(model, topo, values, problems):
         definers = [p for p in ports if _defines(p)]
         where = "{" + ", ".join(p.path for p in ports) + "}"
         elements = sorted({d["component"].name for _, _, d in sub.edges(data=True)})
+        through = f" (through {', '.join(elements)})" if elements else ""
         coords = [p for p in definers if p.name in p.component.coordinate_ports]
         motions = [p for p in definers if p.component.role == "prescribed"]
-        if len(definers) > 1 and (coords or motions):
-            first = (coords or motions)[0]
-            what = "joint flange" if coords else "prescribed motion"
-            why = ("this locks or couples joints, which is not supported yet" if coords else
-                   "one rigid group cannot follow two prescribed motions")
-            problems.append(f"connection set {where} rigidly ties {what} {first.path} to "
-                            f"{', '.join(p.path for p in definers if p != first)}"
-                            + (f" (through {', '.join(elements)})" if elements else "")
-                            + f": {why}")
-        elif len(definers) > 1 and values is not None:
-            spots = {p.path: (topo.set_of[p], _fixed_position(p, values)) for p in definers}
+        held = [p for p in definers if p not in coords and p not in motions]
+        definers = coords + motions + held        # the joint's flange roots its group
+        if len(coords) > 1 or (coords and held):
+            problems.append(f"connection set {where} rigidly ties joint flange "
+                            f"{coords[0].path} to "
+                            f"{', '.join(p.path for p in definers[1:] if p not in motions)}"
+                            f"{through}: this locks or couples joints, which is not "
+                            f"supported yet")
+        elif len(motions) > 1:
+            names = ", ".join(p.path for p in motions)
+            problems.append(
+                f"connection set {where}: joint flange {coords[0].path} is driven by "
+                f"{len(motions)} prescribed motions ({names}){through}; a joint follows one "
+                f"motion: remove all but one" if coords else
+                f"connection set {where} rigidly ties prescribed motion {motions[0].path} to "
+                f"{', '.join(p.path for p in motions[1:])}{through}: one rigid group cannot "
+                f"follow two prescribed motions")
+        elif motions and held:
+            problems.append(f"connection set {where} rigidly ties prescribed motion "
+                            f"{motions[0].path} to {', '.join(p.path for p in held)}"
+                            f"{through}: a flange held in place cannot follow a motion")
+        elif len(held) > 1 and values is not None:
+            spots = {p.path: (topo.set_of[p], _fixed_position(p, values)) for p in held}
             if len(set(spots.values())) > 1:
                 problems.append(f"connection set {where} holds fixed flanges at different "
                                 f"positions: "
-                                + str({k: v[1] for k, v in spots.items()})
-                                + (f" (through {', '.join(elements)})" if elements else ""))
+                                + str({k: v[1] for k, v in spots.items()}) + through)
         cycles = nx.cycle_basis(nx.Graph(sub)) if sub.number_of_edges() else []
         parallel = [sorted(sub.get_edge_data(u, v)) for u, v in {(u, v) for u, v, _ in
                                                                  sub.edges(keys=True)}
@@ -345,7 +362,34 @@ def _oned(model, topo, values, problems):
         topo.oned.append(OneDGroup(len(topo.oned), domain, _rooted(sub, members, definers,
                                                                     topo), ports,
                                    definers[0] if definers else None, kind,
-                                   [d["component"] for _, _, d in sub.edges(data=True)]))
+                                   [d["component"] for _, _, d in sub.edges(data=True)],
+                                   motions[0] if coords and motions else None))
+
+
+def _motions(model, topo, problems):
+    """A motion source takes its reference from its parameter or from its input u, not
+    both; its reaction rests in the world (unwired support, a joint's support or a Fixed:
+    nothing there moves)."""
+    group_of = {s: g for g in topo.oned for s, _, _ in g.sets}
+    for comp in model.components.values():
+        if comp.role != "prescribed":
+            continue
+        key = type(comp).reference.name
+        wired = topo.set_of[comp.port_ref("u")] in topo.signal_source
+        given = comp.reference is not None
+        if wired and given:
+            problems.append(f"{model.place(comp, key)}: {comp.name}.u is wired too; the "
+                            f"reference comes from one of them: remove {key} or the wire")
+        elif not wired and not given:
+            problems.append(f"{model.place(comp, key)}: no reference: give {key} (an "
+                            f"expression in time t) or wire a signal to {comp.name}.u")
+        support = comp.port_ref("support")
+        group = group_of.get(topo.set_of[support])
+        if group is not None and group.kind not in ("fixed", "world"):
+            problems.append(f"{model.place(comp)}: {support.path} is wired to a flange that "
+                            f"moves ({group.kind}); the reaction of a prescribed motion rests "
+                            f"in the world: leave the support unwired, or wire it to a "
+                            f"joint's support or a Fixed")
 
 
 def _inertias(model, bodies, values, problems):

@@ -26,7 +26,11 @@ def test_names_and_units_are_those_of_angles_and_torques():
     assert rot.SpringDamper.params["phi_rel0"].unit == "rad"
     assert rot.Torque.params["tau"].unit == "N*m" and rot.Torque.params["tau"].time
     assert rot.Inertia.params["J"].unit == "kg*m^2"
-    assert set(rot.Speed.params) == {"w_ref", "phi0"} and set(rot.Position.params) == {"phi_ref"}
+    assert set(rot.Position.params) == {"phi_ref", "exact", "f_crit"}
+    assert set(rot.Speed.params) == {"w_ref", "exact", "f_crit", "phi0"}
+    assert set(rot.Accelerate.params) == {"a_ref", "phi0", "w0"}
+    assert rot.Accelerate.params["a_ref"].unit == "rad/s^2"
+    assert rot.Position.params["f_crit"].unit == "Hz"
     assert rot.Fixed("f", phi0=0.4).position() == 0.4
 
 

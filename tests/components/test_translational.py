@@ -26,7 +26,10 @@ def test_names_and_units_are_those_of_positions_and_forces():
     assert tr.SpringDamper.params["s_rel0"].unit == "m"
     assert tr.Force.params["f"].unit == "N" and tr.Force.params["f"].time
     assert tr.Mass.params["m"].unit == "kg"
-    assert set(tr.Speed.params) == {"v_ref", "s0"} and set(tr.Position.params) == {"s_ref"}
+    assert set(tr.Position.params) == {"s_ref", "exact", "f_crit"}
+    assert set(tr.Speed.params) == {"v_ref", "exact", "f_crit", "s0"}
+    assert set(tr.Accelerate.params) == {"a_ref", "s0", "v0"}
+    assert tr.Accelerate.params["a_ref"].unit == "m/s^2"
     assert tr.Fixed("f", s0=-0.2).position() == -0.2
 
 

@@ -264,9 +264,15 @@ ILL_POSED = [
                                             m.connect("a.flange", "r.flange_a"),
                                             m.connect("b.flange", "r.flange_b")),
      r"rigidly ties prescribed motion a.flange to b.flange \(through r\): one rigid group"),
-    ("motion on a joint", lambda m: (m.add(rot.Position("drive", phi_ref="sin(t)")),
-                                     m.connect("drive.flange", "elbow.axis")),
-     r"rigidly ties joint flange elbow.axis to drive.flange"),
+    ("two motions on a joint", lambda m: (m.add(rot.Position("a", phi_ref="sin(t)")),
+                                          m.add(rot.Speed("b", w_ref="1")),
+                                          m.connect("a.flange", "elbow.axis"),
+                                          m.connect("b.flange", "elbow.axis")),
+     r"joint flange elbow.axis is driven by 2 prescribed motions \(a.flange, b.flange\); "
+     r"a joint follows one motion"),
+    ("a joint locked to a Fixed", lambda m: (m.add(rot.Fixed("lock")),
+                                             m.connect("lock.flange", "elbow.axis")),
+     r"rigidly ties joint flange elbow.axis to lock.flange: this locks or couples joints"),
 ]
 
 
