@@ -257,6 +257,11 @@ class MidpointRule(Method):
     newton = True
 
     def check(self, system):
+        if system.asm.prescribed:
+            raise ModelError("method 'midpoint' integrates a conservative tree in canonical "
+                             "coordinates; this model has joints whose motion is prescribed "
+                             "(a Position, Speed or Accelerate on a joint axis): use 'auto' "
+                             "or 'idas'")
         if system.formulation != "tree" or not all(system.asm.regular):
             raise ModelError("method 'midpoint' works in canonical coordinates of a tree of "
                              "angles and distances; this model has kinematic loops or a "

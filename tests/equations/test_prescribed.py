@@ -368,3 +368,17 @@ def test_a_driven_model_saves_and_loads(tmp_path):
     a = kn.simulate(model, t_end=1.0, n_points=11, **TOL)
     b = kn.simulate(again, t_end=1.0, n_points=11, **TOL)
     assert np.array_equal(a.states, b.states)
+
+
+def test_midpoint_refuses_a_prescribed_joint_saying_why():
+    model = kn.Model("driven")
+    model.add(kn.multibody.Ground("ground", gravity=[0, -9.81, 0]))
+    model.add(kn.multibody.Revolute("j1"))
+    model.add(kn.multibody.FixedTranslation("l1", r=[1, 0, 0]))
+    model.add(kn.multibody.RigidBody("b1", mass=1.0))
+    model.add(kn.rotational.Position("drive", phi_ref="0.5*sin(2*t)"))
+    for a, b in [("ground.frame", "j1.frame_a"), ("j1.frame_b", "l1.frame_a"),
+                 ("l1.frame_b", "b1.frame_a"), ("drive.flange", "j1.axis")]:
+        model.connect(a, b)
+    with pytest.raises(kn.ModelError, match="motion is prescribed"):
+        kn.simulate(model, t_end=1, method="midpoint")
