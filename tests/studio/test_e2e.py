@@ -268,6 +268,9 @@ def test_a_subsystem_opens_to_its_definition_and_back(page, studio):
     for comp in ("motor", "rotor", "gear", "angle", "pid"):
         page.wait_for_selector(tid(f"node-{comp}"))
     assert not K(page, "K.dirty")                 # looking changes nothing
+    select(page, "pid")
+    IMAGES.mkdir(parents=True, exist_ok=True)
+    page.screenshot(path=str(IMAGES / "studio-subsystem.png"))
     page.click(tid("crumb-0"))
     page.wait_for_selector(tid("node-shoulder_axis"))
     assert not page.errors, page.errors
@@ -331,6 +334,21 @@ def test_editing_keys_copy_paste_delete_undo_redo(page, studio):
     page.keyboard.press("Delete")
     page.wait_for_selector(tid("node-probe1"), state="detached")
     assert not any("probe1" in a or "probe1" in b for a, b in K(page, "K.doc.connections"))
+    # a wire is selected by a click and deleted alone
+    n = K(page, "K.doc.connections.length")
+    edge = page.locator('[data-testid^="rf__edge-probe2.port~elbow.axis"]')
+    box = edge.bounding_box()
+    page.mouse.click(box["x"] + box["width"] / 2, box["y"] + box["height"] / 2)
+    page.keyboard.press("Delete")
+    page.wait_for_function(f"() => window.__kinetwork.doc.connections.length === {n - 1}")
+    assert ["probe2.port", "elbow.axis"] not in K(page, "K.doc.connections")
+    assert K(page, "K.doc.components.length") == 9    # 9 - probe1 + mass3
+    # a rename follows the wires
+    select(page, "elbow")
+    set_field(page, "param-name", "forearm_joint")
+    page.wait_for_selector(tid("node-forearm_joint"))
+    assert ["link1.frame_b", "forearm_joint.frame_a"] in K(page, "K.doc.connections")
+    assert "forearm_joint" in K(page, "K.doc.layout")
     assert not page.errors, page.errors
 
 
@@ -354,6 +372,10 @@ def test_a_wrong_wire_and_a_bad_parameter_show_their_message(page, studio):
     problems = page.locator(tid("problems"))
     assert "mass1" in problems.inner_text() and ">= 0" in problems.inner_text()
     assert "bad" not in page.locator(tid("node-mass2")).get_attribute("class")
+    wire(page, "shoulder.axis", "link1.frame_a")       # the toast again, for the picture
+    toast.wait_for()
+    IMAGES.mkdir(parents=True, exist_ok=True)
+    page.screenshot(path=str(IMAGES / "studio-problems.png"))
     # fixed: the message goes
     set_field(page, "param-mass", "m1")
     message.wait_for(state="detached")
@@ -430,4 +452,81 @@ def test_screenshot_of_the_seed_with_plots_and_3d_view(page, studio):
     page.screenshot(path=str(IMAGES / "studio.png"))
     print(f"\nstudio load (navigation to palette ready): {load:.2f} s; Run to plotted "
           f"results: {K(page, 'K.timings.runToPlot'):.2f} s")
+    assert not page.errors, page.errors
+
+
+def test_runs_overlay_cancel_and_the_3d_view_follows_the_plot_cursor(page, studio):
+    open_studio(page, studio, open=SEED)
+    page.wait_for_selector(tid("node-spring"))
+    assert run(page) == "done"
+    page.wait_for_selector(f'{tid("viewer")}[data-ready="1"]')
+    select(page, "spring")
+    set_field(page, "param-c", "5")
+    assert run(page) == "done"
+    assert K(page, "K.runs.length") == 2
+    assert K(page, "K.plottedSeries.angle") == 4     # both probes, this run and the last
+    # the plot cursor moves the 3-D view; the 3-D view playing moves the plot cursor
+    box = page.locator(f'{tid("plot-angle")} .u-over').bounding_box()
+    page.mouse.move(box["x"] + box["width"] * 0.5, box["y"] + box["height"] / 2)
+    page.wait_for_function("() => Math.abs(window.__kinetwork.cursorTime - 5) < 0.2")
+    page.wait_for_function("() => document.querySelector('.kn-time') && "
+                           "/t = 5\\.\\d\\d|t = 4\\.9\\d/.test("
+                           "document.querySelector('.kn-time').textContent)")
+    page.evaluate("() => { window.__kinetwork.plotTime = null; window.__kinetwork.viewer().play(); }")
+    page.wait_for_function("() => window.__kinetwork.plotTime > 0")
+    page.evaluate("() => window.__kinetwork.viewer().pause()")
+    # a long run is cancelled and keeps what it computed
+    deselect(page)
+    set_field(page, "sim-t_end", "20000")       # chunks of 2048 outputs, then 16x more
+    set_field(page, "sim-n_points", "20001")
+    page.click(tid("run"))
+    page.wait_for_function("() => window.__kinetwork.runState && "
+                           "window.__kinetwork.runState.state === 'running' && "
+                           "window.__kinetwork.runState.id")
+    page.click(tid("cancel"))
+    page.wait_for_function("() => window.__kinetwork.runState.state === 'cancelled'",
+                           timeout=RUN_TIMEOUT)
+    page.locator(tid("toast")).filter(has_text="cancelled").wait_for()
+    assert 1 <= K(page, "K.runs[0].results.t.length") < 20001   # what it computed, plotted
+    assert K(page, "K.runs[0].state") == "cancelled"
+    assert not page.errors, page.errors
+
+
+def test_measure_load_run_and_3d_frame_rate(page, studio, record_property):
+    """The numbers of the report (not asserted: timings never go in a test): the studio's
+    load (navigation to the palette ready), Run to plotted results for the seed, and the 3-D
+    view's frame rate (requestAnimationFrame callbacks per second while it plays) for a
+    32-link chain in headless Chromium."""
+    from scenes.chains import chain
+
+    loads = sorted(open_studio(page, studio) for _ in range(3))
+    open_studio(page, studio, open=SEED)
+    page.wait_for_selector(tid("node-probe2"))
+    wait_validated(page)
+    run(page)                                      # the first run compiles
+    runs = []
+    for _ in range(3):
+        assert run(page) == "done"
+        page.wait_for_function("() => window.__kinetwork.timings.plotted >= "
+                               "window.__kinetwork.timings.runDone")
+        runs.append(K(page, "K.timings.runToPlot"))
+    chain(32).save(studio.root / "chain32.json")
+    open_studio(page, studio, open="chain32.json")
+    page.wait_for_selector(tid("node-j31"))
+    assert run(page) == "done"
+    page.wait_for_selector(f'{tid("viewer")}[data-ready="1"]')
+    page.evaluate("() => window.__kinetwork.viewer().play()")
+    fps = page.evaluate("""() => new Promise(done => {
+        let n = 0; const t0 = performance.now();
+        const tick = () => { n++; const dt = performance.now() - t0;
+            if (dt < 4000) requestAnimationFrame(tick); else done(1000 * n / dt); };
+        requestAnimationFrame(tick); })""")
+    page.evaluate("() => window.__kinetwork.viewer().pause()")
+    numbers = {"load_s": loads[1], "run_to_plot_s": sorted(runs)[1], "chain32_fps": fps}
+    for key, value in numbers.items():
+        record_property(key, value)
+    print(f"\nstudio load {loads[1]:.2f} s (median of 3); seed Run to plotted "
+          f"{sorted(runs)[1]:.2f} s (median of 3, compiled); 3-D view of a 32-link chain "
+          f"{fps:.1f} frames/s")
+    assert fps > 0 and all(r > 0 for r in runs)
     assert not page.errors, page.errors

@@ -24,6 +24,7 @@ import {
   nameStem,
   orderKeys,
   portDomain,
+  portSide,
   removeComponents,
   renameComponent,
   resolveDef,
@@ -111,11 +112,15 @@ export default function App() {
   const polling = useRef(null);
   const viewerRef = useRef(null);
   const bus = useMemo(() => makeBus(), []);
-  bus.cursor = (t) => viewerRef.current && viewerRef.current.setTime(t);
+  bus.cursor = (t) => {
+    K.cursorTime = t;
+    if (viewerRef.current) viewerRef.current.setTime(t);
+  };
 
   const toast = useCallback((message, kind = "error") => {
     const id = ++toastId;
-    setToasts((ts) => [...ts.slice(-3), { id, message, kind }]);
+    // the same message again replaces the one shown (a repeated refusal is one toast)
+    setToasts((ts) => [...ts.filter((t) => t.message !== message).slice(-3), { id, message, kind }]);
     setTimeout(() => setToasts((ts) => ts.filter((t) => t.id !== id)), kind === "error" ? 8000 : 4000);
   }, []);
 
@@ -213,6 +218,36 @@ export default function App() {
     setAutoPos((ap) => ({ ...ap, [scopeKey]: { ...(ap[scopeKey] || {}), ...autoLayout(body, missing) } }));
   }, [body, posOf, scopeKey]);
 
+  // a definition opened without a layout: the server lays it out (as it does a model)
+  const laidOut = useRef(new Set());
+  useEffect(() => {
+    if (!scopes.length || !resolved) return;
+    const layout = body.layout || {};
+    const comps = body.components || [];
+    if (!comps.length || comps.some((c) => layout[c.name]) || laidOut.current.has(scopeKey)) return;
+    laidOut.current.add(scopeKey);
+    const model = { format: "kinetwork.model", version: 2, name: scope };
+    for (const k of ["parameters", "ports", "components", "connections"]) if (body[k] !== undefined) model[k] = body[k];
+    if (body.definitions) model.definitions = body.definitions;
+    api
+      .layout(model, resolved.ctx.docPath)
+      .then((lr) => {
+        const got = (lr && lr.layout) || {};
+        const pos = {};
+        for (const c of comps) {
+          const p = got[c.name];
+          if (p && typeof p.x === "number" && typeof p.y === "number") pos[c.name] = { x: p.x, y: p.y };
+        }
+        if (Object.keys(pos).length) {
+          setAutoPos((ap) => ({ ...ap, [scopeKey]: { ...(ap[scopeKey] || {}), ...pos } }));
+          setFitRequest((n) => n + 1);
+        }
+      })
+      .catch(() => {
+        /* the studio's own layout stays */
+      });
+  }, [scopes.length, resolved, body, scope, scopeKey]);
+
   // -- validation, debounced ---------------------------------------------------------------
   const validateSeq = useRef(0);
   useEffect(() => {
@@ -274,6 +309,37 @@ export default function App() {
     });
   }, [body, ctx, posOf, problemsOf]);
 
+  // inside a definition: its exposed ports, each beside the inner port it stands for
+  const exposed = useMemo(() => {
+    if (!scopes.length) return [];
+    return Object.entries(body.ports || {}).map(([pname, ref]) => {
+      const [cname, port] = String(ref).split(".");
+      const comp = (body.components || []).find((c) => c.name === cname);
+      const info = comp && typeInfo(comp.type, ctx);
+      const pinfo = info && info.ports.find((p) => p.name === port);
+      const domain = pinfo ? pinfo.domain : "any";
+      const side = pinfo ? portSide(port, domain, info.ports) : "left";
+      const at = posOf(cname) || { x: 0, y: 0 };
+      // above the block, on the side of its port (a row of blocks leaves no room beside)
+      const shift = { left: [-50, -50], right: [70, -50], top: [20, -55], bottom: [20, 75] }[side];
+      const moved = autoPos[scopeKey] && autoPos[scopeKey][`@${pname}`];
+      return { pname, ref, cname, port, domain, side, pos: moved || { x: at.x + shift[0], y: at.y + shift[1] } };
+    });
+  }, [scopes.length, body, ctx, posOf, autoPos, scopeKey]);
+
+  const nodesShown = useMemo(
+    () => [
+      ...nodesIn,
+      ...exposed.map((e) => ({
+        id: `@${e.pname}`,
+        type: "extport",
+        position: { x: e.pos.x * SCALE, y: e.pos.y * SCALE },
+        data: { name: e.pname, domain: e.domain, side: e.side, ref: e.ref },
+      })),
+    ],
+    [nodesIn, exposed],
+  );
+
   const edgesIn = useMemo(() => {
     const badConn = new Set(here.filter((p) => p.connection !== null && p.connection !== undefined).map((p) => p.connection));
     return (body.connections || []).map(([a, b], i) => {
@@ -295,6 +361,23 @@ export default function App() {
       };
     });
   }, [body, ctx, here]);
+
+  const edgesShown = useMemo(
+    () => [
+      ...edgesIn,
+      ...exposed.map((e) => ({
+        id: `@${e.pname}`,
+        source: `@${e.pname}`,
+        sourceHandle: "port",
+        target: e.cname,
+        targetHandle: e.port,
+        data: { exposed: e.pname },
+        className: "kn-edge kn-edge-exposed",
+        style: { stroke: DOMAIN_COLORS[e.domain] || "#888", strokeWidth: 1.6, strokeDasharray: "6 4" },
+      })),
+    ],
+    [edgesIn, exposed],
+  );
 
   // -- editing -------------------------------------------------------------------------------
   const editScope = useCallback(
@@ -321,14 +404,26 @@ export default function App() {
     [scopes, palette, file.path, defCache],
   );
 
+  const domainOf = useCallback(
+    (path) => {
+      if (path.startsWith("@")) {
+        const e = exposed.find((x) => `@${x.pname}.port` === path);
+        return e ? "any" : null;       // an exposed port takes the domain of what it is given
+      }
+      return portDomain(body, path, ctx);
+    },
+    [body, ctx, exposed],
+  );
+
   const checkConnection = useCallback(
     (a, b) => {
-      const da = portDomain(body, a, ctx);
-      const db = portDomain(body, b, ctx);
+      if (a.startsWith("@") && b.startsWith("@")) return "two exposed ports cannot be wired to each other";
+      const da = domainOf(a);
+      const db = domainOf(b);
       if (!da || !db) return `no port ${!da ? a : b}`;
       return connectProblem({ path: a, domain: da }, { path: b, domain: db }, body.connections);
     },
-    [body, ctx],
+    [body, domainOf],
   );
 
   const onConnectPorts = useCallback(
@@ -338,6 +433,13 @@ export default function App() {
         toast(why);
         return;
       }
+      const ext = a.startsWith("@") ? [a, b] : b.startsWith("@") ? [b, a] : null;
+      if (ext) {
+        // wiring an exposed port to an inner port: it now stands for that one
+        const pname = ext[0].slice(1, -".port".length);
+        editScope((s) => ({ ...s, ports: { ...(s.ports || {}), [pname]: ext[1] } }));
+        return;
+      }
       editScope((s) => ({ ...s, connections: [...(s.connections || []), [a, b]] }));
     },
     [checkConnection, editScope, toast],
@@ -345,6 +447,9 @@ export default function App() {
 
   const onMoved = useCallback(
     (moved) => {
+      const ports = Object.fromEntries(Object.entries(moved).filter(([k]) => k.startsWith("@")));
+      if (Object.keys(ports).length) setAutoPos((ap) => ({ ...ap, [scopeKey]: { ...(ap[scopeKey] || {}), ...ports } }));
+      moved = Object.fromEntries(Object.entries(moved).filter(([k]) => !k.startsWith("@")));
       if (!Object.keys(moved).length) return;
       editScope((s) => {
         const old = s.layout || {};
@@ -352,15 +457,20 @@ export default function App() {
         return same ? s : { ...s, layout: { ...old, ...moved } };
       });
     },
-    [editScope],
+    [editScope, scopeKey],
   );
 
   const onDelete = useCallback(
     (names, edges) => {
-      const gone = new Set(names);
-      const drop = new Set(edges.filter(Boolean).map((e) => `${e.a}\u0000${e.b}`));
+      const unexpose = new Set([
+        ...names.filter((n) => n.startsWith("@")).map((n) => n.slice(1)),
+        ...edges.filter((e) => e && e.exposed).map((e) => e.exposed),
+      ]);
+      const gone = new Set(names.filter((n) => !n.startsWith("@")));
+      const drop = new Set(edges.filter((e) => e && !e.exposed).map((e) => `${e.a}\u0000${e.b}`));
       editScope((s) => {
         let next = gone.size ? removeComponents(s, [...gone]) : s;
+        if (unexpose.size) next = { ...next, ports: Object.fromEntries(Object.entries(next.ports || {}).filter(([k]) => !unexpose.has(k))) };
         if (drop.size) next = { ...next, connections: (next.connections || []).filter(([a, b]) => !drop.has(`${a}\u0000${b}`)) };
         return next;
       });
@@ -598,6 +708,7 @@ export default function App() {
         setSelection([]);
         setSelectRequest({ names: [] });
         setAutoPos({});
+        laidOut.current = new Set();
         setRuns([]);
         setRunState(null);
         setValidation({ ok: null, problems: [], summary: null });
@@ -913,8 +1024,8 @@ export default function App() {
             </span>
           </div>
           <Canvas
-            nodesIn={nodesIn}
-            edgesIn={edgesIn}
+            nodesIn={nodesShown}
+            edgesIn={edgesShown}
             selectRequest={selectRequest}
             fitRequest={fitRequest}
             placed={(body.components || []).every((c) => posOf(c.name))}

@@ -13,9 +13,10 @@ import {
   useReactFlow,
 } from "@xyflow/react";
 import BlockNode from "./BlockNode.jsx";
+import PortNode from "./PortNode.jsx";
 import { GRID, SCALE } from "./model.js";
 
-const nodeTypes = { block: BlockNode };
+const nodeTypes = { block: BlockNode, extport: PortNode };
 export const DRAG_MIME = "application/x-kinetwork-type";
 
 export default function Canvas({

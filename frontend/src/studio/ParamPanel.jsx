@@ -85,7 +85,7 @@ function ParamRow({ p, value, problems, onSet }) {
   } else if (p.choices) {
     input = (
       <select className="kn-input" value={given ? String(value) : ""} data-testid={`param-${p.name}`} onChange={(e) => onSet(e.target.value === "" ? undefined : e.target.value)}>
-        <option value="">{`default (${formatValue(p.default)})`}</option>
+        <option value="">{`default (${formatValue(p.default) || "none"})`}</option>
         {p.choices.map((c) => (
           <option key={c} value={c}>{c}</option>
         ))}

@@ -83,7 +83,8 @@ function buildData(names, runs) {
   } else {
     data = uPlot.join(tables.map((tb) => [tb.t, tb.y]));
   }
-  return { series, data, unit, columns };
+  const latestCount = Object.values(columns).reduce((a, c) => a + c.length, 0);
+  return { series, data, unit, columns, latestCount };
 }
 
 function Panel({ title, names, runs, bus, width, height }) {
@@ -128,18 +129,25 @@ function Panel({ title, names, runs, bus, width, height }) {
     };
     const u = new uPlot(opts, built.data, ref.current);
     plotRef.current = u;
+    // the legend lists the latest run; older runs are drawn dashed (named in the header)
+    u.root.querySelectorAll(".u-legend .u-series").forEach((row, i) => {
+      if (i > built.latestCount) row.style.display = "none";
+    });
     bus.plots.add(u);
     // what is drawn, for tests: per signal, t and its columns of the latest run
     const K = (window.__kinetwork = window.__kinetwork || {});
     K.plotted = K.plotted || {};
     for (const [name, idx] of Object.entries(built.columns)) K.plotted[name] = [built.data[0], ...idx.map((i) => built.data[i])];
+    K.plottedSeries = K.plottedSeries || {};
+    K.plottedSeries[title] = built.series.length - 1;
     return () => {
       for (const name of Object.keys(built.columns)) delete K.plotted[name];
+      delete K.plottedSeries[title];
       bus.plots.delete(u);
       u.destroy();
       plotRef.current = null;
     };
-  }, [built, width, height, bus]);
+  }, [built, width, height, bus, title]);
   return (
     <div className="kn-plot" data-testid={`plot-${title}`}>
       <div className="kn-plot-title">
@@ -164,7 +172,20 @@ export function makeBus() {
     silent: false,
     zooming: false,
     cursor: () => {},
+    // the 3-D view playing: the plots' cursors follow at most ten times a second (moving a
+    // uPlot cursor redraws its legend: at every frame it would halve the 3-D frame rate)
+    pending: null,
+    timer: null,
+    follow(t) {
+      this.pending = t;
+      if (this.timer) return;
+      this.timer = setTimeout(() => {
+        this.timer = null;
+        this.setTime(this.pending);
+      }, 100);
+    },
     setTime(t) {
+      window.__kinetwork.plotTime = t;
       this.silent = true;
       try {
         for (const u of this.plots) {

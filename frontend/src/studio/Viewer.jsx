@@ -23,7 +23,7 @@ export default function Viewer({ animation, bus, onViewer }) {
         const create = mod.createViewer || (mod.default && mod.default.createViewer) || mod.default;
         viewer = create(host.current, animation, {
           controls: true,
-          onTime: (t) => bus.setTime(t),
+          onTime: (t) => bus.follow(t),
         });
         onViewer(viewer);
         setReady(true);

@@ -341,7 +341,9 @@ export function formatValue(v) {
 
 export function formatNumber(x) {
   if (!Number.isFinite(x)) return String(x);
-  if (Number.isInteger(x) && Math.abs(x) < 1e15) return String(x);
+  const a = Math.abs(x);
+  // the shortest text that reads back as the same number; 1e-06 rather than 0.000001
+  if (a !== 0 && (a < 1e-4 || a >= 1e15)) return x.toExponential();
   return String(x);
 }
 
