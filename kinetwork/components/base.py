@@ -336,6 +336,11 @@ class Component:
         its body), as messages naming ``place(key)``; the validation calls it. None here."""
         return []
 
+    def required_ports(self):
+        """Optional ports that this instance's parameters make required (a force resolved in
+        the frame wired to its frame_resolve); none here."""
+        return ()
+
     def set_param(self, key, value):
         """Change parameter ``key`` (its file name) to ``value``, checked as at construction.
 

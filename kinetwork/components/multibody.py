@@ -4,7 +4,8 @@ A joint gives the transform of frame_b relative to frame_a as a function of its 
 the solver's Newton-Euler passes derive everything else from it. A body with a shape
 (BodyBox, BodyCylinder) is a rigid part that is also a body on its frame_a: its transform is
 a FixedTranslation's and its mass properties follow from its geometry and density, as in
-Modelica's MultiBody.Parts.
+Modelica's MultiBody.Parts. The force elements on frames (line forces, forces and torques)
+are declared in ``forces.py`` and are part of this library too.
 """
 
 import math
@@ -19,12 +20,47 @@ from .base import Component, Param, Port
 MB = "multibody"
 
 
+#: gravity fields a Ground may have (MSL's World.gravityType, less NoGravity: a uniform zero)
+GRAVITY_TYPES = ("uniform", "point")
+
+
 class Ground(Component, library=MB):
-    """The inertial world frame, with the gravity field of the model."""
+    """The inertial world frame, with the gravity field of the model.
+
+    The field is uniform (``gravity``), or that of a point mass at the world origin
+    (``gravity_type`` "point", MSL's World with gravityType PointGravity): -mue/|r|^2 along r
+    at the world point r, acting on every body at its centre of mass (so a body feels a
+    torque about its frame only through its centre-of-mass offset, as in MSL; no
+    gravity-gradient torque).
+
+    Parameters
+    ----------
+    gravity : m/s^2, 3 values, default [0, -9.81, 0]
+        Uniform gravity acceleration, in the world frame (not used by a point field).
+    gravity_type : "uniform" or "point", default "uniform"
+        Kind of gravity field.
+    mue : m^3/s^2, >= 0, default 3.986004418e14 (the Earth's)
+        Field constant of the point field, G times the central mass (MSL's mu).
+    """
     role = "world"
     frame = Port("frame", "World frame", optional=True)
     gravity = Param([0.0, -9.81, 0.0], unit="m/s^2", shape=(3,),
                     doc="Gravity acceleration, resolved in the world frame")
+    gravity_type = Param("uniform", kind="choice", choices=GRAVITY_TYPES,
+                         doc="Gravity field: uniform (gravity), or point (a central mass at "
+                             "the world origin, field constant mue)")
+    mue = Param(3.986004418e14, unit="m^3/s^2", min=0.0,
+                doc="Field constant of the point gravity field (G times the central mass)")
+
+    def uniform_gravity(self):
+        """The gravity vector of a uniform field, or None for a point field."""
+        return vec3(self.gravity) if self.gravity_type == "uniform" else None
+
+    def gravity_at(self, r):
+        """Gravity acceleration at the world point ``r`` (CasADi)."""
+        if self.gravity_type == "uniform":
+            return vec3(self.gravity)
+        return -self.mue * r / ca.norm_2(r) ** 3
 
 
 class PartialRigidTransform(Component):
@@ -469,6 +505,53 @@ class RigidBody(_CheckedTogether, Component, library=MB):
                 for i, v in enumerate(size) if _numbers(v) is not None and v < 0]
 
 
+class BodyShape(_CheckedTogether, PartialRigidTransform, library=MB):
+    """A rigid body between two frames (MSL's Parts.BodyShape): frame_b is frame_a moved by
+    ``r`` (a FixedTranslation), and the mass, centre of mass and inertia are given as a
+    RigidBody's on frame_a. A rigid part with mass: it folds into the body before it and
+    costs no state, so it hangs from either end alike.
+
+    ``shape``, ``shape_size`` and ``color`` are looks only (MSL's shapeType, length and
+    width, color): what an animation draws from frame_a towards frame_b.
+
+    Parameters
+    ----------
+    r : m, 3 values, required
+        Position of frame_b in frame_a.
+    mass : kg, >= 0, required
+        Mass.
+    r_cm : m, 3 values, default [0, 0, 0]
+        Centre of mass from frame_a, resolved in frame_a.
+    inertia : kg*m^2, 3x3 or its diagonal, default zero
+        Inertia about the centre of mass, in frame_a axes.
+    shape : "box", "cylinder", "sphere", default "cylinder"
+        What the animation draws from frame_a along r; looks only.
+    shape_size : m, 3 values >= 0, default None
+        Length, width and height of the shape (None: |r|, |r| / 20, |r| / 20); looks only.
+    color : "#rrggbb" or None, default None
+        Colour in the animation (None: its default).
+    """
+    has_mass = True
+    frame_a = Port("frame", "Frame a, the body's own (may be left unwired when the body hangs "
+                            "from frame_b)", optional=True)
+    r = Param(unit="m", shape=(3,), doc="Position of frame_b in frame_a")
+    mass = RigidBody.params["mass"]
+    r_cm = RigidBody.params["r_cm"]
+    inertia = RigidBody.params["inertia"]
+    shape = Param("cylinder", kind="choice", choices=SHAPES,
+                  doc="What the animation draws from frame_a along r; looks only")
+    shape_size = Param(None, optional=True, unit="m", shape=(3,),
+                       doc="Length, width, height of the shape (None: |r|, |r|/20, |r|/20); "
+                           "looks only")
+    color = _color()
+
+    def transform(self, q):
+        return ca.SX.eye(3), vec3(self.r)
+
+    mass_properties = RigidBody.mass_properties
+    check_values = RigidBody.check_values
+
+
 class PartialBodyShape(_CheckedTogether, PartialRigidTransform):
     """A solid between two frames: frame_b is frame_a moved by ``r`` (a FixedTranslation),
     and the solid's mass, centre of mass and inertia sit on frame_a (a RigidBody) as MSL's
@@ -481,6 +564,8 @@ class PartialBodyShape(_CheckedTogether, PartialRigidTransform):
     of ``r``: there MSL's inertia is not that of the solid it draws.)
     """
     has_mass = True
+    frame_a = Port("frame", "Frame a, the body's own (may be left unwired when the body hangs "
+                            "from frame_b)", optional=True)
     r = Param(unit="m", shape=(3,), doc="Position of frame_b in frame_a")
     r_shape = Param([0.0, 0.0, 0.0], unit="m", shape=(3,),
                     doc="Start of the shape from frame_a, resolved in frame_a")
@@ -678,59 +763,6 @@ class BodySphere(Component, library=MB):
         return mass, ca.DM.zeros(3), mass * self.diameter**2 / 10 * ca.DM.eye(3)
 
 
-class PartialLineForce(Component):
-    """A force along the line between the origins of frame_a and frame_b.
-
-    ``law(s, s_d)`` gives the tension f from the distance s and its rate: f > 0 pulls the
-    frames together (a stretched spring), as in Modelica's Forces.Spring.
-    """
-    role = "frame_force"
-    frame_a = Port("frame", "Frame a")
-    frame_b = Port("frame", "Frame b")
-
-    def law(self, s, s_d):
-        raise NotImplementedError
-
-
-class SpringDamper(PartialLineForce, library=MB):
-    """Linear spring and damper in parallel between two frame origins."""
-    c = Param(unit="N/m", min=0.0, doc="Spring constant")
-    d = Param(unit="N*s/m", min=0.0, doc="Damping constant")
-    s_unstretched = Param(0.0, unit="m", min=0.0, doc="Unstretched length")
-
-    def law(self, s, s_d):
-        return self.c * (s - self.s_unstretched) + self.d * s_d
-
-
-class Spring(PartialLineForce, library=MB):
-    """Linear spring between two frame origins."""
-    c = Param(unit="N/m", min=0.0, doc="Spring constant")
-    s_unstretched = Param(0.0, unit="m", min=0.0, doc="Unstretched length")
-
-    def law(self, s, s_d):
-        return self.c * (s - self.s_unstretched)
-
-
-class Damper(PartialLineForce, library=MB):
-    """Linear damper between two frame origins."""
-    d = Param(unit="N*s/m", min=0.0, doc="Damping constant")
-
-    def law(self, s, s_d):
-        return self.d * s_d
-
-
-class WorldForce(Component, library=MB):
-    """A force at the origin of frame_b, resolved in the world frame (time allowed)."""
-    role = "frame_force"
-    frame_b = Port("frame", "Frame the force acts on")
-    force = Param(unit="N", shape=(3,), time=True, doc="Force, resolved in the world frame")
-
-
-class WorldTorque(Component, library=MB):
-    """A torque on frame_b, resolved in the world frame (time allowed)."""
-    role = "frame_force"
-    frame_b = Port("frame", "Frame the torque acts on")
-    torque = Param(unit="N*m", shape=(3,), time=True, doc="Torque, resolved in the world frame")
-
-
 from .loopjoints import JointRRR, SphericalSpherical, UniversalSpherical  # noqa: E402,F401
+from .forces import (Damper, Force, ForceAndTorque, Spring, SpringDamper,  # noqa: E402,F401
+                     Torque, WorldForce, WorldTorque)

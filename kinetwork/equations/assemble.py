@@ -14,8 +14,8 @@ import numpy as np
 
 from ..errors import ModelError
 from ..expr import casadi_functions, parse
-from ..spatial import line_length, vec3, vee
-from . import network
+from ..spatial import vee
+from . import applied, network
 from .newton_euler import Body, aba, crba, motion_subspace, rnea, spatial_inertia
 from .signals import probe_signals
 
@@ -66,16 +66,28 @@ class Assembly:
     prescribed: dict = field(default_factory=dict)
     _poses: dict = field(default_factory=dict)
     base: tuple = None         # world pose of the body of the last ``relative_poses``
+    #: the gravity field, and what the point masses of force elements add (applied.Extra)
+    applied: object = None
 
     def mass_matrix(self):
-        return crba(self.bodies, self.u.shape[0], self.armature)
+        M = crba(self.bodies, self.u.shape[0], self.armature)
+        extra = self.applied.mass_matrix()
+        return M if extra is None else M + extra
 
     def mass_times(self, w):
         """M(q) w, by inverse dynamics with no speed and no gravity: an O(n) expression in
         (q, w), where the mass matrix itself is O(n^2)."""
         zero = ca.SX.zeros(self.u.shape[0])
-        return ca.substitute(rnea(self.bodies, zero, w, ca.SX.zeros(6), self.armature),
+        Mw = ca.substitute(rnea(self.bodies, zero, w, ca.SX.zeros(6), self.armature),
+                           self.u, zero)
+        return Mw + self.applied.mass_times(w) if self.applied.masses else Mw
+
+    def solve_mass(self, w):
+        """M(q)^-1 w by the articulated-body algorithm (no speed, no gravity): O(n)."""
+        zero = ca.SX.zeros(self.u.shape[0])
+        tree = ca.substitute(aba(self.bodies, zero, w, ca.SX.zeros(6), self.armature),
                              self.u, zero)
+        return self.applied.forward(tree, self.armature)
 
     def start_function(self):
         """Function p -> (q_start, u_start): the initial coordinates and speeds as given."""
@@ -88,7 +100,10 @@ class Assembly:
         zero = ca.SX.zeros(n)
         C = rnea(self.bodies, self.u, zero, ca.SX.zeros(6))       # udot = 0: no armature
         G = rnea(self.bodies, zero, zero, a_grav)
-        return self.mass_matrix(), C - self.Q, G
+        # Q holds the gravity the Newton-Euler passes do not take (a point field, point
+        # masses): it belongs to G
+        Qg = self.applied.Q_gravity
+        return self.mass_matrix(), C - self.Q + Qg, G - Qg
 
     def pose(self, frame_set):
         """World orientation R and position p of a frame set, in the coordinates q."""
@@ -175,11 +190,13 @@ def assemble(model, topo, values):
                                                           u[uindex[joint.name]])
 
     bodies, place = _bodies(topo, bound, q, u, qindex, uindex)
-    gravity = ca.vertcat(*bound[topo.world.name].gravity) if topo.world else ca.SX.zeros(3)
+    extra = applied.Extra(topo, bound, bodies, place, q, u, qdot)
+    gravity = extra.uniform
     a_grav = ca.vertcat(ca.SX.zeros(3), -gravity)
 
     def inverse(a, armature, passive):     # M(q) a + C(q, u) u + G(q) - Q_passive
-        return rnea(bodies, u, a, a_grav, armature) - passive
+        tree = rnea(bodies, u, a, a_grav, armature) - passive
+        return tree + extra.mass_times(a) - extra.Q if n else tree
     net = network.build(model, topo, bound, q, u, udot, qindex, uindex, t, inverse, p,
                         [values[k] for k in names])
     Q = net.Q
@@ -200,9 +217,10 @@ def assemble(model, topo, values):
                    ca.vertcat(*u_start) if u_start else ca.SX(0, 1), given, u_given, regular,
                    speed_of, Q, None, qdot, gravity, udot, place=place)
     asm.armature, asm.net = net.armature, net
-    asm.Q = Q + _frame_forces(asm, topo, bound, t)
-    asm.udot_tree = aba(bodies, u, asm.Q, ca.vertcat(ca.SX.zeros(3), -gravity), net.armature) \
-        if n else ca.SX(0, 1)
+    asm.applied = extra
+    asm.Q = Q + _frame_forces(asm, topo, bound, t) + extra.Q
+    asm.udot_tree = extra.forward(aba(bodies, u, asm.Q, ca.vertcat(ca.SX.zeros(3), -gravity),
+                                      net.armature), net.armature) if n else ca.SX(0, 1)
     asm.cuts = [(cut, _closure(asm, cut, bound[cut.component.name], qindex))
                 for cut in topo.cuts]
     _place_cut_frames(asm, topo, bound)
@@ -317,28 +335,9 @@ def _zero_pose(comp):
 
 
 def _frame_forces(asm, topo, bound, t):
-    """Generalized forces of line forces and world forces/torques: the power they put in,
-    differentiated by the speeds (a force on a frame enters as J^T f)."""
-    Q = ca.SX.zeros(asm.u.shape[0])
-    if not asm.u.shape[0]:
-        return Q
-    for comp in topo.forces:
-        c = bound[comp.name]
-        if "frame_a" in comp.ports:
-            _, pa = asm.pose(topo.set_of[comp.port_ref("frame_a")])
-            _, pb = asm.pose(topo.set_of[comp.port_ref("frame_b")])
-            s = line_length(pb - pa)
-            s_d = ca.jtimes(s, asm.q, asm.qdot)
-            # the tension times the rate of the length, differentiated by the speeds with
-            # the tension held (a damper's law depends on the speeds itself)
-            Q -= c.law(s, s_d) * ca.gradient(s_d, asm.u)
-        else:
-            R, pos = asm.pose(topo.set_of[comp.port_ref("frame_b")])
-            w, v = asm.angular_velocity(R, False), asm.rate(pos, False)
-            power = ca.dot(vec3(c.force), v) if "force" in comp.params \
-                else ca.dot(vec3(c.torque), w)
-            Q += ca.gradient(power, asm.u)
-    return Q
+    """Generalized forces of the force elements on frames (line forces, forces and torques):
+    the wrench each applies on a frame enters as J^T f + J_w^T t (``applied.py``)."""
+    return applied.element_forces(asm, topo, bound)
 
 
 def _closure(asm, cut, comp, qindex):

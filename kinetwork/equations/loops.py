@@ -539,7 +539,7 @@ class _Loops:
         if dep:
             g[dep] = -ca.solve(JD, c + JP @ acc_P if P else c)
         a_grav = ca.vertcat(ca.SX.zeros(3), -asm.gravity)
-        M = crba(asm.bodies, nv, asm.armature)
+        M = asm.mass_matrix()
         bias = rnea(asm.bodies, u, ca.SX.zeros(nv), a_grav) - asm.Q
         Mr = T.T @ M @ T
         udot_i = ca.solve(Mr, -T.T @ (bias + M @ g))

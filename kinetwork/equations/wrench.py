@@ -24,7 +24,8 @@ probe reports the torque about the frame's own origin.
 
 import casadi as ca
 
-from ..spatial import line_length, skew, vec3
+from ..spatial import skew
+from .applied import element_wrench
 from .newton_euler import motion_subspace
 
 
@@ -139,26 +140,13 @@ class _Balance:
         w = asm.angular_velocity(R)
         alpha = asm.rate(w)
         Iw = R @ Ic @ R.T
-        force = m * (a - asm.gravity)
+        force = m * (a - asm.applied.field(cw))
         return force, ca.cross(cw, force) + Iw @ alpha + ca.cross(w, Iw @ w)
 
     def _applied(self, comp, port):
-        """Force applied by a force element at ``port`` and its moment about the origin."""
-        asm, c = self.asm, self.bound[comp.name]
-        _, pb = asm.pose(self.topo.set_of[comp.port_ref(port)])
-        if "frame_a" in comp.ports:
-            _, pa = asm.pose(self.topo.set_of[comp.port_ref("frame_a")])
-            _, pb_ = asm.pose(self.topo.set_of[comp.port_ref("frame_b")])
-            d = pb_ - pa
-            s = line_length(d)       # as the equations of motion: no force at zero length
-            e = d / s
-            tension = c.law(s, ca.jtimes(s, asm.q, asm.qdot))
-            force = (-tension * e) if port == "frame_b" else tension * e
-            return force, ca.cross(pb, force)
-        if "force" in comp.params:
-            force = vec3(c.force)
-            return force, ca.cross(pb, force)
-        return ca.SX.zeros(3), vec3(c.torque)
+        """Force applied by a force element at ``port`` (its point masses' share of inertia
+        and weight included) and its moment about the origin."""
+        return element_wrench(self.asm, self.topo, self.bound, comp, port)
 
     def _constraint(self, i, cut, port):
         """Constraint wrench a cut joint applies on the frame at ``port``: the dual of the

@@ -123,8 +123,8 @@ def analyze(model):
             continue
         for pname, port in comp.ports.items():
             ref = comp.port_ref(pname)
-            if not port.optional and all(p.component.role == "probe"
-                                         for p in sets[set_of[ref]] if p != ref):
+            if (not port.optional or pname in comp.required_ports()) and all(
+                    p.component.role == "probe" for p in sets[set_of[ref]] if p != ref):
                 problems.append(f"{model.place(comp)}: port {ref.path} ({port.domain}) "
                                 f"is not connected")
 
@@ -146,7 +146,8 @@ def analyze(model):
     _signals(topo, problems)
     _motions(model, topo, problems)
     if values is not None:
-        _inertias(model, roles.get("body", []), values, problems)
+        _inertias(model, [c for c in model.components.values() if c.role == "body" or (
+            c.role in ("joint", "part") and c.has_mass)], values, problems)
         for comp in model.components.values():
             problems.extend(comp.check_values(values[comp.name],
                                               lambda key, c=comp: model.place(c, key)))
@@ -233,6 +234,13 @@ def _tree(model, topo, roles, problems):
                                 f"only, but {', '.join(stray)} is wired to it")
         for pname in comp.ports:
             if comp.ports[pname].domain == "frame" and pname not in placed and \
+                    _dangling(topo, comp, pname) and \
+                    len(topo.sets[topo.set_of[comp.port_ref(pname)]]) > 1 and \
+                    topo.set_of[comp.port_ref(pname)] not in reached:
+                problems.append(f"{model.place(comp)}: {comp.name}.{pname} is not wired, so "
+                                f"it has no pose for a probe to measure")
+            if comp.ports[pname].domain == "frame" and pname not in placed and \
+                    not _dangling(topo, comp, pname) and \
                     topo.set_of[comp.port_ref(pname)] not in reached:
                 problems.append(f"{model.place(comp)}: {comp.name} is not connected to the "
                                 f"ground {topo.world.name!r} through joints or rigid parts")
@@ -276,7 +284,16 @@ def _tree(model, topo, roles, problems):
     topo.bodies = [(b, topo.set_of[b.port_ref("frame_a")]) for b in massive
                    if topo.set_of[b.port_ref("frame_a")] in reached]
     topo.forces = [f for f in roles.get("frame_force", [])
-                   if all(topo.set_of[f.port_ref(pn)] in reached for pn in f.ports)]
+                   if all(topo.set_of[f.port_ref(pn)] in reached for pn, port in f.ports.items()
+                          if port.domain == "frame" and not _dangling(topo, f, pn))]
+
+
+def _dangling(topo, comp, pname):
+    """A force element's optional port left unwired (its frame_resolve): nothing to reach.
+    (A joint's or part's unwired end is reached through the part itself.)"""
+    ref = comp.port_ref(pname)
+    return comp.role == "frame_force" and comp.ports[pname].optional and all(
+        p.component.role == "probe" for p in topo.sets[topo.set_of[ref]] if p != ref)
 
 
 def _oned(model, topo, values, problems):

@@ -19,7 +19,7 @@ import casadi as ca
 import numpy as np
 
 from . import jit as _jit
-from ..equations.newton_euler import aba, rnea
+from ..equations.newton_euler import rnea
 from ..equations.system import mapped
 from .compiled import JACOBIAN_JIT_LIMIT
 
@@ -48,9 +48,7 @@ class Midpoint:
         f_qdd = ca.Function("qdd", [a.t, a.q, a.u, a.p], [a.udot_tree])
         # qd = M(q)^-1 p by the articulated-body algorithm (p as the joint forces, no speed,
         # no gravity): O(n), no mass matrix
-        f_vel = ca.Function("velocity", [a.q, w, a.p],
-                            [ca.substitute(aba(a.bodies, zero, w, ca.SX.zeros(6), a.armature),
-                                           a.u, zero)])
+        f_vel = ca.Function("velocity", [a.q, w, a.p], [a.solve_mass(w)])
 
         v, q0, p0 = ca.SX.sym("v", n), ca.SX.sym("q0", n), ca.SX.sym("p0", n)
         t0, h, par = ca.SX.sym("t0"), ca.SX.sym("h"), ca.SX.sym("par", a.p.shape[0])
