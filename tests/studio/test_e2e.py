@@ -271,6 +271,17 @@ def test_a_subsystem_opens_to_its_definition_and_back(page, studio):
     select(page, "pid")
     IMAGES.mkdir(parents=True, exist_ok=True)
     page.screenshot(path=str(IMAGES / "studio-subsystem.png"))
+    # an edit inside a definition read from a file writes it inline, as kn's writer does
+    set_field(page, "param-k", "2*k")
+    page.wait_for_function("() => window.__kinetwork.doc.definitions.Axis.components")
+    axis = K(page, "K.doc.definitions.Axis")
+    assert next(c for c in axis["components"] if c["name"] == "pid")["params"]["k"] == "2*k"
+    assert set(axis["ports"]) == {"flange", "reference"}
+    wait_validated(page)
+    assert K(page, "K.validation.ok"), K(page, "K.validation.problems")
+    page.keyboard.press("Control+z")
+    page.wait_for_function("() => window.__kinetwork.doc.definitions.Axis.file === 'Axis.json'")
+    assert not K(page, "K.dirty")
     page.click(tid("crumb-0"))
     page.wait_for_selector(tid("node-shoulder_axis"))
     assert not page.errors, page.errors
@@ -298,6 +309,18 @@ def test_make_subsystem_runs_as_the_flat_model(page, studio):
     assert K(page, "K.validation.ok"), K(page, "K.validation.problems")
     assert run(page) == "done"
     assert_signals_match(K(page, "K.lastRun"), seed_results(), atol=1e-8)
+    # saved with its definition inline, it reads back and runs the same
+    page.click(tid("save-as"))
+    set_field(page, "save-path", "models/forearm.json")
+    page.wait_for_function("() => window.__kinetwork.lastSave")
+    saved = kn.load(studio.root / "models" / "forearm.json")
+    assert type(saved.components["forearm1"]).__name__ == "Subsystem"
+    again, reference = kn.simulate(saved, t_end=10.0, n_points=1001, method="auto",
+                                   rtol=1e-8, atol=1e-10), seed_results()
+    for q in ("angle", "speed", "acceleration", "torque"):
+        for probe in ("probe1", "probe2"):
+            np.testing.assert_allclose(again[f"{probe}.{q}"], reference[f"{probe}.{q}"],
+                                       rtol=0, atol=1e-8)
     # undo gives the flat model back
     page.keyboard.press("Control+z")
     page.wait_for_selector(tid("node-elbow"))
@@ -530,3 +553,38 @@ def test_measure_load_run_and_3d_frame_rate(page, studio, record_property):
           f"{fps:.1f} frames/s")
     assert fps > 0 and all(r > 0 for r in runs)
     assert not page.errors, page.errors
+
+
+def test_the_palette_searches_and_describes_types(page, studio):
+    open_studio(page, studio)
+    from kinetwork.components.base import REGISTRY
+    assert page.locator('[data-testid^="palette-"][draggable]').count() == len(REGISTRY)
+    page.fill(tid("palette-search"), "spring damper")
+    shown = [el.get_attribute("data-testid") for el in
+             page.locator('[data-testid^="palette-"][draggable]').all()]
+    assert set(shown) == {"palette-multibody.SpringDamper", "palette-rotational.SpringDamper",
+                          "palette-translational.SpringDamper"}
+    page.hover(tid("palette-rotational.SpringDamper"))
+    info = page.locator(tid("palette-info")).inner_text()
+    assert "rotational.SpringDamper" in info and "N*m/rad" in info and "flange_a" in info
+    # double-click places one too, with a fresh name
+    page.dblclick(tid("palette-rotational.SpringDamper"))
+    page.dblclick(tid("palette-rotational.SpringDamper"))
+    page.wait_for_selector(tid("node-spring2"))
+    assert K(page, "K.doc.components.map(c => c.name)") == ["spring1", "spring2"]
+    assert not page.errors, page.errors
+
+
+def test_a_file_that_is_no_model_is_refused_without_breaking(page, studio):
+    (studio.root / "list.json").write_text("[1, 2, 3]\n")
+    (studio.root / "odd.json").write_text('{"format": "kinetwork.model", "version": 1, '
+                                          '"name": "odd", "components": {"a": 1}}\n')
+    open_studio(page, studio)
+    for path in ("list.json", "odd.json"):
+        page.click(tid("open"))
+        page.click(tid(f"file-{path}"))
+        page.locator(tid("toast")).filter(has_text=path).wait_for()
+        page.keyboard.press("Escape")
+    open_file(page, SEED)                  # the studio still works
+    assert K(page, "K.doc.name") == "double_pendulum"
+    assert not [e for e in page.errors if "Failed to load resource" not in e], page.errors

@@ -2,7 +2,7 @@
 // The document is a model file's top-level object; every edit makes a new one (undo/redo
 // keep them), validation follows edits (debounced), Run posts it to the server.
 import { useCallback, useEffect, useMemo, useReducer, useRef, useState } from "react";
-import { useReactFlow } from "@xyflow/react";
+import { MarkerType, useReactFlow } from "@xyflow/react";
 import { api, OPEN, EXAMPLE } from "./api.js";
 import Canvas from "./Canvas.jsx";
 import Palette from "./Palette.jsx";
@@ -34,6 +34,7 @@ import {
   typeInfo,
   updateDefinition,
   definitionSource,
+  shapeProblem,
 } from "./model.js";
 import { makeSubsystem } from "./subsystem.js";
 
@@ -46,7 +47,8 @@ function historyReducer(h, a) {
   switch (a.type) {
     case "update": {
       const next = a.fn(h.present);
-      if (!next || next === h.present) return h;
+      // an edit that changes nothing is no step to undo
+      if (!next || next === h.present || JSON.stringify(next) === JSON.stringify(h.present)) return h;
       return { past: [...h.past.slice(-199), h.present], present: next, future: [] };
     }
     case "undo":
@@ -196,7 +198,7 @@ export default function App() {
     for (const key of want) {
       api
         .openPath(key)
-        .then((r) => setDefCache((dc) => ({ ...dc, [key]: { status: "ok", model: r.model } })))
+        .then((r) => setDefCache((dc) => ({ ...dc, [key]: shapeProblem(r.model) ? { status: "missing" } : { status: "ok", model: r.model } })))
         .catch(() => setDefCache((dc) => ({ ...dc, [key]: { status: "missing" } })));
     }
   }, [doc, defCache, palette, rootCtx]);
@@ -349,7 +351,13 @@ export default function App() {
       if (!dom || dom === "any") dom = portDomain(body, b, ctx) || dom || "any";
       const bad = badConn.has(i);
       const color = bad ? "#e03131" : DOMAIN_COLORS[dom] || "#888";
+      // a signal wire points at its input
+      const arrow = { type: MarkerType.ArrowClosed, color, width: 14, height: 14 };
+      const markers = dom === "signal_in" || dom === "signal_out"
+        ? portDomain(body, b, ctx) === "signal_in" ? { markerEnd: arrow } : portDomain(body, a, ctx) === "signal_in" ? { markerStart: arrow } : {}
+        : {};
       return {
+        ...markers,
         id: `${a}~${b}~${i}`,
         source: ca,
         sourceHandle: pa,
@@ -702,6 +710,11 @@ export default function App() {
       try {
         const r = src.path ? await api.openPath(src.path) : await api.openExample(src.example);
         const model = r.model;
+        const bad = shapeProblem(model);
+        if (bad) {
+          toast(`cannot show ${src.path || src.example} as a diagram: ${bad}`);
+          return;
+        }
         dispatch({ type: "reset", doc: model });
         setFile({ path: r.path || null, text: r.text, baseline: JSON.stringify(model), example: src.example || null });
         setScopes([]);
@@ -927,6 +940,17 @@ export default function App() {
     window.addEventListener("keydown", onKey);
     return () => window.removeEventListener("keydown", onKey);
   }, [copy, paste, save, deleteSelected]);
+
+  // leaving the page with unsaved changes asks first
+  useEffect(() => {
+    if (!dirty) return undefined;
+    const onLeave = (e) => {
+      e.preventDefault();
+      e.returnValue = "";
+    };
+    window.addEventListener("beforeunload", onLeave);
+    return () => window.removeEventListener("beforeunload", onLeave);
+  }, [dirty]);
 
   // -- the testing hook -------------------------------------------------------------------------
   K.doc = doc;

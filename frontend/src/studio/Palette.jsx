@@ -10,9 +10,17 @@ function firstLine(doc) {
   return String(doc || "").trim().split("\n")[0];
 }
 
+/** A doc's first sentence: what a search looks in, beside names. */
+function firstSentence(doc) {
+  const line = firstLine(doc);
+  const m = /\.(\s|$)/.exec(line);
+  return m ? line.slice(0, m.index + 1) : line;
+}
+
 function matches(t, q) {
   if (!q) return true;
-  const hay = `${t.type} ${t.doc || ""} ${(t.params || []).map((p) => p.name).join(" ")}`.toLowerCase();
+  // the type's name, the first sentence of its doc and its parameters' names
+  const hay = `${t.type} ${firstSentence(t.doc)} ${(t.params || []).map((p) => p.name).join(" ")}`.toLowerCase();
   return q.toLowerCase().split(/\s+/).every((w) => hay.includes(w));
 }
 

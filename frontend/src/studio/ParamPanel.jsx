@@ -1,7 +1,7 @@
 // The right-hand panel: the selected component's parameters (value or expression, with
 // unit, bounds, default and doc), or, with nothing selected, the model (or definition): its
 // name, parameters and simulation settings.
-import { useEffect, useState } from "react";
+import { useEffect, useRef, useState } from "react";
 import { formatValue, parseValue, IDENT } from "./model.js";
 import { TypeIcon } from "./icons.jsx";
 
@@ -12,8 +12,16 @@ export function Field({ value, onCommit, testid, placeholder, className, list, b
   useEffect(() => {
     if (!focused) setText(value);
   }, [value, focused]);
+  useEffect(() => {
+    sent.current = null;
+  }, [value]);
+  const sent = useRef(null);
   const commit = () => {
-    if (text !== value) onCommit(text);
+    // Enter commits and blurs: the blur must not commit the same text again
+    if (text !== value && text !== sent.current) {
+      sent.current = text;
+      onCommit(text);
+    }
   };
   return (
     <input

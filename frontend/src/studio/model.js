@@ -448,3 +448,44 @@ export function autoLayout(body, only) {
   }
   return pos;
 }
+
+/**
+ * Why the studio cannot show ``data`` as a diagram (its validation says the rest), or null:
+ * the parts it draws must have their shape (lists of named components and of pairs).
+ */
+export function shapeProblem(data) {
+  const isObj = (x) => x !== null && typeof x === "object" && !Array.isArray(x);
+  if (!isObj(data)) return "the file does not hold a JSON object";
+  const bodies = [["", data]];
+  if (data.definitions !== undefined) {
+    if (!isObj(data.definitions)) return "definitions: must be an object";
+    for (const [k, v] of Object.entries(data.definitions)) {
+      if (!isObj(v)) return `definitions.${k}: must be an object`;
+      if (typeof v.file !== "string") bodies.push([`definitions.${k}.`, v]);
+    }
+  }
+  for (const [where, b] of bodies) {
+    if (b.components !== undefined) {
+      if (!Array.isArray(b.components)) return `${where}components: must be a list`;
+      for (const [i, c] of b.components.entries()) {
+        if (!isObj(c) || typeof c.name !== "string" || typeof c.type !== "string") {
+          return `${where}components[${i}]: must be an object with a name and a type`;
+        }
+        if (c.params !== undefined && !isObj(c.params)) return `${where}components[${i}] params: must be an object`;
+      }
+    }
+    if (b.connections !== undefined) {
+      if (!Array.isArray(b.connections)) return `${where}connections: must be a list`;
+      for (const [i, c] of b.connections.entries()) {
+        if (!Array.isArray(c) || c.length !== 2 || c.some((x) => typeof x !== "string")) {
+          return `${where}connections[${i}]: must be a pair of "component.port"`;
+        }
+      }
+    }
+    for (const key of ["parameters", "layout", "ports"]) {
+      if (b[key] !== undefined && !isObj(b[key])) return `${where}${key}: must be an object`;
+    }
+  }
+  if (data.simulation !== undefined && !isObj(data.simulation)) return "simulation: must be an object";
+  return null;
+}
