@@ -320,7 +320,7 @@ export default function App() {
       const info = comp && typeInfo(comp.type, ctx);
       const pinfo = info && info.ports.find((p) => p.name === port);
       const domain = pinfo ? pinfo.domain : "any";
-      const side = pinfo ? portSide(port, domain, info.ports) : "left";
+      const side = pinfo ? pinfo.side || portSide(port, domain, info.ports) : "left";
       const at = posOf(cname) || { x: 0, y: 0 };
       // above the block, on the side of its port (a row of blocks leaves no room beside)
       const shift = { left: [-50, -50], right: [70, -50], top: [20, -55], bottom: [20, 75] }[side];
@@ -1044,7 +1044,7 @@ export default function App() {
               </span>
             ))}
             <span className="kn-muted kn-small kn-hint">
-              drag from the palette · wire port to port · drag a box to select · Del deletes · Ctrl+Z/Y · Ctrl+C/V · double-click a subsystem to open it
+              drag from the palette · wire port to port · box-select by dragging · wheel zooms, right-drag pans · Del · Ctrl+Z/Y · Ctrl+C/V · double-click a subsystem to open it
             </span>
           </div>
           <Canvas

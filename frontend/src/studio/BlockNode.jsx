@@ -12,7 +12,7 @@ const PORT_STEP = 20;
 /** Where each port goes: {port, side, offset (0..1 along the side)}; the block's height. */
 export function blockGeometry(ports) {
   const sides = { left: [], right: [], top: [], bottom: [] };
-  for (const p of ports) sides[portSide(p.name, p.domain, ports)].push(p);
+  for (const p of ports) sides[p.side || portSide(p.name, p.domain, ports)].push(p);
   const tall = Math.max(sides.left.length, sides.right.length);
   const height = Math.max(64, tall * PORT_STEP + 24);
   const out = [];

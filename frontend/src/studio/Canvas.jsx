@@ -167,6 +167,7 @@ export default function Canvas({
         onDelete={onDeleteCb}
         onSelectionChange={onSelectionChange}
         onNodeDoubleClick={onNodeDoubleClick}
+        onPaneContextMenu={(e) => e.preventDefault()}
         connectionMode={ConnectionMode.Loose}
         defaultEdgeOptions={defaultEdgeOptions}
         snapToGrid

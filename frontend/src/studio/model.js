@@ -226,6 +226,8 @@ export function typeInfo(type, ctx, depth = 0) {
     domain: refDomain(body, ref, r.ctx, depth + 1),
     doc: `${ref} of ${type}`,
     optional: true,
+    // on the side of the block its inner port is on (link1.frame_a: left)
+    side: refSide(body, ref, r.ctx, depth + 1),
   }));
   const params = Object.entries(body.parameters || {}).map(([name, value]) => ({
     name,
@@ -241,6 +243,17 @@ export function typeInfo(type, ctx, depth = 0) {
     time: false,
   }));
   return { type, doc: body.description || `subsystem ${type}`, ports, params, subsystem: true };
+}
+
+/** The side of its block that "comp.port" inside a body is drawn on, or undefined. */
+function refSide(body, ref, ctx, depth) {
+  if (typeof ref !== "string") return undefined;
+  const [cname, pname] = ref.split(".");
+  const comp = (body.components || []).find((c) => c.name === cname);
+  const info = comp && typeInfo(comp.type, ctx, depth + 1);
+  const port = info && info.ports.find((p) => p.name === pname);
+  if (!port) return undefined;
+  return port.side || portSide(pname, port.domain, info.ports);
 }
 
 /** The domain of "comp.port" inside a body. */
