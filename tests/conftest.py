@@ -26,3 +26,25 @@ def seed_file(tmp_path):
     path = tmp_path / "double_pendulum.json"
     double_pendulum().save(path)
     return path
+
+
+#: Debian's Chromium, driven by Playwright (its own browser download is not reachable here)
+CHROMIUM = "/usr/bin/chromium"
+CHROMIUM_ARGS = ["--headless", "--no-sandbox", "--disable-gpu", "--disable-background-networking",
+                 "--disable-component-update", "--disable-sync", "--no-first-run"]
+
+
+@pytest.fixture(scope="session")
+def chromium():
+    """One headless Chromium for the whole run, shared by every browser test (Playwright's
+    sync API allows one driver per thread: a second one in the same run fails)."""
+    import os
+    if not os.path.exists(CHROMIUM):
+        pytest.skip(f"{CHROMIUM} is missing (as root: apt-get install -y chromium)")
+    sync_api = pytest.importorskip("playwright.sync_api", reason="pip install playwright")
+    with sync_api.sync_playwright() as p:
+        browser = p.chromium.launch(executable_path=CHROMIUM, args=CHROMIUM_ARGS)
+        try:
+            yield browser
+        finally:
+            browser.close()

@@ -16,9 +16,6 @@ from kinetwork.animation import animation_data, video
 from kinetwork.cli import main
 
 MODELS = os.path.join(os.path.dirname(__file__), os.pardir, "models")
-CHROMIUM = "/usr/bin/chromium"
-CHROMIUM_ARGS = ["--headless", "--no-sandbox", "--disable-gpu", "--disable-background-networking",
-                 "--disable-component-update", "--disable-sync", "--no-first-run"]
 
 
 def probed(model):
@@ -271,23 +268,16 @@ def test_a_model_name_cannot_break_the_page(seed_run, tmp_path):
     assert page.count("</script>") == 2 and "alert(1)</script>" not in page
 
 
-def chromium_page(p):
-    browser = p.chromium.launch(executable_path=CHROMIUM, args=CHROMIUM_ARGS)
-    return browser, browser.new_page(viewport={"width": 800, "height": 600})
-
-
 def picture(png):
     from PIL import Image
     return np.asarray(Image.open(io.BytesIO(png)).convert("RGB")).astype(int)
 
 
-def test_the_page_plays_in_chromium(seed_page):
-    if not os.path.exists(CHROMIUM):
-        pytest.skip(f"no Chromium at {CHROMIUM} (apt-get install chromium) for the browser test")
-    sync_api = pytest.importorskip("playwright.sync_api", reason="pip install playwright")
+def test_the_page_plays_in_chromium(seed_page, chromium):
     path, anim = seed_page
-    with sync_api.sync_playwright() as p:
-        browser, page = chromium_page(p)
+    context = chromium.new_context(viewport={"width": 800, "height": 600})
+    try:
+        page = context.new_page()
         problems, requests = [], []
         page.on("console", lambda msg: msg.type == "error" and problems.append(msg.text))
         page.on("pageerror", lambda exc: problems.append(str(exc)))
@@ -331,7 +321,8 @@ def test_the_page_plays_in_chromium(seed_page):
             viewer.dispose();
             return [seen, box.querySelectorAll("canvas").length];
         }""")
-        browser.close()
+    finally:
+        context.close()
     assert not problems, problems
     assert requests == [path.as_uri()]
     seen, canvases = seen

@@ -9,7 +9,6 @@ without derivative part, a line spring-damper of zero length.
 
 import json
 import math
-import os
 import subprocess
 import time
 

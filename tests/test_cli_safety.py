@@ -3,7 +3,6 @@ equations, settings refused before anything runs, outputs that would overwrite t
 each other, long texts summarised, and runs stopped by SIGINT or SIGTERM that still write
 what they computed and exit 128 + the signal."""
 
-import json
 import os
 import signal
 import subprocess

@@ -11,7 +11,7 @@ inertia, once, for all of them.
 
 import casadi as ca
 
-from ..spatial import line_length, vec3
+from ..spatial import line_length
 from .base import Component, Param, Port
 
 MB = "multibody"

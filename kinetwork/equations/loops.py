@@ -54,7 +54,7 @@ import numpy as np
 import scipy.linalg
 
 from ..errors import ModelError
-from .newton_euler import aba, crba, rnea
+from .newton_euler import aba, rnea
 
 FORMULATIONS = ("partition", "projected", "baumgarte")
 #: Newton steps of the projected formulation (from a start within the integrator's tolerance

@@ -19,8 +19,6 @@ REPO = pathlib.Path(__file__).resolve().parents[2]
 CHROMIUM = "/usr/bin/chromium"
 STATIC_INDEX = REPO / "kinetwork" / "studio" / "static" / "index.html"
 E2E_TOKEN = "e2e-token-0123456789abcdef"
-CHROMIUM_ARGS = ["--headless", "--no-sandbox", "--disable-gpu", "--disable-background-networking",
-                 "--disable-component-update", "--disable-sync", "--no-first-run"]
 VIEWPORT = {"width": 1600, "height": 1000}
 
 
@@ -86,20 +84,13 @@ def studio(tmp_path):
         sock.close()
 
 
-@pytest.fixture(scope="session")
-def browser():
-    """Debian's Chromium, headless, for the whole session."""
+@pytest.fixture
+def browser(chromium):
+    """Debian's Chromium, headless, shared with the whole run (tests/conftest.py)."""
     why = _why_not()
     if why:
         pytest.skip(why)
-    from playwright.sync_api import sync_playwright
-
-    with sync_playwright() as p:
-        b = p.chromium.launch(executable_path=CHROMIUM, args=CHROMIUM_ARGS)
-        try:
-            yield b
-        finally:
-            b.close()
+    return chromium
 
 
 @pytest.hookimpl(hookwrapper=True)
