@@ -47,8 +47,6 @@ CHUNK_WORK = 1e8
 #: CHUNK_GROWTH-fold (each chunk restarts a multistep method: few chunks for a fast run)
 FIRST_CHUNK_STEPS = 100
 CHUNK_GROWTH = 16
-#: output intervals of the first chunk of a run that can be cancelled
-CANCELLABLE_FIRST_CHUNK = 4
 #: restarts after a failure, with ``restart=True``, at most
 MAX_RESTARTS = 3
 #: a restarted run must keep the loops closed to this (m, or rotation-matrix entries)
@@ -367,11 +365,6 @@ def _first_chunk(run, method, intervals):
     steps = run.steps_per_interval if method.fixed else FIRST_CHUNK_STEPS
     per_interval = 4 * steps * run.instructions
     fit = CHUNK_WORK / per_interval
-    if run.cancel is not None:
-        # someone waits to cancel (the studio, a signal): the first chunk only measures the
-        # work per interval, whatever the steps of an interval turn out to be (the seed over
-        # 1e5 s at 1001 points ran 25 s in a first chunk sized for 100 steps an interval)
-        fit = min(fit, CANCELLABLE_FIRST_CHUNK)
     if fit >= intervals:
         return intervals
     return 2 ** int(np.log2(max(1.0, fit)))

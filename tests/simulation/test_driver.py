@@ -212,19 +212,3 @@ def test_a_run_in_a_thread_cannot_install_signal_handlers_but_still_runs():
     th.join(60)
     assert len(out["r"].t) == 1001
     assert driver.signal.getsignal(driver.signal.SIGINT) is not None
-
-
-def test_a_long_run_is_cancelled_within_a_chunk_not_at_its_end():
-    """The seed over 1e5 s at 1001 points: thousands of steps an output interval. The first
-    chunk of a cancellable run measures the work before it grows, so a cancel is honoured
-    after a small part of the run (it took all of a first chunk sized for 100 steps an
-    interval: half the run)."""
-    system = double_pendulum().compile()
-    calls = []
-
-    def cancel():
-        calls.append(1)
-        return len(calls) >= 3          # at the end of the second chunk
-    with pytest.raises(kn.SimulationError) as err:
-        kn.simulate(system, t_end=1e5, n_points=1001, cancel=cancel)
-    assert err.value.t_reached < 1e5 / 10
