@@ -10,8 +10,8 @@ faces: ``plot``, ``schema``, ``symbolic``, ``cli``.
 """
 
 from . import animation as _animation  # noqa: F401  (installs Results.animate)
-from . import plot as _plot  # noqa: F401  (installs Results.plot)
 from . import diagram as _diagram  # noqa: F401  (installs Model._repr_svg_ for Jupyter)
+from . import plot as _plot  # noqa: F401  (installs Results.plot)
 from .components import multibody, rotational, signals, translational
 from .components.probe import Probe
 from .equations.system import System
@@ -27,6 +27,6 @@ from .urdf import from_urdf
 
 __version__ = "0.1.0"
 
-__all__ = ["IdealisedInertiaWarning", "METHODS", "Model", "ModelError", "Probe", "Results", "SimulationError", "Subsystem", "System",
-           "dumps", "from_urdf", "load", "loads", "multibody", "rotational", "schema", "signals",
-           "simulate", "translational"]
+__all__ = ["IdealisedInertiaWarning", "METHODS", "Model", "ModelError", "Probe", "Results",
+           "SimulationError", "Subsystem", "System", "dumps", "from_urdf", "load", "loads",
+           "multibody", "rotational", "schema", "signals", "simulate", "translational"]
