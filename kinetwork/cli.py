@@ -507,8 +507,9 @@ def _compiled_summary(system, topo, loops):
         f"equations: {size['states']} states, {size['algebraic']} algebraic variables, "
         f"{len(system.signal_names)} probe signals ({n_values} values); right-hand side "
         f"{size['operations']} operations per evaluation ("
-        + ("articulated-body algorithm, O(N)" if system.formulation == "tree" else
-           "mass matrix projected on the independent speeds") + ")",
+        + {"tree": "articulated-body algorithm, O(N)",
+           "hybrid": "articulated-body algorithm with the prescribed accelerations, O(N)"}.get(
+            system.formulation, "mass matrix projected on the independent speeds") + ")",
     ]
 
 

@@ -275,3 +275,23 @@ def test_progress_bar_goes_to_stderr(seed_file, capfd):
     captured = capfd.readouterr()
     assert "t = " in captured.err and "%" in captured.err      # the bar
     assert "simulated t = 0 .. 5 s" in captured.out
+
+
+def test_validate_says_how_a_driven_tree_is_solved(tmp_path, capsys):
+    m = kn.Model("driven")
+    m.add(kn.multibody.Ground("ground", gravity=[0, -9.81, 0]))
+    m.add(kn.multibody.Revolute("j1"))
+    m.add(kn.multibody.FixedTranslation("l1", r=[1, 0, 0]))
+    m.add(kn.multibody.RigidBody("b1", mass=1.0))
+    m.add(kn.multibody.Revolute("j2"))
+    m.add(kn.multibody.RigidBody("b2", mass=1.0, r_cm=[1, 0, 0]))
+    m.add(kn.rotational.Position("drive", phi_ref="0.5*sin(2*t)"))
+    for a, b in [("ground.frame", "j1.frame_a"), ("j1.frame_b", "l1.frame_a"),
+                 ("l1.frame_b", "b1.frame_a"), ("l1.frame_b", "j2.frame_a"),
+                 ("j2.frame_b", "b2.frame_a"), ("drive.flange", "j1.axis")]:
+        m.connect(a, b)
+    m.save(tmp_path / "driven.json")
+    assert main(["validate", "--compile", str(tmp_path / "driven.json")]) == 0
+    out = capsys.readouterr().out
+    assert "states: 2 (j2.q [rad], j2.qd [rad/s])" in out
+    assert "(articulated-body algorithm with the prescribed accelerations, O(N))" in out
