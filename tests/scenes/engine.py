@@ -604,3 +604,51 @@ if __name__ == "__main__":
     out = pathlib.Path(sys.argv[1] if len(sys.argv) > 1 else "EngineV6.json")
     engine.save(out)
     print(f"wrote {out}: {out.stat().st_size} bytes")
+
+
+def build_engine1a():
+    """MSL's ``Examples.Loops.Engine1a`` (MSL 3.2, Engine1a.mo) as written there, part for
+    part: the mechanical part of one cylinder (no combustion), the output inertia J = 1
+    started at phi = 0, w = 10 rad/s. At phi = 0 the crank pin points up the cylinder: the
+    engine starts at its top dead centre, the loop's Jacobian singular. The loop joints start
+    from MSL's values (B1, B2 at 0, the slider at s = 0.15, none fixed); B1 is MSL's
+    RevolutePlanarLoopConstraint, here the cut revolute (its redundant rows dropped)."""
+    x = [1, 0, 0]
+    model = kn.Model("Engine1a", description=(
+        "Modelica.Mechanics.MultiBody.Examples.Loops.Engine1a (MSL 3.2): one cylinder's "
+        "mechanism, crank, rod and piston as BodyBox/BodyCylinder, started at its top dead "
+        "centre (phi = 0) with the output inertia (J = 1) at 10 rad/s; no combustion, no "
+        "friction: the energy is conserved. See tests/scenes/engine.py."),
+        simulation={"t_end": 5.0, "n_points": 501, "method": "auto", "rtol": 1e-8,
+                    "atol": 1e-10})
+    parts = [
+        mb.Ground("world", gravity=[0, -9.81, 0]),
+        mb.Revolute("Bearing", axis=x, q0=0.0, qd0=10.0),
+        rot.Inertia("Inertia", J=1.0),
+        mb.BodyCylinder("Crank1", r=[0.1, 0, 0], diameter=0.05),
+        mb.BodyBox("Crank2", r=[0, 0.1, 0], height=0.05, width_direction=x, width=0.02),
+        mb.BodyCylinder("Crank3", r=[0.1, 0, 0], diameter=0.03),
+        mb.BodyBox("Crank4", r=[0, -0.1, 0], height=0.05, width_direction=x, width=0.02),
+        mb.FixedTranslation("Mid", r=[0.05, 0, 0]),
+        mb.Revolute("B1", axis=x, cut=True),
+        mb.BodyBox("Rod", r=[0, -0.2, 0], width_direction=x, width=0.02, height=0.06),
+        mb.Revolute("B2", axis=x),
+        mb.BodyCylinder("Piston", r=[0, -0.1, 0], diameter=0.1),
+        mb.Prismatic("Cylinder", axis=[0, -1, 0], q0_guess=0.15),
+        mb.FixedTranslation("cylPosition", r=[0.15, 0.45, 0]),
+        kn.Probe("crank", quantities=["angle", "speed"]),
+        kn.Probe("piston", quantities=["position", "velocity"]),
+    ]
+    for part in parts:
+        model.add(part)
+    for a, b in [("world.frame", "Bearing.frame_a"), ("Crank2.frame_a", "Crank1.frame_b"),
+                 ("Crank2.frame_b", "Crank3.frame_a"), ("Bearing.frame_b", "Crank1.frame_a"),
+                 ("cylPosition.frame_b", "Cylinder.frame_a"),
+                 ("world.frame", "cylPosition.frame_a"), ("Crank3.frame_b", "Crank4.frame_a"),
+                 ("B1.frame_a", "Mid.frame_b"), ("B1.frame_b", "Rod.frame_b"),
+                 ("Rod.frame_a", "B2.frame_b"), ("B2.frame_a", "Piston.frame_b"),
+                 ("Inertia.flange_b", "Bearing.axis"), ("Mid.frame_a", "Crank2.frame_b"),
+                 ("Cylinder.frame_b", "Piston.frame_a"), ("crank.port", "Bearing.axis"),
+                 ("piston.port", "Cylinder.axis")]:
+        model.connect(a, b)
+    return model
