@@ -420,3 +420,23 @@ def test_animate_refuses_bad_paths(seed_run, tmp_path, kwargs, message):
     with pytest.raises(kn.ModelError, match=message):
         res.animate(model=m, **kwargs)
     assert os.listdir(tmp_path) == []
+
+
+def test_a_loop_rod_is_drawn_as_a_rod_of_its_length():
+    """MSL's Fourbar2 closes through a UniversalSpherical: a ball at either end and a rod
+    between, whose end frames stay the rod's length |r_rod| apart in every pose (the loop's
+    closure, read from the animation's own poses)."""
+    model = kn.load(os.path.join(MODELS, "fourbar2.json"))
+    res = kn.simulate(model, t_end=0.5, n_points=21)
+    anim = animation_data(res)
+    rods = [s for s in anim["shapes"] if s["kind"] == "rod"]
+    frames = anim["frames"]
+    joint = model.components["universalSpherical"]
+    a = next(i for i, f in enumerate(frames) if "universalSpherical.frame_a" in f["ports"])
+    b = next(i for i, f in enumerate(frames) if "universalSpherical.frame_b" in f["ports"])
+    assert any(r["frame"] == a and r["to"] == b for r in rods)
+    spheres = {s["frame"] for s in anim["shapes"] if s["kind"] == "sphere"}
+    assert {a, b} <= spheres
+    pa, pb = (np.asarray(frames[i]["position"], dtype=float) for i in (a, b))
+    length = np.linalg.norm(joint.r_rod)
+    np.testing.assert_allclose(np.linalg.norm(pb - pa, axis=1), length, rtol=0, atol=1e-9)

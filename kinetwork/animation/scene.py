@@ -259,6 +259,16 @@ class Scene:
         return [_shape("sphere", self.frame(comp, "frame_a"), np.zeros(3), _X, d, d, d,
                        COLORS["joint"])]
 
+    def rod_joint(self, comp, v):
+        """A massless rod with a joint at each end (SphericalSpherical, UniversalSpherical):
+        a ball at either end, a thin rod between."""
+        d = self.L / 14
+        a, b = self.frame(comp, "frame_a"), self.frame(comp, "frame_b")
+        ends = [_shape("sphere", f, np.zeros(3), _X, d, d, d, COLORS["joint"]) for f in (a, b)]
+        rod = ([{"kind": "rod", "frame": a, "to": b, "diameter": self.L / 40,
+                 "color": COLORS["rod"]}] if a is not None and b is not None and a != b else [])
+        return [e for e in ends if e is not None] + rod
+
     def prismatic(self, comp, v):
         n = unit_vector(_get(v, "axis", _X))
         name = f"{comp.name}.q"
@@ -384,6 +394,8 @@ VISUALS = {
     "multibody.Prismatic": Scene.prismatic,
     "multibody.Spherical": Scene.ball,
     "multibody.Universal": Scene.ball,
+    "multibody.SphericalSpherical": Scene.rod_joint,
+    "multibody.UniversalSpherical": Scene.rod_joint,
     "multibody.Planar": Scene.planar,
     "multibody.FreeMotion": lambda scene, comp, values: [],     # no joint to see: a body flies
     "multibody.FixedTranslation": Scene.rod,
