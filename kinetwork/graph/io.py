@@ -109,16 +109,21 @@ def loads(text, source=None, validate=True, library=None, folder=None):
     if len(text) > MAX_FILE_SIZE:
         raise ModelError(_at(source, f"{len(text)} characters, more than the "
                                      f"{MAX_FILE_SIZE} a model may have"))
+    return model_from_dict(_parse(text, source), source=source, validate=validate,
+                           context=Context.top(folder, library))
+
+
+def _parse(text, source):
+    """The JSON of a model text (keys given twice remembered), or a ModelError saying where
+    it stops being JSON."""
     try:
-        data = json.loads(text, object_pairs_hook=_Object.from_pairs, parse_int=_int)
+        return json.loads(text, object_pairs_hook=_Object.from_pairs, parse_int=_int)
     except json.JSONDecodeError as exc:
         end = " (the text ends early: truncated?)" if exc.pos >= len(text.rstrip()) else ""
         raise ModelError(_at(source, f"line {exc.lineno} column {exc.colno}: invalid JSON: "
                                      f"{exc.msg}{end}")) from None
     except (ValueError, RecursionError) as exc:
         raise ModelError(_at(source, f"invalid JSON ({exc})")) from None
-    return model_from_dict(data, source=source, validate=validate,
-                           context=Context.top(folder, library))
 
 
 def model_from_dict(data, source=None, validate=True, context=None):
@@ -459,15 +464,11 @@ class Context:
             raise ModelError(f"{where} file {quote(ref)}: files reference each other in a "
                              f"cycle: {' references '.join(files + [files[0]])}")
         if path not in self.cache:
-            text = _read(path)
-            try:
-                data = json.loads(text, object_pairs_hook=_Object.from_pairs, parse_int=_int)
-            except (ValueError, RecursionError) as exc:
-                raise ModelError(f"{where} file {quote(ref)}: invalid JSON ({exc})") from None
+            source = os.path.relpath(path, root)
             ctx = Context(os.path.dirname(path), root, self.library, [*self.chain, path],
                           self.cache)
-            model = model_from_dict(data, source=os.path.relpath(path, root), validate=False,
-                                    context=ctx)
+            model = model_from_dict(_parse(_read(path), source), source=source,
+                                    validate=False, context=ctx)
             model.origin = (path, kind, dumps(model))
             self.cache[path] = model
         model = self.cache[path]

@@ -274,3 +274,10 @@ def test_run_sets_a_subsystem_value_by_path(tmp_path, capsys):
     assert float(first[1]) == pytest.approx(0.3)
     assert main(["run", str(path), "--t-end", "0.1", "-q", "--param", "nope.q0=0.3"]) == 1
     assert "a path names a parameter of a subsystem placed in 'arm'" in capsys.readouterr().err
+
+
+def test_a_definition_file_that_is_no_json_says_where(tmp_path):
+    (tmp_path / "parts").mkdir()
+    (tmp_path / "parts" / "link.json").write_text('{"format": "kinetwork.model",\n  "name": }')
+    path = write(tmp_path / "arm.json", arm_file({"link": {"file": "parts/link.json"}}))
+    refused(path, "definitions.link: parts/link.json: line 2 column 11: invalid JSON")
