@@ -1,0 +1,7 @@
+"""Analysis of a model beyond one simulation: linearisation, equilibria, modes, frequency
+response, parameter sensitivities and fitting, sweeps and Monte Carlo.
+
+Every derivative here is CasADi's algorithmic differentiation of the compiled System, never a
+finite difference. Each public name is imported on its own line, so that modules written side
+by side each add one line.
+"""
