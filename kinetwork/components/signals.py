@@ -49,6 +49,15 @@ class Constant(PartialBlock, library=LIB):
         return self.k
 
 
+class Input(PartialBlock, library=LIB):
+    """A named external input: y = value in a simulation; the input channel ``kn.linearize``
+    and ``kn.equilibrium`` take by this block's name (``value`` is its operating point)."""
+    value = Param(0.0, time=True, doc="Value of the input (an expression in t allowed)")
+
+    def output(self, u, x, t):
+        return self.value
+
+
 class Step(PartialBlock, library=LIB):
     """y = offset, then offset + height from start_time on."""
     height = Param(1.0, doc="Height of the step")
