@@ -766,3 +766,4 @@ class BodySphere(Component, library=MB):
 from .loopjoints import JointRRR, SphericalSpherical, UniversalSpherical  # noqa: E402,F401
 from .forces import (Damper, Force, ForceAndTorque, Spring, SpringDamper,  # noqa: E402,F401
                      Torque, WorldForce, WorldTorque)
+from .rolling import RollingWheel, RollingWheelJoint  # noqa: E402,F401
