@@ -767,3 +767,4 @@ from .loopjoints import JointRRR, SphericalSpherical, UniversalSpherical  # noqa
 from .forces import (Damper, Force, ForceAndTorque, Spring, SpringDamper,  # noqa: E402,F401
                      Torque, WorldForce, WorldTorque)
 from .rolling import RollingWheel, RollingWheelJoint  # noqa: E402,F401
+from .rotor import Rotor1D  # noqa: E402,F401
