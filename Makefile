@@ -6,13 +6,18 @@ OUT    := demo
 
 .PHONY: demo test bench frontend clean
 
-$(VENV)/.installed: pyproject.toml
+# the demo needs only the core; the tests add their extras (pinocchio, MuJoCo, the browser
+# tooling) to the same environment
+$(VENV)/.core: pyproject.toml
 	$(PYTHON) -m venv $(VENV)
-	$(PY) -m pip install --quiet --upgrade pip
+	$(PY) -m pip install --quiet -e .
+	touch $@
+
+$(VENV)/.installed: $(VENV)/.core
 	$(PY) -m pip install --quiet -e ".[test,bench,studio]"
 	touch $@
 
-demo: $(VENV)/.installed
+demo: $(VENV)/.core
 	$(VENV)/bin/kinetwork validate models/double_pendulum.json
 	$(VENV)/bin/kinetwork equations models/double_pendulum.json
 	$(VENV)/bin/kinetwork run models/double_pendulum.json --out $(OUT)/double_pendulum.csv --plot $(OUT)/double_pendulum.png

@@ -18,6 +18,7 @@ import time
 
 import kinetwork as kn
 
+from . import examples
 from .graph.settings import check_output, check_settings
 from .graph.subsystem import subsystem_instances
 from .simulation.driver import DEFAULTS, METHODS
@@ -96,7 +97,8 @@ def build_parser():
         "run", help="simulate a model and write its probe signals",
         description="Simulate MODEL.json and write its probe signals (CSV) and probe plots. "
                     "Options not given come from the model's 'simulation' block.")
-    run.add_argument("model", metavar="MODEL.json", help="model file")
+    run.add_argument("model", metavar="MODEL.json",
+                     help="model file, or the name of an example (kinetwork examples)")
     run.add_argument("--t-end", type=float, metavar="T", help="end time [s]")
     run.add_argument("--method", type=str.lower, choices=list(METHODS), metavar="M",
                      help=f"integrator: {', '.join(METHODS)}")
@@ -125,6 +127,10 @@ def build_parser():
     run.add_argument("--out", metavar="FILE.csv", help="write t and the probe signals as CSV")
     run.add_argument("--plot", metavar="FILE.png",
                      help="write the probe plots (format from the extension: png, pdf, svg)")
+    run.add_argument("--plot-signals", nargs="+", default=[], metavar="NAME",
+                     help="plot only these probes or signals (probe1, probe2.torque)")
+    run.add_argument("--hide-flat", action="store_true",
+                     help="leave constant signals out of the plots (named under the figure)")
 
     val = sub.add_parser(
         "validate", help="check a model and summarise it",
@@ -199,6 +205,19 @@ def build_parser():
                         help="port (default: a free one)")
     studio.add_argument("--no-browser", action="store_true",
                         help="print the address, do not open a browser")
+    ex = sub.add_parser(
+        "examples", help="list the example models, or copy one out",
+        description="List the example models that ship with kinetwork (run one by name: "
+                    "'kinetwork run double_pendulum'), or copy one, with the subsystem files it "
+                    "places, into a folder to edit it. Nothing is overwritten.")
+    exsub = ex.add_subparsers(dest="action", metavar="ACTION")
+    excopy = exsub.add_parser("copy", help="copy an example into a folder",
+                              description="Copy the example NAME (and the definition files it "
+                                          "places) into DIR; refuses if a file exists there.")
+    excopy.add_argument("name", metavar="NAME", help="example name (see 'kinetwork examples')")
+    excopy.add_argument("folder", metavar="DIR", nargs="?", default=".",
+                        help="destination folder (default: the current one)")
+
     imp = sub.add_parser(
         "import", help="turn a URDF robot description into a kinetwork model file",
         description="Read ROBOT.urdf (links, joints, inertials, limits, visuals) and write "
@@ -225,7 +244,8 @@ def main(argv=None):
     command = {"run": _run, "validate": _validate, "equations": _equations,
                "methods": _methods, "bench": _bench, "schema": _schema,
                "cache": _cache, "animate": _animate, "diagram": _diagram,
-               "studio": _studio, "import": _import}[args.command]
+               "studio": _studio, "import": _import,
+               "examples": _examples}[args.command]
     try:
         return command(args)
     except kn.ModelError as exc:
@@ -246,10 +266,28 @@ def _error(message):
 
 
 def _load(path, library=None, validate=True):
+    """The model in the file ``path``, or the shipped example of that name (a file wins)."""
+    if not os.path.exists(path):
+        if _example_name(path):
+            path = str(examples.path(path))
+        elif not path.endswith(".json") or "/" not in path:
+            try:
+                examples.path(path)
+            except kn.ModelError as exc:
+                hint = str(exc).split("(", 1)[1].rstrip(")")
+                if "did you mean" in hint:
+                    raise kn.ModelError(f"{path}: no such file, nor an example of that name "
+                                        f"({hint})") from None
     try:
         return kn.load(path, library=library, validate=validate)
     except OSError as exc:
         raise kn.ModelError(f"cannot read {path}: {exc.strerror or exc}") from None
+
+
+def _example_name(text):
+    """Whether ``text`` names a shipped example (``double_pendulum``, ``engine_v6/EngineV6``)."""
+    key = text[:-len(".json")] if text.endswith(".json") else text
+    return key in examples.names()
 
 
 def _write(path, write, what, quiet=False):
@@ -270,7 +308,8 @@ def _outputs(args, results, title):
                f"{len(results.t)} points x {len(results.columns()[0])} columns to", quiet)
     if args.plot:
         from .plot import save_plot
-        _write(args.plot, lambda path: save_plot(results, path, title=title), "probe plots to",
+        _write(args.plot, lambda path: save_plot(results, path, *args.plot_signals,
+                                                 title=title, hide_flat=args.hide_flat), "probe plots to",
                quiet)
 
 
@@ -531,6 +570,27 @@ def _studio(args):
 def _import(args):
     from .urdf import cli_import
     return cli_import(args)
+
+
+def _examples(args):
+    if args.action == "copy":
+        written = examples.copy(args.name, args.folder)
+        print(f"copied {args.name} to {written[0]}"
+              + (f" (with {len(written) - 1} definition file{'s' if len(written) > 2 else ''})"
+                 if len(written) > 1 else ""))
+        print(f"run it: kinetwork run {written[0]}")
+        return 0
+    listed = examples.summaries()
+    if not listed:
+        print("no examples are installed with this copy of kinetwork")
+        return 0
+    width = max(map(len, listed))
+    for name, line in listed.items():
+        print(f"{name:<{width}}  {line}")
+    first = "double_pendulum" if "double_pendulum" in listed else next(iter(listed))
+    print(f"\nrun one: kinetwork run {first} --plot plot.png;  "
+          f"copy one: kinetwork examples copy NAME DIR")
+    return 0
 
 
 def _schema(args):

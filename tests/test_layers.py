@@ -21,7 +21,8 @@ import kinetwork
 PACKAGE = pathlib.Path(kinetwork.__file__).resolve().parent
 LAYERS = [("errors", "util", "expr", "spatial"), ("components",), ("graph",), ("equations",),
           ("simulation",),
-          ("plot", "schema", "symbolic", "animation", "diagram", "urdf", "studio", "cli", "")]
+          ("plot", "schema", "symbolic", "animation", "diagram", "urdf", "examples", "studio",
+           "cli", "")]
 RANK = {name: rank for rank, names in enumerate(LAYERS) for name in names}
 
 

@@ -6,10 +6,8 @@ refused before the disk is touched, so a page (or anything else holding the toke
 writes model files inside that folder and nowhere else.
 """
 
-import functools
 import json
 import os
-import pathlib
 import re
 
 from ..graph.io import MAX_FILE_SIZE
@@ -117,36 +115,11 @@ def parse_model_text(text, what):
 
 
 # -- the examples -----------------------------------------------------------------------------
-def examples_folder():
-    """Where the example models are: ``kinetwork/models`` when the package ships them, else
-    ``models/`` next to the package in a source checkout; None when neither exists."""
-    package = pathlib.Path(__file__).resolve().parents[1]          # kinetwork/
-    for folder in (package / "models", package.parent / "models"):
-        if folder.is_dir():
-            return folder
-    return None
-
-
-@functools.lru_cache(maxsize=1)
 def examples():
-    """Example name (its path in the folder, without ``.json``: ``robot/arm_axes``) -> file.
-
-    Subsystem definitions (files with exposed ``ports``) are parts of other examples, not
-    examples of their own."""
-    folder = examples_folder()
-    if folder is None:
-        return {}
-    out = {}
-    for rel in list_files(str(folder)):
-        path = folder / rel
-        try:
-            data = json.loads(path.read_text(encoding="utf-8-sig"))
-        except (OSError, ValueError):
-            continue
-        if isinstance(data, dict) and data.get("format") == "kinetwork.model" and \
-                not data.get("ports"):
-            out[rel[:-len(SUFFIX)]] = path
-    return out
+    """Example name (its path in the folder, without ``.json``: ``robot/arm_axes``) -> file;
+    the package's own list (``kinetwork.examples``)."""
+    from .. import examples as shipped
+    return shipped.names()
 
 
 def _shown(value):

@@ -1,0 +1,167 @@
+"""The example models that ship inside the package: find one by name, list them, copy one out.
+
+An example's name is its path in the examples folder without ``.json``
+(``double_pendulum``, ``engine_v6/EngineV6``). Subsystem definitions (files with exposed
+``ports``) are parts of other examples, not examples of their own; copying an example copies
+the definition files it places with it.
+
+>>> import kinetwork as kn
+>>> model = kn.load(kn.examples.path("double_pendulum"))
+"""
+
+import functools
+import json
+import os
+import pathlib
+import shutil
+
+from .components import REGISTRY
+from .errors import ModelError
+
+SUFFIX = ".json"
+#: folders the listing does not look into
+_SKIPPED = {"__pycache__", "node_modules"}
+
+
+def folder():
+    """Where the example models are: ``kinetwork/models`` inside the package (a link to the
+    source tree's ``models/`` in a checkout), else ``models/`` next to the package; None when
+    neither exists."""
+    package = pathlib.Path(__file__).resolve().parent
+    for candidate in (package / "models", package.parent / "models"):
+        if candidate.is_dir():
+            return candidate.resolve()
+    return None
+
+
+@functools.lru_cache(maxsize=1)
+def _catalogue():
+    root = folder()
+    if root is None:
+        return {}
+    found = {}
+    for dirpath, dirs, names in os.walk(root):
+        dirs[:] = sorted(d for d in dirs if not d.startswith(".") and d not in _SKIPPED)
+        for name in sorted(names):
+            if not name.endswith(SUFFIX) or name.startswith("."):
+                continue
+            file = pathlib.Path(dirpath) / name
+            data = _read(file)
+            if isinstance(data, dict) and data.get("format") == "kinetwork.model" and \
+                    not data.get("ports"):
+                rel = file.relative_to(root).as_posix()[:-len(SUFFIX)]
+                found[rel] = (file, _summary(data))
+    return dict(sorted(found.items()))
+
+
+def names():
+    """Example name -> its file (a ``pathlib.Path``), sorted by name."""
+    return {name: file for name, (file, _) in _catalogue().items()}
+
+
+def summaries():
+    """Example name -> its one-line summary (the first sentence of its description)."""
+    return {name: line for name, (_, line) in _catalogue().items()}
+
+
+def path(name):
+    """The file of the example ``name`` (``"double_pendulum"``; ``.json`` may be given).
+
+    Raises
+    ------
+    ModelError
+        No example of that name; the message lists the closest names.
+    """
+    key = str(name)[:-len(SUFFIX)] if str(name).endswith(SUFFIX) else str(name)
+    known = names()
+    if key in known:
+        return known[key]
+    raise ModelError(f"{name}: no such example ({_suggest(key, known)})")
+
+
+def copy(name, destination="."):
+    """Copy the example ``name`` and the definition files it places into the folder
+    ``destination`` (made if missing); returns the paths written, the model's first.
+
+    Nothing is overwritten: if any of the files already exists there, nothing is copied.
+
+    Raises
+    ------
+    ModelError
+        No such example, a file that would be overwritten, or a folder that cannot be written.
+    """
+    source = path(name)
+    root = source.parent
+    files = [source] + _placed_definitions(source)
+    dest = pathlib.Path(destination)
+    targets = [dest / f.relative_to(root) for f in files]
+    existing = [str(t) for t in targets if t.exists() or t.is_symlink()]
+    if existing:
+        raise ModelError(f"copying example {name!r}: {', '.join(existing)} already exist"
+                         f"{'s' if len(existing) == 1 else ''}; nothing was copied (choose "
+                         f"another folder, or move the file{'s' if len(existing) > 1 else ''}"
+                         f" away)")
+    try:
+        for src, target in zip(files, targets):
+            target.parent.mkdir(parents=True, exist_ok=True)
+            shutil.copyfile(src, target)
+    except OSError as exc:
+        raise ModelError(f"copying example {name!r} to {destination}: "
+                         f"{exc.strerror or exc}") from None
+    return targets
+
+
+# -- helpers ------------------------------------------------------------------------------------
+def _read(file):
+    try:
+        return json.loads(file.read_text(encoding="utf-8-sig"))
+    except (OSError, ValueError):
+        return None
+
+
+def _summary(data):
+    text = " ".join(str(data.get("description") or data.get("name") or "").split())
+    for end in (". ", ": "):
+        if end in text:
+            text = text.split(end, 1)[0] + ("." if end == ". " else "")
+            break
+    return text if len(text) <= 100 else text[:97].rstrip() + "..."
+
+
+def _placed_definitions(source):
+    """The definition files next to ``source`` that it places (by ``{"file": ...}`` or as
+    ``TYPE.json`` beside it), and theirs in turn, each once."""
+    seen, out, todo = {source.resolve()}, [], [source]
+    while todo:
+        data = _read(todo.pop())
+        if not isinstance(data, dict):
+            continue
+        for file in _references(data, source.parent):
+            real = file.resolve()
+            if real not in seen and file.is_file():
+                seen.add(real)
+                out.append(file)
+                todo.append(file)
+    return out
+
+
+def _references(data, here):
+    definitions = data.get("definitions") or {}
+    inline = [d for d in definitions.values() if isinstance(d, dict) and "file" not in d]
+    for d in definitions.values():
+        if isinstance(d, dict) and isinstance(d.get("file"), str):
+            yield here / d["file"]
+    for body in [data] + inline:
+        for comp in body.get("components") or []:
+            kind = comp.get("type") if isinstance(comp, dict) else None
+            if isinstance(kind, str) and kind not in REGISTRY and kind not in definitions:
+                yield here / f"{kind}{SUFFIX}"
+
+
+def _suggest(key, known):
+    import difflib
+    close = difflib.get_close_matches(key, list(known), n=3, cutoff=0.5)
+    if close:
+        return "did you mean " + " or ".join(close) + "?"
+    return ("'kinetwork examples' lists them" if known else
+            "no examples are installed with this copy of kinetwork")
