@@ -1,12 +1,15 @@
-"""Probe plots: one row per probe, one panel per recorded quantity, against time.
+"""Probe plots: one panel per recorded quantity, against time, units on every axis.
 
-The layout follows the seed paper's probe figures (angle, speed, acceleration and torque of a
-joint side by side). matplotlib is imported only when a plot is asked for, so ``import
+The layout follows the seed paper's probe figures (a joint probe's angle, speed, acceleration
+and torque side by side in one row); probes with fewer quantities share rows, so a figure is
+not mostly empty. Several runs overlay on the same panels. matplotlib is imported only when a plot is asked for, so ``import
 kinetwork`` stays fast and never touches a display.
 """
 
 import os
 import sys
+
+import numpy as np
 
 from .util import atomic_write, suggest
 from .errors import ModelError
@@ -37,37 +40,108 @@ def unit_label(unit):
     return unit.replace("*", "\u00b7")
 
 
-def _panels(results, probes):
-    """The rows of the figure: lists of (probe, quantity), MAX_COLUMNS at most per row."""
+class _Panel:
+    """One panel: the signal it draws (a full name), its title and its axis label."""
+
+    def __init__(self, results, name):
+        self.name = name
+        probe, _, quantity = name.rpartition(".")
+        sig = results.signals.get(name)
+        unit = results.units.get(name, "")
+        if sig is not None:
+            probe, quantity = sig.probe, sig.quantity
+            target = results.probe_targets.get(probe)
+            where = f" ({target})" if target else ""
+            self.title = f"{probe}{where}: {quantity.replace('_', ' ')}"
+        else:                                   # a state
+            self.title = name
+            quantity = quantity or name
+        self.probe = probe
+        self.ylabel = quantity.replace("_", " ") + f" [{unit_label(unit) if unit else '1'}]"
+
+
+def _names(results, selection):
+    """The full names of the panels, in order: every probe's quantities by default; a probe
+    name gives all of its quantities, ``probe.quantity`` (or a state's name) one panel."""
     available = results.probes
-    if not available:
+    if not available and not selection:
         raise ModelError("nothing to plot: the model has no probes (add a kn.Probe and "
                          "connect it to the port to record)")
-    if probes is None:
-        probes = list(available)
-    elif isinstance(probes, str):
-        probes = [probes]
-    rows = []
-    for name in probes:
-        if name not in available:
-            raise ModelError(f"plot: no probe {name!r}{suggest(name, available)}; probes are "
-                             f"{', '.join(available)}")
-        quantities = available[name]
-        for start in range(0, len(quantities), MAX_COLUMNS):
-            rows.append([(name, q) for q in quantities[start:start + MAX_COLUMNS]])
-    return rows
+    if not selection:
+        return [f"{p}.{q}" for p, qs in available.items() for q in qs]
+    names = []
+    for item in selection:
+        if not isinstance(item, str):
+            raise ModelError(f"plot: a probe or signal is named by a string, got {item!r:.60}")
+        if item in available:
+            names += [f"{item}.{q}" for q in available[item]]
+        elif item in results.signals or item in results.state_names:
+            names.append(item)
+        else:
+            known = [*available, *results.signals, *results.state_names]
+            raise ModelError(f"plot: no probe or signal {item!r}{suggest(item, known)}; probes "
+                             f"are {', '.join(available) or 'none'}")
+    return names
 
 
-def plot_results(results, probes=None, title=None, figsize=None, **kwargs):
-    """Plot probe signals against time: one row per probe, one panel per quantity.
+def _rows(results, names, columns=None):
+    """The panels' names row by row. Each probe's quantities stay together, left to right (the
+    seed paper's layout: one row per joint probe); probes with fewer quantities than a row
+    holds share rows, in order, so a figure is not mostly empty; one with more wraps."""
+    groups = []                                  # consecutive names of one probe
+    for name in names:
+        sig = results.signals.get(name)
+        key = sig.probe if sig is not None else name
+        if groups and groups[-1][0] == key:
+            groups[-1][1].append(name)
+        else:
+            groups.append((key, [name]))
+    n = len(names)
+    widest = max(len(g) for _, g in groups)
+    n_cols = columns or min(MAX_COLUMNS, max(widest, -(-n // -(-n // MAX_COLUMNS))))
+    rows = [[]]
+    for _, group in groups:
+        if len(group) > n_cols - len(rows[-1]) and rows[-1]:
+            rows.append([])
+        for name in group:
+            if len(rows[-1]) == n_cols:
+                rows.append([])
+            rows[-1].append(name)
+    return rows, n_cols
+
+
+def _flat(values):
+    """Whether a signal never changes over the run (to the last bits): a dead panel."""
+    values = np.asarray(values, dtype=float)
+    finite = values[np.isfinite(values)]
+    if finite.size == 0:
+        return False
+    return float(np.ptp(finite)) <= 1e-12 * (1.0 + float(np.max(np.abs(finite))))
+
+
+def plot_results(results, *names, probes=None, title=None, labels=None, hide_flat=False,
+                 columns=None, figsize=None, **kwargs):
+    """Plot probe signals against time, one panel per quantity, units on every axis.
 
     Parameters
     ----------
-    results : kinetwork.Results
+    results : kinetwork.Results or sequence of Results
+        One run, or several to overlay (same panels, one colour per run).
+    *names : str
+        What to plot, in this order: a probe (all its quantities), ``"probe1.angle"`` (one
+        quantity) or a state's name. Default: every probe.
     probes : str or sequence of str, optional
-        Probe names to plot, in this order (default: every probe).
+        Probe names (the older spelling of ``names``).
     title : str, optional
         Figure title, e.g. the model name.
+    labels : sequence of str, optional
+        One label per run in the figure's legend (default: run 1, run 2, ... or the method).
+    hide_flat : bool
+        Leave out panels whose signal never changes (the seed's elbow torque is 0); a note
+        under the figure names them and their value.
+    columns : int, optional
+        Panels per row (default: up to four; each probe's quantities side by side, the
+        seed paper's layout, probes with few quantities sharing rows).
     figsize : (float, float), optional
         Inches; by default it grows with the number of rows and columns.
     **kwargs
@@ -80,68 +154,131 @@ def plot_results(results, probes=None, title=None, figsize=None, **kwargs):
     Raises
     ------
     ModelError
-        The results hold no probes, or a probe name is unknown.
+        Nothing to plot, an unknown name, labels not matching the runs, or runs that do not
+        all hold a signal asked for.
     """
-    rows = _panels(results, probes)
-    n_rows, n_cols = len(rows), max(len(r) for r in rows)
+    runs = list(results) if isinstance(results, (list, tuple)) else [results]
+    if not runs:
+        raise ModelError("plot: no results given")
+    if probes is not None:
+        names = names + ((probes,) if isinstance(probes, str) else tuple(probes))
+    if len(names) == 1 and isinstance(names[0], (list, tuple)):
+        names = tuple(names[0])
+    wanted = _names(runs[0], names)
+    for k, run in enumerate(runs[1:], start=2):
+        missing = [n for n in wanted if n not in run]
+        if missing:
+            raise ModelError(f"plot: run {k} has no {', '.join(missing[:3])}: overlaid runs must "
+                             f"record the signals plotted")
+    if labels is not None and len(labels) != len(runs):
+        raise ModelError(f"plot: {len(labels)} labels for {len(runs)} runs")
+    if labels is None and len(runs) > 1:
+        labels = [f"run {k + 1}" for k in range(len(runs))]
+    hidden = []
+    if hide_flat:
+        kept = [n for n in wanted if not all(_flat(run[n]) for run in runs)]
+        hidden = [n for n in wanted if n not in kept]
+        if not kept:
+            raise ModelError(f"plot: every signal asked for is constant ({', '.join(wanted[:4])}"
+                             f"{', ...' if len(wanted) > 4 else ''}); plot without hide_flat")
+        wanted = kept
+    rows, n_cols = _rows(runs[0], wanted, columns)
+    n_rows = len(rows)
     plt = _pyplot()
     if figsize is None:
-        figsize = (0.4 + 3.5 * n_cols, 0.3 + 2.4 * n_rows + (0.4 if title else 0.0))
+        extra = (0.4 if title else 0.0) + (0.3 if len(runs) > 1 else 0.0) + \
+            (0.3 if hidden else 0.0)
+        figsize = (0.4 + 3.5 * n_cols, 0.3 + 2.4 * n_rows + extra)
     fig, axes = plt.subplots(n_rows, n_cols, figsize=figsize, sharex=True, squeeze=False,
                              layout="constrained")
-    t = results.t
     bottom = {}                     # column -> lowest row holding a panel
+    placed = [(i, j, _Panel(runs[0], name)) for i, row in enumerate(rows)
+              for j, name in enumerate(row)]
+    for i, j, panel in placed:
+        ax = axes[i, j]
+        for r, run in enumerate(runs):
+            style = dict(kwargs)
+            if len(runs) > 1:
+                style.setdefault("color", f"C{r}")
+                style.setdefault("label", labels[r])
+            _draw(ax, run.t, run[panel.name], style, legend=r == len(runs) - 1,
+                  overlaid=len(runs) > 1)
+        ax.set_title(panel.title, fontsize="medium")
+        ax.set_ylabel(panel.ylabel)
+        bottom[j] = i
     for i, row in enumerate(rows):
-        for j, (probe, quantity) in enumerate(row):
-            name = f"{probe}.{quantity}"
-            _draw(axes[i, j], t, results[name], kwargs)
-            unit = results.units.get(name, "")
-            target = results.probe_targets.get(probe)
-            where = f" ({target})" if target else ""
-            axes[i, j].set_title(f"{probe}{where}: {quantity.replace('_', ' ')}",
-                                 fontsize="medium")
-            axes[i, j].set_ylabel(quantity.replace("_", " ")
-                                  + (f" [{unit_label(unit)}]" if unit else ""))
-            bottom[j] = i
         for j in range(len(row), n_cols):
             axes[i, j].set_visible(False)
     for i in range(n_rows):
         for j in range(n_cols):
             # shared x: tick labels only where the column ends, which is not always the
-            # last row when probes record different numbers of quantities
+            # last row when the last row is not full
             axes[i, j].tick_params(labelbottom=bottom.get(j) == i)
     for j, i in bottom.items():
         axes[i, j].set_xlabel("time [s]")
+    t = runs[0].t
     if len(t) > 1:                  # a run that failed at once has a single point
-        axes[0, 0].set_xlim(t[0], t[-1])
+        axes[0, 0].set_xlim(min(r.t[0] for r in runs), max(r.t[-1] for r in runs))
+    if len(runs) > 1:
+        handles = [plt.Line2D([], [], color=f"C{r}", label=labels[r]) for r in range(len(runs))]
+        fig.legend(handles=handles, loc="outside upper center", ncols=min(len(runs), 6),
+                   fontsize="small", frameon=False)
     if title:
         fig.suptitle(title)
+    if hidden:
+        shown = [f"{n} = {float(np.ravel(runs[0][n])[0]):.4g}" for n in hidden[:6]]
+        more = f" and {len(hidden) - 6} more" if len(hidden) > 6 else ""
+        fig.text(0.01, 0.002, "constant, not drawn: " + ", ".join(shown) + more,
+                 fontsize="x-small", color="0.35", ha="left", va="bottom")
     return fig
 
 
-def _draw(ax, t, values, kwargs):
-    """One panel: a line, three lines x/y/z, or the nine entries of an orientation."""
+def plot(results, *names, **kwargs):
+    """``kn.plot(res)`` or ``kn.plot([res_a, res_b], labels=["stiff", "soft"])``: probe plots
+    of one run or of several overlaid (see :func:`plot_results` for the options)."""
+    return plot_results(results, *names, **kwargs)
+
+
+def _draw(ax, t, values, kwargs, legend=True, overlaid=False):
+    """One panel: a line, three lines x/y/z, or the nine entries of an orientation. Legends
+    of components sit outside the axes, right of them, so they never cover the data; with
+    several runs, colour is the run and line style the component."""
+    values = np.asarray(values)
     if values.ndim == 1:
         ax.plot(t, values, **kwargs)
     elif values.ndim == 2:
+        styles = ("-", "--", ":")
         for k in range(values.shape[1]):
-            ax.plot(t, values[:, k], **{"label": _AXES[k], **kwargs})
-        ax.legend(fontsize="x-small", ncols=3, loc="best", handlelength=1.2,
-                  columnspacing=0.8, borderpad=0.3)
+            style = {"linestyle": styles[k % 3]} if overlaid else {"color": f"C{k}"}
+            ax.plot(t, values[:, k], **{**style, **kwargs, "label": _AXES[k % 3]})
+        if legend:
+            _outside_legend(ax, overlaid)
     else:
         # colour = column of R (the image of one body axis), line style = its component,
         # so the nine curves stay apart and read as three unit vectors
         styles = ("-", "--", ":")
         for c in range(3):
             for r in range(3):
-                style = {"linestyle": styles[r], "color": f"C{c}", "label": f"R{r + 1}{c + 1}"}
-                ax.plot(t, values[:, r, c], **{**style, **kwargs})
+                style = {"linestyle": styles[r], "color": f"C{c}"}
+                ax.plot(t, values[:, r, c], **{**style, **kwargs, "label": f"R{r + 1}{c + 1}"})
         ax.set_ylim(-1.1, 1.1)
-        ax.legend(fontsize="x-small", ncols=3, loc="best", handlelength=1.6,
-                  columnspacing=0.6, borderpad=0.3, labelspacing=0.2)
+        if legend:
+            _outside_legend(ax, overlaid)
     ax.grid(True, alpha=0.4)
     # a constant signal (the seed's elbow torque is 0) must not read as "1e-16 + offset"
     ax.ticklabel_format(axis="y", useOffset=False)
+
+
+def _outside_legend(ax, overlaid):
+    handles, labels = ax.get_legend_handles_labels()
+    seen = {}
+    for h, lab in zip(handles, labels):
+        if overlaid:            # one entry per component, drawn in black
+            h = type(h)([], [], linestyle=h.get_linestyle(), color="0.2")
+        seen.setdefault(lab, h)
+    ax.legend(list(seen.values()), list(seen), fontsize="x-small", loc="upper left",
+              bbox_to_anchor=(1.01, 1.0), borderaxespad=0.0, handlelength=1.4,
+              labelspacing=0.2, frameon=False)
 
 
 def check_plot_path(path):
@@ -158,7 +295,7 @@ def check_plot_path(path):
                          f"{', '.join(sorted(supported))}")
 
 
-def save_plot(results, path, probes=None, title=None, dpi=150, **kwargs):
+def save_plot(results, path, *names, probes=None, title=None, dpi=150, **kwargs):
     """Plot ``results`` (see :func:`plot_results`) into an image file and close the figure.
 
     The format follows the file extension (png, pdf, svg, ...).
@@ -172,7 +309,7 @@ def save_plot(results, path, probes=None, title=None, dpi=150, **kwargs):
     """
     check_plot_path(path)
     plt = _pyplot()
-    fig = plot_results(results, probes=probes, title=title, **kwargs)
+    fig = plot_results(results, *names, probes=probes, title=title, **kwargs)
     fmt = os.path.splitext(str(path))[1].lstrip(".").lower()
     try:
         # atomically: a full disk or a signal leaves an old image whole

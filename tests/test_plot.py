@@ -74,7 +74,7 @@ def test_select_probes_in_order(seed_results):
 
 
 def test_unknown_probe_is_refused_with_a_suggestion(seed_results):
-    with pytest.raises(kn.ModelError, match=r"no probe 'prob1' \(did you mean 'probe1'\?\)"):
+    with pytest.raises(kn.ModelError, match=r"no probe or signal 'prob1' \(did you mean 'probe1'\?\)"):
         seed_results.plot(probes=["prob1"])
 
 
@@ -153,3 +153,64 @@ def test_single_point_results_plot_without_warnings():
     fig = one.plot()
     fig.canvas.draw()
     assert len(visible(fig)) == 8
+
+
+def test_select_quantities_by_name_and_states(seed_results):
+    fig = seed_results.plot("probe1.angle", "probe2.torque")
+    assert [ax.get_title() for ax in visible(fig)] == ["probe1 (shoulder.axis): angle",
+                                                      "probe2 (elbow.axis): torque"]
+    fig = seed_results.plot(seed_results.state_names[0])
+    [ax] = visible(fig)
+    np.testing.assert_array_equal(ax.get_lines()[0].get_ydata(), seed_results.states[:, 0])
+    assert ax.get_ylabel().endswith("[rad]")
+
+
+def test_small_probes_share_rows(tip_results):
+    """Probes with fewer quantities than a row share rows (arm_pid's four signal probes of
+    one value each fill one row instead of four mostly empty ones)."""
+    model = double_pendulum()
+    for k in range(4):
+        model.add(kn.Probe(f"p{k}", quantities=["angle"]))
+        model.connect(f"p{k}.port", "shoulder.axis")
+    res = kn.simulate(model, t_end=0.2, n_points=11)
+    fig = res.plot()
+    axes = np.array(fig.axes).reshape(3, 4)
+    assert all(ax.get_visible() for ax in axes.ravel())
+    assert [ax.get_title().split(" ")[0] for ax in axes[2]] == ["p0", "p1", "p2", "p3"]
+    fig = res.plot("probe1", "p0", columns=2)
+    assert np.array(fig.axes).shape == (6,) and len(visible(fig)) == 5
+
+
+def test_overlaid_runs_share_panels_with_one_legend():
+    soft = kn.simulate(double_pendulum(), t_end=1.0, n_points=51)
+    stiff_model = double_pendulum()
+    stiff = kn.simulate(stiff_model, t_end=1.0, n_points=51, params={"c": 20.0})
+    fig = kn.plot([soft, stiff], "probe1.angle", labels=["c = 1", "c = 20"], title="springs")
+    [ax] = visible(fig)
+    soft_line, stiff_line = ax.get_lines()
+    np.testing.assert_array_equal(soft_line.get_ydata(), soft["probe1.angle"])
+    np.testing.assert_array_equal(stiff_line.get_ydata(), stiff["probe1.angle"])
+    assert soft_line.get_color() != stiff_line.get_color()
+    [legend] = fig.legends
+    assert [t.get_text() for t in legend.get_texts()] == ["c = 1", "c = 20"]
+    assert fig.get_suptitle() == "springs"
+    with pytest.raises(kn.ModelError, match="1 labels for 2 runs"):
+        kn.plot([soft, stiff], labels=["one"])
+
+
+def test_hide_flat_drops_dead_panels_and_names_them(seed_results):
+    """The seed's elbow torque is 0 throughout: hidden on request, named under the figure."""
+    fig = seed_results.plot(hide_flat=True)
+    titles = [ax.get_title() for ax in visible(fig)]
+    assert "probe2 (elbow.axis): torque" not in titles and len(titles) == 7
+    assert any("constant, not drawn: probe2.torque = 0" in t.get_text() for t in fig.texts)
+    assert len(visible(seed_results.plot())) == 8
+
+
+def test_component_legends_sit_outside_the_data(tip_results):
+    """Legends of x/y/z are placed right of the axes, never over the curves."""
+    fig = tip_results.plot("tip.position", "tip.orientation")
+    fig.canvas.draw()
+    for ax in visible(fig):
+        legend = ax.get_legend().get_window_extent()
+        assert legend.x0 >= ax.get_window_extent().x1

@@ -109,11 +109,110 @@ class Results:
                 fh.write(text.getvalue())
         atomic_write(path, write)
 
-    def plot(self, probes=None, **kwargs):
-        """Probe plots: one row per probe, one panel per quantity (matplotlib Figure)."""
+    def to_pandas(self, states=False):
+        """A ``pandas.DataFrame`` indexed by time ``t`` [s], one column per CSV column (vectors
+        as ``name[0]``, ...); ``df.attrs["units"]`` maps every column to its unit, and
+        ``df.attrs`` also holds the run's settings and, for a partial run, where it stopped.
+        ``states=True`` adds the states as columns."""
+        pd = _optional("pandas", "to_pandas")
+        header, data = self.columns()
+        frame = pd.DataFrame(data[:, 1:], columns=header[1:],
+                             index=pd.Index(self.t, name="t"))
+        units = {}
+        for name, sig in self.signals.items():
+            units.update(dict.fromkeys(sig.column_names(), sig.unit))
+        if states:
+            for name in self.state_names:
+                frame[name] = self[name]
+                units[name] = self.units.get(name, "")
+        frame.attrs.update(self._attrs())
+        frame.attrs["units"] = units
+        return frame
+
+    def to_xarray(self, states=False):
+        """An ``xarray.Dataset``: coordinate ``t`` [s], one variable per signal (vectors along
+        ``axis`` = x, y, z; orientations along ``row``, ``col``), each with ``attrs["units"]``,
+        the probe and the port measured; the run's settings in the dataset's attrs.
+        ``states=True`` adds the states as variables."""
+        xr = _optional("xarray", "to_xarray")
+        variables = {}
+        for name, sig in self.signals.items():
+            dims = ("t",) + {0: (), 1: ("axis",), 2: ("row", "col")}[len(sig.shape)]
+            attrs = {"units": sig.unit, "probe": sig.probe, "quantity": sig.quantity}
+            target = self.probe_targets.get(sig.probe)
+            if target:
+                attrs["port"] = target
+            variables[name] = xr.Variable(dims, self._values[name], attrs)
+        if states:
+            for name in self.state_names:
+                variables[name] = xr.Variable(("t",), self[name],
+                                              {"units": self.units.get(name, "")})
+        coords = {"t": ("t", self.t, {"units": "s", "long_name": "time"})}
+        shapes = {len(sig.shape): sig.shape for sig in self.signals.values()}
+        if 1 in shapes and shapes[1] == (3,):
+            coords["axis"] = ["x", "y", "z"]
+        if 2 in shapes:
+            coords.update(row=[1, 2, 3], col=[1, 2, 3])
+        return xr.Dataset(variables, coords=coords, attrs=self._attrs())
+
+    def _attrs(self):
+        """The run's settings and outcome as flat attributes (netCDF-safe values)."""
+        out = {}
+        for key, value in self.settings.items():
+            if isinstance(value, (int, float, str, bool)):
+                out[key] = value
+        for key, value in (self.settings.get("params") or {}).items():
+            if isinstance(value, (int, float)):
+                out[f"param.{key}"] = float(value)
+        if self.partial is not None:
+            out["partial_t_reached"] = float(self.partial["t_reached"])
+            out["partial_reason"] = str(self.partial["reason"])
+        return out
+
+    def summary(self):
+        """A few lines on the run: points, time span, method and counters, how it ended."""
+        lines = [repr(self)]
+        if self.method:
+            lines.append(f"method: {self.method}" + "".join(
+                f", {k} = {self.settings[k]:g}" for k in ("rtol", "atol")
+                if isinstance(self.settings.get(k), (int, float))))
+        counters = {k: v for k, v in self.stats.items() if isinstance(v, (int, float))}
+        if counters:
+            lines.append(", ".join(f"{k.replace('_', ' ')}: {v:g}" for k, v in counters.items()))
+        if self.partial is not None:
+            lines.append(f"partial: stopped at t = {self.partial['t_reached']:g} s: "
+                         f"{self.partial['reason']}")
+        return "\n".join(lines)
+
+    def _repr_html_(self):
+        """Jupyter's rich display: the summary, a table of the signals with their units and
+        final values, and the probe plots (an inline SVG)."""
+        import html
+        rows = []
+        for name, sig in self.signals.items():
+            last = np.asarray(self._values[name][-1])
+            shown = np.array2string(last, precision=4, suppress_small=True, separator=", ") \
+                if last.ndim else f"{float(last):.6g}"
+            rows.append(f"<tr><td><code>{html.escape(name)}</code></td>"
+                        f"<td>{html.escape(sig.unit)}</td><td>{html.escape(shown)}</td></tr>")
+        text = "<br>".join(html.escape(line) for line in self.summary().splitlines())
+        table = ("<table><thead><tr><th>signal</th><th>unit</th><th>at the end</th></tr>"
+                 f"</thead><tbody>{''.join(rows)}</tbody></table>") if rows else ""
+        figure = ""
+        if self.signals and _plotter is not None and len(self.t) > 1:
+            try:
+                figure = _svg(_plotter(self))
+            except Exception as exc:        # a display must never raise in a notebook
+                figure = f"<p>(no plot: {html.escape(str(exc))})</p>"
+        return f"<div class='kinetwork-results'><p>{text}</p>{table}{figure}</div>"
+
+    def plot(self, *names, **kwargs):
+        """Probe plots (a matplotlib Figure): every probe, or the probes and signals named
+        (``res.plot("probe1.angle", "probe2")``); options as ``kinetwork.plot.plot_results``
+        (``title``, ``hide_flat``, ``columns``, ...)."""
         if _plotter is None:
             raise RuntimeError("no plotter installed: import kinetwork")
-        return _plotter(self, probes=probes, **kwargs)
+        return _plotter(self, *names, **kwargs)
 
     def animate(self, path=None, **kwargs):
         """3-D animation of the run: a self-contained HTML page at ``path`` (the three.js
@@ -126,6 +225,28 @@ class Results:
     def __repr__(self):
         return (f"<Results {len(self.t)} points, t = {self.t[0]:g} .. {self.t[-1]:g}, "
                 f"{len(self.signals)} signals>")
+
+
+def _optional(module, what):
+    """Import an optional library, or say how to install it."""
+    import importlib
+    try:
+        return importlib.import_module(module)
+    except ImportError:
+        raise ImportError(f"Results.{what} needs {module}: pip install 'kinetwork[data]' "
+                          f"(or pip install {module})") from None
+
+
+def _svg(fig):
+    """A matplotlib figure as inline SVG text, the figure closed."""
+    import matplotlib.pyplot as plt
+    buffer = io.StringIO()
+    try:
+        fig.savefig(buffer, format="svg")
+    finally:
+        plt.close(fig)
+    text = buffer.getvalue()
+    return text[text.index("<svg"):]
 
 
 #: what draws ``Results.plot``: installed by ``kinetwork.plot`` when it is imported (the plot
