@@ -12,6 +12,7 @@ faces: ``plot``, ``schema``, ``symbolic``, ``cli``.
 from . import animation as _animation  # noqa: F401  (installs Results.animate)
 from . import diagram as _diagram  # noqa: F401  (installs Model._repr_svg_ for Jupyter)
 from . import plot as _plot  # noqa: F401  (installs Results.plot)
+from . import examples
 from .components import multibody, rotational, signals, translational
 from .components.probe import Probe
 from .equations.system import System
@@ -24,9 +25,11 @@ from .simulation.driver import simulate
 from .simulation.methods import METHODS
 from .simulation.results import Results
 from .urdf import from_urdf
+# kn.plot is the function (kn.plot([res_a, res_b])), not its module
+from .plot import plot  # noqa: E402  isort: skip
 
 __version__ = "0.1.0"
 
 __all__ = ["IdealisedInertiaWarning", "METHODS", "Model", "ModelError", "Probe", "Results",
-           "SimulationError", "Subsystem", "System", "dumps", "from_urdf", "load", "loads",
-           "multibody", "rotational", "schema", "signals", "simulate", "translational"]
+           "SimulationError", "Subsystem", "System", "dumps", "examples", "from_urdf", "load",
+           "loads", "multibody", "plot", "rotational", "schema", "signals", "simulate", "translational"]
