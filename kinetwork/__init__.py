@@ -13,7 +13,7 @@ from . import animation as _animation  # noqa: F401  (installs Results.animate)
 from . import diagram as _diagram  # noqa: F401  (installs Model._repr_svg_ for Jupyter)
 from . import plot as _plot  # noqa: F401  (installs Results.plot)
 from . import examples
-from .components import multibody, rotational, signals, translational
+from .components import electrical, multibody, rotational, signals, translational
 from .components.probe import Probe
 from .equations.system import System
 from .errors import IdealisedInertiaWarning, ModelError, SimulationError
@@ -32,4 +32,5 @@ __version__ = "0.1.0"
 
 __all__ = ["IdealisedInertiaWarning", "METHODS", "Model", "ModelError", "Probe", "Results",
            "SimulationError", "Subsystem", "System", "dumps", "examples", "from_urdf", "load",
-           "loads", "multibody", "plot", "rotational", "schema", "signals", "simulate", "translational"]
+           "loads", "electrical", "multibody", "plot", "rotational", "schema", "signals",
+           "simulate", "translational"]

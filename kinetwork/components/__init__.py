@@ -1,8 +1,8 @@
 """Component libraries; each module is one library of the file format's ``type`` names."""
 
-from . import multibody, rotational, signals, translational
+from . import electrical, multibody, rotational, signals, translational
 from .base import REGISTRY, Component, Param, Port, PortRef
 from .probe import Probe
 
 __all__ = ["REGISTRY", "Component", "Param", "Port", "PortRef", "Probe",
-           "multibody", "rotational", "signals", "translational"]
+           "electrical", "multibody", "rotational", "signals", "translational"]

@@ -15,7 +15,7 @@ from ..expr import parse
 from ..util import check_number, quote, suggest
 
 REQUIRED = object()
-DOMAINS = ("frame", "rotational", "translational", "signal_in", "signal_out")
+DOMAINS = ("frame", "rotational", "translational", "electrical", "signal_in", "signal_out")
 #: placeholder domains: ONED is the class's ``domain`` (rotational or translational); ANY
 #: connects to every domain (a probe)
 ONED, ANY = "1d", "any"

@@ -60,6 +60,11 @@ QUANTITIES = {
         "force": Quantity("N", (3,), lambda p: p.f),
         "torque": Quantity("N*m", (3,), lambda p: p.t - _cross(p.r, p.f)),
     },
+    # an electrical pin: its potential, and the current into the component at it
+    "electrical": {
+        "voltage": Quantity("V", (), lambda p: p.v),
+        "current": Quantity("A", (), lambda p: p.i),
+    },
     "signal_in": {"value": Quantity("", (), lambda p: p.value)},
     "signal_out": {"value": Quantity("", (), lambda p: p.value)},
 }

@@ -36,6 +36,7 @@ import casadi as ca
 import networkx as nx
 
 from ..errors import ModelError
+from .circuit import Circuit
 from .signals import acceleration_unavailable
 
 MECHANICS = "the mechanics"
@@ -158,6 +159,10 @@ class _Builder:
             for ref in self.topo.sets[s]:
                 self.net.pos[ref], self.net.vel[ref], self.net.acc[ref] = k * theta, k * w, k * a
         self._block_states()
+        # circuits next: their currents are expressions of states and speeds, so EMF
+        # torques are known before any balance (``circuit.py``)
+        self.circuit = Circuit(self).build()
+        self.circuit.fill(self.net)
         self._flows("compliant")               # springs and dampers need no signal
         self._passive = ca.SX.zeros(self.u.shape[0])
         for group in self.topo.oned:
@@ -280,6 +285,8 @@ class _Builder:
         if comp.role == "block":
             value = b.evaluate(self._inputs(comp), self.block_x.get(comp.name, []), self.t,
                                _Mechanics(self))
+        elif comp.role == "electrical":
+            value = self.circuit.output(comp)
         elif comp.quantity == "flow":
             value = self.net.flow[comp.port_ref("flange_a")]
         else:
@@ -365,6 +372,7 @@ class _Builder:
                     g.add_edge(source, comp.name)
                 elif comp.role in ("source", "prescribed"):
                     g.add_edge(source, MECHANICS)
+        self._circuit_edges(g)
         # block-lower-triangular order: the strongly connected components (Tarjan) of the
         # graph, each solved as one block, in topological order of the condensation
         dag = nx.condensation(g)
@@ -379,6 +387,22 @@ class _Builder:
                 f"to a source): break it with a state (an Integrator, a FirstOrder or a "
                 f"filtered Derivative)" for c in loops])
         return [c[0] if len(c) == 1 else c for c in blocks]
+
+    def _circuit_edges(self, g):
+        """A signal into an electrical source reaches, at the same instant, the sensors
+        and EMF torques whose circuit it drives (an algebraic loop when fed back)."""
+        feeder = {name: self.topo.signal_source[s].component.name for name, s in (
+            (name, self.circuit.inputs[ph]) for name, ph in self.circuit.sources.items())}
+        if not feeder:
+            return
+        for comp in self.circuit.comps:
+            if getattr(type(comp), "quantity", None):
+                reads = self.circuit.output(comp)
+                for name in self.circuit.placeholders_in(reads):
+                    g.add_edge(feeder[name], comp.name)
+            if getattr(type(comp), "converter", False):
+                for name in self.circuit.placeholders_in(self.circuit.converter_current(comp)):
+                    g.add_edge(feeder[name], MECHANICS)
 
     # -- the mechanics ------------------------------------------------------------------
     def _mechanics(self):
@@ -414,6 +438,8 @@ class _Builder:
             b = self.bound[comp.name]
             # a source's signal input, when wired, replaces its torque or force parameter
             u = self._inputs(comp).get("u") if comp.role == "source" else None
+            if getattr(type(comp), "converter", False):      # an EMF: driven by its current
+                u = self.circuit.converter_current(comp)
             refs = {pn: comp.port_ref(pn) for pn in comp.ports if comp.ports[pn].domain
                     in ("rotational", "translational")}
             out = b.flows({pn: net.pos.get(r, 0) for pn, r in refs.items()},
@@ -509,6 +535,8 @@ class _Builder:
 
     def _finish(self):
         net = self.net
+        for placeholder, s in self.circuit.inputs.items():
+            self.pending[placeholder] = net.signal[s]
         for joint_ports in self._axis_ports():
             ref, u = joint_ports
             net.axis_flow[u] += net.flow.get(ref, 0)

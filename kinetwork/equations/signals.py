@@ -65,6 +65,8 @@ def probe_signals(asm, topo, net, bound, model):
             view = FrameView(asm, topo, target, bound)
         elif target.domain in ("signal_in", "signal_out"):
             view = SignalView(net.signal.get(topo.set_of[target], ca.SX.nan()))
+        elif target.domain == "electrical":
+            view = PinView(net.pos[target], net.flow.get(target, ca.SX(0)))
         else:
             view = FlangeView(net, topo, target, where)
         for quantity in probe.asked(target.domain):
@@ -79,6 +81,13 @@ class SignalView:
 
     def __init__(self, value):
         self.value = value
+
+
+class PinView:
+    """An electrical pin as a probe formula reads it: potential v and current i."""
+
+    def __init__(self, v, i):
+        self.v, self.i = v, i
 
 
 class FlangeView:

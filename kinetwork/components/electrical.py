@@ -1,0 +1,231 @@
+"""Electrical library: pins with potential v [V] and current i [A] (positive into the
+component), as Modelica.Electrical.Analog.
+
+A component states its laws as residuals linear in its pins' potentials and currents
+(``laws``), one per pin; its states (an inductor's current, a capacitor's voltage) get their
+rates from ``rates``. ``kinetwork.equations.circuit`` gathers them with Kirchhoff's current law
+at every connection set, and solves the circuit by structural analysis (the connection sets
+are the alias elimination of the potentials; a block-lower-triangular sort of the rest).
+What a component is handed, ``e``, reads ``e.v("p")``, ``e.i("p")``, ``e.x`` (its states),
+``e.t``, ``e.u`` (the signal at u, or None when unwired) and, for an EMF, ``e.w`` (the speed of
+its flange relative to its support).
+"""
+
+from .base import Component, Param, Port, PortRef
+from .loopjoints import Expansion
+
+LIB = "electrical"
+
+
+class PartialTwoPin(Component):
+    """Two pins p and n; the current i flows into p, through the component, out of n."""
+    role = "electrical"
+    p = Port("electrical", "Positive pin (the current i flows in here)")
+    n = Port("electrical", "Negative pin")
+    n_states = 0
+    state_labels = ()
+    state_units = ()
+
+    def laws(self, e):
+        """The two residuals: the current through (i_p + i_n = 0) and the component's law."""
+        return [e.i("p") + e.i("n"), self.law(e.v("p") - e.v("n"), e.i("p"), e)]
+
+    def law(self, v, i, e):
+        raise NotImplementedError
+
+    def rates(self, e):
+        return []
+
+    def initial(self):
+        return []
+
+
+class Resistor(PartialTwoPin, library=LIB):
+    """Ideal linear resistor: v = R i."""
+    R = Param(unit="Ohm", min=0.0, doc="Resistance")
+
+    def law(self, v, i, e):
+        return v - self.R * i
+
+
+class Inductor(PartialTwoPin, library=LIB):
+    """Ideal linear inductor: L di/dt = v; its current is a state."""
+    L = Param(unit="H", positive=True, doc="Inductance")
+    i0 = Param(0.0, unit="A", doc="Initial current")
+    n_states = 1
+    state_labels = ("i",)
+    state_units = ("A",)
+
+    def law(self, v, i, e):
+        return i - e.x[0]
+
+    def rates(self, e):
+        return [(e.v("p") - e.v("n")) / self.L]
+
+    def initial(self):
+        return [self.i0]
+
+
+class Capacitor(PartialTwoPin, library=LIB):
+    """Ideal linear capacitor: C dv/dt = i; its voltage is a state."""
+    C = Param(unit="F", positive=True, doc="Capacitance")
+    v0 = Param(0.0, unit="V", doc="Initial voltage")
+    n_states = 1
+    state_labels = ("v",)
+    state_units = ("V",)
+
+    def law(self, v, i, e):
+        return v - e.x[0]
+
+    def rates(self, e):
+        return [e.i("p") / self.C]
+
+    def initial(self):
+        return [self.v0]
+
+
+class Ground(Component, library=LIB):
+    """Ground: the potential 0 of a circuit; every circuit needs one."""
+    role = "electrical"
+    p = Port("electrical", "Pin at potential 0")
+    n_states = 0
+    state_labels = state_units = ()
+
+    def laws(self, e):
+        return [e.v("p")]
+
+    def rates(self, e):
+        return []
+
+    def initial(self):
+        return []
+
+
+class PartialSource(PartialTwoPin):
+    """A source of ``value()`` (an expression in time and model parameters), or of the
+    signal at u when it is wired; one of them, not both."""
+    u = Port("signal_in", "Signal giving the source's value (instead of the parameter)",
+             optional=True)
+    reference_key = None
+
+    def source_value(self, e):
+        return self.value() if e.u is None else e.u
+
+
+class VoltageSource(PartialSource, library=LIB):
+    """Ideal voltage source: v = V (an expression in t, or the signal at u)."""
+    V = Param(None, optional=True, unit="V", time=True,
+              doc="Voltage v_p - v_n (when u is not wired)")
+    reference_key = "V"
+
+    def value(self):
+        return self.V
+
+    def law(self, v, i, e):
+        return v - self.source_value(e)
+
+
+class CurrentSource(PartialSource, library=LIB):
+    """Ideal current source: the current I (an expression in t, or the signal at u) flows
+    into pin p, through the source and out of pin n, as MSL's."""
+    I = Param(None, optional=True, unit="A", time=True,  # noqa: E741 (MSL's name)
+              doc="Current through the source, from p to n (when u is not wired)")
+    reference_key = "I"
+
+    def value(self):
+        return self.I
+
+    def law(self, v, i, e):
+        return i - self.source_value(e)
+
+
+class VoltageSensor(Component, library=LIB):
+    """The voltage v_p - v_n as a signal; draws no current."""
+    role = "electrical"
+    quantity = "voltage"
+    p = Port("electrical", "Positive pin")
+    n = Port("electrical", "Negative pin")
+    y = Port("signal_out", "Voltage v_p - v_n [V]", optional=True)
+    n_states = 0
+    state_labels = state_units = ()
+
+    def laws(self, e):
+        return [e.i("p"), e.i("n")]
+
+    def output(self, e):
+        return e.v("p") - e.v("n")
+
+    def rates(self, e):
+        return []
+
+    def initial(self):
+        return []
+
+
+class CurrentSensor(PartialTwoPin, library=LIB):
+    """The current from p to n through the sensor as a signal; no voltage across it (wire it
+    in series)."""
+    quantity = "current"
+    y = Port("signal_out", "Current into p [A]", optional=True)
+
+    def law(self, v, i, e):
+        return v
+
+    def output(self, e):
+        return e.i("p")
+
+
+class EMF(PartialTwoPin, library=LIB):
+    """Ideal electromechanical converter (MSL's Analog.Basic.EMF): v = k w and the torque
+    k i on the flange, w the speed of the flange relative to the support; its reaction goes
+    to the support (unwired: the world)."""
+    #: to the 1-D network it is a torque source whose torque follows the current through it
+    role = "source"
+    converter = True
+    flange = Port("rotational", "Shaft driven by the converter")
+    support = Port("rotational", "Housing (unwired: the world)", optional=True)
+    k = Param(unit="N*m/A", doc="Transformation coefficient (V*s/rad)")
+
+    def law(self, v, i, e):
+        return v - self.k * e.w
+
+    def flows(self, pos, vel, t, current):
+        """Flows into the flanges for the current through the converter (MSL's
+        flange.tau = -k i: it drives what the flange is wired to with k i)."""
+        tau = self.k * current
+        return {"flange": -tau, "support": tau}
+
+
+class DCMotor(Component, library=LIB):
+    """A permanent-magnet DC motor wired as in MSL's examples: armature resistance R and
+    inductance L in series with an EMF of constant k, whose shaft turns a rotor of inertia J.
+    Pins p and n take the armature voltage; flange is the rotor's far side."""
+    p = Port("electrical", "Positive armature pin")
+    n = Port("electrical", "Negative armature pin")
+    flange = Port("rotational", "Shaft (the rotor's flange_b)")
+    support = Port("rotational", "Housing (unwired: the world)", optional=True)
+    R = Param(unit="Ohm", min=0.0, doc="Armature resistance")
+    L = Param(unit="H", positive=True, doc="Armature inductance")
+    k = Param(unit="N*m/A", doc="Torque constant (= back-EMF constant, V*s/rad)")
+    J = Param(unit="kg*m^2", min=0.0, doc="Rotor inertia")
+    i0 = Param(0.0, unit="A", doc="Initial armature current")
+    w0 = Param(None, optional=True, unit="rad/s",
+               doc="Initial rotor speed when the rotor turns freely (None: 0)")
+
+    def expand(self):
+        """Resistor ``Ra``, inductor ``La``, EMF ``emf`` and rotor ``rotor``, wired in MSL's
+        order: p - Ra - La - emf - n, emf.flange - rotor.flange_a."""
+        from .base import REGISTRY
+        inertia = REGISTRY["rotational.Inertia"]
+        parts = [Resistor("Ra", R=self.R), Inductor("La", L=self.L, i0=self.i0),
+                 EMF("emf", k=self.k), inertia("rotor", J=self.J, w0=self.w0)]
+        comps = {c.name: c for c in parts}
+
+        def port(path):
+            name, port_name = path.split(".")
+            return PortRef(comps[name], port_name)
+        wires = [("Ra.n", "La.p"), ("La.n", "emf.p"), ("emf.flange", "rotor.flange_a")]
+        exposed = {"p": "Ra.p", "n": "emf.n", "flange": "rotor.flange_b",
+                   "support": "emf.support"}
+        return Expansion(self.name, comps, [(port(a), port(b)) for a, b in wires],
+                         {k: port(v) for k, v in exposed.items()})
