@@ -55,11 +55,12 @@ ROUTED = 400       # more wires than this are drawn as plain elbows (routing is 
 #: wire colour and width of each domain (Modelica's colours)
 DOMAINS = {"frame": ("#5f5f5f", 2.0), "rotational": ("#404040", 1.3),
            "translational": ("#007f00", 1.3), "signal": ("#00007f", 1.0),
-           ANY: ("#8c8c8c", 1.0)}
+           "electrical": ("#0000ff", 1.2), ANY: ("#8c8c8c", 1.0)}
 #: border and fill of a block, by library
 LIBRARIES = {"multibody": ("#5f5f5f", "#f5f5f5"), "rotational": ("#404040", "#f7f7f7"),
              "translational": ("#007f00", "#f2f9f2"), "signals": ("#00007f", "#f3f3fb"),
-             "probe": ("#a86b00", "#fff8e8"), "subsystem": ("#3a3a3a", "#fffdf2")}
+             "probe": ("#a86b00", "#fff8e8"), "subsystem": ("#3a3a3a", "#fffdf2"),
+             "electrical": ("#0000ff", "#f2f2ff")}
 _OUT = {"left": (-1, 0), "right": (1, 0), "top": (0, -1), "bottom": (0, 1)}
 _PRINCIPAL = re.compile(r"(?:frame|flange)_([ab])")
 
