@@ -25,6 +25,7 @@ from .simulation.driver import simulate
 from .simulation.methods import METHODS
 from .simulation.results import Results
 from .urdf import from_urdf
+from .analysis import bode, equilibrium, fit, linearize, modes, plot_bode, sensitivity
 # kn.plot is the function (kn.plot([res_a, res_b])), not its module
 from .plot import plot  # noqa: E402  isort: skip
 
@@ -34,3 +35,4 @@ __all__ = ["IdealisedInertiaWarning", "METHODS", "Model", "ModelError", "Probe",
            "SimulationError", "Subsystem", "System", "dumps", "examples", "from_urdf", "load",
            "loads", "electrical", "multibody", "plot", "rotational", "schema", "signals",
            "simulate", "translational"]
+__all__ += ["bode", "equilibrium", "fit", "linearize", "modes", "plot_bode", "sensitivity"]

@@ -130,6 +130,65 @@ class Damper(PartialLineForce, library=MB):
         return self.d * s_d
 
 
+class AlongLine(dict):
+    """Where a point mass sits on the line from frame_a's origin to frame_b's: ``distance``
+    from the origin of ``port`` towards the other one (MSL's LineForceWithTwoMasses: L_a
+    from frame_a, L_b from frame_b). Its keys are the two ports; ``position(origins)`` places
+    it, and the solver shares its inertial force over the frames by d(position)/d(origin)."""
+
+    def __init__(self, port, distance):
+        super().__init__(frame_a=None, frame_b=None)
+        self.port, self.distance = port, distance
+
+    def position(self, origins):
+        d = origins["frame_b"] - origins["frame_a"]
+        e = d / line_length(d)
+        return (origins["frame_a"] + self.distance * e if self.port == "frame_a"
+                else origins["frame_b"] - self.distance * e)
+
+
+class LineForceWithTwoMasses(PartialLineForce, library=MB):
+    """A spring and damper between two frame origins with two point masses on their line
+    (MSL's Forces.LineForceWithTwoMasses): ``m_a`` at distance ``L_a`` from frame_a towards
+    frame_b and ``m_b`` at ``L_b`` from frame_b towards frame_a, as the two halves of a
+    hydraulic cylinder. The masses move with the line; their inertial force and weight act
+    on the two frames by virtual work (MSL's f1, f2 with aux2). MSL's 1-D flanges are given
+    here by the law's ``c``, ``d`` and ``s_unstretched`` (a Translational SpringDamper
+    between them: tension c (s - s_unstretched) + d ds/dt).
+
+    Parameters
+    ----------
+    m_a, m_b : kg, >= 0, default 0
+        Point masses near frame_a and near frame_b.
+    L_a : m, default 0
+        Distance of m_a from frame_a, towards frame_b.
+    L_b : m, default None
+        Distance of m_b from frame_b, towards frame_a (None: L_a, as MSL).
+    c : N/m, >= 0, default 0
+        Spring constant of the line force.
+    d : N*s/m, >= 0, default 0
+        Damping constant of the line force.
+    s_unstretched : m, >= 0, default 0
+        Unstretched length of the spring.
+    """
+    m_a = Param(0.0, unit="kg", min=0.0, doc="Point mass at L_a from frame_a")
+    m_b = Param(0.0, unit="kg", min=0.0, doc="Point mass at L_b from frame_b")
+    L_a = Param(0.0, unit="m", doc="Distance of m_a from frame_a, towards frame_b")
+    L_b = Param(None, optional=True, unit="m",
+                doc="Distance of m_b from frame_b, towards frame_a (None: L_a)")
+    c = Param(0.0, unit="N/m", min=0.0, doc="Spring constant of the line force")
+    d = Param(0.0, unit="N*s/m", min=0.0, doc="Damping constant of the line force")
+    s_unstretched = Param(0.0, unit="m", min=0.0, doc="Unstretched length of the spring")
+
+    def law(self, s, s_d):
+        return self.c * (s - self.s_unstretched) + self.d * s_d
+
+    def point_masses(self):
+        L_b = self.L_a if self.L_b is None else self.L_b
+        return [(self.m_a, AlongLine("frame_a", self.L_a)),
+                (self.m_b, AlongLine("frame_b", L_b))]
+
+
 # -- forces and torques between two frames ---------------------------------------------------
 def _resolve_in():
     return Param("frame_b", kind="choice", choices=RESOLVE_AB,
@@ -275,5 +334,5 @@ class WorldTorque(PartialFrameForce, library=MB):
         return {"frame_b": (ZERO, t)}
 
 
-__all__ = ["Damper", "Force", "ForceAndTorque", "Spring", "SpringDamper", "Torque",
-           "WorldForce", "WorldTorque"]
+__all__ = ["Damper", "Force", "ForceAndTorque", "LineForceWithTwoMasses", "Spring",
+           "SpringDamper", "Torque", "WorldForce", "WorldTorque"]

@@ -15,7 +15,9 @@ line forces.
   m J^T (g(r) - (dJ/dt) u). The forward dynamics stay O(n) per point mass: with Y = M^-1 J^T
   from the articulated-body algorithm (3 columns per mass) and W = diag(m),
   (M + J^T W J)^-1 = M^-1 - Y W (I + J Y W)^-1 J M^-1 (Woodbury; I + J Y W is regular for
-  any m >= 0, so a mass that is a parameter may be zero).
+  any m >= 0, so a mass that is a parameter may be zero). A point mass may also sit where its
+  element's ``position(origins)`` puts it (at a fixed distance along a line): J and the
+  shares of its inertial force on the frames, (dr/dr_port)^T m (a - g), follow by AD.
 """
 
 from dataclasses import dataclass
@@ -88,8 +90,8 @@ class Extra:
             for m, weights in bound[comp.name].point_masses():
                 if ca.SX(m).is_zero():
                     continue            # no mass: nothing to add, not even a solve
-                r = sum((w * position(topo.set_of[comp.port_ref(port)])
-                         for port, w in weights.items()), ca.SX.zeros(3))
+                r = mass_position(weights, {port: position(topo.set_of[comp.port_ref(port)])
+                                            for port in weights})
                 J = ca.jacobian(rate(r), u)
                 bias = ca.jtimes(J @ u, q, qdot)
                 self.masses.append(PointMass(comp.name, m, weights, r, J, bias))
@@ -159,9 +161,30 @@ def element_wrench(asm, topo, bound, comp, port):
     for m, weights in c.point_masses():
         if port not in weights or ca.SX(m).is_zero():
             continue
-        r = sum((w * frames[p].r for p, w in weights.items()), ca.SX.zeros(3))
-        force = force - weights[port] * m * (asm.rate(asm.rate(r)) - asm.applied.field(r))
+        origins = {p: frames[p].r for p in weights}
+        r = mass_position(weights, origins)
+        force = force - share(weights, origins, port).T @ (
+            m * (asm.rate(asm.rate(r)) - asm.applied.field(r)))
     return force, ca.cross(frames[port].r, force) + torque
+
+
+def mass_position(weights, origins):
+    """Where a force element's point mass sits, from its element's frame origins
+    (port -> r): sum(w r) for fixed weights, or the placement's own ``position(origins)``
+    (a mass at a fixed distance along a line, as MSL's LineForceWithTwoMasses)."""
+    if hasattr(weights, "position"):
+        return weights.position(origins)
+    return sum((w * origins[p] for p, w in weights.items()), ca.SX.zeros(3))
+
+
+def share(weights, origins, port):
+    """d(position)/d(origin of ``port``), 3 x 3: its transpose takes the point mass's
+    inertial force and weight to ``port`` (virtual work), w I for fixed weights."""
+    if not hasattr(weights, "position"):
+        return weights[port] * ca.SX.eye(3)
+    stand_in = {p: ca.SX.sym(f"r_{p}", 3) for p in origins}
+    J = ca.jacobian(weights.position(stand_in), stand_in[port])
+    return ca.substitute(J, ca.vertcat(*stand_in.values()), ca.vertcat(*origins.values()))
 
 
 def _frames(asm, topo, comp):
