@@ -19,6 +19,8 @@ import time
 import kinetwork as kn
 
 from . import examples
+from .analysis.sweep import add_command as add_sweep, run_command as run_sweep
+from .analysis import commands as analysis_commands
 from .graph.settings import check_output, check_settings
 from .graph.subsystem import subsystem_instances
 from .simulation.driver import DEFAULTS, METHODS
@@ -218,6 +220,7 @@ def build_parser():
     excopy.add_argument("folder", metavar="DIR", nargs="?", default=".",
                         help="destination folder (default: the current one)")
 
+    add_sweep(sub)
     imp = sub.add_parser(
         "import", help="turn a URDF robot description into a kinetwork model file",
         description="Read ROBOT.urdf (links, joints, inertials, limits, visuals) and write "
@@ -230,7 +233,8 @@ def build_parser():
                      help="a free-floating base (default: the root link fixed to the ground)")
     imp.add_argument("--gravity", type=float, nargs=3, metavar=("GX", "GY", "GZ"),
                      default=None, help="gravity of the ground (default 0 0 -9.81)")
-    for command in (run, val, eqs, anim, dia, studio):
+    lin, fit = analysis_commands.add_commands(sub)
+    for command in (run, val, eqs, anim, dia, studio, lin, fit):
         command.add_argument("--library", action="append", default=[], metavar="DIR",
                              help="a folder of subsystem files (TYPE.json), searched after "
                                   "the model's own definitions and folder (repeat for "
@@ -244,8 +248,8 @@ def main(argv=None):
     command = {"run": _run, "validate": _validate, "equations": _equations,
                "methods": _methods, "bench": _bench, "schema": _schema,
                "cache": _cache, "animate": _animate, "diagram": _diagram,
-               "studio": _studio, "import": _import,
-               "examples": _examples}[args.command]
+               "studio": _studio, "import": _import, "sweep": _sweep,
+               "examples": _examples, "linearize": _linearize, "fit": _fit}[args.command]
     try:
         return command(args)
     except kn.ModelError as exc:
@@ -259,6 +263,22 @@ def main(argv=None):
         # Python from complaining again when it flushes stdout at exit
         os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
         return EXIT_MODEL
+
+
+def _linearize(args):
+    return analysis_commands.run_linearize(args, _load(args.model, args.library))
+
+
+def _fit(args):
+    try:
+        return analysis_commands.run_fit(args, _load(args.model, args.library))
+    except kn.SimulationError as exc:
+        _error(exc)
+        return EXIT_SIMULATION
+
+
+def _sweep(args):
+    return run_sweep(args, _load(args.model, args.library))
 
 
 def _error(message):

@@ -22,7 +22,7 @@ PACKAGE = pathlib.Path(kinetwork.__file__).resolve().parent
 LAYERS = [("errors", "util", "expr", "spatial"), ("components",), ("graph",), ("equations",),
           ("simulation",),
           ("plot", "schema", "symbolic", "animation", "diagram", "urdf", "examples", "studio",
-           "cli", "")]
+           "analysis", "cli", "")]
 RANK = {name: rank for rank, names in enumerate(LAYERS) for name in names}
 
 
