@@ -13,6 +13,7 @@ from . import animation as _animation  # noqa: F401  (installs Results.animate)
 from . import diagram as _diagram  # noqa: F401  (installs Model._repr_svg_ for Jupyter)
 from . import plot as _plot  # noqa: F401  (installs Results.plot)
 from . import examples
+from .analysis.sweep import normal, sample, sweep, uniform
 from .components import electrical, multibody, rotational, signals, translational
 from .components.probe import Probe
 from .equations.system import System
@@ -36,3 +37,4 @@ __all__ = ["IdealisedInertiaWarning", "METHODS", "Model", "ModelError", "Probe",
            "loads", "electrical", "multibody", "plot", "rotational", "schema", "signals",
            "simulate", "translational"]
 __all__ += ["bode", "equilibrium", "fit", "linearize", "modes", "plot_bode", "sensitivity"]
+__all__ += ["normal", "sample", "sweep", "uniform"]
