@@ -123,6 +123,9 @@ def _param(spec):
     elif spec.kind == "names":
         items = {"enum": list(spec.choices)} if spec.choices else {"type": "string"}
         out = {"type": "array", "items": items, "uniqueItems": True}
+    elif spec.kind == "table2d":           # grids in the first row and column
+        out = {"type": "array", "minItems": 3, "items": {
+            "type": "array", "minItems": 3, "items": NUMBER}}
     elif spec.kind == "table":
         out = {"type": "array", "minItems": 2, "items": {
             "type": "array", "minItems": 2, "maxItems": 2, "items": NUMBER}}

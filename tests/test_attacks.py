@@ -229,7 +229,8 @@ SIGNAL_BLOCKS = sorted(name for name in REGISTRY if name.startswith("signals."))
 
 def required_value(spec):
     return {"table": [[0.0, 0.0], [1.0, 2.0]], "name": "joint", "bool": False,
-            "names": []}.get(spec.kind, 1.0)
+            "names": [], "table2d": [[0.0, 0.0, 1.0], [0.0, 1.0, 2.0], [1.0, 3.0, 4.0]],
+            "expression": "2*t"}.get(spec.kind, 1.0)
 
 
 @pytest.mark.parametrize("type_name", SIGNAL_BLOCKS)

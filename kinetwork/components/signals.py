@@ -9,8 +9,12 @@ computed-torque controller) overrides ``evaluate``, which is handed them.
 """
 
 import casadi as ca
+import numpy as np
 
-from .base import Component, Param, Port
+from ..errors import ModelError
+from ..expr import parse
+from ..util import check_number, quote
+from .base import REQUIRED, TABLE_ROWS_LIMIT, Component, Param, Port
 
 LIB = "signals"
 
@@ -287,3 +291,139 @@ class InverseDynamics(PartialBlock, library=LIB):
                                                   f"degree of freedom of this model")
         a = [u[f"a{i + 1}"] if u[f"a{i + 1}"] is not None else 0 for i in range(n)]
         return mechanics.inverse(a)[speed]
+
+
+class ExpressionParam(Param):
+    """A parameter holding an expression whose free names are only known when the model is
+    compiled (the block's inputs as well as model parameters and t): parsed and checked for
+    form here, its names checked by the block that evaluates it."""
+
+    def __init__(self, default=REQUIRED, *, doc=""):
+        super().__init__(default, kind="expression", doc=doc)
+
+    def normalize(self, value, where):
+        if isinstance(value, (int, float)) and not isinstance(value, bool):
+            return float(check_number(value, where, "a number or an expression"))
+        if not isinstance(value, str) or not value.strip():
+            raise ModelError(f"{where}: must be an expression (a string), got {quote(value)}")
+        try:
+            expr = parse(value)
+        except ModelError as exc:
+            raise ModelError(f"{where}: {exc}") from None
+        dotted = sorted(n for n in expr.names if "." in n)
+        if dotted:
+            raise ModelError(f"{where}: {quote(dotted[0])} is not a name here: use the "
+                             f"block's inputs, t and the model's parameters")
+        return value
+
+
+class Expression(PartialBlock, library=LIB):
+    """y = an expression in the inputs u1 .. u4 (or the names given them in ``names``), time
+    t and the model's parameters, as MSL's RealExpression with inputs: a force law in sensor
+    signals is one block (``"-p0*A*(1 + s/L)"``). Differentiated exactly by CasADi."""
+    u1 = Port("signal_in", "Input 1", optional=True)
+    u2 = Port("signal_in", "Input 2", optional=True)
+    u3 = Port("signal_in", "Input 3", optional=True)
+    u4 = Port("signal_in", "Input 4", optional=True)
+    expression = ExpressionParam(doc="The output, in u1..u4 (or their names), t and the "
+                                     "model's parameters")
+    names = Param(None, optional=True, kind="names",
+                  doc="Names of u1, u2, ... in the expression (default: u1, u2, ...)")
+    inputs = ("u1", "u2", "u3", "u4")
+
+    def evaluate(self, u, x, t, mechanics):
+        from ..expr import casadi_functions
+        if not isinstance(self.expression, str):
+            return ca.SX(self.expression)
+        aliases = list(self.names or [])
+        if len(aliases) > len(self.inputs):
+            raise mechanics.refuse(self, "names", f"{len(aliases)} names for "
+                                                  f"{len(self.inputs)} inputs")
+        parameters = mechanics.parameters
+        clash = sorted(set(aliases) & (set(parameters) | {"t", *self.inputs}))
+        if clash:
+            raise mechanics.refuse(self, "names", f"{clash[0]!r} is also a model parameter, "
+                                                  f"t or an input's port name: choose another")
+        env = {**parameters, "t": t}
+        wired = {}
+        for k, port in enumerate(self.inputs):
+            wired[port] = u[port]
+            if k < len(aliases):
+                wired[aliases[k]] = u[port]
+        env.update({name: v for name, v in wired.items() if v is not None})
+        expr = parse(self.expression)
+        unknown = sorted(expr.names - set(env) - set(wired))
+        if unknown:
+            raise mechanics.refuse(self, "expression", f"unknown name {unknown[0]!r} in "
+                                   f"{self.expression!r}; names are the inputs "
+                                   f"{', '.join(aliases or self.inputs)}, t and the model's "
+                                   f"parameters {', '.join(parameters) or '(none)'}")
+        unwired = sorted(n for n in expr.names if n in wired and wired[n] is None)
+        if unwired:
+            port = (self.inputs[aliases.index(unwired[0])] if unwired[0] in aliases
+                    else unwired[0])
+            raise mechanics.refuse(self, "expression", f"uses {unwired[0]!r}, but "
+                                   f"{self.name}.{port} is not wired")
+        return ca.SX(expr.evaluate(env, casadi_functions()))
+
+
+class Table2DParam(Param):
+    """A 2-D table as MSL's CombiTable2D: the first row holds the u2 grid (after a corner
+    entry that is ignored), the first column the u1 grid, the rest the values."""
+
+    def __init__(self, *, doc=""):
+        super().__init__(kind="table2d", doc=doc)
+
+    def normalize(self, value, where):
+        if isinstance(value, np.ndarray):
+            value = value.tolist()
+        if not isinstance(value, (list, tuple)) or len(value) < 3 or not all(
+                isinstance(r, (list, tuple)) for r in value):
+            raise ModelError(f"{where}: must be a matrix of at least 3 x 3 (grids in the "
+                             f"first row and column), got {quote(value)}")
+        if len(value) * len(value[0]) > TABLE_ROWS_LIMIT:
+            raise ModelError(f"{where}: more than {TABLE_ROWS_LIMIT} entries; resample it")
+        width = len(value[0])
+        rows = []
+        for i, row in enumerate(value):
+            if len(row) != width or width < 3:
+                raise ModelError(f"{where}[{i}]: every row must have the first row's "
+                                 f"{width} entries (at least 3), got {len(row)}")
+            rows.append([float(check_number(v, f"{where}[{i}][{j}]")) for j, v in
+                         enumerate(row)])
+        for label, grid, at in (("first column (u1)", [r[0] for r in rows[1:]], "[{}][0]"),
+                                ("first row (u2)", rows[0][1:], "[0][{}]")):
+            for k in range(1, len(grid)):
+                if grid[k] <= grid[k - 1]:
+                    raise ModelError(f"{where}{at.format(k + 1)}: the {label} must increase, "
+                                     f"got {grid[k]} after {grid[k - 1]}")
+        return rows
+
+
+class Table2D(PartialBlock, library=LIB):
+    """y interpolated bilinearly in a 2-D ``table`` at (u1, u2) (MSL's CombiTable2D with
+    linear segments), extrapolated linearly from the boundary cells; differentiable
+    everywhere but on the grid lines (CasADi's derivatives are exact inside each cell)."""
+    u1 = Port("signal_in", "Abscissa along the first column")
+    u2 = Port("signal_in", "Abscissa along the first row")
+    table = Table2DParam(doc="[[ignored, u2 grid...], [u1, values...], ...], grids "
+                             "increasing")
+    #: up to this many values, an SX expression (hat functions of pw_lin on each axis);
+    #: beyond, a CasADi interpolant
+    expression_cells = 400
+
+    def output(self, u, x, t):
+        grid1 = [r[0] for r in self.table[1:]]
+        grid2 = self.table[0][1:]
+        values = np.array([r[1:] for r in self.table[1:]])
+        if values.size > self.expression_cells:
+            return ca.interpolant(f"{self.name}_table", "linear", [grid1, grid2],
+                                  values.ravel(order="F"))(ca.vertcat(u["u1"], u["u2"]))
+        return ca.dot(_hats(u["u1"], grid1), ca.mtimes(ca.DM(values), _hats(u["u2"], grid2)))
+
+
+def _hats(at, grid):
+    """The piecewise-linear hat functions of ``grid`` at ``at``, extrapolated linearly (they
+    sum to one): a linear interpolant is their product with the values."""
+    eye = np.eye(len(grid))
+    return ca.vertcat(*[ca.pw_lin(at, ca.DM(grid), ca.DM(eye[k])) for k in range(len(grid))])

@@ -628,6 +628,11 @@ class _Mechanics:
         self._b = builder
         self.n_speeds = builder.u.shape[0]
 
+    @property
+    def parameters(self):
+        """The model's parameters by name, as the symbols they stay in the System."""
+        return {name: self._b.p[i] for i, name in enumerate(self._b.model.parameters)}
+
     def speed_of(self, joint_name):
         """Index of the speed of a one-degree-of-freedom joint of the model, or None."""
         joint = self._b.model.components.get(joint_name)
