@@ -88,7 +88,8 @@ class Extra:
                 self.Q_gravity += ca.jtimes(rate(cw), u, m * self.field(cw), True)
         for comp in topo.forces:
             for m, weights in bound[comp.name].point_masses():
-                if ca.SX(m).is_zero():
+                if ca.SX(m).is_zero() or set(topo.junctions) & {
+                        topo.set_of[comp.port_ref(port)] for port in weights}:
                     continue            # no mass: nothing to add, not even a solve
                 r = mass_position(weights, {port: position(topo.set_of[comp.port_ref(port)])
                                             for port in weights})
@@ -133,7 +134,10 @@ def element_forces(asm, topo, bound):
     Q = ca.SX.zeros(asm.u.shape[0])
     if not asm.u.shape[0]:
         return Q
+    junctions = asm.junctions.elements if asm.junctions is not None else set()
     for comp in topo.forces:
+        if comp.name in junctions:
+            continue            # a line force with an end at a junction: junctions.py
         frames = _frames(asm, topo, comp)
         out = bound[comp.name].wrenches(frames, _inputs(asm, topo, comp))
         for port, (force, torque) in out.items():
@@ -144,13 +148,16 @@ def element_forces(asm, topo, bound):
                              f"signal input of {comp.name} reads an acceleration or a force "
                              f"at the same instant; break it with a state (an Integrator, a "
                              f"FirstOrder or a filtered Derivative)")
-    return Q
+    return Q + asm.junctions.Q if junctions else Q
 
 
 def element_wrench(asm, topo, bound, comp, port):
     """(force, moment about the world origin) that force element ``comp`` applies on the
     frame at ``port``: its wrench there and the share of its point masses' inertia and
     weight, -w m (a - g) (in q, u and udot)."""
+    if asm.junctions is not None and comp.name in asm.junctions.lines:
+        force = asm.junctions.lines[comp.name].force[port]
+        return force, ca.cross(asm.pose(topo.set_of[comp.port_ref(port)])[1], force)
     frames = _frames(asm, topo, comp)
     if frames.get(port) is None:
         return ca.SX.zeros(3), ca.SX.zeros(3)
@@ -194,7 +201,7 @@ def _frames(asm, topo, comp):
         if port.domain != "frame":
             continue
         s = topo.set_of[comp.port_ref(name)]
-        if s not in asm.place:
+        if s not in asm.place and (asm.junctions is None or s not in asm.junctions.position):
             out[name] = None
             continue
         R, r = asm.pose(s)

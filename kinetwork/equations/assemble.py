@@ -15,7 +15,7 @@ import numpy as np
 from ..errors import ModelError
 from ..expr import casadi_functions, parse
 from ..spatial import vee
-from . import applied, network
+from . import applied, junctions, network
 from .newton_euler import Body, aba, crba, motion_subspace, rnea, spatial_inertia
 from .signals import probe_signals
 
@@ -68,6 +68,8 @@ class Assembly:
     base: tuple = None         # world pose of the body of the last ``relative_poses``
     #: the gravity field, and what the point masses of force elements add (applied.Extra)
     applied: object = None
+    #: massless junctions of line forces (junctions.Junctions), None without any
+    junctions: object = None
 
     def mass_matrix(self):
         M = crba(self.bodies, self.u.shape[0], self.armature)
@@ -107,6 +109,8 @@ class Assembly:
 
     def pose(self, frame_set):
         """World orientation R and position p of a frame set, in the coordinates q."""
+        if self.junctions is not None and frame_set in self.junctions.position:
+            return ca.SX.eye(3), self.junctions.position[frame_set]
         if frame_set not in self._poses:
             k, R, pos = self.place[frame_set]
             while k >= 0:
@@ -145,6 +149,12 @@ class Assembly:
         out = ca.jtimes(flat, self.q, self.qdot)
         if accelerations:
             out += ca.jtimes(flat, self.u, self.udot)
+        J = self.junctions
+        if J is not None and ca.depends_on(flat, ca.vertcat(J.y, J.s)):
+            # a junction's position and its dampers' rates follow (q, s) implicitly
+            out += ca.jtimes(flat, J.y, J.ydot(self.q, self.qdot))
+            if J.s.numel():
+                out += ca.jtimes(flat, J.s, J.sd)
         return ca.reshape(out, *expr.shape)
 
     def angular_velocity(self, R, accelerations=True):
@@ -218,6 +228,7 @@ def assemble(model, topo, values):
                    speed_of, Q, None, qdot, gravity, udot, place=place)
     asm.armature, asm.net = net.armature, net
     asm.applied = extra
+    asm.junctions = junctions.build(asm, topo, bound)
     asm.Q = Q + _frame_forces(asm, topo, bound, t) + extra.Q
     asm.udot_tree = extra.forward(aba(bodies, u, asm.Q, ca.vertcat(ca.SX.zeros(3), -gravity),
                                       net.armature), net.armature) if n else ca.SX(0, 1)

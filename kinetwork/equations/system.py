@@ -12,6 +12,7 @@ import casadi as ca
 import numpy as np
 
 from ..errors import ModelError
+from . import junctions
 from .assemble import assemble
 from .loops import BAUMGARTE_RATE, formulate, newton
 
@@ -36,6 +37,8 @@ class System:
         self.asm = asm = assemble(model, self.topology, values)
         self.eq = eq = formulate(asm, self.topology, values, loops,
                                  BAUMGARTE_RATE if baumgarte_rate is None else baumgarte_rate)
+        if asm.junctions is not None:
+            junctions.extend(eq, asm, self.topology)
         self.param_names = asm.param_names
         self.coordinate_names = asm.coordinate_names
         self.speed_names = asm.speed_names
@@ -287,7 +290,8 @@ class System:
     def frame_sets(self):
         """The frame connection sets placed by the kinematic tree (topology indices, in
         order): the frames ``f_frames`` gives the poses of."""
-        return sorted(self.asm.place)
+        return sorted({*self.asm.place, *(self.asm.junctions.sets if self.asm.junctions
+                                          else ())})
 
     @functools.cached_property
     def f_frames(self):

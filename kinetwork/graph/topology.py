@@ -76,6 +76,8 @@ class Topology:
     loops: list = field(default_factory=list)     # lists of component names
     cuts: list = field(default_factory=list)      # Cut, one per independent loop
     forces: list = field(default_factory=list)    # frame force elements (line, world)
+    #: frame sets only line forces meet at (massless junctions), placed by their balance
+    junctions: list = field(default_factory=list)
     signal_source: dict = field(default_factory=dict)   # signal set -> its output PortRef
 
     @property
@@ -145,6 +147,8 @@ def analyze(model):
     _oned(model, topo, values, problems)
     _signals(topo, problems)
     _motions(model, topo, problems)
+    if values is not None and topo.junctions:
+        _junction_masses(model, topo, values, problems)
     if values is not None:
         _inertias(model, [c for c in model.components.values() if c.role == "body" or (
             c.role in ("joint", "part") and c.has_mass)], values, problems)
@@ -223,25 +227,28 @@ def _tree(model, topo, roles, problems):
             frames.add_node(topo.set_of[comp.port_ref(pname)])
 
     reached = nx.node_connected_component(frames, topo.root)
+    topo.junctions = _junctions(model, topo, roles.get("frame_force", []), frames, reached,
+                                problems)
+    placed = reached | set(topo.junctions)
     for comp in [*joints, *roles.get("body", []), *roles.get("frame_force", [])]:
         # frames a cut joint places from where its ends are (a rod's frame_ia): for probes
-        placed = getattr(type(comp), "placed_frames", ())
-        for pname in placed:
+        by_cut = getattr(type(comp), "placed_frames", ())
+        for pname in by_cut:
             stray = [p.path for p in topo.sets[topo.set_of[comp.port_ref(pname)]]
                      if p.component is not comp and p.component.role != "probe"]
             if stray:
                 problems.append(f"{model.place(comp)}: {comp.name}.{pname} is for probes "
                                 f"only, but {', '.join(stray)} is wired to it")
         for pname in comp.ports:
-            if comp.ports[pname].domain == "frame" and pname not in placed and \
+            if comp.ports[pname].domain == "frame" and pname not in by_cut and \
                     _dangling(topo, comp, pname) and \
                     len(topo.sets[topo.set_of[comp.port_ref(pname)]]) > 1 and \
                     topo.set_of[comp.port_ref(pname)] not in reached:
                 problems.append(f"{model.place(comp)}: {comp.name}.{pname} is not wired, so "
                                 f"it has no pose for a probe to measure")
-            if comp.ports[pname].domain == "frame" and pname not in placed and \
+            if comp.ports[pname].domain == "frame" and pname not in by_cut and \
                     not _dangling(topo, comp, pname) and \
-                    topo.set_of[comp.port_ref(pname)] not in reached:
+                    topo.set_of[comp.port_ref(pname)] not in placed:
                 problems.append(f"{model.place(comp)}: {comp.name} is not connected to the "
                                 f"ground {topo.world.name!r} through joints or rigid parts")
                 break
@@ -284,8 +291,68 @@ def _tree(model, topo, roles, problems):
     topo.bodies = [(b, topo.set_of[b.port_ref("frame_a")]) for b in massive
                    if topo.set_of[b.port_ref("frame_a")] in reached]
     topo.forces = [f for f in roles.get("frame_force", [])
-                   if all(topo.set_of[f.port_ref(pn)] in reached for pn, port in f.ports.items()
+                   if all(topo.set_of[f.port_ref(pn)] in placed for pn, port in f.ports.items()
                           if port.domain == "frame" and not _dangling(topo, f, pn))]
+
+
+def _frame_sets(topo, comp):
+    """The frame sets a force element's wired frame ports are in."""
+    return [topo.set_of[comp.port_ref(pn)] for pn, port in comp.ports.items()
+            if port.domain == "frame" and not _dangling(topo, comp, pn)]
+
+
+def _junctions(model, topo, forces, frames, reached, problems):
+    """Massless junctions: frame sets that only line forces meet at (no body, joint or rigid
+    part), as the point between springs in series of MSL's ThreeSprings. Nothing there has
+    mass, so the junction sits where the line forces on it balance (the solver's
+    ``equations/junctions.py``). Each needs two line forces (one end alone is an unwired
+    port, refused as such) and a path of line forces to a frame the joints place; a force
+    element that is no line force (its wrench would need the junction's orientation) or a
+    line force with a point mass is refused there."""
+    candidates = set()
+    for s in frames.nodes:
+        physical = [p for p in topo.sets[s] if p.component.role != "probe"]
+        # one port alone is an unwired one (refused as such, or an optional one left free)
+        if s not in reached and len(physical) > 1 and all(
+                p.component.role == "frame_force" and p.domain == "frame" for p in physical):
+            candidates.add(s)
+    if not candidates:
+        return []
+
+    def where(s):
+        return "{" + ", ".join(p.path for p in topo.sets[s] if p.component.role != "probe") + "}"
+    joined = nx.Graph()
+    joined.add_nodes_from([*candidates, "placed"])
+    refused = set()
+    for comp in forces:
+        sets = _frame_sets(topo, comp)
+        touching = [s for s in sets if s in candidates]
+        if not touching:
+            continue
+        if not hasattr(type(comp), "law"):
+            problems.append(f"{model.place(comp)}: {comp.name} acts on {where(touching[0])}, a "
+                            f"frame no body, joint or rigid part holds (a massless junction); "
+                            f"only line forces (Spring, Damper, SpringDamper) may meet there, "
+                            f"since a {comp.type_name} needs that frame's orientation")
+            refused.update(touching)
+            continue
+        nodes = [s if s in candidates else "placed" for s in sets]
+        nx.add_path(joined, nodes)
+    out = []
+    for s in sorted(candidates):
+        lines = [p.path for p in topo.sets[s] if p.component.role == "frame_force"]
+        if s in refused:
+            continue
+        if len({p.component.name for p in topo.sets[s] if p.component.role != "probe"}) < 2:
+            problems.append(f"{lines[0]}: wired only to the other end of the same line force, "
+                            f"with no body, joint or other line force there; wire it to a frame")
+        elif not nx.has_path(joined, s, "placed"):
+            problems.append(f"massless junction {where(s)}: its line forces reach no frame "
+                            f"that joints or rigid parts connect to the ground, so where it "
+                            f"sits is not determined")
+        else:
+            out.append(s)
+    return out
 
 
 def _dangling(topo, comp, pname):
@@ -407,6 +474,17 @@ def _motions(model, topo, problems):
                             f"moves ({group.kind}); the reaction of a prescribed motion rests "
                             f"in the world: leave the support unwired, or wire it to a "
                             f"joint's support or a Fixed")
+
+
+def _junction_masses(model, topo, values, problems):
+    """A line force at a massless junction carries no point mass: it would ride on a line
+    whose end only the balance of forces places."""
+    junctions = set(topo.junctions)
+    for comp in topo.forces:
+        if values[comp.name].get("mass", 0.0) and junctions & set(_frame_sets(topo, comp)):
+            problems.append(f"{model.place(comp, 'mass')}: {comp.name} ends at a massless "
+                            f"junction (a frame with no body), where a point mass on the line "
+                            f"is not supported; put a body at the junction instead")
 
 
 def _inertias(model, bodies, values, problems):
