@@ -205,6 +205,7 @@ def plot_results(results, *names, probes=None, title=None, labels=None, hide_fla
                   overlaid=len(runs) > 1)
         ax.set_title(panel.title, fontsize="medium")
         ax.set_ylabel(panel.ylabel)
+        _event_marks(ax, runs)
         bottom[j] = i
     for i, row in enumerate(rows):
         for j in range(len(row), n_cols):
@@ -319,3 +320,12 @@ def save_plot(results, path, *names, probes=None, title=None, dpi=150, **kwargs)
 
 
 install_plotter(plot_results)
+
+
+def _event_marks(ax, runs):
+    """The runs' events (friction sticking or slipping, impacts: ``res.stats["events"]``) as
+    thin dotted vertical lines, in the run's colour when runs are overlaid."""
+    for r, run in enumerate(runs):
+        for event in (getattr(run, "stats", None) or {}).get("events", ()):
+            ax.axvline(event["t"], color=f"C{r}" if len(runs) > 1 else "0.55",
+                       linewidth=0.6, linestyle=":", gid=f"event:{event['component']}")

@@ -125,3 +125,7 @@ class IdealGear(PartialRigid, library=LIB):
 
     def ratio(self):
         return self.gear_ratio
+
+
+from .rotational_friction import (BearingFriction, Brake, Clutch, ElastoGap,  # noqa: E402,F401
+                                  Stop)

@@ -113,3 +113,6 @@ class Accelerate(PartialMotion, library=LIB):
                       doc="Prescribed acceleration (when u is not wired)")
     position0 = Param(0.0, unit="m", name="s0", doc="Initial position")
     speed0 = Param(0.0, unit="m/s", name="v0", doc="Initial speed")
+
+
+from .translational_friction import ElastoGap, Friction, Stop  # noqa: E402,F401

@@ -67,6 +67,8 @@ class Network:
     no_acceleration: set = field(default_factory=set)  # sets of massless groups
     #: speed index -> Prescribed, for joints whose coordinate a motion source gives
     prescribed: dict = field(default_factory=dict)
+    #: elements with modes (friction, stops), in the order placed: ``Hybrid`` records
+    hybrid: list = field(default_factory=list)
 
     def summary(self, topo):
         """A line on what structural analysis made of the 1-D network and the blocks."""
@@ -101,6 +103,20 @@ def build(model, topo, bound, q, u, udot, qindex, uindex, t, inverse=None, p=Non
     """
     return _Builder(model, topo, bound, q, u, udot, qindex, uindex, t, inverse, p,
                     p_values).run()
+
+
+@dataclass
+class Hybrid:
+    """An element with modes while the network is built: the model's component, its bound
+    twin, its mode state, the symbol of its holding force, its flanges a and b (their
+    PortRefs) and the set of its signal input u (or None)."""
+    comp: object
+    bound: object
+    mode: ca.SX
+    F: ca.SX
+    a: object
+    b: object
+    u: object
 
 
 @dataclass
@@ -442,10 +458,28 @@ class _Builder:
                 u = self.circuit.converter_current(comp)
             refs = {pn: comp.port_ref(pn) for pn in comp.ports if comp.ports[pn].domain
                     in ("rotational", "translational")}
+            if getattr(type(comp), "hybrid", False):
+                self._hybrid(comp, b, refs)
             out = b.flows({pn: net.pos.get(r, 0) for pn, r in refs.items()},
                           {pn: net.vel.get(r, 0) for pn, r in refs.items()}, self.t, u)
             for pn, f in out.items():
                 flow[refs[pn]] = f
+
+    def _hybrid(self, comp, b, refs):
+        """An element with modes (``components/friction.py``): its mode is a state that only
+        events change (rate 0), and F, what it holds with while held, a symbol solved with
+        the dynamics once they are known (``modes.py``)."""
+        for pn, ref in refs.items():
+            group = self.group_of.get(self.topo.set_of[ref])
+            if group is not None and group.kind == "massless":
+                raise ModelError(f"{self.model.place(comp)}: {ref.path} is on a massless "
+                                 f"flange, which has no acceleration for {comp.name} to hold "
+                                 f"or stop: give it an inertia or a mass")
+        b._mode = self._state(f"{comp.name}.mode", "", 0, ca.SX(0))
+        b._F = ca.SX.sym(f"F_{comp.name}")
+        u = self.topo.set_of[comp.port_ref("u")] if "u" in comp.ports else None
+        self.net.hybrid.append(Hybrid(comp, b, b._mode, b._F, refs[b.side_a] if b.side_a in
+                                      refs else None, refs[b.side_b], u))
 
     def _applied(self, s, roles=("compliant", "source")):
         """Flows into the non-rigid elements at a connection set (compliant, sources; with
@@ -559,13 +593,16 @@ class _Builder:
         if not self.pending:
             return lambda e: ca.SX(e)
         keys = list(self.pending)
-        old, new = ca.vertcat(*keys), ca.vertcat(*[ca.SX(self.pending[k]) for k in keys])
+        # dense: a structural zero (the exact acceleration of a constant speed) must not
+        # make the sparsities of the placeholders and their values differ
+        old = ca.vertcat(*keys)
+        new = ca.densify(ca.vertcat(*[ca.SX(self.pending[k]) for k in keys]))
         # placeholders may refer to each other (a free rotor's acceleration to a massless
         # node's position): substitute until none is left
         for _ in range(len(keys) + 1):
             if not ca.depends_on(new, old):
                 break
-            new = ca.substitute(new, old, new)
+            new = ca.densify(ca.substitute(new, old, new))
         return lambda e: ca.substitute(ca.SX(e), old, new)
 
     def _motion_laws(self):

@@ -15,6 +15,7 @@ from ..errors import ModelError
 from . import junctions
 from .assemble import assemble
 from .loops import BAUMGARTE_RATE, formulate, newton
+from .modes import close as close_modes
 
 
 class System:
@@ -39,6 +40,8 @@ class System:
                                  BAUMGARTE_RATE if baumgarte_rate is None else baumgarte_rate)
         if asm.junctions is not None:
             junctions.extend(eq, asm, self.topology)
+        #: friction and stops: their holding forces solved, their events (``modes.py``)
+        self.modes = close_modes(asm, eq, model)
         self.param_names = asm.param_names
         self.coordinate_names = asm.coordinate_names
         self.speed_names = asm.speed_names
@@ -60,6 +63,9 @@ class System:
         coords = asm.q if eq.q is None else eq.q
         values_in_states = ca.densify(ca.vertcat(coords, eq.u, eq.udot, eq.lam))
         kinematics = ca.vertcat(asm.q, asm.u, asm.udot, asm.lam)
+        if self.modes is not None:      # what friction and stops hold with
+            values_in_states = ca.vertcat(values_in_states, self.modes.F_solution)
+            kinematics = ca.vertcat(kinematics, self.modes.F)
         outs = [ca.substitute(sig.flat(), kinematics, values_in_states) for sig in asm.signals]
         # outputs read the whole state: differential, then algebraic
         self.f_out = ca.Function("outputs", [asm.t, ca.vertcat(eq.x, eq.z), asm.p],

@@ -30,6 +30,7 @@ from ..util import quote, suggest
 from . import jit as _jit
 from .capture import SOLVER_LOCK, last_words, solver_output
 from .compiled import compiled
+from .events import EVENT_CHUNK, Events
 from .loopwatch import near_singular, watch
 from .methods import METHODS, Failure, choose, shift_times
 from .results import Results
@@ -75,6 +76,7 @@ class Run:
         self.signal = None              # the signal that stopped the run, if one did
         self.instructions = (system.f_rhs or system.f_dae).n_instructions()
         self.said = []                  # what the solvers printed
+        self.events = None              # friction and stops: events.Events
         self._sink = None               # the file that catches it
 
     # -- what methods use --------------------------------------------------------------------
@@ -196,6 +198,9 @@ def simulate(model, t_end=None, n_points=None, method=None, rtol=None, atol=None
     stats = {}
     jit_on = _jit.enabled(jit) and system.n_states > 0
     run = Run(system, p, x0, grid, settings, None, cancel, progress, restart)
+    if system.modes is not None:       # modes consistent with the start, before any method
+        run.events = Events(run)
+        run.x0 = run.events.start(float(grid[0]), run.x0)
     with _running(run):
         if jit_on:
             run.jit = {"stats": stats, "required": jit is True, "deadline": run.deadline,
@@ -209,6 +214,8 @@ def simulate(model, t_end=None, n_points=None, method=None, rtol=None, atol=None
             stats.update(method_stats)
     if run.said:
         stats["solver_output"] = "".join(run.said)
+    if run.events is not None:
+        stats["events"] = run.events.log
     stats["jit"] = bool(run.jit) and not stats.get("jit_fallback")
     t = grid[:len(X)]
     X = system.polish(X, p)
@@ -317,7 +324,11 @@ def _integrate(run, method):
     except Failure as failure:
         return np.array(X), failure.reason, stats
     chunk = n - 1 if method.stepper else _first_chunk(run, method, n - 1)
+    if run.events is not None:
+        run.events.log = []            # of this method (auto may try another after it)
+        chunk = min(chunk, EVENT_CHUNK)
     k, failure = 0, None
+    origin = restart_at = None          # with events: where the method started last
     while k < n - 1:
         failure = run.stop_reason()
         if failure is not None:
@@ -334,6 +345,18 @@ def _integrate(run, method):
                 # CasADi keeps nothing of a failed call: go again an output at a time,
                 # to keep every output before the failure (and stop there all the same)
                 new, failure = _piecewise(run, method, grid[k], X[-1], times, failure)
+        if run.events is not None and failure is None:
+            origin = restart_at or (grid[k], X[-1])
+            try:
+                new, restart_at = run.events.check(method, times, origin, new)
+            except Failure as exc:
+                new, restart_at, failure = new[:0], None, exc.reason
+            if restart_at is not None:        # an event: the method starts afresh there
+                stats = _merge(stats, stepper.stats)
+                try:
+                    stepper = method.start(run, *restart_at)
+                except Failure as exc:
+                    failure = exc.reason
         if run.system.f_dependent is not None:
             new, failure = watch(run, X, new, failure)
         X.extend(new)
@@ -349,6 +372,9 @@ def _integrate(run, method):
             break
         if not method.stepper:
             chunk = _next_chunk(run, m, _work(run, stepper.stats) - work_before, n - 1 - k)
+            chunk = chunk if run.events is None else min(chunk, EVENT_CHUNK)
+        elif run.events is not None:
+            chunk = 1
     if failure is not None and run.system.f_dependent is not None and \
             run.stop_reason() is None and "singular" not in failure:
         failure += near_singular(run, np.array(X), grid)

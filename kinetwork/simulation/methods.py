@@ -137,13 +137,15 @@ class _CasadiRun:
             opts["number_of_finite_elements"] = run.steps_per_interval * len(times)
         return opts
 
-    def integrator(self, times, opts):
+    def integrator(self, times, opts, exact=False):
         """An integrator over ``times`` in the time since ``self.t``: on an output grid of
-        equal intervals, the same one for every chunk of as many intervals."""
+        equal intervals, the same one for every chunk of as many intervals (unless
+        ``exact``: times an event is looked for at, which must not be rounded to the grid)."""
         m, run = self.method, self.run
         dae = run.compiled.dae(run.jit, m.newton)
         n = len(times)
-        if abs(times[-1] - self.t - n * run.spacing) <= 1e-9 * max(1.0, abs(times[-1])):
+        if not exact and \
+                abs(times[-1] - self.t - n * run.spacing) <= 1e-9 * max(1.0, abs(times[-1])):
             grid = ("uniform", n, run.spacing)          # equal intervals: j * spacing
             taus = (np.arange(1, n + 1) * run.spacing).tolist()
         else:
@@ -155,7 +157,7 @@ class _CasadiRun:
             return build()
         return run.compiled.integrator(key, build)
 
-    def advance(self, times):
+    def advance(self, times, exact=False):
         m, run = self.method, self.run
         nx = run.system.n_states
         opts = self.options(times)
@@ -163,7 +165,7 @@ class _CasadiRun:
             # the consistent initial rate is f(t0, x0) (loops: z0 is consistent already):
             # IDAS's own search for it fails when it is large (a stiff spring)
             opts.update(calc_ic=False, init_xdot=run.rate(self.t, self.x))
-        integ = self.integrator(times, opts)
+        integ = self.integrator(times, opts, exact)
         try:
             with run.solver_section(self.t):
                 out = integ(x0=self.x[:nx], z0=self.x[nx:], p=np.append(run.p, self.t))
@@ -220,11 +222,17 @@ class _ScipyRun:
         self.steps = 0
         self.stats = {}
 
-    def advance(self, times):
+    def advance(self, times, exact=False):
         solver, run = self.solver, self.run
         out, in_interval = [], 0
         with np.errstate(all="ignore"):     # a blow-up is reported below, not warned
             while len(out) < len(times):
+                if solver.t_old is not None and times[len(out)] <= solver.t:
+                    # the last step, taken for an earlier call, reaches past this time
+                    dense = solver.dense_output()
+                    while len(out) < len(times) and times[len(out)] <= solver.t:
+                        out.append(dense(times[len(out)]))
+                    continue
                 message = solver.step()
                 in_interval, self.steps = in_interval + 1, self.steps + 1
                 if solver.status == "failed":
@@ -257,6 +265,11 @@ class MidpointRule(Method):
     newton = True
 
     def check(self, system):
+        if system.modes is not None:
+            raise ModelError("method 'midpoint' integrates a conservative tree with fixed "
+                             "steps, and this model has friction or stops, whose events it "
+                             "cannot locate: use 'auto', a CVODES, IDAS or scipy method, 'rk' "
+                             "or 'collocation'")
         if system.asm.prescribed:
             raise ModelError("method 'midpoint' integrates a conservative tree in canonical "
                              "coordinates; this model has joints whose motion is prescribed "

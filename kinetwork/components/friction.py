@@ -1,0 +1,205 @@
+"""Friction with stiction, elastic gaps and hard stops: 1-D elements with modes.
+
+Each element acts between a flange ``b`` and a flange ``a`` (its support: unwired, the
+world) and is in one of a few modes, which the integration driver changes at events
+(``kinetwork.simulation.events``). A mode is a state of the model (``brake.mode``, its rate
+zero), so one compiled system serves every mode. The force into flange b is
+
+    f = (1 - held(mode)) * law(rel, w_rel, mode) + F
+
+where F is what the element holds with while it is held (stuck friction, a body resting on a
+stop): solved with the dynamics from held * a_rel + (1 - held) * F = 0, so a held element
+keeps its flanges together exactly, and F is 0 otherwise (``kinetwork.equations.modes``).
+
+Every element declares an ``indicator``: positive while its mode holds, crossing zero where
+it ends (a sliding speed reaching zero, a holding force reaching the static limit, a gap
+closing), and ``next_mode``, what happens there, in numbers: the new mode and, for an
+impact or a sticking, the relative speed right after it (an impulse through the mechanism).
+
+Modes of friction: +1 sliding forward (w_rel > 0), -1 sliding backward, 0 stuck (MSL's
+``Forward``, ``Backward``, ``Stuck``). No regularisation: a stuck element is exactly stuck.
+"""
+
+import casadi as ca
+
+from .base import ONED, Component, Port
+
+
+class PartialHybrid(Component):
+    """An element with modes between its ``side_b`` flange and its ``side_a`` flange."""
+    role = "source"          # its law may read a signal (a brake's normal force)
+    hybrid = True
+    side_a, side_b = "flange_a", "flange_b"
+    #: mode names, for the events reported
+    modes = {}
+
+    def held(self, mode):
+        """1 where the mode holds the flanges together, else 0 (an SX of the mode)."""
+        return ca.SX(0)
+
+    def law(self, rel, w_rel, mode, u):
+        """The force into flange b when not held."""
+        return ca.SX(0)
+
+    def values(self, t, u):
+        """Two numbers the events read (a static limit, a restitution), as SX."""
+        return ca.SX(0), ca.SX(0)
+
+    def indicator(self, mode, rel, w_rel, force, values):
+        raise NotImplementedError
+
+    def first_mode(self, ev):
+        """(mode, relative speed after, kind) at the start, from the numbers ``ev``."""
+        raise NotImplementedError
+
+    def next_mode(self, ev):
+        """(mode, relative speed after or None, kind) where the indicator crossed zero."""
+        raise NotImplementedError
+
+    def flows(self, pos, vel, t, u=None):
+        a, b = self.side_a, self.side_b
+        rel, w_rel = pos[b] - pos[a], vel[b] - vel[a]
+        f = (1 - self.held(self._mode)) * self.law(rel, w_rel, self._mode, u) + self._F
+        return {a: -f, b: f}
+
+
+class PartialFriction(PartialHybrid):
+    """Coulomb friction with stiction and viscous friction: sliding, the force into flange b is
+    mode * f_kinetic + d * w_rel (opposing the motion); stuck, whatever holds the flanges
+    together, up to peak * f_kinetic in either direction."""
+    modes = {-1: "sliding backward", 0: "stuck", 1: "sliding forward"}
+    hold_mode = 0
+
+    def kinetic(self, u):
+        raise NotImplementedError
+
+    def held(self, mode):
+        return 1 - mode * mode
+
+    def law(self, rel, w_rel, mode, u):
+        return mode * self.kinetic(u) + self.d * w_rel
+
+    def values(self, t, u):
+        return self.peak * self.kinetic(u), ca.SX(0)
+
+    def indicator(self, mode, rel, w_rel, force, values):
+        # sliding: the speed in the direction of sliding; stuck: the margin to the limit
+        return mode * mode * (mode * w_rel) + (1 - mode * mode) * (values[0] - ca.fabs(force))
+
+    def first_mode(self, ev):
+        if abs(ev.w_rel) > ev.tiny:
+            return (1 if ev.w_rel > 0 else -1), None, None
+        return self._at_rest(ev)
+
+    def next_mode(self, ev):
+        if ev.mode == 0:                      # the holding force reached the static limit
+            return (1 if ev.force > 0 else -1), None, None
+        return self._at_rest(ev)              # the sliding speed reached zero
+
+    @staticmethod
+    def _at_rest(ev):
+        """At zero relative speed: stuck if the force that holds is within the static limit,
+        else sliding the way that force pushes."""
+        if abs(ev.stuck_force) <= ev.values[0]:
+            return 0, 0.0, None
+        return (1 if ev.stuck_force > 0 else -1), None, None
+
+
+class PartialBearingFriction(PartialFriction):
+    side_a, side_b = "support", "flange"
+    flange = Port(ONED, "Flange (wire the shaft's elements to it: MSL's flange_a and flange_b "
+                        "are one here)")
+    support = Port(ONED, "Housing (unwired: the world)", optional=True)
+
+    def kinetic(self, u):
+        return self.f_kinetic
+
+
+class PartialNormalForceFriction(PartialFriction):
+    """Friction pressed by a normal force fn_max * f_normalized (the signal at u, or the
+    parameter), as MSL's Brake and Clutch: f_kinetic = mu * cgeo * fn."""
+    u = Port("signal_in", "Normalized normal force f_normalized, 0..1 (instead of the "
+                          "parameter)", optional=True)
+
+    def kinetic(self, u):
+        fn = self.fn_max * (self.f_normalized if u is None else u)
+        return self.mu * self.cgeo * ca.fmax(fn, 0)
+
+
+class PartialElastoGap(PartialHybrid):
+    """MSL's ElastoGap: a linear spring and damper acting only while the gap is closed
+    (rel < rel0); the damping force is limited so that it never pulls (MSL 4.0's law)."""
+    modes = {0: "open", 1: "contact"}
+    flange_a = Port(ONED, "Flange a")
+    flange_b = Port(ONED, "Flange b")
+
+    def law(self, rel, w_rel, mode, u):
+        spring = self.c * (rel - self.rel0)
+        reach = ca.fabs(spring)
+        return mode * (spring + ca.fmin(ca.fmax(self.d * w_rel, -reach), reach))
+
+    def indicator(self, mode, rel, w_rel, force, values):
+        return (1 - 2 * mode) * (rel - self.rel0)
+
+    def first_mode(self, ev):
+        return (1 if ev.indicator < 0 else 0), None, None     # ev: read in mode 0 (open)
+
+    def next_mode(self, ev):
+        return 1 - ev.mode, None, None
+
+
+class PartialStop(PartialHybrid):
+    """A hard stop: flange b moves freely relative to flange a between rel_min and rel_max
+    (either may be unset) and bounces off a limit with the coefficient of restitution e (an
+    impact: an impulse through the mechanism); an impact slower than v_rest leaves it resting
+    on the limit until the force holding it there would have to pull."""
+    modes = {0: "free", 1: "resting"}
+    hold_mode = 1
+    flange_a = Port(ONED, "Flange a (the reference side: a joint's support)")
+    flange_b = Port(ONED, "Flange b (a joint's axis)")
+
+    def held(self, mode):
+        return mode
+
+    def _side(self, rel):
+        """+1 nearer the lower limit, -1 nearer the upper."""
+        if self.rel_min is None:
+            return ca.SX(-1)
+        if self.rel_max is None:
+            return ca.SX(1)
+        return ca.if_else(rel - self.rel_min <= self.rel_max - rel, 1, -1)
+
+    def _gap(self, rel):
+        gaps = [g for g in (None if self.rel_min is None else rel - self.rel_min,
+                            None if self.rel_max is None else self.rel_max - rel)
+                if g is not None]
+        return gaps[0] if len(gaps) == 1 else ca.fmin(*gaps)
+
+    def values(self, t, u):
+        return ca.SX(self.e), ca.SX(self.v_rest)
+
+    def indicator(self, mode, rel, w_rel, force, values):
+        # free: the gap to the nearer limit; resting: the push of the limit (never a pull)
+        return (1 - mode) * self._gap(rel) + mode * (-self._side(rel) * force)
+
+    def first_mode(self, ev):
+        if ev.indicator < -ev.tiny:
+            raise ValueError("starts beyond its limit")
+        return 0, None, None
+
+    def next_mode(self, ev):
+        if ev.mode == 1:
+            return 0, None, "lift-off"
+        if abs(ev.w_rel) > ev.values[1]:
+            return 0, -ev.values[0] * ev.w_rel, "impact"
+        return 1, 0.0, None
+
+
+def stop_check(values, place, lo, hi):
+    """Problems of a stop's limits taken together: at least one, and in order."""
+    a, b = values.get(lo), values.get(hi)
+    if a is None and b is None:
+        return [f"{place(lo)}: a stop needs a limit: give {lo}, {hi} or both"]
+    if isinstance(a, (int, float)) and isinstance(b, (int, float)) and not a < b:
+        return [f"{place(hi)} = {b}: must be > {lo} = {a}"]
+    return []

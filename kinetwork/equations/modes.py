@@ -1,0 +1,92 @@
+"""Elements with modes (friction with stiction, elastic gaps, hard stops): what they hold with,
+and the functions their events read.
+
+Each such element (``components/friction.py``) puts a force F_i into the network besides its
+law, and a mode state. Once the formulation has the speeds' rates in the states, the
+relative acceleration of each element is affine in the forces F, so the conditions
+
+    held_i * a_rel_i + (1 - held_i) * F_i = 0
+
+(a held element keeps its flanges together, any other holds with nothing) are one small
+linear system in F, solved symbolically: one compiled system serves every combination of
+modes, and a stuck friction is exactly stuck. The driver (``simulation/events.py``) reads
+the indicators and numbers of ``f_values`` and applies impulses with ``f_response``.
+"""
+
+from dataclasses import dataclass
+
+import casadi as ca
+
+from ..errors import ModelError
+
+#: columns of ``Modes.f_values``: the indicator, the relative position and speed, the holding
+#: force, and the element's two numbers (a static limit, a restitution)
+COLUMNS = ("indicator", "rel", "w_rel", "force", "value0", "value1")
+
+
+@dataclass
+class Modes:
+    """The elements with modes of a System, and their compiled functions."""
+    comps: list                 # the model's components, in order
+    mode_index: list            # index of each one's mode in the state vector
+    F: ca.SX                    # the symbols of their holding forces ...
+    F_solution: ca.SX           # ... and what they are, in (t, x, p)
+    f_values: ca.Function       # (t, x, p) -> (k, len(COLUMNS))
+    f_response: ca.Function     # (t, x, p) -> (d a_rel / d F (k, k), d xdot / d F (n, k))
+
+
+def close(asm, eq, model):
+    """Solve the holding forces of ``asm``'s elements with modes into ``eq`` (changed in
+    place) and return their Modes, or None when the model has none."""
+    net = asm.net
+    if net is None or not net.hybrid:
+        return None
+    names = [h.comp.name for h in net.hybrid]
+    if eq.z.numel():
+        raise ModelError(f"{', '.join(names)}: friction and stops are handled by events, which "
+                         f"need the equations as ODEs; this model has algebraic variables "
+                         f"({', '.join(eq.algebraic_names)}): compile it with "
+                         f"loops='projected'")
+    q = asm.q if eq.q is None else eq.q
+    lam = eq.lam if eq.lam is not None else ca.SX(0, 1)
+
+    def in_states(e):
+        return ca.substitute(ca.SX(e), ca.vertcat(asm.q, asm.u, asm.udot, asm.lam),
+                             ca.densify(ca.vertcat(q, eq.u, eq.udot, lam)))
+
+    def at(d, ref):
+        return ca.SX(0) if ref is None else ca.SX(d.get(ref, 0))
+
+    F = ca.vertcat(*[h.F for h in net.hybrid])
+    rel = [at(net.pos, h.b) - at(net.pos, h.a) for h in net.hybrid]
+    w_rel = [at(net.vel, h.b) - at(net.vel, h.a) for h in net.hybrid]
+    a_rel = in_states(ca.vertcat(*[at(net.acc, h.b) - at(net.acc, h.a) for h in net.hybrid]))
+    held = ca.vertcat(*[ca.SX(h.bound.held(h.mode)) for h in net.hybrid])
+    residual = held * a_rel + (1 - held) * F
+    A = ca.jacobian(residual, F)
+    if ca.depends_on(A, F):
+        raise ModelError(f"{', '.join(names)}: the relative accelerations are not linear in "
+                         f"the friction and stop forces")
+    b = ca.substitute(residual, F, ca.SX.zeros(F.shape[0]))
+    solution = -b / A if F.shape[0] == 1 else -ca.solve(A, b)
+
+    rows = []
+    for i, h in enumerate(net.hybrid):
+        u = net.signal.get(h.u) if h.u is not None else None
+        values = tuple(ca.SX(v) for v in h.bound.values(asm.t, u))
+        g = h.bound.indicator(h.mode, rel[i], w_rel[i], F[i], values)
+        rows.append(ca.horzcat(g, rel[i], w_rel[i], F[i], *values))
+    table = ca.substitute(in_states(ca.vertcat(*rows)), F, solution)
+    zero = ca.SX.zeros(F.shape[0])
+    response = [ca.substitute(ca.jacobian(a_rel, F), F, zero),
+                ca.substitute(ca.jacobian(eq.ode, F), F, zero)]
+
+    for key in ("ode", "alg", "udot", "lam", "u"):
+        value = getattr(eq, key)
+        if value is not None:
+            setattr(eq, key, ca.substitute(value, F, solution))
+    args = [asm.t, eq.x, asm.p]
+    return Modes([h.comp for h in net.hybrid],
+                 [eq.state_names.index(f"{n}.mode") for n in names], F, solution,
+                 ca.Function("mode_values", args, [ca.densify(table)]),
+                 ca.Function("mode_response", args, [ca.densify(r) for r in response]))

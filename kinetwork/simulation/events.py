@@ -1,0 +1,218 @@
+"""Events: where an element with modes (friction, stops: ``components/friction.py``) changes
+mode, found, located and applied between the integrator's outputs.
+
+After every chunk of a run the driver hands the rows it got to ``Events.check``. An event is
+an indicator (compiled with the model: ``equations/modes.py``) going from positive to zero
+or below between two rows. It is located by Brent's method on the indicator of the state
+integrated by the same method from the row before it to the trial time (so the time is as
+exact as the integration, to about 1e-14 s in the bracketing itself), the element says what
+its new mode is (``next_mode``) and whether its relative speed jumps (an impact, a
+sticking: an impulse through the mechanism, along the response of the state's rates to the
+element's force), modes that the change makes inconsistent follow at the same instant, and
+the method starts afresh there. Events are logged (time, component, kind) for
+``res.stats["events"]``.
+
+Crossings are looked for at the output points (and at the event restarts): two crossings
+within one output interval that cancel out are not seen. Runs with events therefore go in
+short chunks of at most EVENT_CHUNK output intervals.
+"""
+
+from types import SimpleNamespace
+
+import numpy as np
+
+from .compiled import numeric
+from .methods import Failure
+
+#: output intervals per chunk at most, in a run with events (what follows an event in a
+#: chunk is computed again from it)
+EVENT_CHUNK = 8
+#: events in one run at most: beyond, the run stops (a stop bouncing ever faster, chattering)
+MAX_EVENTS = 100_000
+#: mode changes at one instant at most (a cascade through coupled elements)
+MAX_CASCADE = 50
+#: events at the same instant (within this many seconds) at most before the run stops
+SAME_INSTANT = 1e-13
+ZENO_LIMIT = 200
+#: trial intervals shorter than this (relative to the time) are stepped by RK4 directly
+SHORT = 1e-6
+
+
+class Events:
+    """The events of one run of a System with modes (``system.modes``)."""
+
+    def __init__(self, run):
+        self.run = run
+        self.modes = modes = run.system.modes
+        n = run.system.n_states
+        self._values = numeric(modes.f_values, run.p, n)
+        self._response = numeric_pair(modes.f_response, run.p)
+        self._rhs = numeric(run.system.f_rhs, run.p, n)
+        self.log = []
+        self._last = (None, 0)          # time of the last event, events at it
+
+    # -- numbers ---------------------------------------------------------------------------
+    def values(self, t, x):
+        """(k, 6): indicator, rel, w_rel, force, value0, value1 of every element."""
+        k = len(self.modes.comps)
+        return np.asarray(self._values(t, x)).reshape(k, -1)
+
+    def _numbers(self, t, x, i, table=None):
+        """What element i's ``first_mode`` and ``next_mode`` read."""
+        table = self.values(t, x) if table is None else table
+        comp = self.modes.comps[i]
+        row = table[i]
+        mode = int(round(x[self.modes.mode_index[i]]))
+        stuck = row[3]
+        hold = getattr(type(comp), "hold_mode", None)
+        if hold is not None and mode != hold:
+            held = np.array(x, dtype=float)
+            held[self.modes.mode_index[i]] = hold
+            stuck = self.values(t, held)[i, 3]
+        return SimpleNamespace(mode=mode, indicator=row[0], rel=row[1], w_rel=row[2],
+                               force=row[3], values=(row[4], row[5]), stuck_force=stuck,
+                               tiny=self.run.atol)
+
+    # -- the start -------------------------------------------------------------------------
+    def start(self, t, x):
+        """The initial state with every element's mode consistent with it (speeds, gaps,
+        the forces that would hold)."""
+        x = np.array(x, dtype=float)
+        targets = {}
+        for i, comp in enumerate(self.modes.comps):
+            try:
+                mode, after, _ = comp.first_mode(self._numbers(t, x, i))
+            except ValueError as exc:
+                from ..errors import ModelError
+                raise ModelError(f"{comp.name}: {exc} at the start") from None
+            x[self.modes.mode_index[i]] = mode
+            if after is not None:
+                targets[i] = after
+        if targets:
+            x = self._impulse(t, x, targets)
+        return self._settle(t, x, None)
+
+    # -- during the run --------------------------------------------------------------------
+    def check(self, method, times, before, rows):
+        """The rows up to the first event among ``rows`` (at ``times``, after the state
+        ``before`` = (t, x)) and, when there is one, the (t, x) to start again from."""
+        t_prev, x_prev = before
+        g_prev = self.values(t_prev, x_prev)[:, 0]
+        for j, (t, x) in enumerate(zip(times, rows)):
+            g = self.values(t, x)[:, 0]
+            crossed = np.flatnonzero((g_prev > 0) & (g <= 0))
+            if len(crossed):
+                t_ev, x_ev, i = self._locate(method, t_prev, x_prev, t, crossed)
+                after = self.apply(t_ev, x_ev, i)
+                if t_ev >= t:                 # at the output time itself: it shows the after
+                    return np.vstack([rows[:j], after[None, :]]), (t, after)
+                return rows[:j], (t_ev, after)
+            t_prev, x_prev, g_prev = t, x, g
+        return rows, None
+
+    def _locate(self, method, t0, x0, t1, crossed):
+        """The earliest crossing in (t0, t1]: (time, state, element)."""
+        from scipy.optimize import brentq          # 0.3 s to import: only with events
+
+        cache = {}
+
+        def state(t):
+            if t not in cache:
+                if t - t0 < SHORT * max(1.0, abs(t0)):
+                    # CasADi's integrators do not step over a tiny interval (they return x0)
+                    cache[t] = self._rk4(t0, x0, t - t0)
+                else:
+                    cache[t] = method.start(self.run, t0, x0).advance(np.array([t]),
+                                                                      exact=True)[0]
+            return cache[t]
+
+        best = None
+        for i in crossed:
+            def g(t, i=i):
+                return self.values(t, state(t))[i, 0]
+            if g(t1) == 0.0:
+                t_i = t1
+            else:
+                t_i = brentq(g, t0, t1, xtol=1e-15, rtol=4 * np.finfo(float).eps,
+                             maxiter=200)
+                # the side of the root where the indicator has crossed
+                if g(t_i) > 0:
+                    step = max(abs(t_i), 1.0) * 4 * np.finfo(float).eps
+                    t_i = min(t1, t_i + step)
+            if best is None or t_i < best[0]:
+                best = (t_i, i)
+        return best[0], state(best[0]), best[1]
+
+    def _rk4(self, t, x, h):
+        """One classical Runge-Kutta step: for intervals far below the tolerances' steps
+        (error h^5 |x^(5)|)."""
+        f = self._rhs
+        k1 = f(t, x)
+        k2 = f(t + h / 2, x + h / 2 * k1)
+        k3 = f(t + h / 2, x + h / 2 * k2)
+        k4 = f(t + h, x + h * k3)
+        return x + h / 6 * (k1 + 2 * k2 + 2 * k3 + k4)
+
+    def apply(self, t, x, i):
+        """The state after element i's event at (t, x): its new mode, its impulse, and the
+        modes that change with it at the same instant; logged."""
+        if len(self.log) >= MAX_EVENTS:
+            raise Failure(f"more than {MAX_EVENTS} events: a stop bouncing ever faster or "
+                          f"friction chattering (give the stop a larger v_rest)")
+        last, count = self._last
+        count = count + 1 if last is not None and abs(t - last) <= SAME_INSTANT else 1
+        self._last = (t, count)
+        if count > ZENO_LIMIT:
+            raise Failure(f"{ZENO_LIMIT} events at t = {t:.15g} s without time passing: "
+                          f"the modes of {self.modes.comps[i].name} chatter")
+        x = self._change(t, np.array(x, dtype=float), i)
+        return self._settle(t, x, i)
+
+    def _change(self, t, x, i):
+        comp = self.modes.comps[i]
+        ev = self._numbers(t, x, i)
+        mode, after, kind = comp.next_mode(ev)
+        x[self.modes.mode_index[i]] = mode
+        if after is not None:
+            x = self._impulse(t, x, {i: after})
+        self.log.append({"t": float(t), "component": comp.name,
+                         "kind": kind or comp.modes[mode]})
+        return x
+
+    def _settle(self, t, x, first):
+        """Modes made inconsistent by a change at the same instant change too (a stuck
+        element whose holding force now exceeds its limit)."""
+        for _ in range(MAX_CASCADE):
+            g = self.values(t, x)[:, 0]
+            wrong = [i for i in np.flatnonzero(g < -self.run.atol) if i != first]
+            if not wrong:
+                return x
+            x = self._change(t, x, wrong[0])
+            first = None
+        names = ", ".join(c.name for c in self.modes.comps)
+        raise Failure(f"the modes of {names} do not settle at t = {t:.15g} s")
+
+    def _impulse(self, t, x, targets):
+        """The state whose relative speeds are ``targets`` (element -> speed) while the held
+        elements keep theirs at zero: impulses P through the mechanism, dx = dxdot/dF P."""
+        table = self.values(t, x)
+        held = [i for i, comp in enumerate(self.modes.comps)
+                if float(comp.held(int(round(x[self.modes.mode_index[i]])))) > 0.5]
+        which = sorted(set(targets) | set(held))
+        want = np.array([targets.get(i, 0.0) - table[i, 2] for i in which])
+        A, Jx = self._response(t, x)
+        P = np.linalg.lstsq(A[np.ix_(which, which)], want, rcond=None)[0]
+        out = x + Jx[:, which] @ P
+        for i, k in enumerate(self.modes.mode_index):
+            out[k] = x[k]
+        return out
+
+
+def numeric_pair(f, p):
+    """A Python callable (t, x) -> (A, B) of a two-output Function of (t, x, p)."""
+    p = np.asarray(p, dtype=float)
+
+    def call(t, x):
+        A, B = f(t, x, p)
+        return np.asarray(A, dtype=float), np.asarray(B, dtype=float)
+    return call

@@ -1,0 +1,225 @@
+"""Friction with stiction, elastic gaps and stops, against closed forms and an independently
+written event-driven scipy reference (``components/friction.py``, ``equations/modes.py``)."""
+
+import numpy as np
+import pytest
+from scipy.integrate import solve_ivp
+from scipy.special import ellipkinc
+
+import kinetwork as kn
+
+FAST = dict(jit=False)
+
+
+def sliding_block(v0=3.0, m=2.0, f_c=4.0, d=0.0, peak=1.0, push=None):
+    """A block of mass m sliding at v0 on a rough floor (Coulomb f_c, viscous d), pushed by
+    the force ``push`` (an expression in t) if given."""
+    model = kn.Model("block")
+    block = model.add(kn.translational.Mass("block", m=m, v0=v0))
+    floor = model.add(kn.translational.Friction("floor", f_c=f_c, d=d, peak=peak))
+    probe = model.add(kn.Probe("p", quantities=["velocity", "force"]))
+    model.connect(block.flange_a, floor.flange)
+    model.connect(probe.port, floor.flange)
+    if push is not None:
+        force = model.add(kn.translational.Force("push", f=push))
+        model.connect(force.flange, block.flange_b)
+    return model
+
+
+@pytest.mark.parametrize("method", ["cvodes", "rk45", "rk"])
+def test_block_slides_to_a_stop_at_the_closed_form_time(method):
+    # m v' = -f_c - d v: v = (v0 + f_c/d) exp(-d t/m) - f_c/d, zero at t = m/d ln(1 + d v0/f_c)
+    m, v0, f_c, d = 2.0, 3.0, 4.0, 0.5
+    res = kn.simulate(sliding_block(v0, m, f_c, d), t_end=3.0, n_points=31, method=method,
+                      rtol=1e-11, atol=1e-13, step=1e-3, **FAST)
+    t_stop = m / d * np.log(1 + d * v0 / f_c)
+    events = res.stats["events"]
+    assert [(e["component"], e["kind"]) for e in events] == [("floor", "stuck")]
+    assert abs(events[0]["t"] - t_stop) < 1e-9
+    v = res["block.v"]
+    before = res.t < t_stop
+    exact = (v0 + f_c / d) * np.exp(-d * res.t[before] / m) - f_c / d
+    assert np.max(np.abs(v[before] - exact)) < 1e-8
+    assert np.all(v[~before] == 0.0)                 # stuck exactly, not creeping
+    s_stop = (m / d) * ((v0 + f_c / d) * (1 - np.exp(-d * t_stop / m))) - f_c / d * t_stop
+    assert abs(res["block.s"][-1] - s_stop) < 1e-8
+
+
+def test_a_push_below_the_static_limit_holds_and_breaks_away_where_it_reaches_it():
+    # a ramp k t against static friction peak f_c: stuck until t_b = peak f_c / k, then
+    # m v' = k t - f_c: v = k (t^2 - t_b^2) / (2 m) - f_c (t - t_b) / m
+    m, f_c, peak, k = 2.0, 4.0, 1.5, 3.0
+    res = kn.simulate(sliding_block(0.0, m, f_c, 0.0, peak, push=f"{k}*t"), t_end=3.0,
+                      n_points=61, method="rk45", rtol=1e-11, atol=1e-13, **FAST)
+    t_b = peak * f_c / k
+    events = res.stats["events"]
+    assert [(e["component"], e["kind"]) for e in events] == [("floor", "sliding forward")]
+    assert abs(events[0]["t"] - t_b) < 1e-9
+    stuck = res.t < t_b
+    assert np.all(res["block.v"][stuck] == 0.0)
+    # stuck, the floor holds against the push: it takes the push (the flow into its flange)
+    assert np.allclose(res["p.force"][stuck], k * res.t[stuck], atol=1e-12)
+    t = res.t[~stuck]
+    exact = k * (t ** 2 - t_b ** 2) / (2 * m) - f_c * (t - t_b) / m
+    assert np.max(np.abs(res["block.v"][~stuck] - exact)) < 1e-8
+
+
+def belt_model(m, c, f_c, peak, v_belt):
+    """A block on a belt moving at v_belt, tied to the wall by a spring c: stick-slip."""
+    model = kn.Model("belt")
+    wall = model.add(kn.translational.Fixed("wall"))
+    spring = model.add(kn.translational.Spring("spring", c=c))
+    block = model.add(kn.translational.Mass("block", m=m))
+    belt = model.add(kn.translational.Speed("belt", v_ref=v_belt))
+    rub = model.add(kn.translational.Friction("rub", f_c=f_c, peak=peak))
+    model.connect(wall.flange, spring.flange_a)
+    model.connect(spring.flange_b, block.flange_a)
+    model.connect(block.flange_a, rub.flange)
+    model.connect(rub.support, belt.flange)
+    return model
+
+
+def belt_reference(m, c, f_c, peak, v_belt, t_end):
+    """Switching times of the same scene, written apart from kinetwork: scipy's solve_ivp
+    with its own events, phase by phase. x is the block's position (the spring unstretched
+    at 0), s the sign of its speed relative to the belt while it slips: m x'' = -c x - s f_c.
+    Stuck, it rides the belt while the spring's pull stays within peak f_c."""
+    t, x, v = 0.0, 0.0, 0.0
+    s, stuck, times = np.sign(v - v_belt), False, []
+    while True:
+        if stuck:
+            limit = peak * f_c / c            # the belt stretches the spring up to here
+            t_next = t + (limit - x) / v_belt
+            if t_next >= t_end:
+                return np.array(times)
+            t, x, v, s, stuck = t_next, limit, v_belt, -1.0, False
+            times.append(t)
+            continue
+
+        def rhs(_, y, s=s):
+            return [y[1], (-c * y[0] - s * f_c) / m]
+
+        def same_speed(_, y):
+            return y[1] - v_belt
+        same_speed.terminal, same_speed.direction = True, -s
+        sol = solve_ivp(rhs, (t, t_end), [x, v], events=same_speed, rtol=1e-13, atol=1e-15,
+                        method="DOP853")
+        if not sol.t_events[0].size:
+            return np.array(times)
+        t, (x, v) = sol.t_events[0][0], sol.y_events[0][0]
+        times.append(t)
+        if abs(c * x) <= peak * f_c:
+            stuck = True
+        else:
+            s = np.sign(-c * x)
+
+
+@pytest.mark.parametrize("method", ["cvodes", "dop853"])
+def test_stick_slip_on_a_belt_switches_at_the_reference_times(method):
+    m, c, f_c, peak, v_belt = 1.0, 10.0, 2.0, 1.5, 0.5
+    t_end = 6.0
+    ref = belt_reference(m, c, f_c, peak, v_belt, t_end)
+    res = kn.simulate(belt_model(m, c, f_c, peak, v_belt), t_end=t_end, n_points=601,
+                      method=method, rtol=1e-12, atol=1e-14, **FAST)
+    got = np.array([e["t"] for e in res.stats["events"]])
+    kinds = [e["kind"] for e in res.stats["events"]]
+    assert len(ref) >= 6 and "stuck" in kinds and "sliding backward" in kinds
+    assert len(got) == len(ref)
+    assert np.max(np.abs(got - ref)) < 1e-8
+
+
+def test_brake_stops_a_rotor_at_the_closed_form_time():
+    # J w' = -mu cgeo fn_max: stops at J w0 / (mu cgeo fn_max), then stays
+    J, w0, mu, cgeo, fn = 0.5, 10.0, 0.4, 0.1, 50.0
+    model = kn.Model("brake")
+    rotor = model.add(kn.rotational.Inertia("rotor", J=J, w0=w0))
+    brake = model.add(kn.rotational.Brake("brake", mu=mu, cgeo=cgeo, fn_max=fn, peak=1.2))
+    model.connect(rotor.flange_b, brake.flange)
+    res = kn.simulate(model, t_end=4.0, n_points=41, method="cvodes", rtol=1e-11,
+                      atol=1e-13, **FAST)
+    t_stop = J * w0 / (mu * cgeo * fn)
+    (event,) = res.stats["events"]
+    assert event["kind"] == "stuck" and abs(event["t"] - t_stop) < 1e-9
+    assert np.all(res["rotor.w"][res.t > t_stop] == 0.0)
+
+
+def test_clutch_locks_two_rotors_at_the_closed_form_time_and_keeps_momentum():
+    # tau = mu cgeo fn on each, opposite: w1 - w2 closes at rate tau (1/J1 + 1/J2)
+    J1, J2, w1, mu, cgeo, fn = 1.0, 3.0, 8.0, 0.5, 0.2, 20.0
+    model = kn.Model("clutch")
+    a = model.add(kn.rotational.Inertia("a", J=J1, w0=w1))
+    b = model.add(kn.rotational.Inertia("b", J=J2, w0=0.0))
+    clutch = model.add(kn.rotational.Clutch("clutch", mu=mu, cgeo=cgeo, fn_max=fn))
+    model.connect(a.flange_b, clutch.flange_a)
+    model.connect(clutch.flange_b, b.flange_a)
+    res = kn.simulate(model, t_end=3.0, n_points=31, method="rk45", rtol=1e-11, atol=1e-13,
+                      **FAST)
+    tau = mu * cgeo * fn
+    t_lock = w1 / (tau * (1 / J1 + 1 / J2))
+    (event,) = res.stats["events"]
+    assert event["component"] == "clutch" and abs(event["t"] - t_lock) < 1e-9
+    after = res.t > t_lock
+    w_common = J1 * w1 / (J1 + J2)
+    assert np.allclose(res["a.w"][after], w_common, atol=1e-9)
+    assert np.allclose(res["b.w"][after], w_common, atol=1e-9)
+
+
+def test_elasto_gap_contact_lasts_half_a_period_and_returns_the_speed():
+    # a mass at v0 toward a spring gap: contact at gap / v0, leaves pi sqrt(m/c) later at -v0
+    m, c, v0, gap = 2.0, 800.0, -1.5, 0.3
+    model = kn.Model("gap")
+    wall = model.add(kn.translational.Fixed("wall"))
+    mass = model.add(kn.translational.Mass("mass", m=m, s0=gap, v0=v0))
+    elasto = model.add(kn.translational.ElastoGap("gap", c=c, d=0.0))
+    model.connect(wall.flange, elasto.flange_a)
+    model.connect(elasto.flange_b, mass.flange_a)
+    res = kn.simulate(model, t_end=1.0, n_points=101, method="rk45", rtol=1e-11, atol=1e-13,
+                      **FAST)
+    events = res.stats["events"]
+    assert [e["kind"] for e in events] == ["contact", "open"]
+    t_in = gap / -v0
+    assert abs(events[0]["t"] - t_in) < 1e-9
+    assert abs(events[1]["t"] - (t_in + np.pi * np.sqrt(m / c))) < 1e-9
+    assert abs(res["mass.v"][-1] + v0) < 1e-8
+
+
+def test_pendulum_hits_its_end_stop_at_the_elliptic_integral_time():
+    # released at rest from q0, it reaches q_stop after sqrt(L/g) (K(k) - F(phi, k)) with
+    # k = sin(q0/2), sin(q/2) = k sin(phi); it leaves with -e times the speed it came with
+    g, L, q0, q_stop, e = 9.81, 0.8, -2.0, 0.6, 0.7
+    model = kn.Model("pendulum")
+    world = model.add(kn.multibody.Ground("world", gravity=[0, -g, 0]))
+    joint = model.add(kn.multibody.Revolute("joint", axis=[0, 0, 1], q0=q0))
+    bob = model.add(kn.multibody.RigidBody("bob", mass=1.0, r_cm=[0, -L, 0]))
+    stop = model.add(kn.rotational.Stop("stop", phi_max=q_stop, e=e))
+    model.connect(world.frame, joint.frame_a)
+    model.connect(joint.frame_b, bob.frame_a)
+    model.connect(stop.flange_a, joint.support)
+    model.connect(stop.flange_b, joint.axis)
+    res = kn.simulate(model, t_end=2.0, n_points=201, method="cvodes", rtol=1e-12,
+                      atol=1e-14, **FAST)
+    k = np.sin(abs(q0) / 2)
+    amplitude = np.arcsin(np.sin(q_stop / 2) / k)
+    t_hit = np.sqrt(L / g) * (ellipkinc(np.pi / 2, k ** 2) + ellipkinc(amplitude, k ** 2))
+    first = res.stats["events"][0]
+    assert first["kind"] == "impact" and abs(first["t"] - t_hit) < 1e-9
+    # after it, the energy of the speed -e w_in at q_stop, w_in from the energy of the fall
+    w_in = np.sqrt(2 * g / L * (np.cos(q_stop) - np.cos(q0)))
+    energy = 0.5 * L ** 2 * res["joint.qd"] ** 2 - g * L * np.cos(res["joint.q"])
+    between = (res.t > first["t"]) & (res.t < res.stats["events"][1]["t"])
+    after = 0.5 * L ** 2 * (e * w_in) ** 2 - g * L * np.cos(q_stop)
+    assert between.sum() > 10 and np.max(np.abs(energy[between] - after)) < 1e-9
+    assert np.all(res["joint.q"] <= q_stop + 1e-12)
+
+
+def test_a_stop_without_limits_and_a_midpoint_run_are_refused_by_name():
+    model = kn.Model("nolimit")
+    wall = model.add(kn.translational.Fixed("wall"))
+    mass = model.add(kn.translational.Mass("mass", m=1.0))
+    stop = model.add(kn.translational.Stop("stop"))
+    model.connect(wall.flange, stop.flange_a)
+    model.connect(stop.flange_b, mass.flange_a)
+    with pytest.raises(kn.ModelError, match="stop.*s_min"):
+        model.compile()
+    with pytest.raises(kn.ModelError, match="midpoint.*friction or stops"):
+        kn.simulate(sliding_block(), t_end=1.0, method="midpoint", **FAST)
