@@ -43,6 +43,9 @@ from ..spatial import line_length
 
 #: a junction balance below this (N) at the start counts as balanced
 BALANCED = 1e-9
+#: the balance's Jacobian is singular at the start when its smallest singular value is below
+#: this fraction of its largest (a junction no tension holds across its lines)
+SINGULAR = 1e-10
 
 
 @dataclass
@@ -180,6 +183,9 @@ def extend(eq, asm, topo):
                             [in_states(ca.vertcat(*[line.distance for line in lines])),
                              in_states(start_rates)])
 
+    f_regular = ca.Function("junction_jacobian", [J.y, ca.vertcat(eq.x, z_before, asm.p)],
+                            [ca.jacobian(in_states(J.residual), J.y)])
+
     def initial(p):
         x0, z0 = mechanism(p)
         kn = np.concatenate([x0, z0, p])
@@ -197,7 +203,15 @@ def extend(eq, asm, topo):
                              f"them do not balance anywhere at the initial state (residual "
                              f"{np.max(np.abs(fun(sol.x))):.3g} N)")
         s0, sd0 = (np.asarray(v, dtype=float).ravel() for v in f_lengths(sol.x, kn))
-        return np.concatenate([x0, s0]), np.concatenate([z0, sol.x, sd0])
+        y0 = np.concatenate([sol.x, sd0])
+        jac = np.asarray(f_regular(y0, np.concatenate([x0, s0, z0, p])), dtype=float)
+        sv = np.linalg.svd(jac, compute_uv=False)
+        if not sv.size or sv[-1] <= SINGULAR * max(sv[0], 1.0):
+            raise ModelError(f"massless junction(s) {', '.join(J.names)}: the line forces on "
+                             f"them carry no tension at the start, so nothing holds a junction "
+                             f"across its lines (the balance is singular there); start them "
+                             f"stretched or moving, or put a body at the junction")
+        return np.concatenate([x0, s0]), np.concatenate([z0, y0])
     eq.initial = initial
     return eq
 

@@ -243,3 +243,11 @@ def test_junctions_that_reach_no_placed_frame_are_refused():
         model.connect("s1.frame_b", "s2.frame_b")
     with pytest.raises(kn.ModelError, match=r"reach no frame"):
         _hanging(ring).compile()
+
+
+def test_a_slack_series_chain_at_the_start_is_refused_by_name():
+    """A spring and damper in series starting at rest carry no tension: nothing holds their
+    junction across the line, so the balance is singular there."""
+    model = series(kn.multibody.Damper("lower", d=3.0))
+    with pytest.raises(kn.ModelError, match=r"junction\(s\) upper.frame_b: .* no tension"):
+        model.compile()
