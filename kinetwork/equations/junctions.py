@@ -22,7 +22,9 @@ IDAS integrates, as the dependent coordinates of loops and the nonlinear algebra
 signals already are (Newton on y from its previous value at every step, and a Newton polish
 of the outputs). That is why junctions are algebraic variables rather than an inner Newton in
 every right-hand side: the driver and the formulations already carry algebraic variables,
-start them consistently and polish them; nothing new is integrated.
+start them consistently and polish them; nothing new is integrated. A probe on a junction
+reads its position, velocity and acceleration (the rates through the implicit-function
+theorem) and the forces there; its orientation is the world's, as line forces need none.
 
 The start: each damper extends at the rate its two ends give it were the junctions at rest
 (so a model that starts at rest starts with its dampers unloaded), and the junctions sit
