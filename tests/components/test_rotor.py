@@ -5,9 +5,9 @@ References:
   carrier of inertia I_C - J n n^T with a child revolute about n of inertia J n n^T (MSL's
   rotor leaves the carrier to hold its whole inertia as a rigid body): mass matrix and
   forward dynamics, with a torque on the rotor, to 1e-9;
-- MSL's own claim in Rotational3DEffects.GyroscopicEffects: a cylinder spinning on a
-  revolute, and the same cylinder fixed to its mount plus a Rotor1D of its axial inertia,
-  move alike;
+- MSL's own claim in Rotational3DEffects.GyroscopicEffects (a cylinder spinning on a
+  revolute and the same cylinder fixed to its mount plus a Rotor1D of its axial inertia move
+  alike) is checked on models/gyroscopic_effects.json in tests/scenes/test_msl_parts.py;
 - the torque on the rotor reacting on the carrier through ``support`` (MSL's Mounting1D):
   with no other load the angular momentum about the fixed axis is conserved.
 """
@@ -103,41 +103,3 @@ def test_a_motor_on_a_free_carrier_keeps_the_angular_momentum():
     np.testing.assert_allclose(J * (wc + w) + (2.0 - J) * wc, 0, atol=1e-10)
     # the rotor alone: J (w_c + w)' = tau, so J (w_c + w) = (1 - cos 3t) / 3
     np.testing.assert_allclose(J * (wc + w), (1 - np.cos(3 * res.t)) / 3, atol=1e-9)
-
-
-def gyroscopic_effects(rotor):
-    """MSL's GyroscopicEffects: a cylinder on a ball joint carries, turned 45 degrees, a
-    second cylinder spinning at 10 rad/s: on a revolute (``rotor`` False), or fixed to its
-    mount with a Rotor1D of its axial inertia (``rotor`` True)."""
-    model = kn.Model("gyroscopic_effects")
-    model.add(mb.Ground("world", gravity=[0, -9.81, 0]))
-    model.add(mb.Spherical("spherical"))
-    model.add(mb.BodyCylinder("body1", r=[0.25, 0, 0], diameter=0.05))
-    model.add(mb.FixedRotation("rotation", axis=[0, 1, 0], angle="pi/4"))
-    model.add(mb.FixedTranslation("shift", r=[-0.1, 0, 0]))
-    cylinder = model.add(mb.BodyCylinder("body2", r=[0.2, 0, 0], diameter=0.1))
-    wires = [("world.frame", "spherical.frame_a"), ("spherical.frame_b", "body1.frame_a"),
-             ("body1.frame_b", "rotation.frame_a"), ("shift.frame_b", "body2.frame_a")]
-    if rotor:
-        axial = float(cylinder.mass_properties()[2][0, 0])
-        model.add(mb.Rotor1D("rotor1D", J=axial, n=[1, 0, 0], w0=10.0))
-        wires += [("rotation.frame_b", "shift.frame_a"), ("rotation.frame_b", "rotor1D.frame_a")]
-    else:
-        model.add(mb.Revolute("revolute", axis=[1, 0, 0], qd0=10.0))
-        wires += [("rotation.frame_b", "revolute.frame_a"), ("revolute.frame_b", "shift.frame_a")]
-    for a, b in wires:
-        model.connect(a, b)
-    model.add(kn.Probe("ball", quantities=["position", "force", "torque"]))
-    model.connect("ball.port", "spherical.frame_a")
-    return model
-
-
-def test_msl_gyroscopic_effects_rotor_equals_the_spinning_cylinder():
-    runs = [kn.simulate(gyroscopic_effects(r), t_end=1.0, n_points=11, rtol=1e-11,
-                        atol=1e-12) for r in (False, True)]
-    for a, b in zip(runs[0].states.T, runs[1].states.T):
-        np.testing.assert_allclose(b, a, atol=1e-9)
-    # the reaction on the world through the ball joint (MSL: identical for both models)
-    for key in ("ball.force", "ball.torque"):
-        np.testing.assert_allclose(runs[1][key], runs[0][key], atol=1e-8)
-    assert np.ptp(runs[0].states[:, 0]) > 0.1        # it does swing and precess
