@@ -618,7 +618,11 @@ def build_engine1a():
         "Modelica.Mechanics.MultiBody.Examples.Loops.Engine1a (MSL 3.2): one cylinder's "
         "mechanism, crank, rod and piston as BodyBox/BodyCylinder, started at its top dead "
         "centre (phi = 0) with the output inertia (J = 1) at 10 rad/s; no combustion, no "
-        "friction: the energy is conserved. See tests/scenes/engine.py."),
+        "friction: the energy is conserved. See tests/scenes/engine.py. MSL's figure is the "
+        "animation of the engine; reproduced here through its dead centres as the piston's "
+        "position (probe piston) on the slider-crank's closed form s(phi) = 0.35 - 0.1 cos(phi) "
+        "- sqrt(0.2^2 - 0.1^2 sin(phi)^2) at the crank angle (probe crank), checked in "
+        "tests/scenes/test_engine1a.py."),
         simulation={"t_end": 5.0, "n_points": 501, "method": "auto", "rtol": 1e-8,
                     "atol": 1e-10})
     parts = [
