@@ -131,7 +131,7 @@ def plant(model, inputs=(), params=None):
         return model
     if isinstance(model, System):
         base, loops = model.model, model.formulation
-        loops = "partition" if loops == "tree" else loops
+        loops = loops if loops in ("projected", "baumgarte") else "partition"
     elif isinstance(model, Model):
         base, loops = model, "partition"
     else:
@@ -184,7 +184,8 @@ def _drive(flat, twin, name, d):
     """Make the input ``name`` of ``twin`` the parameter d; return its operating value."""
     if not isinstance(name, str):
         raise ModelError(f"inputs: expected names, got {quote(name)}")
-    if "." not in name:
+    # a block's name, or "component.port" (a component of a subsystem: "axis.motor.u")
+    if name in flat.components or "." not in name:
         comp = flat.components.get(name)
         if not isinstance(comp, Input):
             kind = f"a {comp.type_name}" if comp is not None else "no component"
@@ -192,13 +193,13 @@ def _drive(flat, twin, name, d):
                              f"; an input is a signals.Input block or an open signal input "
                              f"'component.port' (inputs here: "
                              f"{', '.join(_inputs_of(flat)) or 'none'})")
-        block = Input(name, value=d)
+        block = _input(name, d)
         twin.components[name] = block
         twin.connections = [tuple(PortRef(block, r.name) if r.component is comp else r
                                   for r in c) for c in twin.connections]
         twin._wired = {frozenset(c) for c in twin.connections}
         return comp._values["value"]
-    cname, _, pname = name.partition(".")
+    cname, _, pname = name.rpartition(".")
     comp = flat.components.get(cname)
     if comp is None:
         raise ModelError(f"inputs: {quote(name)}: no component {quote(cname)}"
@@ -216,10 +217,18 @@ def _drive(flat, twin, name, d):
         raise ModelError(f"inputs: {name} is the reference of a prescribed motion, which "
                          f"the model differentiates in time: it is no input of a "
                          f"linearisation; drive the joint with a Torque or Force instead")
-    block = Input(_fresh(f"{cname}_{pname}_input", twin.components), value=d)
+    block = _input(_fresh(f"{cname}_{pname}_input".replace(".", "_"), twin.components), d)
     twin.add(block)
     twin.connect(block.y, ref)
     return _replaced(comp, pname)[0]
+
+
+def _input(name, d):
+    """An Input block giving the parameter d, named ``name`` (a path in a flat model, as the
+    flattening names the components of subsystems)."""
+    block = Input("input", value=d)
+    object.__setattr__(block, "name", name)
+    return block
 
 
 def _replaced(comp, pname):
@@ -238,8 +247,8 @@ def _replaced(comp, pname):
 
 def _input_unit(flat, name):
     """The unit of an input: of what it replaces; an Input block's, of what it feeds."""
-    if "." in name:
-        cname, _, pname = name.partition(".")
+    if name not in flat.components:
+        cname, _, pname = name.rpartition(".")
         return _replaced(flat.components[cname], pname)[1]
     block = flat.components[name]
     units = {_replaced(r.component, r.name)[1] for c in flat.connections for r in c

@@ -8,6 +8,7 @@ import weakref
 import casadi as ca
 import numpy as np
 
+from ..equations.system import System
 from ..errors import ModelError, SimulationError
 from ..util import quote, suggest
 from .channels import plant
@@ -69,12 +70,16 @@ def equilibrium(model, at=None, inputs=(), free=(), fix=None, params=None, t=0.0
     """
     given = dict(inputs) if isinstance(inputs, dict) else {}
     names = list(inputs) if not isinstance(inputs, str) else [inputs]
+    free = [free] if isinstance(free, str) else list(free)
+    flat = (model.model if isinstance(model, System) else model).flat()
+    # a freed input need not be listed in inputs as well
+    names += [k for k in free if k not in flat.parameters and k not in names
+              and (k in flat.components or "." in k)]
     pl = plant(model, names, params)
     s = pl.system
     p = pl.param_vector(params, given, t)
     states = s.state_names + s.algebraic_names
     fix = dict(fix or {})
-    free = [free] if isinstance(free, str) else list(free)
     problems = [f"fix: {quote(k)} is not a state{suggest(k, states)}" for k in fix
                 if k not in states]
     where = []

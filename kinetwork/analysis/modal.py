@@ -58,7 +58,9 @@ def modes(model, **linearize_args):
         damping = -lam.real / freq if freq > 0 else 1.0
         shape = vec[coords] if coords else vec
         big = shape[np.argmax(np.abs(shape))] if shape.size else 1.0
-        shape = shape / big if abs(big) > 0 else shape
+        # a mode the joints take no part in (a controller's filter): a shape of zeros
+        moves = abs(big) > 1e-9 * np.max(np.abs(vec))
+        shape = shape / big if moves else np.zeros_like(shape)
         names = [lin.state_names[k] for k in coords] if coords else lin.state_names
         out.append(Mode(complex(lam), float(freq), float(damping), float(max(lam.imag, 0.0)),
                         dict(zip(names, shape.astype(complex)))))
