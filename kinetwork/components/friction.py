@@ -190,7 +190,7 @@ class PartialStop(PartialHybrid):
     def next_mode(self, ev):
         if ev.mode == 1:
             return 0, None, "lift-off"
-        if abs(ev.w_rel) > ev.values[1]:
+        if abs(ev.w_rel) > max(ev.values[1], ev.tiny):
             return 0, -ev.values[0] * ev.w_rel, "impact"
         return 1, 0.0, None
 

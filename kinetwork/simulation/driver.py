@@ -348,7 +348,8 @@ def _integrate(run, method):
         if run.events is not None and failure is None:
             origin = restart_at or (grid[k], X[-1])
             try:
-                new, restart_at = run.events.check(method, times, origin, new)
+                new, restart_at = run.events.check(method, times, origin, new,
+                                                   restarted=restart_at is not None)
             except Failure as exc:
                 new, restart_at, failure = new[:0], None, exc.reason
             if restart_at is not None:        # an event: the method starts afresh there

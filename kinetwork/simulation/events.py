@@ -36,6 +36,9 @@ SAME_INSTANT = 1e-13
 ZENO_LIMIT = 200
 #: trial intervals shorter than this (relative to the time) are stepped by RK4 directly
 SHORT = 1e-6
+#: where, as fractions of the interval, an indicator that starts at zero after a restart is
+#: looked for above zero (it leaves zero rising: first right after the start)
+SCAN = np.array([1e-12, 1e-9, 1e-6, 1e-3, *np.arange(1, 16) / 16])
 
 
 class Events:
@@ -93,16 +96,22 @@ class Events:
         return self._settle(t, x, None)
 
     # -- during the run --------------------------------------------------------------------
-    def check(self, method, times, before, rows):
+    def check(self, method, times, before, rows, restarted=False):
         """The rows up to the first event among ``rows`` (at ``times``, after the state
-        ``before`` = (t, x)) and, when there is one, the (t, x) to start again from."""
+        ``before`` = (t, x)) and, when there is one, the (t, x) to start again from.
+        ``restarted``: ``before`` is where an event left the run, with indicators at zero
+        (a gap just closed, a speed just zero) that count as positive: they leave zero
+        rising, and one that is at or below zero at the next output fell back in between."""
         t_prev, x_prev = before
         g_prev = self.values(t_prev, x_prev)[:, 0]
+        if restarted:
+            g_prev = np.where(g_prev <= 0, np.inf, g_prev)
         for j, (t, x) in enumerate(zip(times, rows)):
             g = self.values(t, x)[:, 0]
             crossed = np.flatnonzero((g_prev > 0) & (g <= 0))
-            if len(crossed):
-                t_ev, x_ev, i = self._locate(method, t_prev, x_prev, t, crossed)
+            found = self._locate(method, t_prev, x_prev, t, crossed) if len(crossed) else None
+            if found is not None:
+                t_ev, x_ev, i = found
                 after = self.apply(t_ev, x_ev, i)
                 if t_ev >= t:                 # at the output time itself: it shows the after
                     return np.vstack([rows[:j], after[None, :]]), (t, after)
@@ -130,10 +139,18 @@ class Events:
         for i in crossed:
             def g(t, i=i):
                 return self.values(t, state(t))[i, 0]
+            start = t0
+            if g(t0) <= 0:            # at zero after a restart: where it was above zero
+                start = next((t for t in t0 + (t1 - t0) * SCAN if g(t) > 0), None)
+                if start is None:     # it fell back at once: an event where it started
+                    t_i = t0
+                    if best is None or t_i < best[0]:
+                        best = (t_i, i)
+                    continue
             if g(t1) == 0.0:
                 t_i = t1
             else:
-                t_i = brentq(g, t0, t1, xtol=1e-15, rtol=4 * np.finfo(float).eps,
+                t_i = brentq(g, start, t1, xtol=1e-15, rtol=4 * np.finfo(float).eps,
                              maxiter=200)
                 # the side of the root where the indicator has crossed
                 if g(t_i) > 0:
@@ -141,6 +158,8 @@ class Events:
                     t_i = min(t1, t_i + step)
             if best is None or t_i < best[0]:
                 best = (t_i, i)
+        if best is None:
+            return None
         return best[0], state(best[0]), best[1]
 
     def _rk4(self, t, x, h):
