@@ -223,3 +223,53 @@ def test_a_stop_without_limits_and_a_midpoint_run_are_refused_by_name():
         model.compile()
     with pytest.raises(kn.ModelError, match="midpoint.*friction or stops"):
         kn.simulate(sliding_block(), t_end=1.0, method="midpoint", **FAST)
+
+
+def test_bearing_friction_on_a_pendulum_joint_stops_it_at_the_energy_balance_angle():
+    # Coulomb friction tau_c on the joint: between turning points q_n and q_n+1 the energy
+    # lost is the friction's work, m g L (cos q_n+1 - cos q_n) = tau_c |q_n+1 - q_n|; it
+    # sticks at the first turning point where m g L |sin q| <= peak tau_c
+    from scipy.optimize import brentq
+    g, L, q0, tau_c, peak = 9.81, 0.8, 1.0, 0.8, 1.3
+    model = kn.Model("pendulum")
+    world = model.add(kn.multibody.Ground("world", gravity=[0, -g, 0]))
+    joint = model.add(kn.multibody.Revolute("joint", axis=[0, 0, 1], q0=q0))
+    bob = model.add(kn.multibody.RigidBody("bob", mass=1.0, r_cm=[0, -L, 0]))
+    bearing = model.add(kn.rotational.BearingFriction("bearing", tau_c=tau_c, peak=peak))
+    probe = model.add(kn.Probe("p", quantities=["torque"]))
+    model.connect(world.frame, joint.frame_a)
+    model.connect(joint.frame_b, bob.frame_a)
+    model.connect(bearing.support, joint.support)
+    model.connect(bearing.flange, joint.axis)
+    model.connect(probe.port, bearing.flange)
+    res = kn.simulate(model, t_end=6.0, n_points=61, method="cvodes", rtol=1e-11,
+                      atol=1e-13, **FAST)
+    q, turns = q0, 0
+    while g * L * abs(np.sin(q)) > peak * tau_c:
+        ends = sorted([-np.sign(q) * 1e-9, -q * (1 - 1e-12)])      # on the other side
+        q = brentq(lambda r, q=q: g * L * (np.cos(r) - np.cos(q)) - tau_c * abs(r - q), *ends,
+                   xtol=1e-15)
+        turns += 1
+    kinds = [ev["kind"] for ev in res.stats["events"]]
+    assert kinds[-1] == "stuck" and len(kinds) == turns
+    assert abs(res["joint.q"][-1] - q) < 1e-9
+    # stuck, the bearing holds the weight's torque
+    assert abs(res["p.torque"][-1] + g * L * np.sin(res["joint.q"][-1])) < 1e-10
+
+
+def test_friction_on_a_massless_flange_is_refused_and_files_keep_the_elements(tmp_path):
+    model = kn.Model("massless")
+    spring = model.add(kn.translational.Spring("spring", c=1.0))
+    wall = model.add(kn.translational.Fixed("wall"))
+    rub = model.add(kn.translational.Friction("rub", f_c=1.0))
+    model.connect(wall.flange, spring.flange_a)
+    model.connect(spring.flange_b, rub.flange)
+    with pytest.raises(kn.ModelError, match="rub.*massless"):
+        model.compile()
+    belt = belt_model(1.0, 10.0, 2.0, 1.5, 0.5)
+    belt.save(tmp_path / "belt.json")
+    again = kn.load(tmp_path / "belt.json")
+    assert again.components["rub"].peak == 1.5 and again.components["rub"].f_kinetic == 2.0
+    a = kn.simulate(belt, t_end=1.0, n_points=11, method="rk45", **FAST)
+    b = kn.simulate(again, t_end=1.0, n_points=11, method="rk45", **FAST)
+    assert a.stats["events"] == b.stats["events"] and np.array_equal(a.states, b.states)
