@@ -330,6 +330,13 @@ class Scene:
         return [_shape(kind, self.frame(comp, "frame_a"), start, ld, length, width, height,
                        _color(_get(v, "color", None), COLORS["body"]), wd)]
 
+    def wheel(self, comp, v):
+        """A rolling wheel as a disk of its radius about the wheel axis (frame_b's y), a
+        fifth of the radius thick."""
+        r = float(_get(v, "radius", self.L / 10))
+        return [_shape("cylinder", self.frame(comp, "frame_b"), -_Y * r / 10, _Y, r / 5,
+                       2 * r, 2 * r, COLORS["body"])]
+
     def sphere_body(self, comp, v):
         d = float(_get(v, "diameter", self.L / 9))
         start = np.asarray(_get(v, "r_shape", np.zeros(3)), dtype=float)
@@ -398,6 +405,7 @@ VISUALS = {
     "multibody.UniversalSpherical": Scene.rod_joint,
     "multibody.Planar": Scene.planar,
     "multibody.FreeMotion": lambda scene, comp, values: [],     # no joint to see: a body flies
+    "multibody.RollingWheelJoint": Scene.wheel,
     "multibody.FixedTranslation": Scene.rod,
     "multibody.FixedRotation": Scene.rod,
     "multibody.RigidBody": Scene.body,

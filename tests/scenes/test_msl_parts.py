@@ -8,6 +8,7 @@ import pathlib
 import numpy as np
 
 import kinetwork as kn
+from kinetwork.animation.scene import animation_data
 from scenes.line_masses import Scene, msl_cut_forces, solve
 
 MODELS = pathlib.Path(__file__).resolve().parents[2] / "models"
@@ -58,6 +59,9 @@ def test_rolling_wheel_keeps_its_energy_and_does_not_slip():
     energy = (0.5 * m * np.sum(v**2, axis=1) + m * 9.81 * pos[:, 2]
               + 0.5 * inertia[1, 1] * spin**2 + 0.5 * inertia[0, 0] * np.sum(w_perp**2, axis=1))
     np.testing.assert_allclose(energy, energy[0], rtol=1e-9)
+    # the animation draws the wheel as a disk of its diameter about its axis, on its frame
+    disk, = [s for s in animation_data(res)["shapes"] if s["component"] == "wheel1.joint"]
+    assert (disk["kind"], disk["length_direction"], disk["width"]) == ("cylinder", [0, 1, 0], 0.6)
 
 
 def test_line_force_with_two_masses_matches_an_independent_lagrangian():
