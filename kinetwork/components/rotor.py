@@ -12,9 +12,11 @@ move exactly as the same cylinder on a revolute).
 Compiled, a Rotor1D is what that amounts to: a revolute about n from frame_a (its
 coordinate is phi, its axis flange both of the rotor's flanges) carrying an inertia J n n^T,
 and on frame_a the inertia -J n n^T, which takes back the share the carrier already holds;
-its kinetic energy is J w^2 / 2 + J w (n . w_a), MSL's. The revolute's support flange is
-MSL's Mounting1D on frame_a with the same axis: a torque source between it and a flange
-reacts on the carrier.
+its kinetic energy is J w^2 / 2 + J w (n . w_a), MSL's. A torque on the rotor's flanges is
+the revolute's generalized force, so it reacts on the carrier, as MSL's does through a
+Mounting1D on frame_a with the same axis: ``support`` is that flange (wiring a source's
+support to it, or leaving the source's support unwired, is the same). The cut-force probes
+of frames near the rotor take the reaction to rest in the world, as for any joint's drive.
 """
 
 import numbers
@@ -43,7 +45,8 @@ class RotorHousing(Component):
     role = "body"
     frame_a = Port("frame", "The rotor's housing frame")
     J = Param(unit="kg*m^2", min=0.0, doc="Moment of inertia of the rotor about its axis")
-    n = Param([1.0, 0.0, 0.0], shape=(3,), nonzero=True, doc="Rotor axis, in frame_a")
+    n = Param([1.0, 0.0, 0.0], unit="1", shape=(3,), nonzero=True,
+              doc="Rotor axis, in frame_a")
 
     def mass_properties(self):
         e = unit(vec3(self.n))
@@ -58,9 +61,9 @@ class Rotor1D(Component, library=MB):
     flange_a and flange_b are the rotor: their angle phi is relative to frame_a. As in MSL,
     the carrier holds the rotor's mass and inertia as a rigid body; the rotor adds what its
     spin relative to frame_a does (the torque cross(w_a, J n w) - n J (n . der(w_a)) on
-    frame_a). ``support`` is MSL's Mounting1D with the same axis on frame_a: a torque between
-    it and a flange reacts on the carrier. Its states are ``<name>.spin.q`` and
-    ``<name>.spin.qd`` (phi and w).
+    frame_a). A torque on the flanges reacts on the carrier, as through MSL's Mounting1D with
+    the same axis on frame_a; ``support`` is that flange. Its states are ``<name>.spin.q``
+    and ``<name>.spin.qd`` (phi and w).
 
     Parameters
     ----------
@@ -81,7 +84,8 @@ class Rotor1D(Component, library=MB):
     support = Port("rotational", "Housing flange on frame_a (MSL's Mounting1D): the reaction "
                                  "of a torque on the rotor", optional=True)
     J = Param(unit="kg*m^2", min=0.0, doc="Moment of inertia of the rotor about its axis")
-    n = Param([1.0, 0.0, 0.0], shape=(3,), nonzero=True, doc="Rotor axis, resolved in frame_a")
+    n = Param([1.0, 0.0, 0.0], unit="1", shape=(3,), nonzero=True,
+              doc="Rotor axis, resolved in frame_a")
     phi0 = Param(None, optional=True, unit="rad",
                  doc="Initial angle relative to frame_a (None: 0)")
     w0 = Param(None, optional=True, unit="rad/s",
