@@ -116,6 +116,8 @@ def linearize(model, at=None, inputs=(), outputs=None, params=None):
     Linearization
         A, B, C, D with named states, inputs and outputs and their units.
     """
+    # at an Equilibrium: its inputs, and the parameters it solved for
+    params = {**(params or {}), **(getattr(at, "params", None) or {})}
     pl = plant(model, inputs, params)
     s = pl.system
     input_values = getattr(at, "inputs", None) or {}
