@@ -66,6 +66,7 @@ def schema():
             **body,
             "simulation": {"type": "object", "additionalProperties": False,
                            "properties": _simulation()},
+            "initial": _initial(),
             "definitions": {"type": "object",
                             "propertyNames": {"pattern": IDENT, "not": {"enum": types}},
                             "additionalProperties": {"oneOf": [reference, inline]}},
@@ -156,6 +157,22 @@ def _bounded(spec):
     if spec.nonzero:
         number["not"] = {"const": 0}
     return {"anyOf": [number, EXPRESSION]}
+
+
+def _initial():
+    """Initial conditions as equations (``kinetwork.graph.initial``)."""
+    names = {"type": "array", "items": {"type": "string", "minLength": 1},
+             "uniqueItems": True}
+    return {"type": "object", "additionalProperties": False,
+            "description": "initial conditions as equations: a steady state, given "
+                           "derivatives, states and parameters solved from them",
+            "properties": {
+                "steady": {"type": "boolean", "description": "every state's derivative zero"},
+                "derivatives": {"type": "object", "additionalProperties": NUMBER,
+                                "description": "state name -> its derivative at t = 0"},
+                "fixed": {**names, "description": "states a steady state keeps"},
+                "solve": {**names, "description": "model parameters (and, without steady, "
+                                                  "states) solved from the equations"}}}
 
 
 def _simulation():

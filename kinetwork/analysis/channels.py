@@ -126,14 +126,18 @@ class Plant:
 
 
 def plant(model, inputs=(), params=None):
-    """The Plant of ``model`` (a Model or a System) with the named input channels."""
+    """The Plant of ``model`` (a Model or a System) with the named input channels. Loops
+    are always in their independent coordinates (the partition formulation): a System
+    compiled with projected or Baumgarte loops would add the projection's or the
+    stabilisation's own eigenvalues to the mechanism's."""
     if isinstance(model, Plant):
         return model
     if isinstance(model, System):
-        base, loops = model.model, model.formulation
-        loops = loops if loops in ("projected", "baumgarte") else "partition"
+        base = model.model
+        if model.formulation in ("projected", "baumgarte"):
+            model = base.compile()
     elif isinstance(model, Model):
-        base, loops = model, "partition"
+        base = model
     else:
         raise ModelError(f"expected a kn.Model or kn.System, got {type(model).__name__}")
     if isinstance(inputs, str):
@@ -152,7 +156,7 @@ def plant(model, inputs=(), params=None):
         twins[key] = _twin(flat, inputs)
     twin, names, nominal = twins[key]
     twin.parameters.update(flat.parameters)
-    system = twin.compile(loops)
+    system = twin.compile()
     units = [_input_unit(flat, name) for name in inputs]
     return Plant(system, source, inputs, units, [system.param_names.index(d) for d in names],
                  nominal)

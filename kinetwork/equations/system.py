@@ -14,6 +14,7 @@ import numpy as np
 from ..errors import ModelError
 from . import junctions
 from .assemble import assemble
+from .initial import InitialEquations
 from .loops import BAUMGARTE_RATE, formulate, newton
 from .modes import close as close_modes
 
@@ -184,7 +185,10 @@ class System:
         values = self.model.parameter_values(params)
         if params:
             self.model.numeric_values(params)     # bounds of everything that depends on them
-        return np.array([values[k] for k in self.param_names], dtype=float)
+        p = np.array([values[k] for k in self.param_names], dtype=float)
+        if self.initial_equations.solves_parameters():     # found from the start (initial.py)
+            p = self.initial_equations.apply(p, self.eq.initial(p)[0])[1]
+        return p
 
     @property
     def x0(self):
@@ -206,7 +210,14 @@ class System:
     def initial_full_p(self, p):
         """(x0, z0): consistent initial states and algebraic variables (loops closed)."""
         x0, z0 = self.eq.initial(np.asarray(p, dtype=float))
+        x0 = self.initial_equations.apply(p, x0)[0]      # Model.initial, when it asks
         return np.asarray(x0, dtype=float), np.asarray(z0, dtype=float)
+
+    @functools.cached_property
+    def initial_equations(self):
+        """The model's initial equations (``Model.initial``): a steady state, given
+        derivatives, parameters solved from the start."""
+        return InitialEquations(self)
 
     @property
     def n_states(self):

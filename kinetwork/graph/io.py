@@ -15,6 +15,7 @@ import stat
 from ..components.base import _NAME, NAME_LIMIT, REGISTRY
 from ..errors import ModelError
 from ..util import QUOTE_LIMIT, quote, suggest
+from .initial import check_initial
 from .model import Model, model_name_problem, text_problem
 from .settings import check_setting, check_steps
 from .subsystem import Subsystem
@@ -189,6 +190,10 @@ def _build(data, problems, context):
     model.definitions = context.build_all(problems)
     _body(model, data, problems, context)
     model.simulation = _simulation(data.get("simulation", {}), problems)
+    found = check_initial(data.get("initial", {}))
+    problems.extend(found)
+    if not found:
+        model.initial = data.get("initial", {})
     return model
 
 

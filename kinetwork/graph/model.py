@@ -60,6 +60,8 @@ class Model:
         self._wired = set()            # the connections as unordered pairs, for O(1) checks
         self.parameters = {}
         self.simulation = dict(simulation or {})
+        #: initial conditions as equations (``set_initial``; ``kinetwork.graph.initial``)
+        self.initial = {}
         self.layout = {}
         #: ports this model shows when placed as a subsystem: name -> PortRef of a component
         self.exposed = {}
@@ -84,6 +86,7 @@ class Model:
         Model.__init__(self, model.name, description=model.description,
                        simulation=model.simulation)
         self.parameters = dict(model.parameters)
+        self.initial = model.initial
 
     # -- building -----------------------------------------------------------------------
     def set_parameter(self, name, value):
@@ -116,6 +119,17 @@ class Model:
             check_placement(self, component)
         self.components[component.name] = component
         return component
+
+    def set_initial(self, steady=False, derivatives=None, fixed=(), solve=()):
+        """Ask for initial conditions as equations (see ``kinetwork.graph.initial``):
+        ``steady`` (every derivative zero), ``derivatives`` ({state: value} at t = 0),
+        ``fixed`` (states a steady state keeps) and ``solve`` (model parameters, or states
+        without ``steady``, found from them): ``model.set_initial(steady=True,
+        fixed=["rev.q"], solve=["c"])`` is MSL's InitSpringConstant. No arguments: the
+        given start again."""
+        from .initial import normalized
+        self.initial = normalized({"steady": steady, "derivatives": dict(derivatives or {}),
+                                   "fixed": list(fixed), "solve": list(solve)})
 
     def expose(self, name, port):
         """Show ``port`` (``comp.port`` or ``"comp.port"``) as this model's port ``name``
@@ -188,6 +202,7 @@ class Model:
             self._flat = (key, flatten(self))
         flat = self._flat[1]
         flat.parameters.update(self.parameters)
+        flat.initial = self.initial          # current, as the parameter values
         return flat
 
     def parameter_values(self, overrides=None):

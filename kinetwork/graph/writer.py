@@ -11,6 +11,7 @@ import os
 from ..components.base import _NAME, REGISTRY
 from ..errors import ModelError
 from ..util import atomic_write, finite
+from .initial import check_initial
 from .settings import check_setting
 from .subsystem import Subsystem
 
@@ -19,9 +20,9 @@ from .subsystem import Subsystem
 FORMAT, VERSION = "kinetwork.model", 2
 #: top-level keys, in the order files are written (version 1, and version 2's)
 KEYS = ("format", "version", "name", "description", "parameters", "components", "connections",
-        "simulation", "layout")
+        "simulation", "initial", "layout")
 KEYS_V2 = ("format", "version", "name", "description", "parameters", "ports", "components",
-           "connections", "simulation", "layout", "definitions")
+           "connections", "simulation", "initial", "layout", "definitions")
 #: what an inline definition holds
 DEFINITION_KEYS = ("description", "parameters", "ports", "components", "connections", "layout")
 #: a list of scalars stays on one line up to this many characters
@@ -55,6 +56,9 @@ def model_to_dict(model, folder=None):
         isinstance(c, Subsystem) for c in model.components.values()))
     data = {"format": FORMAT, "version": 2 if v2 else 1, "name": model.name,
             **body, "simulation": copy.deepcopy(model.simulation)}
+    if getattr(model, "initial", None):           # written only when asked for
+        problems.extend(check_initial(model.initial))
+        data["initial"] = copy.deepcopy(model.initial)
     data["layout"] = data.pop("layout")
     if v2:
         data = {key: data[key] for key in KEYS_V2 if key in data}

@@ -89,6 +89,10 @@ def test_fourbar_has_one_pair_of_eigenvalues_in_its_independent_coordinates():
     system = model.compile()
     assert system.n_algebraic > 0 and lin.A.shape == (2, 2)
     assert len(lin.eigenvalues) == 2
+    # a System compiled with Baumgarte's stabilisation is linearised in the same coordinates:
+    # its stabilising eigenvalues belong to the formulation, not to the mechanism
+    stabilised = kn.linearize(model.compile(loops="baumgarte"), outputs=["rocker_probe.angle"])
+    np.testing.assert_allclose(stabilised.A, lin.A, atol=1e-12)
     # against central differences of the nonlinear model, whose rhs closes the loop by
     # Newton at every perturbed state (no derivative of the closure involved)
     x = system.x0

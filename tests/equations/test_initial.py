@@ -1,0 +1,147 @@
+"""Initial conditions as equations: MSL's InitSpringConstant (the spring constant that holds a
+pendulum still at its start) on a rotational spring and on a line spring, against the closed
+forms of their moment balance; an equilibrium solved for the angle (scipy's brentq on the same
+balance); a DC motor started in its steady run from given derivatives (the closed-form
+operating point); refusals; the file form."""
+
+import json
+
+import numpy as np
+import pytest
+import scipy.optimize
+
+import kinetwork as kn
+from kinetwork.equations.initial import solved
+
+G, MASS, ARM = 9.81, 2.0, 0.8
+
+
+def _pendulum(q0=-0.3, c=100.0, phi_rel0=0.0):
+    m = kn.Model("isc", parameters={"c": c})
+    for comp in (kn.multibody.Ground("ground", gravity=[0, -G, 0]),
+                 kn.multibody.Revolute("rev", axis=[0, 0, 1], q0=q0),
+                 kn.multibody.RigidBody("bob", mass=MASS, r_cm=[ARM, 0, 0], inertia=[0, 0, 0]),
+                 kn.rotational.Spring("spring", c="c", phi_rel0=phi_rel0),
+                 kn.Probe("p", quantities=["angle", "speed"])):
+        m.add(comp)
+    for a, b in [("ground.frame", "rev.frame_a"), ("rev.frame_b", "bob.frame_a"),
+                 ("spring.flange_a", "rev.support"), ("spring.flange_b", "rev.axis"),
+                 ("p.port", "rev.axis")]:
+        m.connect(a, b)
+    return m
+
+
+def test_init_spring_constant_on_a_rotational_spring():
+    m = _pendulum()
+    m.set_initial(steady=True, fixed=["rev.q"], solve=["c"])
+    c = MASS * G * ARM * np.cos(0.3) / 0.3          # c (0 - q0) = m g l cos q0
+    assert solved(m.compile()) == pytest.approx({"c": c, "rev.qd": 0.0}, rel=1e-12, abs=1e-12)
+    res = kn.simulate(m, t_end=1.0, n_points=5, rtol=1e-10, atol=1e-12)
+    assert np.max(abs(res["p.angle"] + 0.3)) < 1e-9 and np.max(abs(res["p.speed"])) < 1e-8
+    # the same from a given derivative: no acceleration at the start, c the unknown
+    m.set_initial(derivatives={"rev.qd": 0}, solve=["c"])
+    assert solved(m.compile())["c"] == pytest.approx(c, rel=1e-12)
+
+
+def test_init_spring_constant_on_a_line_spring_as_msl():
+    """MSL's Examples.Elementary.InitSpringConstant: a spring from a world point to the tip of
+    a pendulum; the constant found keeps it at rest."""
+    q0, h, s0 = 0.2, 0.7, 0.1
+    m = kn.Model("line", parameters={"c": 50.0})
+    for comp in (kn.multibody.Ground("ground", gravity=[0, -G, 0]),
+                 kn.multibody.Revolute("rev", axis=[0, 0, 1], q0=q0),
+                 kn.multibody.FixedTranslation("rod", r=[ARM, 0, 0]),
+                 kn.multibody.RigidBody("bob", mass=MASS, inertia=[0, 0, 0]),
+                 kn.multibody.FixedTranslation("anchor", r=[ARM, h, 0]),
+                 kn.multibody.Spring("spring", c="c", s_unstretched=s0),
+                 kn.Probe("p", quantities=["angle"])):
+        m.add(comp)
+    for a, b in [("ground.frame", "rev.frame_a"), ("rev.frame_b", "rod.frame_a"),
+                 ("rod.frame_b", "bob.frame_a"), ("ground.frame", "anchor.frame_a"),
+                 ("anchor.frame_b", "spring.frame_a"), ("rod.frame_b", "spring.frame_b"),
+                 ("p.port", "rev.axis")]:
+        m.connect(a, b)
+    m.set_initial(steady=True, fixed=["rev.q"], solve=["c"])
+    tip = ARM * np.array([np.cos(q0), np.sin(q0)])
+    d = np.array([ARM, h]) - tip
+    length = np.hypot(*d)
+    moment = (length - s0) / length * (tip[0] * d[1] - tip[1] * d[0])   # per unit c
+    c = MASS * G * tip[0] / moment
+    assert solved(m.compile())["c"] == pytest.approx(c, rel=1e-12)
+    res = kn.simulate(m, t_end=0.5, n_points=3, rtol=1e-10, atol=1e-12)
+    assert np.max(abs(res["p.angle"] - q0)) < 1e-9
+
+
+def test_steady_state_solves_the_angle():
+    m = _pendulum(q0=0.0, c=40.0)
+    m.set_initial(steady=True)
+    q = solved(m.compile())["rev.q"]
+    ref = scipy.optimize.brentq(lambda q: -40.0 * q - MASS * G * ARM * np.cos(q), -2, 0,
+                                xtol=1e-15)
+    assert q == pytest.approx(ref, abs=1e-12)
+    assert kn.simulate(m, t_end=0.5, n_points=3)["p.angle"] == pytest.approx([ref] * 3,
+                                                                             abs=1e-9)
+
+
+def test_dc_motor_started_in_its_steady_run():
+    """Given derivatives on electrical and mechanical states: no change of current and
+    speed, both unknown: i = d w / k, V = R i + k w."""
+    R, L, k, J, d, V = 1.2, 0.05, 0.3, 2e-3, 0.01, 12.0
+    m = kn.Model("run")
+    E = kn.electrical
+    for comp in (E.Ground("g"), E.VoltageSource("src", V=V),
+                 E.DCMotor("motor", R=R, L=L, k=k, J=J), kn.rotational.Damper("friction", d=d),
+                 kn.rotational.Fixed("housing"), kn.Probe("pw", quantities=["speed"])):
+        m.add(comp)
+    for a, b in [("src.p", "motor.p"), ("motor.n", "src.n"), ("g.p", "src.n"),
+                 ("motor.flange", "friction.flange_b"), ("friction.flange_a", "housing.flange"),
+                 ("motor.support", "housing.flange"), ("pw.port", "motor.flange")]:
+        m.connect(a, b)
+    m.set_initial(derivatives={"motor.La.i": 0, "motor.rotor.w": 0},
+                  solve=["motor.La.i", "motor.rotor.w"])
+    w = V * k / (R * d + k ** 2)
+    assert solved(m.compile()) == pytest.approx({"motor.rotor.w": w, "motor.La.i": d * w / k},
+                                                rel=1e-12)
+    res = kn.simulate(m, t_end=0.5, n_points=3, rtol=1e-10, atol=1e-12)
+    assert res["pw.speed"] == pytest.approx([w] * 3, rel=1e-9)
+    # a steady state of everything leaves the rotor's angle to nothing: refused by name
+    m.set_initial(steady=True)
+    with pytest.raises(kn.ModelError, match=r"do not determine motor.rotor.phi"):
+        m.compile().x0
+
+
+def test_initial_equations_that_cannot_hold_are_refused():
+    m = _pendulum()
+    m.set_initial(steady=True, solve=["c"])
+    with pytest.raises(kn.ModelError, match=r"2 equation\(s\).*3 unknown\(s\)"):
+        m.compile().x0
+    m.set_initial(steady=True, fixed=["rev.q"], solve=["k"])
+    with pytest.raises(kn.ModelError, match=r"initial.solve\[0\]: 'k' is neither"):
+        m.compile().x0
+    m.set_initial(derivatives={"rev.q": 0}, solve=["rev.qd"], steady=False)
+    assert solved(m.compile())["rev.qd"] == 0.0
+    # a spring that is unstretched at the start cannot hold the pendulum, whatever its c
+    m = _pendulum(q0=-0.3, phi_rel0=-0.3)
+    m.set_initial(steady=True, fixed=["rev.q"], solve=["c"])
+    with pytest.raises(kn.ModelError, match=r"cannot satisfy der\(rev.q\) = 0, der\(rev.qd\)"):
+        m.compile().x0
+    with pytest.raises(kn.ModelError, match=r"initial.fixed: only with steady"):
+        m.set_initial(fixed=["rev.q"])
+
+
+def test_initial_in_files(tmp_path):
+    m = _pendulum()
+    m.set_initial(steady=True, fixed=["rev.q"], solve=["c"])
+    path = tmp_path / "isc.json"
+    m.save(path)
+    text = path.read_text()
+    assert json.loads(text)["initial"] == {"steady": True, "fixed": ["rev.q"], "solve": ["c"]}
+    again = kn.load(path)
+    again.save(tmp_path / "again.json")
+    assert (tmp_path / "again.json").read_text() == text
+    assert solved(again.compile())["c"] == pytest.approx(solved(m.compile())["c"], rel=1e-14)
+    data = json.loads(text)
+    data["initial"] = {"steady": "yes", "solv": ["c"]}
+    with pytest.raises(kn.ModelError, match=r"initial.solv: unknown key.*solve") as err:
+        kn.loads(json.dumps(data))
+    assert any("initial.steady: must be true or false" in p for p in err.value.problems)
