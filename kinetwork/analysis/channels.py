@@ -25,7 +25,8 @@ from ..util import check_number, quote, suggest
 
 #: a force element's signal port says which entry of which parameter it replaces
 _REPLACES = re.compile(r"replaces (\w+)\[(\d)\]")
-#: model -> {(content key, inputs): (twin model, its parameter names of the inputs)}
+#: model -> {(content key, inputs): (twin model, the names of the inputs' parameters in it,
+#: the inputs' operating values)}
 _TWINS = weakref.WeakKeyDictionary()
 
 
@@ -41,10 +42,6 @@ class Plant:
     input_units: list = field(default_factory=list)
     input_index: list = field(default_factory=list)
     nominal: list = field(default_factory=list)
-
-    @property
-    def n_states(self):
-        return self.system.n_states
 
     def param_vector(self, params=None, inputs=None, t=0.0):
         """p with ``params`` overrides, the inputs at ``inputs`` (name -> value) or else at
@@ -125,7 +122,7 @@ class Plant:
         return self._closed(res.states[-1], p)
 
 
-def plant(model, inputs=(), params=None):
+def plant(model, inputs=()):
     """The Plant of ``model`` (a Model or a System) with the named input channels. Loops
     are always in their independent coordinates (the partition formulation): a System
     compiled with projected or Baumgarte loops would add the projection's or the

@@ -75,7 +75,7 @@ def equilibrium(model, at=None, inputs=(), free=(), fix=None, params=None, t=0.0
     # a freed input need not be listed in inputs as well
     names += [k for k in free if k not in flat.parameters and k not in names
               and (k in flat.components or "." in k)]
-    pl = plant(model, names, params)
+    pl = plant(model, names)
     s = pl.system
     p = pl.param_vector(params, given, t)
     states = s.state_names + s.algebraic_names

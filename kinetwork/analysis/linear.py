@@ -83,9 +83,9 @@ class Linearization:
         i = [f"{n} [{u}]" if u else n for n, u in zip(self.input_names, self.input_units)]
         o = [f"{n} [{u}]" if u else n for n, u in zip(self.output_names, self.output_units)]
         return "\n\n".join([table("A", self.A, s, self.state_names),
-                            table("B", self.B, s, self.input_names),
+                            table("B", self.B, s, i),
                             table("C", self.C, o, self.state_names),
-                            table("D", self.D, o, self.input_names)])
+                            table("D", self.D, o, i)])
 
     def __repr__(self):
         return (f"<Linearization at t = {self.t:g} s: {self.A.shape[0]} states, "
@@ -118,7 +118,7 @@ def linearize(model, at=None, inputs=(), outputs=None, params=None):
     """
     # at an Equilibrium: its inputs, and the parameters it solved for
     params = {**(params or {}), **(getattr(at, "params", None) or {})}
-    pl = plant(model, inputs, params)
+    pl = plant(model, inputs)
     s = pl.system
     input_values = getattr(at, "inputs", None) or {}
     p = pl.param_vector(params, {k: v for k, v in input_values.items() if k in pl.inputs},
