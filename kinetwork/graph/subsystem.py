@@ -210,7 +210,7 @@ class _Flat:
             given, values = {}, {}
             for key, spec in comp.params.items():
                 value = comp._values[key]
-                if spec.kind == "real" and value is not None:
+                if spec.kind in ("real", "expression") and value is not None:
                     value = _map(value, lambda text: _constant(rename(text, scope)))
                 elif spec.kind == "name" and value is not None and prefix:
                     value = prefix + value

@@ -157,3 +157,22 @@ def test_a_large_table2d_is_an_interpolant_with_the_same_values():
     ref = RegularGridInterpolator((g1, g2), values, method="linear")
     assert np.max(abs(res["py.value"] - ref(np.column_stack([0.9 * res.t, res.t - 0.5])))) \
         < 1e-12
+
+
+def test_expression_in_a_subsystem_reads_its_parameters():
+    """Inside a subsystem the expression's parameters are the definition's: a constant of the
+    instance, or an outer parameter that stays a symbol."""
+    inner = kn.Model("law", parameters={"k": 3.0})
+    inner.add(S.Expression("e", expression="k*x + t", names=["x"]))
+    inner.expose("u", "e.u1")
+    inner.expose("y", "e.y")
+    m = kn.Model("outer", parameters={"K": 5.0})
+    for comp in (S.Constant("c", k=2.0), kn.Subsystem("a", inner, params={"k": "K"}),
+                 kn.Subsystem("b", inner), kn.Probe("pa", quantities=["value"]),
+                 kn.Probe("pb", quantities=["value"])):
+        m.add(comp)
+    for a, b in [("c.y", "a.u"), ("c.y", "b.u"), ("pa.port", "a.y"), ("pb.port", "b.y")]:
+        m.connect(a, b)
+    res = kn.simulate(m, t_end=1.0, n_points=3, method="rk45", params={"K": 1.0})
+    assert np.allclose(res["pa.value"], 1.0 * 2 + res.t, rtol=1e-14)
+    assert np.allclose(res["pb.value"], 3.0 * 2 + res.t, rtol=1e-14)
