@@ -1,7 +1,8 @@
 """Safe arithmetic expressions for parameter values, such as ``"-L1/2"`` or ``"2*sin(3*t)"``.
 
 Strings are parsed with :mod:`ast` and only numbers, names, arithmetic operators and a fixed
-set of functions are accepted; nothing from a string is ever executed. An expression is
+set of functions are accepted; nothing from a string is ever executed. ``^`` is a power, as in
+Modelica and Maple (``"L^2"`` is ``L**2``). An expression is
 evaluated over any numeric type that supports arithmetic (floats, CasADi SX), so the same
 parsed tree serves validation with numbers and compilation with symbols.
 """
@@ -30,6 +31,22 @@ _BINARY = {ast.Add: lambda a, b: a + b, ast.Sub: lambda a, b: a - b,
            ast.Mult: lambda a, b: a * b, ast.Div: lambda a, b: a / b,
            ast.Pow: lambda a, b: a ** b}
 _UNARY = {ast.USub: lambda a: -a, ast.UAdd: lambda a: a}
+#: how a refused operator is written, to name it in the message
+_SYMBOLS = {ast.Mod: "%", ast.FloorDiv: "//", ast.MatMult: "@", ast.BitAnd: "&",
+            ast.BitOr: "|", ast.LShift: "<<", ast.RShift: ">>", ast.Invert: "~",
+            ast.Not: "not", ast.And: "and", ast.Or: "or", ast.Eq: "==", ast.NotEq: "!=",
+            ast.Lt: "<", ast.LtE: "<=", ast.Gt: ">", ast.GtE: ">=", ast.Is: "is",
+            ast.IsNot: "is not", ast.In: "in", ast.NotIn: "not in"}
+#: what other refused constructs are called in a message
+_CONSTRUCTS = {ast.IfExp: "a conditional (x if c else y)", ast.Subscript: "indexing ([...])",
+               ast.List: "a list", ast.Tuple: "a tuple (a comma)", ast.Dict: "a dict",
+               ast.Set: "a set", ast.Lambda: "lambda", ast.NamedExpr: "assignment (:=)",
+               ast.Starred: "unpacking (*)", ast.JoinedStr: "an f-string",
+               ast.Attribute: "an attribute (.)", ast.Await: "await",
+               ast.ListComp: "a comprehension", ast.GeneratorExp: "a comprehension",
+               ast.SetComp: "a comprehension", ast.DictComp: "a comprehension",
+               ast.Slice: "a slice"}
+_ALLOWED = "numbers, parameter names, + - * / ** ^ and functions"
 _MAX_LENGTH = 2000
 
 
@@ -49,7 +66,8 @@ class Expression:
             raise ModelError(f"expression {quote(text)}: not valid text (a lone surrogate "
                              f"at character {exc.start})") from None
         try:
-            tree = ast.parse(text.strip(), mode="eval")
+            # no bitwise operators are accepted, so "^" is free to mean a power
+            tree = ast.parse(text.strip().replace("^", "**"), mode="eval")
             self.names = set()
             self._check(tree.body)
         except ModelError:
@@ -98,8 +116,8 @@ class Expression:
                 raise ModelError(f"expression {text}: call of {quote(name)} is not allowed"
                                  f"{suggest(name, FUNCTIONS)}; functions are "
                                  f"{', '.join(sorted(FUNCTIONS))}")
-            raise ModelError(f"expression {text}: {type(node).__name__} is not allowed "
-                             f"(only numbers, names, + - * / ** and functions)")
+            raise ModelError(f"expression {text}: {_refused(node)} is not allowed (only "
+                             f"{_ALLOWED})")
 
     def evaluate(self, env, functions=None):
         """Evaluate with ``env`` mapping names to values; ``functions`` overrides FUNCTIONS."""
@@ -128,6 +146,16 @@ class Expression:
 
     def __repr__(self):
         return f"Expression({self.text!r})"
+
+
+def _refused(node):
+    """What the refused node ``node`` is, in the words its writer used."""
+    op = getattr(node, "op", None)
+    if isinstance(node, ast.Compare):
+        op = node.ops[0]
+    if op is not None and type(op) in _SYMBOLS:
+        return f"the operator {_SYMBOLS[type(op)]!r}"
+    return _CONSTRUCTS.get(type(node), type(node).__name__)
 
 
 def dotted(node):

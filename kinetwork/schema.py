@@ -3,12 +3,14 @@ on top of the layers, as the command line does: it lists the solver's methods to
 
 Every component type of the ``REGISTRY`` becomes one branch of ``components.items`` (its
 ``type`` a constant, its parameters with their shapes, units and docs, the required ones
-required, no others allowed), so the schema never drifts from the code. Editors use it for
+required, no others allowed), written from the type's ``reference()`` as its docstring is, so
+the schema never drifts from the code. Editors use it for
 completion and first checks; ``kinetwork.load`` remains the judge (it also checks what a
 schema cannot: wiring, units of expressions, physical sense).
 """
 
 from .components.base import COLOR, REGISTRY
+from .components.reference import param_line, reference
 from .graph.io import DEFINITION_KEYS, FORMAT, KEYS, KEYS_V2, VERSION
 from .graph.settings import SIMULATION_KEYS
 from .simulation.methods import METHODS
@@ -16,7 +18,8 @@ from .simulation.methods import METHODS
 IDENT = "^[A-Za-z_][A-Za-z0-9_]*$"
 NUMBER = {"type": "number"}
 EXPRESSION = {"type": "string", "minLength": 1,
-              "description": "arithmetic in model parameters (and t where allowed)"}
+              "description": "arithmetic in model parameters (and t where allowed), or a "
+                             "number with a unit ('5 mm', '30 deg'), converted to SI"}
 SCALAR = {"anyOf": [NUMBER, EXPRESSION]}
 
 
@@ -94,13 +97,13 @@ def _subsystem(types):
 
 def _component(type_name):
     cls = REGISTRY[type_name]
-    params = {name: _param(spec) for name, spec in cls.params.items()}
-    required = [name for name, spec in cls.params.items() if spec.required]
-    doc = (cls.__doc__ or "").strip().split("\n\n")[0].replace("\n", " ")
-    ports = ", ".join(f"{p} ({port.domain})" for p, port in cls.ports.items())
+    ref = reference(cls)
+    params = {info["name"]: _param(cls.params[info["name"]], info) for info in ref["params"]}
+    required = [info["name"] for info in ref["params"] if info["required"]]
+    ports = ", ".join(f"{p['name']} ({p['domain']})" for p in ref["ports"])
     return {
         "type": "object", "title": type_name,
-        "description": f"{doc} Ports: {ports}.",
+        "description": f"{ref['summary']} Ports: {ports}.",
         "required": ["name", "type"], "additionalProperties": False,
         "properties": {
             "name": {"type": "string", "pattern": IDENT},
@@ -111,8 +114,8 @@ def _component(type_name):
     }
 
 
-def _param(spec):
-    doc = spec.describe()
+def _param(spec, info):
+    doc = f"{info['doc']} ({param_line(info)})"
     if spec.kind == "bool":
         out = {"type": "boolean"}
     elif spec.kind == "name":

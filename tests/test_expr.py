@@ -44,7 +44,15 @@ def test_a_dotted_name_is_a_path_never_an_attribute():
 @pytest.mark.parametrize("text, message", [
     ("open('f')", r"call of 'open' is not allowed"),
     ("sine(t)", r"call of 'sine' is not allowed \(did you mean 'sin'\?\)"),
-    ("L1[0].real", r"Attribute is not allowed"),
+    ("L1[0].real", r"an attribute \(\.\) is not allowed"),
+    # the refused operator is named, and the message lists what is allowed (issue 19)
+    ("L % 2", r"the operator '%' is not allowed \(only numbers, parameter names, \+ - \* / "
+              r"\*\* \^ and functions\)"),
+    ("L // 2", r"the operator '//' is not allowed"),
+    ("a < b", r"the operator '<' is not allowed"),
+    ("a and b", r"the operator 'and' is not allowed"),
+    ("a if b else c", r"a conditional \(x if c else y\) is not allowed"),
+    ("L[1]", r"indexing \(\[\.\.\.\]\) is not allowed"),
     ("(lambda: 1)()", r"calling anything but a named function"),
     ("sin(x=1)", r"sin\(\) takes no keyword arguments"),
     ("'abc'", r"only numbers are allowed as constants"),
@@ -57,6 +65,15 @@ def test_a_dotted_name_is_a_path_never_an_attribute():
 def test_refusals_say_why(text, message):
     with pytest.raises(kn.ModelError, match=message):
         Expression(text)
+
+
+@pytest.mark.parametrize("text, expected", [
+    ("L^2", 9.0), ("2*L^2/3", 6.0), ("-L^2", -9.0), ("L^0.5^2", 3.0 ** 0.25), ("(L+1)^-1", 0.25),
+])
+def test_a_caret_is_a_power_as_in_modelica(text, expected):
+    # Modelica's and Maple's habit: "^" is exponentiation (Python's bitwise xor is refused
+    # anyway); it binds as "**" does, so "-L^2" is -(L^2) as in Modelica
+    assert Expression(text).evaluate({"L": 3.0}) == pytest.approx(expected, rel=1e-15)
 
 
 @pytest.mark.parametrize("name", sorted(FUNCTIONS))

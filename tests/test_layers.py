@@ -3,10 +3,10 @@
 Every module is read with ``ast`` (nothing is imported): each import, at any depth (inside
 functions too), relative or absolute, is resolved to the kinetwork module it names. Layers,
 lowest first (the package docstring's list): the helpers ``errors``, ``util``, ``expr``,
-``spatial``; ``components``; ``graph``; ``equations``; ``simulation``; the faces ``plot``,
-``schema``, ``symbolic``, ``cli`` (and ``kinetwork/__init__.py``, which gathers them all). A
-module of a sub-package is in its package's layer. A module may import from its own layer and
-those below it; the imports must not form a cycle, within a layer either.
+``units``, ``spatial``; ``components``; ``graph``; ``equations``; ``simulation``; the faces
+``plot``, ``schema``, ``symbolic``, ``cli`` (and ``kinetwork/__init__.py``, which gathers
+them all). A module of a sub-package is in its package's layer. A module may import from its
+own layer and those below it; the imports must not form a cycle, within a layer either.
 """
 
 import ast
@@ -19,8 +19,8 @@ import pytest
 import kinetwork
 
 PACKAGE = pathlib.Path(kinetwork.__file__).resolve().parent
-LAYERS = [("errors", "util", "expr", "spatial"), ("components",), ("graph",), ("equations",),
-          ("simulation",),
+LAYERS = [("errors", "util", "expr", "units", "spatial"), ("components",), ("graph",),
+          ("equations",), ("simulation",),
           ("plot", "schema", "symbolic", "animation", "diagram", "urdf", "examples", "studio",
            "analysis", "cli", "")]
 RANK = {name: rank for rank, names in enumerate(LAYERS) for name in names}

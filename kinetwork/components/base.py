@@ -5,16 +5,31 @@ format and validation are all generated from the same declarations and never dri
 """
 
 import copy
+import functools
+import inspect
 import math
 import re
 
 import numpy as np
 
+from .. import units
 from ..errors import ModelError
 from ..expr import parse
 from ..util import check_number, quote, suggest
+from .reference import docstring, signature
 
-REQUIRED = object()
+
+class _Required:
+    """The default of a parameter that has none: the user must give a value."""
+
+    def __repr__(self):
+        return "required"
+
+
+REQUIRED = _Required()
+#: placeholder units of a joint's initial values: those of its coordinates (the class's
+#: ``units``) and of their rates; resolved per class, as ONED ports are
+COORDINATES, RATES = "<coordinates>", "<rates>"
 DOMAINS = ("frame", "rotational", "translational", "electrical", "signal_in", "signal_out")
 #: placeholder domains: ONED is the class's ``domain`` (rotational or translational); ANY
 #: connects to every domain (a probe)
@@ -82,10 +97,15 @@ class PortRef:
 class Param:
     """A parameter: default, unit, bounds and a one-line doc.
 
-    A value is a number, or a string expression in model parameters (and in time ``t`` where
-    ``time=True``); ``shape`` (3,) takes three of those, (3, 3) a matrix or its diagonal.
-    ``kind`` "bool", "name" and "names" take a flag, a component name and a list of strings,
-    "table" rows [x, y], "choice" one string of ``choices``, "color" a colour "#rrggbb".
+    A value is a number, a quantity with a unit (``"5 mm"``, converted to ``unit``: see
+    :mod:`kinetwork.units`), or a string expression in model parameters (and in time ``t``
+    where ``time=True``); ``shape`` (3,) takes three of those, (3, 3) a matrix or its
+    diagonal. ``kind`` "bool", "name" and "names" take a flag, a component name and a list of
+    strings, "table" rows [x, y], "choice" one string of ``choices``, "color" a colour
+    "#rrggbb".
+
+    ``unit`` is the SI unit of the value ("1": dimensionless; "": any, as a signal block's
+    gain, in the unit of its signal), or one unit per entry of a vector (a tuple).
     """
 
     def __init__(self, default=REQUIRED, *, unit="", min=None, max=None, shape=(), doc="",
@@ -97,6 +117,7 @@ class Param:
         self.positive = positive
         # ``name`` lets a parameter share its file name with a port (a joint's "axis")
         self.name = name
+        self.__doc__ = self.describe()        # what help() shows under the attribute
 
     def __set_name__(self, owner, name):
         self.name = self.name or name
@@ -113,9 +134,56 @@ class Param:
     def required(self):
         return self.default is REQUIRED
 
+    def unit_at(self, index=None):
+        """The unit of entry ``index`` of a vector (a tuple ``unit`` has one per entry), or of
+        the whole value."""
+        if isinstance(self.unit, tuple):
+            return self.unit[index] if index is not None else ", ".join(self.unit)
+        return self.unit
+
     def describe(self):
-        unit = f" [{self.unit}]" if self.unit else ""
-        return f"{self.doc}{unit}"
+        unit = self.unit_at()
+        return f"{self.doc} [{unit}]" if unit else self.doc
+
+    def info(self):
+        """The declaration as data (JSON-ready): what the docs, the schema and the studio's
+        palette show."""
+        return {"name": self.name, "kind": self.kind,
+                "unit": list(self.unit) if isinstance(self.unit, tuple) else self.unit,
+                "shape": list(self.shape), "required": self.required,
+                "default": None if self.required else _plain(self.default),
+                "min": self.min, "max": self.max, "positive": self.positive,
+                "nonzero": self.nonzero, "optional": self.optional, "time": self.time,
+                "choices": list(self.choices) if self.choices else None, "doc": self.doc}
+
+    def resolved(self, owner):
+        """This declaration for class ``owner``: COORDINATES and RATES units read from its
+        joint coordinates' ``units`` (self if there is nothing to resolve)."""
+        if self.unit not in (COORDINATES, RATES) or not getattr(owner, "units", None):
+            return self
+        coords = tuple(owner.units)[:owner.dof]
+        if self.unit == RATES:
+            coords = tuple(f"{u}/s" if u else "1/s" for u in coords)
+        twin = copy.copy(self)
+        twin.unit = coords[0] if self.shape == () else coords
+        twin.__doc__ = twin.describe()
+        return twin
+
+    def si(self, value):
+        """A normalized value with its quantities (``"5 mm"``) replaced by SI numbers: what
+        the equations see. Expressions stay as they are."""
+        if self.kind != "real" or value is None:
+            return value
+        if self.shape == ():
+            return self._number(value)
+        if len(self.shape) == 1:
+            return [self._number(v, i) for i, v in enumerate(value)]
+        return [[self._number(v) for v in row] for row in value]
+
+    def _number(self, value, index=None):
+        if isinstance(value, str) and _is_quantity(value):
+            return units.to_si(value, self.unit_at(index))
+        return value
 
     def normalize(self, value, where):
         """Check the structure of ``value``; return it in canonical nested-list form.
@@ -170,13 +238,13 @@ class Param:
             raise ModelError(f"{where}: must have {self.shape[0]} entries, got {len(value)}")
         problems = []
 
-        def scalar(v, at):          # every bad entry is reported, not only the first
+        def scalar(v, at, index=None):      # every bad entry is reported, not only the first
             try:
-                return self._scalar(v, at, bounds=False)
+                return self._scalar(v, at, bounds=False, index=index)
             except ModelError as exc:
                 problems.extend(exc.problems)
         if len(self.shape) == 1:
-            out = [scalar(v, f"{where}[{i}]") for i, v in enumerate(value)]
+            out = [scalar(v, f"{where}[{i}]", i) for i, v in enumerate(value)]
         else:
             out = []
             for i, row in enumerate(value):
@@ -189,16 +257,27 @@ class Param:
             raise ModelError(f"{where}: must not be the zero vector")
         return out
 
-    def _scalar(self, value, where, bounds=True):
+    def _scalar(self, value, where, bounds=True, index=None):
         if isinstance(value, np.generic):
             value = value.item()
         if isinstance(value, str):
             if not value.strip():
                 raise ModelError(f"{where}: empty expression")
+            if _is_quantity(value):
+                unit = self.unit_at(index)
+                try:
+                    number = units.to_si(value, unit)
+                except ModelError as exc:
+                    raise ModelError(f"{where} = {quote(value)}: {exc}") from None
+                if bounds:
+                    self.check_bounds(number, f"{where} = {quote(value)}, i.e.", equals=" ")
+                elif not math.isfinite(number):
+                    raise ModelError(f"{where} = {quote(value)}: must be finite")
+                return value
             try:
                 expr = parse(value)
             except ModelError as exc:
-                raise ModelError(f"{where}: {exc}") from None
+                raise ModelError(f"{where}: {exc}{units.hint(value)}") from None
             dotted = sorted(n for n in expr.names if "." in n)
             if dotted:
                 raise ModelError(f"{where}: {quote(dotted[0])} is not a parameter here: "
@@ -213,19 +292,39 @@ class Param:
             self.check_bounds(value, where)
         return value
 
-    def check_bounds(self, number, where):
+    def check_bounds(self, number, where, equals=" = "):
         """Bounds check of one evaluated scalar, worded for the person at the diagram."""
-        unit = f" {self.unit}" if self.unit else ""
+        unit = self.unit_at()
+        unit = f" {unit}" if unit and unit != "1" else ""
+        at = f"{where}{equals}{number}{unit}"
         if not math.isfinite(number):
-            raise ModelError(f"{where} = {number}{unit}: must be finite")
+            raise ModelError(f"{at}: must be finite")
         if self.positive and number <= 0:
-            raise ModelError(f"{where} = {number}{unit}: must be > 0")
+            raise ModelError(f"{at}: must be > 0")
         if self.nonzero and not self.shape and number == 0:
-            raise ModelError(f"{where} = {number}{unit}: must not be 0")
+            raise ModelError(f"{at}: must not be 0")
         if self.min is not None and number < self.min:
-            raise ModelError(f"{where} = {number}{unit}: must be >= {self.min}")
+            raise ModelError(f"{at}: must be >= {self.min}")
         if self.max is not None and number > self.max:
-            raise ModelError(f"{where} = {number}{unit}: must be <= {self.max}")
+            raise ModelError(f"{at}: must be <= {self.max}")
+
+
+@functools.lru_cache(maxsize=4096)
+def _is_quantity(text):
+    """Whether ``text`` is a quantity ("5 mm") rather than an expression ("L/2"): it does not
+    parse as an expression and reads as one number and a unit."""
+    try:
+        parse(text)
+    except ModelError:
+        return units.split(text) is not None
+    return False
+
+
+def _plain(value):
+    """A default as JSON data (nested lists; REQUIRED has none)."""
+    if isinstance(value, (tuple, list)):
+        return [_plain(v) for v in value]
+    return value
 
 
 def _table(value, where):
@@ -267,6 +366,8 @@ class Component:
     params = {}
     #: what the component is to the solver: world, joint, body, compliant, source, fixed, probe
     role = None
+    #: the class's docstring as written (``__doc__`` is generated from the declarations)
+    _own_doc = ""
     #: 1-D ports whose position is a joint coordinate (port -> coordinate index) or zero
     coordinate_ports = {}
     zero_ports = ()
@@ -283,12 +384,16 @@ class Component:
                         val.domain = cls.domain
                     cls.ports[key] = val
                 elif isinstance(val, Param):
-                    cls.params[val.name] = val
+                    cls.params[val.name] = val.resolved(cls)
         # a subclass declared without ``library=`` is not a file type (not its parent's either)
         cls.type_name = None
+        cls._own_doc = inspect.cleandoc(vars(cls).get("__doc__") or "") or cls._own_doc
         if library is not None and not cls.__name__.startswith("Partial"):
             cls.type_name = f"{library}.{cls.__name__}" if library else cls.__name__
             REGISTRY[cls.type_name] = cls
+            # help(), IDEs and the docs read what the declarations say
+            cls.__signature__ = signature(cls)
+            cls.__doc__ = docstring(cls)
 
     def __init__(self, name, **params):
         self._declare(name, params, None)
@@ -321,11 +426,11 @@ class Component:
             try:
                 if key in params:
                     self.given[key] = spec.normalize(params[key], place(key))
-                    self._values[key] = self.given[key]
+                    self._values[key] = spec.si(self.given[key])
                 elif spec.required:
                     problems.append(f"{place(key)}: a value is required ({spec.describe()})")
                 else:
-                    self._values[key] = spec.normalize(spec.default, place(key))
+                    self._values[key] = spec.si(spec.normalize(spec.default, place(key)))
             except ModelError as exc:
                 problems.extend(exc.problems)
         if problems:
@@ -353,7 +458,7 @@ class Component:
                              f"{', '.join(self.params) or 'none'}")
         value = self.params[key].normalize(value, f"{self.name}.{key}")
         self.given[key] = value
-        self._values[key] = value
+        self._values[key] = self.params[key].si(value)
 
     def __setattr__(self, key, value):
         declared = getattr(type(self), key, None)

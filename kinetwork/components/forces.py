@@ -61,7 +61,7 @@ def _point_mass():
     parameters (so forms and files list c, d first)."""
     return (Param(0.0, unit="kg", min=0.0,
                   doc="Point mass on the line (0: none), as MSL's Spring m"),
-            Param(0.5, min=0.0, max=1.0,
+            Param(0.5, unit="1", min=0.0, max=1.0,
                   doc="Where the point mass sits: its distance from frame_a as a fraction of "
                       "the distance from frame_a to frame_b"))
 

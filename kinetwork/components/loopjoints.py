@@ -71,7 +71,7 @@ class UniversalSpherical(PartialRod, library=MB):
     zero). It is there for probes: nothing with mass or a force may rest on it. The joint is
     singular where the rod lies along ``n_a``.
     """
-    n_a = Param([0.0, 0.0, 1.0], shape=(3,), nonzero=True,
+    n_a = Param([0.0, 0.0, 1.0], unit="1", shape=(3,), nonzero=True,
                 doc="Axis 1 of the universal joint, in frame_a (axis 2 is normal to it and to "
                     "the rod)")
     r_rod = Param([1.0, 0.0, 0.0], unit="m", shape=(3,), nonzero=True,
@@ -146,7 +146,7 @@ class JointRRR(Component, library=MB):
                     optional=True)
     axis = Port("rotational", "Flange driving the third revolute", optional=True)
     support = Port("rotational", "Reaction flange of that drive", optional=True)
-    n_a = Param([0.0, 0.0, 1.0], shape=(3,), nonzero=True,
+    n_a = Param([0.0, 0.0, 1.0], unit="1", shape=(3,), nonzero=True,
                 doc="Axis of the three revolutes, in frame_a")
     r_rod1 = Param([1.0, 0.0, 0.0], unit="m", shape=(3,),
                    doc="Middle revolute from frame_a's origin, resolved in frame_ia (rod 1)")

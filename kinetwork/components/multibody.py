@@ -15,7 +15,7 @@ import numpy as np
 
 from ..errors import ModelError
 from ..spatial import cardan_quat, mat3, quat_rate, quat_rotation, rotation, unit, vec3
-from .base import Component, Param, Port
+from .base import COORDINATES, RATES, Component, Param, Port
 
 MB = "multibody"
 
@@ -100,7 +100,7 @@ class FixedTranslation(PartialRigidTransform, library=MB):
 class FixedRotation(PartialRigidTransform, library=MB):
     """frame_b = frame_a moved by ``r``, then rotated by ``angle`` about ``axis``."""
     r = Param([0.0, 0.0, 0.0], unit="m", shape=(3,), doc="Position of frame_b in frame_a")
-    direction = Param([0.0, 0.0, 1.0], shape=(3,), nonzero=True, name="axis",
+    direction = Param([0.0, 0.0, 1.0], unit="1", shape=(3,), nonzero=True, name="axis",
                       doc="Rotation axis, resolved in frame_a")
     angle = Param(unit="rad", doc="Rotation angle about axis")
 
@@ -173,11 +173,13 @@ class PartialAxisJoint(PartialJoint):
     zero_ports = ("support",)
     axis = Port("1d", "Flange driving the joint coordinate", optional=True)
     support = Port("1d", "Reaction flange of the drive", optional=True)
-    direction = Param([0.0, 0.0, 1.0], shape=(3,), nonzero=True, name="axis",
+    direction = Param([0.0, 0.0, 1.0], unit="1", shape=(3,), nonzero=True, name="axis",
                       doc="Joint axis, resolved in frame_a")
-    q0 = Param(None, optional=True, doc="Initial coordinate (None: 0, or solved in a loop)")
-    qd0 = Param(None, optional=True, doc="Initial coordinate speed (None: 0)")
-    q0_guess = Param(0.0, doc="Start of the search for q0 when it is solved in a loop")
+    q0 = Param(None, optional=True, unit=COORDINATES,
+               doc="Initial coordinate (None: 0, or solved in a loop)")
+    qd0 = Param(None, optional=True, unit=RATES, doc="Initial coordinate speed (None: 0)")
+    q0_guess = Param(0.0, unit=COORDINATES,
+                     doc="Start of the search for q0 when it is solved in a loop")
 
 
 class Revolute(PartialAxisJoint, library=MB):
@@ -193,18 +195,18 @@ class Prismatic(PartialAxisJoint, library=MB):
     """frame_b is frame_a moved by q along ``axis`` (resolved in frame_a)."""
     domain = "translational"
     units = ("m",)
-    direction = Param([1.0, 0.0, 0.0], shape=(3,), nonzero=True, name="axis",
+    direction = Param([1.0, 0.0, 0.0], unit="1", shape=(3,), nonzero=True, name="axis",
                       doc="Direction of motion, resolved in frame_a")
 
     def transform(self, q):
         return ca.SX.eye(3), unit(vec3(self.direction)) * q[0]
 
 
-def _pair(doc):
-    return Param(None, optional=True, shape=(2,), doc=doc)
+def _pair(doc, unit_=COORDINATES):
+    return Param(None, optional=True, shape=(2,), unit=unit_, doc=doc)
 
 
-def _triple(doc, default=None, unit_=""):
+def _triple(doc, default=None, unit_=COORDINATES):
     return Param(default, optional=default is None, shape=(3,), unit=unit_, doc=doc)
 
 
@@ -219,12 +221,14 @@ class Universal(PartialJoint, library=MB):
     axis_a = Port("rotational", "Flange driving q[0] (about n_a)", optional=True)
     axis_b = Port("rotational", "Flange driving q[1] (about n_b)", optional=True)
     support = Port("rotational", "Reaction flange of both drives", optional=True)
-    n_a = Param([1.0, 0.0, 0.0], shape=(3,), nonzero=True, doc="First axis, in frame_a")
-    n_b = Param([0.0, 1.0, 0.0], shape=(3,), nonzero=True,
+    n_a = Param([1.0, 0.0, 0.0], unit="1", shape=(3,), nonzero=True,
+                doc="First axis, in frame_a")
+    n_b = Param([0.0, 1.0, 0.0], unit="1", shape=(3,), nonzero=True,
                 doc="Second axis, in the frame rotated about n_a")
-    q0 = _pair("Initial angles (None: 0, or solved in a loop) [rad]")
-    qd0 = _pair("Initial angular speeds (None: 0) [rad/s]")
-    q0_guess = Param([0.0, 0.0], shape=(2,), doc="Start of the search for q0 in a loop")
+    q0 = _pair("Initial angles (None: 0, or solved in a loop)")
+    qd0 = _pair("Initial angular speeds (None: 0)", RATES)
+    q0_guess = Param([0.0, 0.0], shape=(2,), unit=COORDINATES,
+                     doc="Start of the search for q0 in a loop")
 
     def transform(self, q):
         return rotation(vec3(self.n_a), q[0]) @ rotation(vec3(self.n_b), q[1]), ca.SX.zeros(3)
@@ -240,11 +244,12 @@ class Cylindrical(PartialJoint, library=MB):
     support_phi = Port("rotational", "Reaction flange of the rotation", optional=True)
     axis_s = Port("translational", "Flange driving the distance q[1]", optional=True)
     support_s = Port("translational", "Reaction flange of the translation", optional=True)
-    direction = Param([0.0, 0.0, 1.0], shape=(3,), nonzero=True, name="axis",
+    direction = Param([0.0, 0.0, 1.0], unit="1", shape=(3,), nonzero=True, name="axis",
                       doc="Axis of rotation and translation, resolved in frame_a")
     q0 = _pair("Initial angle and distance (None: 0, or solved in a loop)")
-    qd0 = _pair("Initial angular and linear speed (None: 0)")
-    q0_guess = Param([0.0, 0.0], shape=(2,), doc="Start of the search for q0 in a loop")
+    qd0 = _pair("Initial angular and linear speed (None: 0)", RATES)
+    q0_guess = Param([0.0, 0.0], shape=(2,), unit=COORDINATES,
+                     doc="Start of the search for q0 in a loop")
 
     def transform(self, q):
         n = vec3(self.direction)
@@ -264,12 +269,14 @@ class Planar(PartialJoint, library=MB):
     axis_phi = Port("rotational", "Flange driving the angle q[2]", optional=True)
     support_s = Port("translational", "Reaction flange of the translations", optional=True)
     support_phi = Port("rotational", "Reaction flange of the rotation", optional=True)
-    n = Param([0.0, 0.0, 1.0], shape=(3,), nonzero=True, doc="Plane normal, in frame_a")
-    n_x = Param([1.0, 0.0, 0.0], shape=(3,), nonzero=True,
+    n = Param([0.0, 0.0, 1.0], unit="1", shape=(3,), nonzero=True,
+              doc="Plane normal, in frame_a")
+    n_x = Param([1.0, 0.0, 0.0], unit="1", shape=(3,), nonzero=True,
                 doc="Direction of q[0] in the plane, in frame_a")
     q0 = _triple("Initial x, y, angle (None: 0, or solved in a loop)")
-    qd0 = _triple("Initial speeds (None: 0)")
-    q0_guess = Param([0.0, 0.0, 0.0], shape=(3,), doc="Start of the search for q0 in a loop")
+    qd0 = _triple("Initial speeds (None: 0)", unit_=RATES)
+    q0_guess = Param([0.0, 0.0, 0.0], shape=(3,), unit=COORDINATES,
+                     doc="Start of the search for q0 in a loop")
 
     def transform(self, q):
         n = unit(vec3(self.n))
@@ -569,7 +576,7 @@ class PartialBodyShape(_CheckedTogether, PartialRigidTransform):
     r = Param(unit="m", shape=(3,), doc="Position of frame_b in frame_a")
     r_shape = Param([0.0, 0.0, 0.0], unit="m", shape=(3,),
                     doc="Start of the shape from frame_a, resolved in frame_a")
-    length_direction = Param(None, optional=True, shape=(3,), nonzero=True,
+    length_direction = Param(None, optional=True, unit="1", shape=(3,), nonzero=True,
                              doc="Direction of the length, in frame_a (None: r - r_shape)")
     length = Param(None, optional=True, unit="m", min=0.0,
                    doc="Length (None: |r - r_shape|)")
@@ -642,7 +649,7 @@ class BodyBox(PartialBodyShape, library=MB):
         Colour in the animation (None: its default).
     """
     holes = (("inner_width", "width"), ("inner_height", "height"))
-    width_direction = Param([0.0, 1.0, 0.0], shape=(3,), nonzero=True,
+    width_direction = Param([0.0, 1.0, 0.0], unit="1", shape=(3,), nonzero=True,
                             doc="Direction of the width, in frame_a (made orthogonal to the "
                                 "length)")
     width = Param(None, optional=True, unit="m", min=0.0,

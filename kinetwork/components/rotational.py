@@ -121,7 +121,8 @@ class IdealGear(PartialRigid, library=LIB):
     world (or on the support, when wired)."""
     domain = LIB
     support = Port("1d", "Reaction flange (unwired: the world)", optional=True)
-    gear_ratio = Param(unit="", name="ratio", nonzero=True, doc="flange_a angle / flange_b angle")
+    gear_ratio = Param(unit="1", name="ratio", nonzero=True,
+                       doc="flange_a angle / flange_b angle")
 
     def ratio(self):
         return self.gear_ratio

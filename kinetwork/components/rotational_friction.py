@@ -10,7 +10,7 @@ class BearingFriction(PartialBearingFriction, library="rotational"):
     peak * tau_c, else sliding against tau_c + d * w."""
     domain = "rotational"
     f_kinetic = Param(unit="N*m", min=0.0, name="tau_c", doc="Coulomb friction torque")
-    peak = Param(1.0, unit="", min=1.0, doc="Static over Coulomb friction torque")
+    peak = Param(1.0, unit="1", min=1.0, doc="Static over Coulomb friction torque")
     d = Param(0.0, unit="N*m*s/rad", min=0.0, doc="Viscous friction coefficient")
 
 
@@ -21,11 +21,11 @@ class Brake(PartialNormalForceFriction, library="rotational"):
     side_a, side_b = "support", "flange"
     flange = Port(ONED, "Braked flange")
     support = Port(ONED, "Housing (unwired: the world)", optional=True)
-    mu = Param(unit="", min=0.0, doc="Coefficient of kinetic friction")
-    peak = Param(1.0, unit="", min=1.0, doc="Static over kinetic friction coefficient")
+    mu = Param(unit="1", min=0.0, doc="Coefficient of kinetic friction")
+    peak = Param(1.0, unit="1", min=1.0, doc="Static over kinetic friction coefficient")
     cgeo = Param(1.0, unit="m", min=0.0, doc="Geometry constant: torque = cgeo * mu * force")
     fn_max = Param(unit="N", min=0.0, doc="Largest normal force")
-    f_normalized = Param(1.0, unit="", time=True,
+    f_normalized = Param(1.0, unit="1", time=True,
                          doc="Normal force / fn_max (when u is not wired)")
     d = Param(0.0, unit="N*m*s/rad", min=0.0, doc="Viscous friction coefficient")
 
@@ -36,11 +36,11 @@ class Clutch(PartialNormalForceFriction, library="rotational"):
     domain = "rotational"
     flange_a = Port(ONED, "Flange a")
     flange_b = Port(ONED, "Flange b")
-    mu = Param(unit="", min=0.0, doc="Coefficient of kinetic friction")
-    peak = Param(1.0, unit="", min=1.0, doc="Static over kinetic friction coefficient")
+    mu = Param(unit="1", min=0.0, doc="Coefficient of kinetic friction")
+    peak = Param(1.0, unit="1", min=1.0, doc="Static over kinetic friction coefficient")
     cgeo = Param(1.0, unit="m", min=0.0, doc="Geometry constant: torque = cgeo * mu * force")
     fn_max = Param(unit="N", min=0.0, doc="Largest normal force")
-    f_normalized = Param(1.0, unit="", time=True,
+    f_normalized = Param(1.0, unit="1", time=True,
                          doc="Normal force / fn_max (when u is not wired)")
     d = Param(0.0, unit="N*m*s/rad", min=0.0, doc="Viscous friction coefficient")
 
@@ -61,7 +61,7 @@ class Stop(PartialStop, library="rotational"):
                     doc="Lower limit of flange_b relative to flange_a (None: none)")
     rel_max = Param(None, optional=True, unit="rad", name="phi_max",
                     doc="Upper limit of flange_b relative to flange_a (None: none)")
-    e = Param(0.8, unit="", min=0.0, max=1.0, doc="Coefficient of restitution")
+    e = Param(0.8, unit="1", min=0.0, max=1.0, doc="Coefficient of restitution")
     v_rest = Param(1e-4, unit="rad/s", min=0.0,
                    doc="Impact speed below which the flange comes to rest on the limit")
 

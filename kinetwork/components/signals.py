@@ -229,8 +229,9 @@ class PID(PartialBlock, library=LIB):
     k = Param(1.0, nonzero=True, doc="Gain")
     Ti = Param(None, optional=True, unit="s", positive=True, doc="Integral time (None: no I)")
     Td = Param(0.0, unit="s", min=0.0, doc="Derivative time (0: no D)")
-    Nd = Param(10.0, positive=True, doc="Derivative filter: gain at high frequency")
-    Ni = Param(0.9, positive=True, doc="Anti-windup: Ni Ti is the back-calculation time")
+    Nd = Param(10.0, unit="1", positive=True, doc="Derivative filter: gain at high frequency")
+    Ni = Param(0.9, unit="1", positive=True,
+               doc="Anti-windup: Ni Ti is the back-calculation time")
     y_max = Param(None, optional=True, doc="Upper output limit (None: none)")
     y_min = Param(None, optional=True, doc="Lower output limit (None: -y_max)")
     xi_start = Param(0.0, doc="Initial integral state")

@@ -10,7 +10,7 @@ class Friction(PartialBearingFriction, library="translational"):
     sliding against f_c + d * v."""
     domain = "translational"
     f_kinetic = Param(unit="N", min=0.0, name="f_c", doc="Coulomb friction force")
-    peak = Param(1.0, unit="", min=1.0, doc="Static over Coulomb friction force")
+    peak = Param(1.0, unit="1", min=1.0, doc="Static over Coulomb friction force")
     d = Param(0.0, unit="N*s/m", min=0.0, doc="Viscous friction coefficient")
 
 
@@ -30,7 +30,7 @@ class Stop(PartialStop, library="translational"):
                     doc="Lower limit of flange_b relative to flange_a (None: none)")
     rel_max = Param(None, optional=True, unit="m", name="s_max",
                     doc="Upper limit of flange_b relative to flange_a (None: none)")
-    e = Param(0.8, unit="", min=0.0, max=1.0, doc="Coefficient of restitution")
+    e = Param(0.8, unit="1", min=0.0, max=1.0, doc="Coefficient of restitution")
     v_rest = Param(1e-4, unit="m/s", min=0.0,
                    doc="Impact speed below which the flange comes to rest on the limit")
 

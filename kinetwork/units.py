@@ -1,0 +1,111 @@
+"""Units where users write numbers: ``"2 kg"``, ``"30 deg"``, ``"5 mm"``, ``"1 N*m/rad"``.
+
+The rule: a parameter value is a number (SI), an expression in model parameters (SI), or a
+*quantity*, one number followed by a unit (``"5 mm"``, ``"-30 deg"``, ``"1e-3 kg*m^2"``). A
+quantity is converted to the SI unit the parameter declares, exactly (pint with rational
+arithmetic: ``"5 mm"`` is 0.005, ``"30 deg"`` the double nearest to pi/6), and refused with
+both units named when its dimension differs (``"2 m"`` for a mass). Units do not mix with
+expressions (``"L/2 + 5 mm"`` is refused): model parameters are plain SI numbers, so an
+expression has no units to check.
+
+Angles are dimensionless, as in SI and Modelica (``"1 N*m"`` is a valid ``N*m/rad``). A
+parameter whose unit is ``""`` (a signal block's gain or offset, in the unit of its signal)
+takes any quantity, converted to SI base units unchecked; ``"1"`` means dimensionless.
+
+pint is imported the first time a quantity is met, so models written in plain numbers never
+pay for it.
+"""
+
+import functools
+import re
+from fractions import Fraction
+
+from .errors import ModelError
+
+#: one number, then a unit starting with a letter (or degree sign, percent, micro sign)
+_QUANTITY = re.compile(r"\s*[+-]?(?:\d+(?:\.\d*)?|\.\d+)(?:[eE][+-]?\d+)?\s*"
+                       r"(?P<unit>(?:[^\W\d]|[°%µ]).*?)\s*", re.S)
+#: a number directly followed by a name, somewhere in a text: a unit inside an expression
+_UNIT_INSIDE = re.compile(r"(?<![\w.])\d+(?:\.\d*)?(?:[eE][+-]?\d+)?\s*[^\W\d]", re.S)
+
+
+def split(text):
+    """The unit text of a quantity ``"5 mm"`` (``"mm"``), or None if ``text`` is not one."""
+    match = _QUANTITY.fullmatch(text)
+    return match["unit"] if match else None
+
+
+def hint(text):
+    """Advice for an expression that failed to parse and seems to hold a unit, or ""."""
+    if _UNIT_INSIDE.search(text):
+        return ("; a unit goes after one number, as in '5 mm' or '30 deg' (expressions are "
+                "in SI units)")
+    return ""
+
+
+@functools.lru_cache(maxsize=1)
+def registry():
+    """pint's unit registry, with exact (rational) arithmetic."""
+    import pint
+    ureg = pint.UnitRegistry(non_int_type=Fraction)
+    ureg.define("Ohm = ohm")          # Modelica's spelling
+    return ureg
+
+
+def _dimension(quantity):
+    """The dimension of ``quantity`` as "[mass]*[length]^2/[time]^2" (pint's own formatter
+    fails on the rational exponents of an exact registry)."""
+    def power(name, exp):
+        exp = abs(exp)
+        exp = int(exp) if exp == int(exp) else exp
+        return name if exp == 1 else f"{name}^{exp}"
+    dims = sorted(quantity.dimensionality.items())
+    up = "*".join(power(k, e) for k, e in dims if e > 0)
+    down = "*".join(power(k, e) for k, e in dims if e < 0)
+    if not up and not down:
+        return "dimensionless"
+    return (up or "1") + (f"/{down}" if down else "")
+
+
+@functools.lru_cache(maxsize=4096)
+def to_si(text, unit):
+    """The number of quantity ``text`` in ``unit`` (a declared SI unit; "" converts to SI
+    base units, "1" to a pure number). Raises ModelError (without a place: the caller adds
+    it) for an unknown unit or a wrong dimension, naming both units."""
+    import pint
+    ureg = registry()
+    written = split(text)
+    try:
+        quantity = ureg.Quantity(text.strip())
+    except pint.UndefinedUnitError as exc:
+        name = exc.unit_names[0] if exc.unit_names else written
+        raise ModelError(f"unknown unit {name!r} in {text!r}") from None
+    except pint.OffsetUnitCalculusError:
+        raise ModelError(f"{written!r} is a unit with an offset (a temperature scale); "
+                         f"give the value in {unit or 'SI units'}") from None
+    except Exception as exc:      # pint's parser raises several kinds on malformed units
+        why = str(exc) or type(exc).__name__
+        raise ModelError(f"cannot read the unit {written!r} in {text!r} ({why})") from None
+    if not isinstance(quantity, ureg.Quantity):   # "2 pi" parses to a bare number
+        quantity = ureg.Quantity(quantity)
+    try:
+        if unit == "":
+            value = quantity.to_base_units().magnitude
+        else:
+            value = quantity.to("dimensionless" if unit == "1" else unit).magnitude
+    except pint.DimensionalityError:
+        target = ureg.Quantity(1, "dimensionless" if unit == "1" else unit)
+        raise ModelError(f"{written} ({_dimension(quantity)}) does not convert to {unit} "
+                         f"({_dimension(target)})") from None
+    return float(value)
+
+
+def check_unit(unit):
+    """Whether pint reads the declared unit ``unit`` ("" and "1" included)."""
+    if unit in ("", "1"):
+        return True
+    try:
+        registry().Quantity(1, unit)
+    except Exception:
+        return False
+    return True

@@ -1,0 +1,111 @@
+"""Self-documenting components (issue 19, item 1): every component type's signature,
+docstring and reference data are generated from its Param and Port declarations, and say the
+same as the declarations (and as the compiled equations, for the units of joint coordinates).
+"""
+
+import inspect
+import json
+import pydoc
+
+import pytest
+
+import kinetwork as kn
+from kinetwork import units
+from kinetwork.components.base import REGISTRY
+from kinetwork.components.quantities import QUANTITIES
+from kinetwork.components.reference import param_line, reference
+
+TYPES = sorted(REGISTRY)
+
+
+def test_help_shows_the_real_signature_with_units_defaults_and_ports():
+    text = pydoc.render_doc(kn.multibody.RigidBody, renderer=pydoc.plaintext)
+    assert ("RigidBody(name: str, *, mass: float | str, r_cm: list[float | str] = "
+            "(0.0, 0.0, 0.0), inertia: list[list[float | str]] = ") in text
+    assert "mass : kg, >= 0, required" in text
+    assert "r_cm : m, 3 values, default [0, 0, 0]" in text
+    assert "inertia : kg*m^2, 3x3 or its diagonal" in text
+    assert "frame_a (frame)\n |      Frame the body is fixed to" in text
+    assert "angular_velocity [rad/s]" in text, "what a probe at frame_a records"
+    assert text.count("Parameters\n |  ----------") == 1, "the written list is replaced"
+    ground = pydoc.render_doc(kn.multibody.Ground, renderer=pydoc.plaintext)
+    assert "gravity : m/s^2, 3 values, default [0, -9.81, 0]" in ground
+
+
+@pytest.mark.parametrize("type_name", TYPES)
+def test_the_signature_is_the_declarations(type_name):
+    cls = REGISTRY[type_name]
+    sig = inspect.signature(cls)
+    assert list(sig.parameters) == ["name", *cls.params]
+    for key, spec in cls.params.items():
+        p = sig.parameters[key]
+        assert p.kind is inspect.Parameter.KEYWORD_ONLY
+        if spec.required:
+            assert p.default is inspect.Parameter.empty
+        else:
+            assert json.dumps(p.default) == json.dumps(spec.default), key
+    # it is what the constructor takes: refused keywords are refused by both
+    with pytest.raises(TypeError):
+        sig.bind("x", no_such_parameter=1)
+
+
+@pytest.mark.parametrize("type_name", TYPES)
+def test_every_parameter_has_a_doc_and_a_unit_pint_reads(type_name):
+    cls = REGISTRY[type_name]
+    for key, spec in cls.params.items():
+        assert spec.doc.strip(), f"{type_name}.{key} has no doc"
+        if spec.kind != "real":
+            continue
+        # "" is the unit of a signal block's signal (any, converted to SI); nothing else may
+        # leave its unit out ("1" is dimensionless)
+        assert spec.unit or type_name.startswith("signals."), f"{type_name}.{key}: no unit"
+        for unit in (spec.unit if isinstance(spec.unit, tuple) else (spec.unit,)):
+            assert units.check_unit(unit), f"{type_name}.{key}: pint cannot read {unit!r}"
+
+
+@pytest.mark.parametrize("type_name", TYPES)
+def test_the_docstring_and_the_data_say_the_same(type_name):
+    cls = REGISTRY[type_name]
+    ref = reference(cls)
+    json.dumps(ref)                                   # data, ready for the studio and docs
+    doc = inspect.getdoc(cls)
+    assert doc.startswith(ref["summary"])
+    for info in ref["params"]:
+        assert f"{info['name']} : {param_line(info)}\n    {info['doc']}" in doc
+    for port in ref["ports"]:
+        assert port["name"] in doc and port["doc"] in doc
+        assert port["quantities"] == [
+            {"name": n, "unit": q.unit, "shape": list(q.shape)}
+            for n, q in QUANTITIES.get(port["domain"], {}).items()]
+    schema = next(b for b in kn.schema()["properties"]["components"]["items"]["oneOf"]
+                  if b.get("title") == type_name) if type_name == TYPES[0] else None
+    if schema is not None:
+        for info in ref["params"]:
+            assert schema["properties"]["params"]["properties"][info["name"]][
+                "description"] == f"{info['doc']} ({param_line(info)})"
+
+
+def _joint_model(joint):
+    model = kn.Model("m")
+    model.add(kn.multibody.Ground("ground"))
+    model.add(joint)
+    model.add(kn.multibody.RigidBody("body", mass=1.0, inertia=[1.0, 1.0, 1.0]))
+    model.connect("ground.frame", f"{joint.name}.frame_a")
+    model.connect(f"{joint.name}.frame_b", "body.frame_a")
+    return model
+
+
+@pytest.mark.parametrize("cls", [kn.multibody.Revolute, kn.multibody.Prismatic,
+                                 kn.multibody.Universal, kn.multibody.Cylindrical,
+                                 kn.multibody.Planar], ids=lambda c: c.__name__)
+def test_initial_values_carry_the_units_of_the_states_they_start(cls):
+    # the units declared for q0 and qd0 are those the compiled System gives its states
+    system = _joint_model(cls("j")).compile()
+    units_of = dict(zip(system.state_names, system.state_units))
+    q0, qd0 = cls.params["q0"].unit, cls.params["qd0"].unit
+    q0, qd0 = (q0,) if isinstance(q0, str) else q0, (qd0,) if isinstance(qd0, str) else qd0
+    n = len(q0)
+    coords = [name for name in system.state_names if "qd" not in name][:n]
+    speeds = [name for name in system.state_names if "qd" in name][:n]
+    assert [units_of[c] for c in coords] == list(q0)
+    assert [units_of[s] for s in speeds] == list(qd0)
