@@ -219,12 +219,14 @@ class Job:
         self.columns = [system.param_names.index(n) for n in self.names]
         self.grid = np.linspace(self.t_start, settings["t_end"], int(settings["n_points"]))
         self._checks = _dependent_parameters(system.model, self.names)
+        self._x0 = _constant_start(system, self.columns, self.p)
 
     def __getstate__(self):
         from ..graph.io import dumps
         state = dict(self.__dict__)
         state["system"] = (dumps(self.system.model), _formulation(self.system))
         state.pop("_checks")
+        state.pop("_x0")
         return state
 
     def __setstate__(self, state):
@@ -232,6 +234,7 @@ class Job:
         self.__dict__.update(state)
         self.system = _remote_system(text, loops)
         self._checks = _dependent_parameters(self.system.model, self.names)
+        self._x0 = _constant_start(self.system, self.columns, self.p)
 
     # -- one member's numbers ------------------------------------------------------------------
     def prepare(self, values):
@@ -252,7 +255,7 @@ class Job:
             raise ModelError(problems)
         p = self.p.copy()
         p[self.columns] = values
-        x0 = np.concatenate(system.initial_full_p(p))
+        x0 = self._x0 if self._x0 is not None else np.concatenate(system.initial_full_p(p))
         return p, x0
 
 
@@ -269,6 +272,22 @@ def _dependent_parameters(model, names):
             if any(names & parse(s).names for s in _strings(value)):
                 out.append((value, spec, flat.place(comp, key)))
     return out
+
+
+def _constant_start(system, columns, p):
+    """The initial state when it is the same for every member: a tree (no loop to close, no
+    prescribed motion, no algebraic loop of signals) whose given start values do not depend on
+    the swept parameters (CasADi's dependency test); else None (found per member)."""
+    asm = system.asm
+    net = asm.net
+    if system.formulation != "tree" or asm.prescribed or system.n_algebraic or \
+            (net is not None and net.alg_z):
+        return None
+    starts = [asm.q_start, asm.u_start] + ([ca.SX(s) for s in net.start] if net else [])
+    swept = ca.vertcat(*[asm.p[k] for k in columns])
+    if ca.depends_on(ca.densify(ca.vertcat(*starts)), swept):
+        return None
+    return np.concatenate(system.initial_full_p(p))
 
 
 def _strings(value):

@@ -211,3 +211,19 @@ def test_command_line_sweep_writes_netcdf(seed_file, tmp_path, capsys):
     ds.close()
     assert main(["sweep", str(seed_file), "--param", "cc=1"]) == 1     # named, not a trace
     assert "'cc' is no model parameter" in capsys.readouterr().err
+
+
+def test_a_swept_initial_angle_starts_each_member_there():
+    """The start is found once when the swept parameters cannot change it (c, d) and per
+    member when they do (q0 given as a parameter)."""
+    model = double_pendulum()
+    model.parameters["a0"] = 0.05
+    model.components["shoulder"].q0 = "a0"
+    ds = kn.sweep(model, {"a0": [0.05, 0.3], "c": [1.0, 3.0]}, t_end=0.5, n_points=51,
+                  jit=False, progress=False)
+    np.testing.assert_array_equal(ds["shoulder.q"].values[:, :, 0], [[0.05, 0.05], [0.3, 0.3]])
+    res = kn.simulate(model, params={"a0": 0.3, "c": 3.0}, t_end=0.5, n_points=51, jit=False)
+    np.testing.assert_allclose(ds["probe1.angle"].sel(a0=0.3, c=3.0).values,
+                               res["probe1.angle"], atol=1e-7)
+    ref = seed_reference(ds.time.values, x0=(0.3, 0.05, 0.0, 0.0), c=3.0)
+    np.testing.assert_allclose(ds["elbow.q"].sel(a0=0.3, c=3.0).values, ref[:, 1], atol=1e-6)
