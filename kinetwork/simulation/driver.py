@@ -328,7 +328,7 @@ def _integrate(run, method):
         run.events.log = []            # of this method (auto may try another after it)
         chunk = min(chunk, EVENT_CHUNK)
     k, failure = 0, None
-    origin = restart_at = None          # with events: where the method started last
+    restart_at = None                   # with events: where the last one left the run
     while k < n - 1:
         failure = run.stop_reason()
         if failure is not None:
@@ -336,28 +336,27 @@ def _integrate(run, method):
         m = min(chunk, n - 1 - k)
         times = grid[k + 1:k + 1 + m]
         work_before = _work(run, stepper.stats)
+        # with events: from where the method started last (an event between outputs)
+        origin, restarted = restart_at or (grid[k], X[-1]), restart_at is not None
+        restart_at = None
         try:
-            new = stepper.advance(times)
+            if run.events is None:
+                new = stepper.advance(times)
+            else:
+                new, restart_at = run.events.advance(method, stepper, times, origin, restarted)
         except Failure as exc:
             new = exc.states if exc.states is not None else np.zeros((0, len(X[0])))
             failure = exc.reason
-            if not len(new) and m > 1 and not method.stepper:
+            if not len(new) and m > 1 and not method.stepper and run.events is None:
                 # CasADi keeps nothing of a failed call: go again an output at a time,
                 # to keep every output before the failure (and stop there all the same)
                 new, failure = _piecewise(run, method, grid[k], X[-1], times, failure)
-        if run.events is not None and failure is None:
-            origin = restart_at or (grid[k], X[-1])
+        if restart_at is not None:            # an event: the method starts afresh there
+            stats = _merge(stats, stepper.stats)
             try:
-                new, restart_at = run.events.check(method, times, origin, new,
-                                                   restarted=restart_at is not None)
+                stepper = method.start(run, *restart_at)
             except Failure as exc:
-                new, restart_at, failure = new[:0], None, exc.reason
-            if restart_at is not None:        # an event: the method starts afresh there
-                stats = _merge(stats, stepper.stats)
-                try:
-                    stepper = method.start(run, *restart_at)
-                except Failure as exc:
-                    failure = exc.reason
+                failure = exc.reason
         if run.system.f_dependent is not None:
             new, failure = watch(run, X, new, failure)
         X.extend(new)

@@ -1,9 +1,10 @@
 """Events: where an element with modes (friction, stops: ``components/friction.py``) changes
 mode, found, located and applied between the integrator's outputs.
 
-After every chunk of a run the driver hands the rows it got to ``Events.check``. An event is
-an indicator (compiled with the model: ``equations/modes.py``) going from positive to zero
-or below between two rows. It is located by Brent's method on the indicator of the state
+The driver advances a method with ``Events.advance``: to the output times and to SAMPLES - 1
+points between each two, where the indicators (compiled with the model:
+``equations/modes.py``) are looked at. An event is an indicator going from positive to zero
+or below between two of those points. It is located by Brent's method on the indicator of the state
 integrated by the same method from the row before it to the trial time (so the time is as
 exact as the integration, to about 1e-14 s in the bracketing itself), the element says what
 its new mode is (``next_mode``) and whether its relative speed jumps (an impact, a
@@ -12,9 +13,11 @@ element's force), modes that the change makes inconsistent follow at the same in
 the method starts afresh there. Events are logged (time, component, kind) for
 ``res.stats["events"]``.
 
-Crossings are looked for at the output points (and at the event restarts): two crossings
-within one output interval that cancel out are not seen. Runs with events therefore go in
-short chunks of at most EVENT_CHUNK output intervals.
+Two crossings between two sampled points, which cancel out, are not seen (right after an
+event, an indicator at zero counts as positive, so a bounce within the first interval is
+found). Runs with events go in short chunks of at most EVENT_CHUNK output intervals, as what
+follows an event in a chunk is computed again; a fixed-step method steps each sampled
+interval, so its steps are SAMPLES times shorter than without events.
 """
 
 from types import SimpleNamespace
@@ -27,6 +30,9 @@ from .methods import Failure
 #: output intervals per chunk at most, in a run with events (what follows an event in a
 #: chunk is computed again from it)
 EVENT_CHUNK = 8
+#: points per output interval where the indicators are looked at (two crossings between two
+#: of them, which cancel out, are not seen)
+SAMPLES = 4
 #: events in one run at most: beyond, the run stops (a stop bouncing ever faster, chattering)
 MAX_EVENTS = 100_000
 #: mode changes at one instant at most (a cascade through coupled elements)
@@ -96,6 +102,20 @@ class Events:
         return self._settle(t, x, None)
 
     # -- during the run --------------------------------------------------------------------
+    def advance(self, method, stepper, times, origin, restarted):
+        """``stepper`` advanced to the output ``times`` from ``origin`` = (t, x), looking for
+        events at SAMPLES points in each interval: (rows at the output times up to the first
+        event, the (t, x) to start again from or None). A Failure keeps its rows at the
+        output times."""
+        fine, output = _refined(origin[0], times)
+        try:
+            rows = stepper.advance(fine)
+        except Failure as exc:
+            states = None if exc.states is None else exc.states[output[:len(exc.states)]]
+            raise Failure(exc.reason, states) from None
+        rows, restart = self.check(method, fine, origin, rows, restarted)
+        return rows[output[:len(rows)]], restart
+
     def check(self, method, times, before, rows, restarted=False):
         """The rows up to the first event among ``rows`` (at ``times``, after the state
         ``before`` = (t, x)) and, when there is one, the (t, x) to start again from.
@@ -235,3 +255,15 @@ def numeric_pair(f, p):
         A, B = f(t, x, p)
         return np.asarray(A, dtype=float), np.asarray(B, dtype=float)
     return call
+
+
+def _refined(t0, times):
+    """The output ``times`` after ``t0`` with SAMPLES - 1 points between each and the one
+    before, and which of them are outputs."""
+    edges = np.concatenate([[t0], times])
+    fine = np.concatenate([np.linspace(a, b, SAMPLES + 1)[1:] for a, b in
+                           zip(edges[:-1], edges[1:])])
+    output = np.zeros(len(fine), dtype=bool)
+    output[SAMPLES - 1::SAMPLES] = True
+    fine[output] = times                    # exactly the output times, not rounded
+    return fine, output
