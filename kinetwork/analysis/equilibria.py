@@ -20,7 +20,8 @@ _RESIDUALS = weakref.WeakKeyDictionary()
 class Equilibrium:
     """A state at rest: ``X`` the full state (x, then the dependent coordinates of loops),
     ``state`` the same by name, ``inputs`` the inputs' values, ``params`` the parameters
-    solved for, ``residual`` the largest |rate| left, ``undetermined`` the states the
+    solved for, ``residual`` the largest |rate| left, ``iterations`` the evaluations it took,
+    ``undetermined`` the states the
     equilibrium leaves free (a rotor with nothing holding its angle)."""
 
     def __init__(self, t, X, names, inputs, params, residual, iterations, undetermined):
@@ -105,45 +106,71 @@ def equilibrium(model, at=None, inputs=(), free=(), fix=None, params=None, t=0.0
     for k, v in fix.items():
         X[states.index(k)] = float(v)
     f = _residual(s, tuple(where))
-    v = np.concatenate([X[unknown], p[where]])
+    v0 = np.concatenate([X[unknown], p[where]])
 
     def evaluate(v):
         X[unknown], p[where] = v[:len(unknown)], v[len(unknown):]
         R, JX, Jp = (np.asarray(a, dtype=float) for a in f(t, X, p))
         return R.ravel(), np.hstack([JX[:, unknown], Jp])
 
+    _, R, J, norm, it = _newton(evaluate, v0, tol, max_iter)
+    if norm > tol and n:
+        # Newton's steps get stuck where a rate is flat in some direction (a controller's
+        # output at its limit): a trust region on |R|^2 (scipy's trf) passes there
+        _, R, J, norm, more = _trust_region(evaluate, v0, tol, max_iter)
+        it += more
+    if norm <= tol:
+        return _done(pl, t, X, p, states, where, norm, it, J, unknown)
+    worst = np.argsort(-np.abs(R))[:3] if n else []
+    rates = ", ".join(f"d({states[k]})/dt = {R[k]:.3g}" if k < s.n_states else
+                      f"closure of {states[k]}: {R[k]:.3g}" for k in worst)
+    raise SimulationError(
+        f"no equilibrium of {s.model.name!r} found: Newton and a trust region stalled after "
+        f"{it} evaluations with {rates} left (largest |rate| {norm:.3g}, asked {tol:g}); "
+        f"there may be none (a load nothing can hold), or none near the start: give another "
+        f"'at'",
+        reason="no equilibrium")
+
+
+def _newton(evaluate, v, tol, max_iter):
+    """Newton's method, each step halved until the largest |rate| falls: (v, R, J, that
+    largest |rate|, evaluations)."""
     R, J = evaluate(v)
-    norm = np.max(np.abs(R)) if n else 0.0
-    it = 0
-    for it in range(max_iter):
-        if not np.isfinite(norm):
+    norm = np.max(np.abs(R)) if R.size else 0.0
+    count = 1
+    for _ in range(max_iter):
+        if not np.isfinite(norm) or norm <= tol:
             break
-        if norm <= tol:
-            return _done(pl, t, X, p, states, where, norm, it, J, unknown)
         step = np.linalg.lstsq(J, -R, rcond=None)[0]
-        # halve the step until the largest rate falls (Armijo on the max norm)
         for _ in range(30):
             trial = v + step
             with np.errstate(all="ignore"):
                 Rt, Jt = evaluate(trial)
+            count += 1
             nt = np.max(np.abs(Rt))
             if np.isfinite(nt) and nt < norm:
                 break
             step = step / 2
         else:
-            evaluate(v)
+            R, J = evaluate(v)           # X and p back at the best point
             break
         v, R, J, norm = trial, Rt, Jt, nt
-    if norm <= tol:
-        return _done(pl, t, X, p, states, where, norm, max_iter, J, unknown)
-    worst = np.argsort(-np.abs(R))[:3] if n else []
-    rates = ", ".join(f"d({states[k]})/dt = {R[k]:.3g}" if k < s.n_states else
-                      f"closure of {states[k]}: {R[k]:.3g}" for k in worst)
-    raise SimulationError(
-        f"no equilibrium of {s.model.name!r} found: Newton stalled after {it + 1} "
-        f"iterations with {rates} left (largest |rate| {norm:.3g}, asked {tol:g}); there may "
-        f"be none (a load nothing can hold), or none near the start: give another 'at'",
-        reason="no equilibrium")
+    return v, R, J, norm, count
+
+
+def _trust_region(evaluate, v0, tol, max_iter):
+    """scipy's trust-region least squares on the rates, with the exact Jacobian: (v, R, J,
+    largest |rate|, evaluations)."""
+    from scipy.optimize import least_squares
+    try:
+        out = least_squares(lambda v: evaluate(v)[0], v0, jac=lambda v: evaluate(v)[1],
+                            method="trf", xtol=1e-15, ftol=1e-15, gtol=1e-15,
+                            max_nfev=20 * max_iter)
+    except ValueError:                    # not finite at the start
+        R, J = evaluate(v0)
+        return v0, R, J, np.inf, 1
+    R, J = evaluate(out.x)
+    return out.x, R, J, float(np.max(np.abs(R))), int(out.nfev)
 
 
 def _done(pl, t, X, p, states, where, norm, iterations, J, unknown):

@@ -1,5 +1,7 @@
 """kn.equilibrium against closed-form statics, and its refusals."""
 
+import pathlib
+
 import numpy as np
 import pytest
 from scipy.optimize import brentq
@@ -9,6 +11,8 @@ from scenes import fourbar
 from scenes.reference import PAPER
 
 from .plants import seed_with_motor
+
+MODELS = pathlib.Path(__file__).resolve().parents[2] / "models"
 
 
 def pendulum(tau):
@@ -81,3 +85,20 @@ def test_refusals_name_what_is_wrong():
         kn.equilibrium(model, free=["tauu"], fix={"elbow.q": 0.3})
     with pytest.raises(kn.ModelError, match="fix: 'elbow' is not a state"):
         kn.equilibrium(model, fix={"elbow": 0.3}, free=["tau"])
+
+
+def test_a_saturated_pid_arm_finds_its_set_point():
+    """arm_pid at t = 1 s: the joints at their references (0.5 and 0.3 sin(pi) = 0 rad),
+    each PID's integral holding the joint's static torque through the gear,
+    I = (G + c q) / (n k) from the paper's G. Newton alone stalls there (the controllers
+    start at their output limit); the trust region finds it."""
+    model = kn.load(MODELS / "arm_pid.json")
+    eq = kn.equilibrium(model, t=1.0, at={"shoulder.q": 0.5})
+    g, c, n, k = (model.parameters[key] for key in ("g", "c", "n", "k"))
+    assert eq.state["shoulder.q"] == pytest.approx(0.5, abs=1e-10)
+    assert eq.state["elbow.q"] == pytest.approx(0.0, abs=1e-10)
+    held = [g * 2 * np.sin(0.5) + c * 0.5, g * 0.5 * np.sin(0.5)]
+    assert eq.state["pid_shoulder.x[0]"] == pytest.approx(held[0] / (n * k), rel=1e-9)
+    assert eq.state["pid_elbow.x[0]"] == pytest.approx(held[1] / (n * k), rel=1e-9)
+    system = model.compile()
+    np.testing.assert_allclose(system.rhs(1.0, eq.X), 0, atol=1e-9)
