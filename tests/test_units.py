@@ -176,3 +176,23 @@ def test_a_signal_parameter_takes_any_unit_in_si():
     # a block's value is in the unit of its signal: converted to SI, not checked
     assert kn.signals.Constant("k", k="30 deg").k == exact(sp.pi / 6)
     assert kn.signals.Constant("k", k="2 kN").k == 2000.0
+
+
+def test_a_subsystem_value_with_a_unit_is_taken_in_si_and_saved_as_written():
+    # a definition's parameters declare no unit: a quantity given to one is converted to SI
+    # base units (unchecked), as a signal block's value is
+    link = kn.Model("link", parameters={"L": 1.0})
+    link.add(mb.Revolute("joint"))
+    link.add(mb.FixedTranslation("rod", r=["L", 0, 0]))
+    link.add(mb.RigidBody("body", mass=1.0))
+    link.connect("joint.frame_b", "rod.frame_a")
+    link.connect("rod.frame_b", "body.frame_a")
+    link.expose("frame_a", "joint.frame_a")
+    arm = kn.Model("arm")
+    arm.add(mb.Ground("ground"))
+    arm.add(kn.Subsystem("upper", link, params={"L": "700 mm"}))
+    arm.connect("ground.frame", "upper.frame_a")
+    assert arm.flat().components["upper.rod"]._values["r"][0] == 0.7
+    saved = json.loads(kn.dumps(arm))
+    upper = next(c for c in saved["components"] if c["name"] == "upper")
+    assert upper["params"] == {"L": "700 mm"}

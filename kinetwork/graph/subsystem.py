@@ -235,7 +235,9 @@ class _Flat:
         parameter ``path.name``, an expression is rewritten in the outer names."""
         inner = {}
         for key, default in sub.definition.parameters.items():
-            value = sub.given.get(key, default)
+            # the value in SI: a quantity given ("700 mm") is a number by now, in base units
+            # (a definition's parameters declare none to check it against)
+            value = sub._values.get(key, default) if key in sub.given else default
             if isinstance(value, str):
                 expr = parse(value)
                 unknown = sorted(expr.names - set(scope))
