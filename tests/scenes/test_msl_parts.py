@@ -16,7 +16,7 @@ MODELS = pathlib.Path(__file__).resolve().parents[2] / "models"
 
 def run(name, t_end, n=21, **kw):
     return kn.simulate(kn.load(MODELS / f"{name}.json"), t_end=t_end, n_points=n, rtol=1e-11,
-                       atol=1e-12, **kw)
+                       atol=1e-12, jit=False, **kw)
 
 
 def test_actuated_drive_body_and_rotor1d_follow_the_closed_form():
@@ -64,20 +64,32 @@ def test_rolling_wheel_keeps_its_energy_and_does_not_slip():
     assert (disk["kind"], disk["length_direction"], disk["width"]) == ("cylinder", [0, 1, 0], 0.6)
 
 
-def test_line_force_with_two_masses_matches_an_independent_lagrangian():
+def test_line_force_with_two_masses_both_halves_and_an_independent_lagrangian():
+    """MSL's figure: the JointUPS half and the LineForceWithTwoMasses half move alike and cut
+    the same forces at the boxes' tips (body_f_diff = 0); the lower half is also the sympy
+    Lagrangian of scenes/line_masses.py, its cut forces MSL's equations. rod_f_diff is minus
+    the damper's tension along the line: kinetwork's cut forces put a joint drive's reaction
+    in the world (a Prismatic's support, as Modelica's), MSL's JointUPS on frame_a."""
     box = 7700 * 0.7 * 0.035**2                           # MSL's BodyBox: width = length/20
     scene = Scene(pivot=(0.0, 0.3, 0.3), anchor=(0.0, -0.9, 0.3), tip=0.7, mass=box, cm=0.35,
                   izz=box * (0.7**2 + 0.035**2) / 12, m_a=1.0, m_b=1.0, L_a=0.2, L_b=0.2,
                   c=0.0, d=3.0, s0=0.0)
     res = run("line_force_with_two_masses", 1.5, 16)
     acc, kin, phi, w = solve(scene, res.t)
-    np.testing.assert_allclose(res["angle.angle"], phi, atol=1e-9)
-    np.testing.assert_allclose(res["angle.speed"], w, atol=1e-9)
+    for half in ("angle1", "angle2"):
+        np.testing.assert_allclose(res[f"{half}.angle"], phi, atol=1e-9)
+        np.testing.assert_allclose(res[f"{half}.speed"], w, atol=1e-9)
     assert np.ptp(phi) > 0.5
+    np.testing.assert_allclose(res["box1_f.force"], res["box2_f.force"], atol=1e-8)
     for k in range(0, len(res.t), 5):
         f_a, f_b = msl_cut_forces(scene, acc, kin, phi[k], w[k])
-        np.testing.assert_allclose(res["rod_f.force"][k], f_a, atol=1e-8)
-        np.testing.assert_allclose(res["body_f.force"][k], f_b, atol=1e-8)
+        # the line's frames are wired to rod3 and to the box: their flows are the opposites
+        np.testing.assert_allclose(res["rod3_f.force"][k], -f_a, atol=1e-8)
+        np.testing.assert_allclose(res["box2_f.force"][k], -f_b, atol=1e-8)
+        *_, e, _, dl = [np.asarray(v, dtype=float).ravel() for v in kin(phi[k])]
+        tension = scene.d * dl[0] * w[k]
+        np.testing.assert_allclose(res["rod1_f.force"][k] - res["rod3_f.force"][k],
+                                   -tension * e, atol=1e-8)
 
 
 def _circles(a, b, ra, rb, side):
