@@ -8,7 +8,7 @@ import pytest
 
 import kinetwork as kn
 from kinetwork import cli
-from scenes import fourbar
+from scenes import build_kinetwork, fourbar, random_mechanism, random_state
 
 from .plants import paper_A, seed_with_motor
 
@@ -69,6 +69,31 @@ def test_torque_input_matches_finite_differences_of_the_nonlinear_model(tau):
     np.testing.assert_allclose(lin.C, C[rows], atol=1e-6 * np.max(np.abs(C[rows])))
     np.testing.assert_allclose(lin.D, D[rows], atol=1e-6 * np.max(np.abs(D[rows])))
     assert abs(lin.D[2, 0]) > 1.0       # the acceleration feels the torque at once
+
+
+@pytest.mark.parametrize("seed", [3, 4])
+def test_random_trees_match_pinocchios_derivatives_of_its_forward_dynamics(seed):
+    """A and B of a random spatial tree (revolute and prismatic joints on skew axes, some
+    reversed) against Pinocchio's analytical derivatives of the articulated-body algorithm
+    (computeABADerivatives: d qdd / d q, d qdd / d qd and M^-1), another engine."""
+    pin = pytest.importorskip("pinocchio")
+    from equations.test_pinocchio import build_pinocchio
+    links, gravity = random_mechanism(seed, 4, reversed_fraction=0.3, tree=True)
+    model = build_kinetwork(links, gravity)
+    j = max(i for i, link in enumerate(links) if not link.reversed)
+    source = kn.rotational.Torque if links[j].kind == "revolute" else kn.translational.Force
+    model.add(source("motor"))
+    model.connect("motor.flange", f"j{j}.axis")
+    q, qd = random_state(seed, links)
+    lin = kn.linearize(model, at=np.concatenate([q, qd]), inputs=["motor.u"], outputs=[])
+    pmodel = build_pinocchio(links, gravity)
+    data, n = pmodel.createData(), len(q)
+    pin.computeABADerivatives(pmodel, data, q, qd, np.zeros(n))
+    Minv = np.triu(data.Minv) + np.triu(data.Minv, 1).T     # Pinocchio fills the upper part
+    A = np.block([[np.zeros((n, n)), np.eye(n)], [data.ddq_dq, data.ddq_dv]])
+    B = np.concatenate([np.zeros(n), Minv[:, j]])[:, None]
+    np.testing.assert_allclose(lin.A, A, atol=1e-10 * np.max(np.abs(A)))
+    np.testing.assert_allclose(lin.B, B, atol=1e-10 * np.max(np.abs(B)))
 
 
 def test_input_block_is_the_same_channel_as_the_open_port():
