@@ -164,3 +164,16 @@ def test_cli_prints_the_matrices(seed_file, capsys):
     text = capsys.readouterr().out
     assert "A:" in text and "C:" in text and "probe1.angle [rad]" in text
     assert "-23.6" in text                # -(M^-1 K)[0, 0] of the paper's pencil
+
+
+@pytest.mark.parametrize("t", [0.0, 0.7])
+def test_computed_torque_control_linearises_to_its_error_dynamics(t, monkeypatch):
+    """arm_computed_torque cancels the arm's own dynamics (signals.InverseDynamics): at any
+    state of its run the closed loop is qdd = -kp q - kd qd + (the reference's terms), so
+    A = [[0, I], [-kp I, -kd I]] exactly, whatever M(q), V and G are there."""
+    monkeypatch.setenv("KINETWORK_JIT", "0")
+    model = kn.load(MODELS / "arm_computed_torque.json")
+    lin = kn.linearize(model, at=t, outputs=[])
+    kp, kd = model.parameters["kp"], model.parameters["kd"]
+    I = np.eye(2)
+    np.testing.assert_allclose(lin.A, np.block([[0 * I, I], [-kp * I, -kd * I]]), atol=1e-9)
