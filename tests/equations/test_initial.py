@@ -145,3 +145,14 @@ def test_initial_in_files(tmp_path):
     with pytest.raises(kn.ModelError, match=r"initial.solv: unknown key.*solve") as err:
         kn.loads(json.dumps(data))
     assert any("initial.steady: must be true or false" in p for p in err.value.problems)
+
+
+def test_msl_init_spring_constant_model_file():
+    """models/init_spring_constant.json, MSL's example part for part: its documentation's
+    c = 49.05 N/m (m g r_CM over the spring's stretch, 1 * 9.81 * 0.5 / 0.1), and at rest."""
+    path = __import__("pathlib").Path(__file__).resolve().parents[2] / "models" / \
+        "init_spring_constant.json"
+    model = kn.load(path)
+    assert solved(model.compile())["c"] == pytest.approx(9.81 * 0.5 / 0.1, rel=1e-12)
+    res = kn.simulate(model, t_end=1.0, n_points=11, rtol=1e-10, atol=1e-12)
+    assert np.max(abs(res["angle.angle"])) < 1e-9
