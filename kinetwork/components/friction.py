@@ -45,7 +45,7 @@ class PartialHybrid(Component):
         """Two numbers the events read (a static limit, a restitution), as SX."""
         return ca.SX(0), ca.SX(0)
 
-    def indicator(self, mode, rel, w_rel, force, values):
+    def indicator(self, mode, rel, w_rel, force, values, power=None):
         raise NotImplementedError
 
     def first_mode(self, ev):
@@ -82,7 +82,7 @@ class PartialFriction(PartialHybrid):
     def values(self, t, u):
         return self.peak * self.kinetic(u), ca.SX(0)
 
-    def indicator(self, mode, rel, w_rel, force, values):
+    def indicator(self, mode, rel, w_rel, force, values, power=None):
         # sliding: the speed in the direction of sliding; stuck: the margin to the limit
         return mode * mode * (mode * w_rel) + (1 - mode * mode) * (values[0] - ca.fabs(force))
 
@@ -138,7 +138,7 @@ class PartialElastoGap(PartialHybrid):
         reach = ca.fabs(spring)
         return mode * (spring + ca.fmin(ca.fmax(self.d * w_rel, -reach), reach))
 
-    def indicator(self, mode, rel, w_rel, force, values):
+    def indicator(self, mode, rel, w_rel, force, values, power=None):
         return (1 - 2 * mode) * (rel - self.rel0)
 
     def first_mode(self, ev):
@@ -178,7 +178,7 @@ class PartialStop(PartialHybrid):
     def values(self, t, u):
         return ca.SX(self.e), ca.SX(self.v_rest)
 
-    def indicator(self, mode, rel, w_rel, force, values):
+    def indicator(self, mode, rel, w_rel, force, values, power=None):
         # free: the gap to the nearer limit; resting: the push of the limit (never a pull)
         return (1 - mode) * self._gap(rel) + mode * (-self._side(rel) * force)
 
@@ -193,6 +193,34 @@ class PartialStop(PartialHybrid):
         if abs(ev.w_rel) > max(ev.values[1], ev.tiny):
             return 0, -ev.values[0] * ev.w_rel, "impact"
         return 1, 0.0, None
+
+
+class GearModes:
+    """The modes of a gear with an efficiency eta < 1 (``rotational.IdealGear``), standing in
+    for it among the elements with modes: +1 while flange_a drives (power flows from a to
+    b: torque_b = -ratio eta torque_a), -1 while flange_b does (torque_b = -ratio torque_a /
+    eta). Its indicator is the power into the gear at flange_a, times the mode: where it turns
+    (the speed or the torque changes sign), the other flange drives."""
+    modes = {1: "flange_a driving", -1: "flange_b driving"}
+    hold_mode = None
+
+    def __init__(self, gear):
+        self.gear, self.name = gear, gear.name
+
+    def held(self, mode):
+        return 0
+
+    def values(self, t, u):
+        return ca.SX(0), ca.SX(0)
+
+    def indicator(self, mode, rel, w_rel, force, values, power=None):
+        return mode * power
+
+    def first_mode(self, ev):
+        return (1 if ev.indicator >= 0 else -1), None, None
+
+    def next_mode(self, ev):
+        return -ev.mode, None, None
 
 
 def stop_check(values, place, lo, hi):

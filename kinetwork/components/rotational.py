@@ -116,13 +116,18 @@ class Accelerate(PartialMotion, library=LIB):
 
 
 class IdealGear(PartialRigid, library=LIB):
-    """A lossless gear: flange_a turns ``ratio`` times as far as flange_b (Modelica's
-    convention), and flange_b's torque is ``ratio`` times flange_a's; the reaction rests in the
-    world (or on the support, when wired)."""
+    """A gear: flange_a turns ``ratio`` times as far as flange_b (Modelica's convention), and
+    flange_b's torque is ``ratio`` times flange_a's, times the efficiency eta when flange_a
+    drives, divided by it when flange_b does (the driving side found by events); the reaction
+    rests in the world (or on the support, when wired)."""
     domain = LIB
+    lossy = True
     support = Port("1d", "Reaction flange (unwired: the world)", optional=True)
     gear_ratio = Param(unit="1", name="ratio", nonzero=True,
                        doc="flange_a angle / flange_b angle")
+
+    eta = Param(1.0, unit="", positive=True, max=1.0,
+                doc="Efficiency (1: lossless, no mode; below 1: the loss of the driven side)")
 
     def ratio(self):
         return self.gear_ratio

@@ -74,7 +74,8 @@ def close(asm, eq, model):
     for i, h in enumerate(net.hybrid):
         u = net.signal.get(h.u) if h.u is not None else None
         values = tuple(ca.SX(v) for v in h.bound.values(asm.t, u))
-        g = h.bound.indicator(h.mode, rel[i], w_rel[i], F[i], values)
+        power = at(net.flow, h.a) * at(net.vel, h.a)      # into the element at flange a
+        g = h.bound.indicator(h.mode, rel[i], w_rel[i], F[i], values, power)
         rows.append(ca.horzcat(g, rel[i], w_rel[i], F[i], *values))
     table = ca.substitute(in_states(ca.vertcat(*rows)), F, solution)
     zero = ca.SX.zeros(F.shape[0])

@@ -156,6 +156,8 @@ class _Builder:
         n = u.shape[0]
         self.net = Network({}, {}, {}, {}, ca.SX.zeros(n), ca.SX.zeros(n), ca.SX.zeros(n))
         self.k = {}                  # connection set -> ratio to its group's coordinate
+        self.kt = {}                 # ... and of its torques (differs through gear losses)
+        self.losses = {}             # gear with a loss -> eta^mode
         self.group_of = {}           # connection set -> group
         self.coord = {}              # group index -> (theta, theta', theta'')
         self.pending = {}            # placeholder symbol -> expression, substituted at the end
@@ -198,12 +200,31 @@ class _Builder:
         for s, parent, element in group.sets:
             self.group_of[s] = group
             if parent is None:
-                self.k[s] = ca.SX(1)
+                self.k[s] = self.kt[s] = ca.SX(1)
                 continue
             r = self.bound[element.name].ratio()
             a_here = self.topo.set_of[element.port_ref("flange_a")] == s
             # position(flange_a) = r * position(flange_b)
             self.k[s] = self.k[parent] * r if a_here else self.k[parent] / r
+            # torques pass a gear with efficiency eta as torque_b = -r eta^m torque_a, m = +1
+            # while flange_a drives (power from a to b), -1 while flange_b does
+            loss = self._loss(element)
+            self.kt[s] = self.kt[parent] * r * loss if a_here else self.kt[parent] / (r * loss)
+
+    def _loss(self, element):
+        """eta^m of a gear with a loss (its mode m a state, changed at events where the power
+        through it turns: ``components/friction.py``), else 1."""
+        b = self.bound[element.name]
+        if not getattr(type(element), "lossy", False) or element.eta == 1:
+            return ca.SX(1)
+        if element.name not in self.losses:
+            from ..components.friction import GearModes
+            mode = self._state(f"{element.name}.mode", "", 1, ca.SX(0))
+            refs = (element.port_ref("flange_a"), element.port_ref("flange_b"))
+            self.net.hybrid.append(Hybrid(GearModes(element), GearModes(b), mode,
+                                          ca.SX.sym(f"F_{element.name}"), *refs, None))
+            self.losses[element.name] = (1 + mode) / 2 * b.eta + (1 - mode) / 2 / b.eta
+        return self.losses[element.name]
 
     def _coordinate(self, group):
         kind = group.kind
@@ -488,13 +509,16 @@ class _Builder:
                     if r.component.role in roles), ca.SX(0))
 
     def _generalized(self, group, roles=("compliant", "source")):
-        return sum((-self.k[s] * self._applied(s, roles) for s, _, _ in group.sets), ca.SX(0))
+        return sum((-self.kt[s] * self._applied(s, roles) for s, _, _ in group.sets),
+                   ca.SX(0))
 
     def _inertia(self, group):
         """The group's inertia; on a joint, its armature, and the passive generalized force
         (springs and dampers) that an InverseDynamics block compensates."""
-        inertia = sum((self.bound[e.name].inertia() * self.k[self.topo.set_of[
-            e.port_ref("flange_a")]] ** 2 for e in group.rigid if e.has_inertia), ca.SX(0))
+        at = self.topo.set_of
+        inertia = sum((self.bound[e.name].inertia() * self.k[at[e.port_ref("flange_a")]] *
+                       self.kt[at[e.port_ref("flange_a")]] for e in group.rigid
+                       if e.has_inertia), ca.SX(0))
         self.inertia[group.index] = inertia
         if group.kind == "joint":
             u = self._speed(group)
@@ -562,9 +586,9 @@ class _Builder:
             if element.has_inertia:
                 flow[near] = b.inertia() * k[s] * a - flow[far]
             elif far.name == "flange_a":          # torque_b = -ratio * torque_a
-                flow[near] = -b.ratio() * flow[far]
+                flow[near] = -b.ratio() * self.losses.get(element.name, 1) * flow[far]
             else:
-                flow[near] = -flow[far] / b.ratio()
+                flow[near] = -flow[far] / (b.ratio() * self.losses.get(element.name, 1))
             beyond[parent] = beyond[parent] + flow[near]
 
     def _finish(self):

@@ -273,3 +273,37 @@ def test_friction_on_a_massless_flange_is_refused_and_files_keep_the_elements(tm
     a = kn.simulate(belt, t_end=1.0, n_points=11, method="rk45", **FAST)
     b = kn.simulate(again, t_end=1.0, n_points=11, method="rk45", **FAST)
     assert a.stats["events"] == b.stats["events"] and np.array_equal(a.states, b.states)
+
+
+@pytest.mark.parametrize("method", ["cvodes", "dop853"])
+def test_gear_efficiency_loses_power_whichever_flange_drives(method):
+    # a motor rotor J1 drives a load J2 through a gear (ratio r, efficiency eta) with the
+    # torque T = T0 - k t. By the power balance, while the motor drives (eta of its power
+    # reaches the load) a_load = c1 T, c1 = eta r / (J2 + eta r^2 J1); once T < 0 the load
+    # drives the motor (eta of the load's power reaches it): a_load = c2 T,
+    # c2 = r / (J1 r^2 + eta J2); stopped, the motor drives again
+    J1, J2, r, eta, T0, k = 0.01, 0.5, 10.0, 0.8, 2.0, 2.0
+    model = kn.Model("lossy")
+    motor = model.add(kn.rotational.Inertia("motor", J=J1))
+    gear = model.add(kn.rotational.IdealGear("gear", ratio=r, eta=eta))
+    load = model.add(kn.rotational.Inertia("load", J=J2))
+    torque = model.add(kn.rotational.Torque("torque", tau=f"{T0} - {k}*t"))
+    probe = model.add(kn.Probe("p", quantities=["speed"]))
+    model.connect(torque.flange, motor.flange_a)
+    model.connect(motor.flange_b, gear.flange_a)
+    model.connect(gear.flange_b, load.flange_a)
+    model.connect(probe.port, load.flange_b)
+    res = kn.simulate(model, t_end=3.0, n_points=31, method=method, rtol=1e-12, atol=1e-14,
+                      **FAST)
+    c1, c2 = eta * r / (J2 + eta * r ** 2 * J1), r / (J1 * r ** 2 + eta * J2)
+    t1 = T0 / k
+    w1 = c1 * T0 ** 2 / (2 * k)
+    s_stop = np.sqrt(2 * w1 / (c2 * k))
+    events = res.stats["events"]
+    assert [e["kind"] for e in events] == ["flange_b driving", "flange_a driving"]
+    assert abs(events[0]["t"] - t1) < 1e-9 and abs(events[1]["t"] - (t1 + s_stop)) < 1e-9
+    t, s = res.t, res.t - t1
+    exact = np.where(t <= t1, c1 * (T0 * t - k * t ** 2 / 2),
+                     np.where(s <= s_stop, w1 - c2 * k * s ** 2 / 2,
+                              -c1 * k * (s ** 2 - s_stop ** 2) / 2))
+    assert np.max(np.abs(res["p.speed"] - exact)) < 1e-9
