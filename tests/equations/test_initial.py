@@ -36,7 +36,7 @@ def test_init_spring_constant_on_a_rotational_spring():
     m.set_initial(steady=True, fixed=["rev.q"], solve=["c"])
     c = MASS * G * ARM * np.cos(0.3) / 0.3          # c (0 - q0) = m g l cos q0
     assert solved(m.compile()) == pytest.approx({"c": c, "rev.qd": 0.0}, rel=1e-12, abs=1e-12)
-    res = kn.simulate(m, t_end=1.0, n_points=5, rtol=1e-10, atol=1e-12)
+    res = kn.simulate(m, t_end=1.0, n_points=5, rtol=1e-10, atol=1e-12, jit=False)
     assert np.max(abs(res["p.angle"] + 0.3)) < 1e-9 and np.max(abs(res["p.speed"])) < 1e-8
     # the same from a given derivative: no acceleration at the start, c the unknown
     m.set_initial(derivatives={"rev.qd": 0}, solve=["c"])
@@ -68,7 +68,7 @@ def test_init_spring_constant_on_a_line_spring_as_msl():
     moment = (length - s0) / length * (tip[0] * d[1] - tip[1] * d[0])   # per unit c
     c = MASS * G * tip[0] / moment
     assert solved(m.compile())["c"] == pytest.approx(c, rel=1e-12)
-    res = kn.simulate(m, t_end=0.5, n_points=3, rtol=1e-10, atol=1e-12)
+    res = kn.simulate(m, t_end=0.5, n_points=3, rtol=1e-10, atol=1e-12, jit=False)
     assert np.max(abs(res["p.angle"] - q0)) < 1e-9
 
 
@@ -79,7 +79,7 @@ def test_steady_state_solves_the_angle():
     ref = scipy.optimize.brentq(lambda q: -40.0 * q - MASS * G * ARM * np.cos(q), -2, 0,
                                 xtol=1e-15)
     assert q == pytest.approx(ref, abs=1e-12)
-    assert kn.simulate(m, t_end=0.5, n_points=3)["p.angle"] == pytest.approx([ref] * 3,
+    assert kn.simulate(m, t_end=0.5, n_points=3, jit=False)["p.angle"] == pytest.approx([ref] * 3,
                                                                              abs=1e-9)
 
 
@@ -102,7 +102,7 @@ def test_dc_motor_started_in_its_steady_run():
     w = V * k / (R * d + k ** 2)
     assert solved(m.compile()) == pytest.approx({"motor.rotor.w": w, "motor.La.i": d * w / k},
                                                 rel=1e-12)
-    res = kn.simulate(m, t_end=0.5, n_points=3, rtol=1e-10, atol=1e-12)
+    res = kn.simulate(m, t_end=0.5, n_points=3, rtol=1e-10, atol=1e-12, jit=False)
     assert res["pw.speed"] == pytest.approx([w] * 3, rel=1e-9)
     # a steady state of everything leaves the rotor's angle to nothing: refused by name
     m.set_initial(steady=True)
@@ -154,5 +154,5 @@ def test_msl_init_spring_constant_model_file():
         "init_spring_constant.json"
     model = kn.load(path)
     assert solved(model.compile())["c"] == pytest.approx(9.81 * 0.5 / 0.1, rel=1e-12)
-    res = kn.simulate(model, t_end=1.0, n_points=11, rtol=1e-10, atol=1e-12)
+    res = kn.simulate(model, t_end=1.0, n_points=11, rtol=1e-10, atol=1e-12, jit=False)
     assert np.max(abs(res["angle.angle"])) < 1e-9
