@@ -123,7 +123,7 @@ def fit(model, data, params, columns=None, values=None, weights=None, level=0.95
             memo.clear()
             q = p.copy()
             q[index] = v
-            Y, J = evaluate(f, q, index)
+            Y, J = evaluate(f, system, q, index)
             n_out = len(rows)
             J = J.reshape(len(grid), n_out, -1)[skip:]
             memo[key] = (((Y[skip:] - measured) * w).ravel(),

@@ -81,7 +81,7 @@ def sensitivity(model, params, t_end=None, n_points=None, outputs=None, values=N
     index = param_index(system, params)
     p = system.param_vector(values)
     f = trajectory(system, index, rows, grid, rtol or settings["rtol"], atol or settings["atol"])
-    Y, J = evaluate(f, p, index)
+    Y, J = evaluate(f, system, p, index)
     return Sensitivity(grid, names, units, [system.param_names[k] for k in index], Y,
                        J.reshape(len(grid), len(rows), len(index)))
 
@@ -102,11 +102,13 @@ def param_index(system, params):
     return [system.param_names.index(k) for k in params]
 
 
-def evaluate(f, p, index):
+def evaluate(f, system, p, index):
     """(outputs (n_t, n_out), Jacobian (n_t * n_out, n_params)) of a ``trajectory``
     Function at the parameter vector p."""
+    p = np.asarray(p, dtype=float)
+    x0, z0 = system.initial_full_p(p)
     try:
-        Y, J = f(np.asarray(p, dtype=float)[index], p)
+        Y, J = f(p[index], p, x0, z0)
     except RuntimeError as exc:
         raise SimulationError(f"the integration of the sensitivities failed: "
                               f"{str(exc).splitlines()[-1][:300]}",
@@ -135,15 +137,19 @@ def _grid(t, t_end, n_points):
 
 
 def trajectory(system, index, rows, grid, rtol, atol):
-    """The Function (p[index], p) -> (outputs on the grid (n_rows, n_t), their Jacobian in
-    p[index]): an integrator whose forward sensitivities CasADi derives."""
+    """The Function (p[index], p, x0, z0) -> (outputs on the grid (n_rows, n_t), their
+    Jacobian in p[index]): an integrator whose forward sensitivities CasADi derives. x0 and
+    z0 are the initial state at p (``System.initial_full_p``), which a model without loops
+    replaces by its start's own expressions in p (so that they are differentiated too)."""
     eq, a = system.eq, system.asm
     w = ca.MX.sym("w", len(index))
     pm = ca.MX.sym("p", a.p.numel())
     # the full parameter vector, with the differentiated entries the symbols w
     chosen = dict(zip(index, range(len(index))))
     P = ca.vertcat(*[w[chosen[k]] if k in chosen else pm[k] for k in range(a.p.numel())])
-    X0, Z0 = _start(system, P)
+    x0 = ca.MX.sym("x0", eq.x.numel())
+    z0 = ca.MX.sym("z0", eq.z.numel())
+    X0, Z0 = _start(system, P, x0, z0)
     dae = {"x": eq.x, "z": eq.z, "p": a.p, "t": a.t, "ode": eq.ode, "alg": eq.alg}
     if not system.n_algebraic:
         dae = {k: v for k, v in dae.items() if k not in ("z", "alg")}
@@ -159,23 +165,27 @@ def trajectory(system, index, rows, grid, rtol, atol):
     Y = system.f_out.map(n)(ca.DM(grid).T, XF, ca.repmat(P, 1, n)) if system.signals \
         else ca.MX(0, n)
     picked = ca.vertcat(*[XF[-1 - r, :] if r < 0 else Y[r, :] for r in rows])
-    return ca.Function("trajectory", [w, pm], [picked, ca.jacobian(ca.vec(picked), w)])
+    return ca.Function("trajectory", [w, pm, x0, z0],
+                       [picked, ca.jacobian(ca.vec(picked), w)])
 
 
-def _start(system, P):
-    """The initial state (x0, z0) as expressions of the parameters P (MX)."""
+def _start(system, P, x0, z0):
+    """The initial state (X0, Z0) as expressions of the parameters P, given its values x0,
+    z0 at P (symbols): a tree's start by its own expressions, a loop's dependent
+    coordinates by the closure (a rootfinder, which CasADi differentiates by the implicit
+    function theorem), the other states held."""
     eq, a = system.eq, system.asm
     p0 = system.param_vector()
-    x0, z0 = system.initial_full_p(p0)
-    X0 = ca.MX(ca.DM(x0))
+    x_start = system.initial_full_p(p0)[0]
+    X0 = x0
     if system.formulation == "tree" and not system.n_algebraic:
         net = a.net
         extra = [ca.SX(s) for s in net.start] if net is not None else []
         given = ca.DM(np.asarray(a.given, dtype=float))
         start = ca.vertcat(given * a.q_start, a.u_start, *extra)
         f = ca.Function("x0", [a.p], [ca.densify(start)])
-        if start.numel() == x0.size and np.allclose(np.asarray(f(p0)).ravel(), x0,
-                                                    rtol=0, atol=1e-12):
+        if start.numel() == x_start.size and np.allclose(np.asarray(f(p0)).ravel(),
+                                                         x_start, rtol=0, atol=1e-12):
             X0 = f(P)
     if not system.n_algebraic:
         return X0, ca.MX(0, 1)
@@ -184,4 +194,4 @@ def _start(system, P):
     g = ca.substitute(ca.substitute(g, eq.z, z), a.t, ca.SX(0))    # the start is t = 0
     closure = ca.rootfinder("closure", "newton", ca.Function("g", [z, xp], [g]),
                             {"abstol": 1e-14})
-    return X0, closure(ca.DM(z0), ca.vertcat(X0, P))
+    return X0, closure(z0, ca.vertcat(X0, P))

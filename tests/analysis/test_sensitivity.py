@@ -55,6 +55,18 @@ def test_fourbar_sensitivities_follow_the_closure():
         assert np.all(np.max(np.abs(sens.S[:, :, k] - fd), axis=0) <= 1e-6 * scale), name
 
 
+def test_a_loop_starts_where_the_values_asked_put_it():
+    """The four-bar's crank starting at a parameter th0: the trajectory differentiated is
+    the one at the values given, its loop closed there."""
+    model = fourbar()
+    model.set_parameter("th0", 1.0)
+    model.components["A"].q0 = "th0"
+    outputs = ["rocker_probe.angle"]
+    sens = kn.sensitivity(model, ["g"], t_end=0.3, n_points=4, outputs=outputs,
+                          values={"th0": 1.2}, rtol=1e-11, atol=1e-12)
+    np.testing.assert_allclose(sens.values, runs(model, outputs, 0.3, 4, th0=1.2), atol=1e-8)
+
+
 def test_unknown_parameters_are_refused():
     with pytest.raises(kn.ModelError, match="'cc' is not a model parameter.*'c'"):
         kn.sensitivity(double_pendulum(), ["cc"], t_end=1.0)
