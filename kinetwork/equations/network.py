@@ -208,15 +208,22 @@ class _Builder:
             self.k[s] = self.k[parent] * r if a_here else self.k[parent] / r
             # torques pass a gear with efficiency eta as torque_b = -r eta^m torque_a, m = +1
             # while flange_a drives (power from a to b), -1 while flange_b does
-            loss = self._loss(element)
+            loss = self._loss(element, group)
             self.kt[s] = self.kt[parent] * r * loss if a_here else self.kt[parent] / (r * loss)
 
-    def _loss(self, element):
+    def _loss(self, element, group):
         """eta^m of a gear with a loss (its mode m a state, changed at events where the power
         through it turns: ``components/friction.py``), else 1."""
         b = self.bound[element.name]
         if not getattr(type(element), "lossy", False) or element.eta == 1:
             return ca.SX(1)
+        if group.kind != "free" or group.motion is not None:
+            # on a joint the inertia it reflects, which depends on the driving side, would
+            # enter the mass matrix, which is a function of the coordinates alone
+            raise ModelError(f"{self.model.place(element, 'eta')}: a gear with a loss is "
+                             f"taken between rotors that move freely (a drive train of "
+                             f"inertias), not yet on a joint's axis or a prescribed motion; "
+                             f"set eta = 1 there, or put the loss in a BearingFriction")
         if element.name not in self.losses:
             from ..components.friction import GearModes
             mode = self._state(f"{element.name}.mode", "", 1, ca.SX(0))

@@ -307,3 +307,20 @@ def test_gear_efficiency_loses_power_whichever_flange_drives(method):
                      np.where(s <= s_stop, w1 - c2 * k * s ** 2 / 2,
                               -c1 * k * (s ** 2 - s_stop ** 2) / 2))
     assert np.max(np.abs(res["p.speed"] - exact)) < 1e-9
+
+
+def test_a_gear_with_a_loss_on_a_joint_axis_is_refused_by_name():
+    model = kn.Model("arm")
+    world = model.add(kn.multibody.Ground("world", gravity=[0, -9.81, 0]))
+    joint = model.add(kn.multibody.Revolute("joint", axis=[0, 0, 1], q0=0.5))
+    bob = model.add(kn.multibody.RigidBody("bob", mass=1.0, r_cm=[0, -0.8, 0]))
+    rotor = model.add(kn.rotational.Inertia("rotor", J=1e-3))
+    gear = model.add(kn.rotational.IdealGear("gear", ratio=20.0, eta=0.7))
+    model.connect(world.frame, joint.frame_a)
+    model.connect(joint.frame_b, bob.frame_a)
+    model.connect(rotor.flange_b, gear.flange_a)
+    model.connect(gear.flange_b, joint.axis)
+    with pytest.raises(kn.ModelError, match="gear.eta: a gear with a loss"):
+        model.compile()
+    gear.eta = 1.0                                   # lossless: the rotor is armature
+    assert model.compile().state_names == ["joint.q", "joint.qd"]
