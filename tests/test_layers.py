@@ -47,8 +47,16 @@ def imports(module):
     path = MODULES[module]
     tree = ast.parse(path.read_text(), filename=str(path))
     package = module if path.name == "__init__.py" else module.rpartition(".")[0]
+    # imports for annotations only (``if TYPE_CHECKING:``) never run: a Model.compile may
+    # say it returns a System without the graph layer importing the equations
+    typing_only = {id(inner) for node in ast.walk(tree) if isinstance(node, ast.If)
+                   and (getattr(node.test, "id", None) == "TYPE_CHECKING"
+                        or getattr(node.test, "attr", None) == "TYPE_CHECKING")
+                   for stmt in node.body for inner in ast.walk(stmt)}
     found = []
     for node in ast.walk(tree):
+        if id(node) in typing_only:
+            continue
         if isinstance(node, ast.Import):
             found += [(node.lineno, alias.name) for alias in node.names]
         elif isinstance(node, ast.ImportFrom):

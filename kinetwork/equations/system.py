@@ -6,7 +6,10 @@ running it: whatever a run compiles or caches (C code, integrators) lives in
 parameter value.
 """
 
+from __future__ import annotations
+
 import functools
+from collections.abc import Mapping
 
 import casadi as ca
 import numpy as np
@@ -86,7 +89,7 @@ class System:
         self._z_last = None
 
     @property
-    def signal_names(self):
+    def signal_names(self) -> list[str]:
         return [sig.name for sig in self.signals]
 
     def _check_mass_matrix(self):
@@ -142,7 +145,7 @@ class System:
                            [newton(self.eq.alg, self._z)])
 
     @property
-    def dof(self):
+    def dof(self) -> int:
         """Degrees of freedom: speeds less the independent loop-closure equations and the
         prescribed joint speeds, plus the free rotors and sliding masses of the 1-D network."""
         free = sum(1 for g in self.topology.oned if g.kind == "free")
@@ -180,7 +183,7 @@ class System:
                            [ca.norm_inf(self.eq.residual)])
 
     # -- parameters -----------------------------------------------------------------------
-    def param_vector(self, params=None):
+    def param_vector(self, params: Mapping[str, float] | None = None) -> np.ndarray:
         """Model parameters as the vector p, with ``params`` overrides checked."""
         values = self.model.parameter_values(params)
         if params:
@@ -191,10 +194,10 @@ class System:
         return p
 
     @property
-    def x0(self):
+    def x0(self) -> np.ndarray:
         return self.initial_state()
 
-    def initial_state(self, params=None):
+    def initial_state(self, params: Mapping[str, float] | None = None) -> np.ndarray:
         """Initial state for the given parameter overrides."""
         return self.initial_state_p(self.param_vector(params))
 
@@ -220,11 +223,12 @@ class System:
         return InitialEquations(self)
 
     @property
-    def n_states(self):
+    def n_states(self) -> int:
         return len(self.state_names)
 
     # -- numbers --------------------------------------------------------------------------
-    def rhs(self, t, x, params=None):
+    def rhs(self, t: float, x: np.ndarray, params: Mapping[str, float] | None = None
+            ) -> np.ndarray:
         """dx/dt of the ODE at (t, x), as numpy (n_states,).
 
         With loops (algebraic variables z), z is first solved from the closure by Newton,
@@ -255,12 +259,15 @@ class System:
     def _f_mass(self):
         return ca.Function("M", [self.asm.q, self.asm.p], [self.asm.mass_matrix()])
 
-    def mass_matrix(self, q, params=None):
+    def mass_matrix(self, q: np.ndarray, params: Mapping[str, float] | None = None
+                    ) -> np.ndarray:
         """Joint-space mass matrix M(q) of the tree, numpy (n, n)."""
         q = self._vector(q, len(self.coordinate_names), "q")
         return np.asarray(self._f_mass(q, self.param_vector(params)))
 
-    def dynamics_terms(self, q, qd, params=None, t=0.0):
+    def dynamics_terms(self, q: np.ndarray, qd: np.ndarray,
+                       params: Mapping[str, float] | None = None, t: float = 0.0
+                       ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """(M, V, G) as numpy with M qdd + V + G = 0, in the form of the seed paper.
 
         V holds the Coriolis and centripetal terms minus the generalized forces of the 1-D
@@ -272,7 +279,7 @@ class System:
                     self.param_vector(params))
         return np.asarray(M), np.asarray(V).ravel(), np.asarray(G).ravel()
 
-    def equations(self):
+    def equations(self) -> dict:
         """Symbolic M, V, G (CasADi SX) with their symbols: q, qd, p (parameters), t, and
         ``x``, the states of 1-D networks and signal blocks V depends on (a PID's
         integral), named in ``x_names``."""
@@ -284,7 +291,8 @@ class System:
                 "x": ca.vertcat(*x) if x else ca.SX(0, 1), "x_names": [v.name() for v in x],
                 "param_names": list(a.param_names)}
 
-    def outputs(self, t, x, params=None):
+    def outputs(self, t: np.ndarray, x: np.ndarray, params: Mapping[str, float] | None = None
+                ) -> np.ndarray:
         """Probe signals at the given times and states (x: (n_points, n_states +
         n_algebraic)): differential states, then the algebraic variables of loops)."""
         return self.outputs_p(t, x, self.param_vector(params))

@@ -7,10 +7,13 @@ nothing from the file. Every problem is reported with its place in the file
 when the whole file is sound.
 """
 
+from __future__ import annotations
+
 import json
 import math
 import os
 import stat
+from collections.abc import Iterable
 
 from ..components.base import _NAME, NAME_LIMIT, REGISTRY
 from ..errors import ModelError
@@ -37,7 +40,8 @@ MAX_FILE_SIZE = 64 * 2**20
 
 
 # -- reading ----------------------------------------------------------------------------------
-def load(path, validate=True, library=None):
+def load(path: str | os.PathLike, validate: bool = True,
+         library: Iterable[str | os.PathLike] | None = None) -> Model:
     """Read a model file.
 
     Parameters
@@ -91,7 +95,9 @@ def _read(source):
         raise ModelError(f"{source}: not UTF-8 text (byte {exc.start})") from None
 
 
-def loads(text, source=None, validate=True, library=None, folder=None):
+def loads(text: str | bytes, source: str | None = None, validate: bool = True,
+          library: Iterable[str | os.PathLike] | None = None,
+          folder: str | os.PathLike | None = None) -> Model:
     """Read a model from JSON text, as :func:`load` does.
 
     Parameters

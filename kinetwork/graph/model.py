@@ -1,8 +1,13 @@
 """Model: the components, their wiring and the model parameters."""
 
+from __future__ import annotations
+
 import math
+import os
 import re
 import threading
+from collections.abc import Mapping
+from typing import TYPE_CHECKING, Any, TypeVar
 
 import numpy as np
 
@@ -12,6 +17,13 @@ from .subsystem import Subsystem, check_placement, check_port_name, flatten, has
 from .writer import save
 from ..errors import ModelError
 from ..expr import CONSTANTS, FUNCTIONS, parse
+
+if TYPE_CHECKING:       # annotations only: a model does not import what compiles it
+    from ..equations.system import System
+    from .topology import Topology
+
+#: a component, as ``Model.add`` gives it back (its own class, for editors and type checkers)
+C = TypeVar("C", bound=Component)
 
 _IDENT = re.compile(r"[A-Za-z_][A-Za-z0-9_]{0,199}\Z")      # whole, as NAME_LIMIT in base.py
 RESERVED = {"t", *CONSTANTS, *FUNCTIONS}
@@ -50,7 +62,8 @@ class Model:
         step).
     """
 
-    def __init__(self, name, parameters=None, description="", simulation=None):
+    def __init__(self, name: str, parameters: Mapping[str, float] | None = None,
+                 description: str = "", simulation: Mapping[str, Any] | None = None):
         if (problem := model_name_problem(name)) is not None:
             raise ModelError(f"model name: {problem}")
         self.name = name
@@ -89,7 +102,7 @@ class Model:
         self.initial = model.initial
 
     # -- building -----------------------------------------------------------------------
-    def set_parameter(self, name, value):
+    def set_parameter(self, name: str, value: float | str) -> None:
         """Add or change a model parameter; a path (``"cyl1.phi0"``) sets the value given to
         a parameter of a subsystem placed here (as ``model.components["cyl1"].phi0 = v``)."""
         if isinstance(name, str) and "." in name:
@@ -109,7 +122,7 @@ class Model:
             raise ModelError(f"parameter name {name!r} is reserved (time, constants, functions)")
         self.parameters[name] = check_number(value, f"parameters.{name}")
 
-    def add(self, component):
+    def add(self, component: C) -> C:
         """Add ``component`` and return it."""
         if not isinstance(component, Component):
             raise ModelError(f"model.add expects a component, got {component!r}")
@@ -120,7 +133,9 @@ class Model:
         self.components[component.name] = component
         return component
 
-    def set_initial(self, steady=False, derivatives=None, fixed=(), solve=()):
+    def set_initial(self, steady: bool = False, derivatives: Mapping[str, float] | None = None,
+                    fixed: tuple[str, ...] | list[str] = (),
+                    solve: tuple[str, ...] | list[str] = ()) -> None:
         """Ask for initial conditions as equations (see ``kinetwork.graph.initial``):
         ``steady`` (every derivative zero), ``derivatives`` ({state: value} at t = 0),
         ``fixed`` (states a steady state keeps) and ``solve`` (model parameters, or states
@@ -131,7 +146,7 @@ class Model:
         self.initial = normalized({"steady": steady, "derivatives": dict(derivatives or {}),
                                    "fixed": list(fixed), "solve": list(solve)})
 
-    def expose(self, name, port):
+    def expose(self, name: str, port: PortRef | str) -> None:
         """Show ``port`` (``comp.port`` or ``"comp.port"``) as this model's port ``name``
         when it is placed as a subsystem: ``link.expose("frame_a", "joint.frame_a")``."""
         check_port_name(name)
@@ -144,7 +159,7 @@ class Model:
             raise ModelError([f"{self.name} port {name!r}: {p}" for p in exc.problems]) \
                 from None
 
-    def connect(self, a, b):
+    def connect(self, a: PortRef | str, b: PortRef | str) -> None:
         """Wire two ports, given as ``comp.port`` attributes or ``"comp.port"`` strings."""
         pa, pb = self.port(a), self.port(b)
         if pa == pb:
@@ -161,7 +176,7 @@ class Model:
         self.connections.append((pa, pb))
         self._wired.add(frozenset((pa, pb)))
 
-    def port(self, ref):
+    def port(self, ref: PortRef | str) -> PortRef:
         """Resolve a PortRef or a ``"comp.port"`` string to a PortRef of this model."""
         if isinstance(ref, PortRef):
             comp = self.components.get(ref.component.name)
@@ -191,7 +206,7 @@ class Model:
             return f"{component.name}.{key}" if key else component.name
         return f"{base} params.{key}" if key else base
 
-    def flat(self):
+    def flat(self) -> Model:
         """The model with every subsystem expanded in place, names by path: what validation
         and compilation work on (the model itself when it places no subsystem). Kept while the
         structure does not change; parameter values are always the current ones."""
@@ -205,7 +220,8 @@ class Model:
         flat.initial = self.initial          # current, as the parameter values
         return flat
 
-    def parameter_values(self, overrides=None):
+    def parameter_values(self, overrides: Mapping[str, float] | None = None
+                         ) -> dict[str, float]:
         """Model parameters with ``overrides`` applied and checked."""
         values = dict(self.parameters)
         for key, value in (overrides or {}).items():
@@ -223,7 +239,8 @@ class Model:
             values[key] = check_number(value, f"params.{key}")
         return values
 
-    def numeric_values(self, overrides=None):
+    def numeric_values(self, overrides: Mapping[str, float] | None = None
+                       ) -> dict[str, dict[str, Any]]:
         """Every component parameter evaluated to numbers: {component name: {param: value}}.
 
         Gathers every unknown name, failed evaluation and violated bound into one ModelError.
@@ -260,7 +277,7 @@ class Model:
         exposed = tuple((k, v.path, id(v.component)) for k, v in self.exposed.items())
         return tuple(self.parameters), comps, wiring, exposed
 
-    def validate(self):
+    def validate(self) -> Topology:
         """Check the whole model; return its Topology or raise one ModelError listing all.
 
         The Topology of an unchanged model (same content, same parameter values) is kept, so
@@ -275,7 +292,8 @@ class Model:
         self._validated = (key, values, topology)
         return topology
 
-    def compile(self, loops="partition", baumgarte_rate=None):
+    def compile(self, loops: str = "partition", baumgarte_rate: float | None = None
+                ) -> System:
         """Validate and build the equations: a ``kn.System``.
 
         ``loops`` chooses the formulation of kinematic loops (see ``kinetwork.equations.loops``):
@@ -302,7 +320,7 @@ class Model:
                 self._compiled[key] = system
             return self._compiled[key]
 
-    def save(self, path):
+    def save(self, path: str | os.PathLike) -> None:
         """Write the model as JSON (atomically: a failed save leaves the old file whole)."""
         save(self, path)
 

@@ -4,9 +4,12 @@ What ``kinetwork.graph.io`` would refuse for its form is refused here, so a save
 reads back.
 """
 
+from __future__ import annotations
+
 import copy
 import json
 import os
+from typing import TYPE_CHECKING
 
 from ..components.base import _NAME, REGISTRY
 from ..errors import ModelError
@@ -14,6 +17,9 @@ from ..util import atomic_write, finite
 from .initial import check_initial
 from .settings import check_setting
 from .subsystem import Subsystem
+
+if TYPE_CHECKING:                     # annotations only: model.py imports this module
+    from .model import Model
 
 #: the newest version; a model is written in the smallest version that holds it: 1 unless it
 #: has subsystems or exposed ports
@@ -155,7 +161,7 @@ def _reference(definition, folder):
     return {"file": rel.replace(os.sep, "/")}
 
 
-def dumps(model, folder=None):
+def dumps(model: Model, folder: str | os.PathLike | None = None) -> str:
     """The file's text for ``model`` (to be written in ``folder``: see :func:`model_to_dict`).
 
     Indented JSON with the keys in file order, short lists of scalars on one line (vectors,
@@ -168,7 +174,7 @@ def dumps(model, folder=None):
     return _render(model_to_dict(model, folder), 0) + "\n"
 
 
-def save(model, path):
+def save(model: Model, path: str | os.PathLike) -> None:
     """Write ``model`` to ``path`` atomically: a failed save leaves the old file whole.
 
     The text goes to a temporary file in the same folder, is flushed to disk, then replaces

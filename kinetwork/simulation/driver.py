@@ -14,12 +14,16 @@ second on any machine, and the same chunks on every machine, so a run's numbers 
 method restarts at each chunk) never depend on how fast the machine is or how loaded.
 """
 
+from __future__ import annotations
+
 import contextlib
 import math
 import signal
 import tempfile
 import threading
 import time
+from collections.abc import Callable, Mapping
+from typing import TYPE_CHECKING
 
 import numpy as np
 
@@ -34,6 +38,9 @@ from .events import EVENT_CHUNK, Events
 from .loopwatch import near_singular, watch
 from .methods import METHODS, Failure, choose, shift_times
 from .results import Results
+
+if TYPE_CHECKING:                     # annotations only
+    from ..graph.model import Model
 
 DEFAULTS = {"t_end": 10.0, "n_points": 1001, "method": "auto", "rtol": 1e-6, "atol": 1e-8,
             "step": None}
@@ -123,9 +130,12 @@ class Run:
             raise Failure(reason, states)
 
 
-def simulate(model, t_end=None, n_points=None, method=None, rtol=None, atol=None,
-             params=None, t_start=0.0, step=None, jit=None, max_steps=None,
-             time_limit=None, progress=None, cancel=None, restart=False):
+def simulate(model: Model | System, t_end: float | None = None, n_points: int | None = None,
+             method: str | None = None, rtol: float | None = None, atol: float | None = None,
+             params: Mapping[str, float] | None = None, t_start: float = 0.0,
+             step: float | None = None, jit: bool | None = None, max_steps: int | None = None,
+             time_limit: float | None = None, progress: Callable[[float], object] | None = None,
+             cancel: Callable[[], object] | None = None, restart: bool = False) -> Results:
     """Integrate ``model`` (a Model or a compiled System) and record its probes.
 
     Settings not given come from the model's ``simulation`` block, then from DEFAULTS.

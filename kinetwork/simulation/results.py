@@ -5,12 +5,24 @@ measured), made where the quantity was defined; results, CSV columns and plots r
 guessing a shape from a size.
 """
 
+from __future__ import annotations
+
 import csv
 import io
+import os
+from collections.abc import Sequence
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
 from ..util import atomic_write, suggest
+
+if TYPE_CHECKING:                     # annotations only
+    from ..equations.signals import Signal
+    from ..equations.system import System
+    import pandas
+    import xarray
+    from matplotlib.figure import Figure
 
 
 class Results:
@@ -19,8 +31,10 @@ class Results:
     Scalars read as (n_points,), vectors as (n_points, 3), orientations as (n_points, 3, 3).
     """
 
-    def __init__(self, t, states, state_names, values, signals, stats=None, state_units=None,
-                 settings=None, probe_targets=None, system=None):
+    def __init__(self, t: np.ndarray, states: np.ndarray, state_names: Sequence[str],
+                 values: np.ndarray, signals: Sequence[Signal], stats: dict | None = None,
+                 state_units: Sequence[str] | None = None, settings: dict | None = None,
+                 probe_targets: dict[str, str] | None = None, system: System | None = None):
         self.t = np.asarray(t, dtype=float)
         self.states = np.asarray(states, dtype=float).reshape(len(self.t), len(state_names))
         self.state_names = list(state_names)
@@ -47,26 +61,26 @@ class Results:
             self._values[sig.name] = block.reshape(len(self.t), *sig.shape)
 
     @property
-    def method(self):
+    def method(self) -> str | None:
         """The integration method that produced these results (None if not recorded)."""
         return self.settings.get("method")
 
     @property
-    def signal_names(self):
+    def signal_names(self) -> list[str]:
         return list(self.signals)
 
     @property
-    def probes(self):
+    def probes(self) -> dict[str, list[str]]:
         """Probe name -> the quantities it recorded, in order."""
         out = {}
         for sig in self.signals.values():
             out.setdefault(sig.probe, []).append(sig.quantity)
         return out
 
-    def keys(self):
+    def keys(self) -> list[str]:
         return ["t", *self.signals, *self.state_names]
 
-    def __getitem__(self, key):
+    def __getitem__(self, key: str) -> np.ndarray:
         if key == "t":
             return self.t
         if key in self._values:
@@ -76,13 +90,13 @@ class Results:
         raise KeyError(f"{key!r:.200}{suggest(key, self.keys())}; available: "
                        f"{', '.join(self.keys())}")
 
-    def __contains__(self, key):
+    def __contains__(self, key: object) -> bool:
         return key == "t" or key in self._values or key in self.state_names
 
-    def __len__(self):
+    def __len__(self) -> int:
         return len(self.t)
 
-    def columns(self):
+    def columns(self) -> tuple[list[str], np.ndarray]:
         """(header, 2-D array) of the CSV: t, then every probe signal, vectors expanded."""
         header, cols = ["t"], [self.t[:, None]]
         for name, sig in self.signals.items():
@@ -90,7 +104,7 @@ class Results:
             cols.append(self._values[name].reshape(len(self.t), sig.size))
         return header, np.hstack(cols)
 
-    def to_csv(self, path):
+    def to_csv(self, path: str | os.PathLike) -> None:
         """Write t and every probe signal as CSV with a header row, atomically (a failed
         write leaves an old file whole). Partial results end with a comment line
         ``# partial: ...`` saying where and why the run stopped."""
@@ -109,7 +123,7 @@ class Results:
                 fh.write(text.getvalue())
         atomic_write(path, write)
 
-    def to_pandas(self, states=False):
+    def to_pandas(self, states: bool = False) -> pandas.DataFrame:
         """A ``pandas.DataFrame`` indexed by time ``t`` [s], one column per CSV column (vectors
         as ``name[0]``, ...); ``df.attrs["units"]`` maps every column to its unit, and
         ``df.attrs`` also holds the run's settings and, for a partial run, where it stopped.
@@ -129,7 +143,7 @@ class Results:
         frame.attrs["units"] = units
         return frame
 
-    def to_xarray(self, states=False):
+    def to_xarray(self, states: bool = False) -> xarray.Dataset:
         """An ``xarray.Dataset``: coordinate ``t`` [s], one variable per signal (vectors along
         ``axis`` = x, y, z; orientations along ``row``, ``col``), each with ``attrs["units"]``,
         the probe and the port measured; the run's settings in the dataset's attrs.
@@ -169,7 +183,7 @@ class Results:
             out["partial_reason"] = str(self.partial["reason"])
         return out
 
-    def summary(self):
+    def summary(self) -> str:
         """A few lines on the run: points, time span, method and counters, how it ended."""
         lines = [repr(self)]
         if self.method:
@@ -206,7 +220,7 @@ class Results:
                 figure = f"<p>(no plot: {html.escape(str(exc))})</p>"
         return f"<div class='kinetwork-results'><p>{text}</p>{table}{figure}</div>"
 
-    def plot(self, *names, **kwargs):
+    def plot(self, *names: str, **kwargs: Any) -> Figure:
         """Probe plots (a matplotlib Figure): every probe, or the probes and signals named
         (``res.plot("probe1.angle", "probe2")``); options as ``kinetwork.plot.plot_results``
         (``title``, ``hide_flat``, ``columns``, ...)."""
@@ -214,7 +228,7 @@ class Results:
             raise RuntimeError("no plotter installed: import kinetwork")
         return _plotter(self, *names, **kwargs)
 
-    def animate(self, path=None, **kwargs):
+    def animate(self, path: str | os.PathLike | None = None, **kwargs: Any) -> Any:
         """3-D animation of the run: a self-contained HTML page at ``path`` (the three.js
         player inlined, opens without a network) and ``gif=``/``mp4=`` videos; returns the
         Animation (see ``kinetwork.animation.animate`` for the options)."""

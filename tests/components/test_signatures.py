@@ -3,10 +3,14 @@ docstring and reference data are generated from its Param and Port declarations,
 same as the declarations (and as the compiled equations, for the units of joint coordinates).
 """
 
+import functools
 import inspect
 import json
+import pathlib
 import pydoc
+import typing
 
+import matplotlib.figure
 import pytest
 
 import kinetwork as kn
@@ -58,7 +62,8 @@ def test_every_parameter_has_a_doc_and_a_unit_pint_reads(type_name):
             continue
         # "" is the unit of a signal block's signal (any, converted to SI); nothing else may
         # leave its unit out ("1" is dimensionless)
-        assert spec.unit or type_name.startswith("signals."), f"{type_name}.{key}: no unit"
+        assert spec.unit or type_name.startswith("signals."), \
+            f"{type_name}.{key}: no unit (a dimensionless one is unit=\"1\")"
         for unit in (spec.unit if isinstance(spec.unit, tuple) else (spec.unit,)):
             assert units.check_unit(unit), f"{type_name}.{key}: pint cannot read {unit!r}"
 
@@ -109,3 +114,56 @@ def test_initial_values_carry_the_units_of_the_states_they_start(cls):
     speeds = [name for name in system.state_names if "qd" in name][:n]
     assert [units_of[c] for c in coords] == list(q0)
     assert [units_of[s] for s in speeds] == list(qd0)
+
+
+# -- type hints of the public API (issue 19, item 6) ------------------------------------------
+def _public_callables():
+    yield "kn.simulate", kn.simulate
+    yield "kn.load", kn.load
+    yield "kn.loads", kn.loads
+    yield "kn.dumps", kn.dumps
+    for cls in (kn.Model, kn.Results, kn.System):
+        for name, member in vars(cls).items():
+            if name.startswith("_") and name not in ("__init__", "__getitem__"):
+                continue
+            if isinstance(member, property):
+                member = member.fget
+            elif isinstance(member, functools.cached_property):
+                member = member.func
+            if callable(member):
+                yield f"{cls.__name__}.{name}", member
+
+
+PUBLIC = dict(_public_callables())
+ANNOTATED = ["kn.simulate", "kn.load", "kn.loads", "kn.dumps", "Model.__init__",
+             "Model.set_parameter", "Model.add", "Model.set_initial", "Model.expose",
+             "Model.connect", "Model.port", "Model.flat", "Model.parameter_values",
+             "Model.numeric_values", "Model.validate", "Model.compile", "Model.save",
+             "Results.__init__", "Results.__getitem__", "Results.keys", "Results.method",
+             "Results.probes", "Results.to_csv", "Results.to_pandas", "Results.to_xarray",
+             "Results.summary", "Results.plot", "Results.animate", "System.rhs",
+             "System.mass_matrix", "System.dynamics_terms", "System.x0", "System.outputs",
+             "System.initial_state", "System.param_vector", "System.n_states", "System.dof"]
+
+
+@pytest.mark.parametrize("name", ANNOTATED)
+def test_the_public_api_is_annotated_and_its_annotations_resolve(name):
+    func = PUBLIC[name]
+    sig = inspect.signature(func)
+    for p in sig.parameters.values():
+        if p.name != "self":
+            assert p.annotation is not inspect.Parameter.empty, f"{name}({p.name}) has no type"
+    if not name.endswith("__init__"):
+        assert sig.return_annotation is not inspect.Signature.empty, f"{name}: no return type"
+    # the names used only for annotations (imported under TYPE_CHECKING, as the layers ask)
+    # are the real ones: the hints resolve with kinetwork's public names and its optional
+    # libraries
+    names = {"Model": kn.Model, "System": kn.System, "Results": kn.Results,
+             "Topology": kn.graph.topology.Topology, "Signal": kn.equations.signals.Signal,
+             "pandas": pytest.importorskip("pandas"), "xarray": pytest.importorskip("xarray"),
+             "Figure": matplotlib.figure.Figure}
+    typing.get_type_hints(func, globalns={**func.__globals__, **names})
+
+
+def test_the_package_says_it_is_typed():
+    assert (pathlib.Path(kn.__file__).parent / "py.typed").is_file()
