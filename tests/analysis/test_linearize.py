@@ -1,6 +1,7 @@
 """kn.linearize against the paper's closed forms and finite differences of the nonlinear
 model; loops in their independent coordinates; inputs by open port or Input block."""
 
+import json
 import pathlib
 
 import numpy as np
@@ -10,7 +11,7 @@ import kinetwork as kn
 from kinetwork import cli
 from scenes import build_kinetwork, fourbar, random_mechanism, random_state
 
-from .plants import paper_A, seed_with_motor
+from .plants import paper_A, paper_pencil, seed_with_motor
 
 MODELS = pathlib.Path(__file__).resolve().parents[2] / "models"
 REST = np.zeros(4)
@@ -177,3 +178,16 @@ def test_computed_torque_control_linearises_to_its_error_dynamics(t, monkeypatch
     kp, kd = model.parameters["kp"], model.parameters["kd"]
     I = np.eye(2)
     np.testing.assert_allclose(lin.A, np.block([[0 * I, I], [-kp * I, -kd * I]]), atol=1e-9)
+
+
+def test_cli_takes_inputs_and_writes_json(tmp_path, capsys):
+    path = tmp_path / "motor.json"
+    seed_with_motor().save(path)
+    assert cli.main(["linearize", str(path), "--input", "motor.u", "--output", "elbow.q",
+                     "--at-state", "shoulder.q=0,elbow.q=0", "--json"]) == 0
+    out = json.loads(capsys.readouterr().out)
+    assert out["inputs"] == ["motor.u"] and out["input_units"] == ["N*m"]
+    M, _, _ = paper_pencil()
+    # d(elbow acceleration)/d(torque at the elbow) at rest: (M^-1)[1, 1] of the paper's M
+    assert out["B"][3][0] == pytest.approx(np.linalg.inv(M)[1, 1], rel=1e-12)
+    assert cli.main(["linearize", str(path), "--input", "motr.u"]) == 1
