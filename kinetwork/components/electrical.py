@@ -175,6 +175,28 @@ class CurrentSensor(PartialTwoPin, library=LIB):
         return e.i("p")
 
 
+class IdealOpAmp(Component, library=LIB):
+    """Ideal operational amplifier, a nullator-norator pair (MSL's Analog.Ideal.IdealOpAmp):
+    no voltage across and no current into the input port p1, n1; the output port p2, n2
+    carries whatever current the circuit needs, with i_p2 + i_n2 = 0."""
+    role = "electrical"
+    p1 = Port("electrical", "Positive pin of the input port")
+    n1 = Port("electrical", "Negative pin of the input port")
+    p2 = Port("electrical", "Positive pin of the output port")
+    n2 = Port("electrical", "Negative pin of the output port")
+    n_states = 0
+    state_labels = state_units = ()
+
+    def laws(self, e):
+        return [e.v("p1") - e.v("n1"), e.i("p1"), e.i("n1"), e.i("p2") + e.i("n2")]
+
+    def rates(self, e):
+        return []
+
+    def initial(self):
+        return []
+
+
 class EMF(PartialTwoPin, library=LIB):
     """Ideal electromechanical converter (MSL's Analog.Basic.EMF): v = k w and the torque
     k i on the flange, w the speed of the flange relative to the support; its reaction goes

@@ -236,3 +236,84 @@ def test_a_circuit_saves_and_loads(tmp_path):
     r1 = kn.simulate(m, t_end=0.2, n_points=3, jit=False)
     r2 = kn.simulate(again, t_end=0.2, n_points=3, jit=False)
     assert np.array_equal(r1["pl.current"], r2["pl.current"])
+
+
+def test_inverting_amplifier_of_an_ideal_op_amp():
+    """v_out = -R2/R1 v_in; the op-amp's output drives a load resistor."""
+    m = kn.Model("amp")
+    for c in (E.Ground("g"), E.VoltageSource("src", V="2*sin(3*t)"), E.Resistor("r1", R=1e3),
+              E.Resistor("r2", R=4.7e3), E.Resistor("load", R=100.0), E.IdealOpAmp("op"),
+              E.VoltageSensor("vm"), kn.Probe("pv", quantities=["value"])):
+        m.add(c)
+    for a, b in [("src.n", "g.p"), ("src.p", "r1.p"), ("r1.n", "op.n1"), ("op.n1", "r2.p"),
+                 ("r2.n", "op.p2"), ("op.p1", "g.p"), ("op.n2", "g.p"), ("op.p2", "load.p"),
+                 ("load.n", "g.p"), ("vm.p", "op.p2"), ("vm.n", "g.p"), ("pv.port", "vm.y")]:
+        m.connect(a, b)
+    res = kn.simulate(m, t_end=1.0, n_points=11, method="rk45", jit=False)
+    assert np.max(abs(res["pv.value"] + 4.7 * 2 * np.sin(3 * res.t))) < 1e-12
+
+
+def msl_robot_motor(J_load=0.3):
+    """MSL's RobotR3 motor (Modelica.Mechanics.MultiBody.Examples.Systems.RobotR3.Utilities
+    .Motor) wired part for part: a current controller of three ideal op-amps (difference
+    amplifier, integrator, power stage) driving Ra, La and the EMF, the current fed back
+    through hall1 and hall2; the shaft turns a load inertia. Started as MSL starts it, in
+    steady state: der(C.v) = 0, der(La.i) = 0."""
+    J, k, w, D = 0.0013, 1.1616, 4590.0, 0.6
+    m = kn.Model("motor")
+    parts = [E.VoltageSource("Vs"), E.IdealOpAmp("power"), E.IdealOpAmp("diff"),
+             E.EMF("emf", k=k), E.Inductor("La", L=250 / (2 * D * w)), E.Resistor("Ra", R=250),
+             E.Resistor("Rd2", R=100), E.Capacitor("C", C=0.004 * D / w), E.IdealOpAmp("OpI"),
+             E.Resistor("Ri", R=10), E.Resistor("Rd1", R=100), E.Resistor("Rp1", R=200),
+             E.Resistor("Rp2", R=50), E.Resistor("Rd4", R=100), E.VoltageSource("hall2"),
+             E.Resistor("Rd3", R=100), E.CurrentSensor("hall1"),
+             *[E.Ground(f"g{i}") for i in range(1, 6)],
+             kn.rotational.Inertia("Jmotor", J=J), kn.rotational.Inertia("load", J=J_load),
+             kn.signals.Gain("convert1", k=1.0), kn.signals.Gain("convert2", k=1.0),
+             kn.signals.Sine("current_ref", amplitude=1.0, f=20.0, offset=0.5),
+             kn.Probe("pw", quantities=["speed"]), kn.Probe("pi", quantities=["value"])]
+    for c in parts:
+        m.add(c)
+    for a, b in [("La.n", "emf.p"), ("Ra.n", "La.p"), ("Rd2.n", "diff.n1"), ("C.n", "OpI.p2"),
+                 ("OpI.p2", "power.p1"), ("Vs.p", "Rd2.p"), ("diff.n1", "Rd1.p"),
+                 ("Rd1.n", "diff.p2"), ("diff.p2", "Ri.p"), ("Ri.n", "OpI.n1"),
+                 ("OpI.n1", "C.p"), ("power.n1", "Rp1.p"), ("power.p2", "Rp1.n"),
+                 ("Rp1.p", "Rp2.p"), ("power.p2", "Ra.p"), ("Rd3.p", "hall2.p"),
+                 ("Rd3.n", "diff.p1"), ("Rd3.n", "Rd4.p"), ("Vs.n", "g1.p"), ("g2.p", "hall2.n"),
+                 ("Rd4.n", "g3.p"), ("g3.p", "OpI.p1"), ("g5.p", "Rp2.n"), ("emf.n", "hall1.p"),
+                 ("hall1.n", "g4.p"), ("OpI.n2", "power.n2"), ("OpI.p1", "OpI.n2"),
+                 ("OpI.p1", "diff.n2"), ("hall1.y", "convert1.u"), ("convert1.y", "hall2.u"),
+                 ("current_ref.y", "convert2.u"), ("convert2.y", "Vs.u"),
+                 ("emf.flange", "Jmotor.flange_a"), ("Jmotor.flange_b", "load.flange_a"),
+                 ("pw.port", "load.flange_b"), ("pi.port", "hall1.y")]:
+        m.connect(a, b)
+    m.set_initial(derivatives={"C.v": 0, "La.i": 0}, solve=["C.v", "La.i"])
+    return m, dict(J=J + J_load, k=k, La=250 / (2 * D * w), Ra=250.0, C=0.004 * D / w, Ri=10.0)
+
+
+def test_msl_robot_motor_against_its_circuit_by_nodal_analysis():
+    """By hand: the difference amplifier gives i - i_ref, the op-amp integrator
+    dv_C/dt = (i - i_ref) / (Ri C) at its virtual ground, the power stage 5 (-v_C) (gain
+    1 + Rp1/Rp2), so La di/dt = -5 v_C - Ra i - k w and J dw/dt = k i."""
+    m, p = msl_robot_motor()
+    system = m.compile()
+    # only the inductor's current, the capacitor's voltage and the load's motion are states
+    assert sorted(system.state_names) == ["C.v", "Jmotor.phi", "Jmotor.w", "La.i"]
+    # MSL's steady start: the current on its reference (0.5 A at t = 0), the power stage
+    # holding Ra i against no back EMF
+    x0 = dict(zip(system.state_names, system.x0))
+    assert x0["La.i"] == pytest.approx(0.5, rel=1e-10)
+    assert x0["C.v"] == pytest.approx(-p["Ra"] * 0.5 / 5, rel=1e-10)
+    res = kn.simulate(system, t_end=0.05, n_points=11, **TOL)
+    # x = (i, v_C, w) is linear, x' = A x + b(t) with i_ref = 0.5 + sin(W t): the state
+    # augmented with (sin, cos, 1) evolves by one matrix exponential, the closed form
+    W, rc = 2 * np.pi * 20, p["Ri"] * p["C"]
+    M = np.zeros((6, 6))
+    M[:3, :3] = [[-p["Ra"] / p["La"], -5 / p["La"], -p["k"] / p["La"]], [1 / rc, 0, 0],
+                 [p["k"] / p["J"], 0, 0]]
+    M[1, 3], M[1, 5] = -1 / rc, -0.5 / rc            # - i_ref / (Ri C)
+    M[3, 4], M[4, 3] = W, -W                          # (sin, cos)' = (W cos, -W sin)
+    z0 = np.array([0.5, -25.0, 0.0, 0.0, 1.0, 1.0])
+    ref = np.array([scipy.linalg.expm(M * t) @ z0 for t in res.t]).T
+    assert np.max(abs(res["pi.value"] - ref[0])) < 1e-7
+    assert np.max(abs(res["pw.speed"] - ref[2])) < 1e-7
