@@ -114,7 +114,7 @@ def sweep(model, grid, *, params=None, t_end=None, n_points=None, method=None, r
         use). Not used on Dask, whose workers are the cluster's.
     batch : int, optional
         Members integrated together in one integrator (default: the members shared evenly by
-        the workers, at most MAX_BATCH).
+        the workers, rounded up to a power of two, at most MAX_BATCH).
     scheduler : None, "local", address or distributed.Client
         None: this process, in threads. "local": a Dask LocalCluster on this machine, made
         for the sweep and closed after it. "tcp://host:8786": the Dask scheduler there. A
@@ -582,8 +582,8 @@ def _run(system, names, values, layout, params, t_end, n_points, method, rtol, a
         if v is not None and (isinstance(v, bool) or not isinstance(v, (int, np.integer))
                               or v < 1):
             raise ModelError(f"{what}: must be a positive integer, got {v!r:.40}")
-    if batch is None:
-        batch = max(1, min(MAX_BATCH, math.ceil(n / workers)))
+    if batch is None:       # a power of two: sweeps of other sizes reuse the compiled batch
+        batch = min(MAX_BATCH, 1 << max(0, math.ceil(n / workers) - 1).bit_length())
     outcome = Outcome(job, n)
     done = np.zeros(n, dtype=bool)
     started = time.perf_counter()
@@ -640,7 +640,7 @@ def _dask(job, values, batch, scheduler, outcome, done, report):
     if isinstance(scheduler, Client):
         client = scheduler
     elif scheduler == "local":
-        cluster = LocalCluster(threads_per_worker=1, dashboard_address=None)
+        cluster = LocalCluster(threads_per_worker=1, dashboard_address=":0")
         client = Client(cluster)
         own = [client, cluster]
     elif isinstance(scheduler, str) and "://" in scheduler:

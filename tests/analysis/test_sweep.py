@@ -181,7 +181,7 @@ def test_dask_cluster_gives_the_local_numbers():
     local = kn.sweep(model, grid, batch=2, workers=1, t_end=0.5, n_points=51, jit=False,
                      progress=False)
     with distributed.LocalCluster(n_workers=1, threads_per_worker=1, processes=False,
-                                  dashboard_address=None) as cluster, \
+                                  dashboard_address=":0") as cluster, \
             distributed.Client(cluster) as client:
         ds = kn.sweep(model, grid, batch=2, scheduler=client, t_end=0.5, n_points=51,
                       jit=False, progress=False)
