@@ -173,7 +173,7 @@ class _Problem:
 
 def solved(system, params=None):
     """The unknowns of the model's ``initial`` block as solved for ``params``: {name: value}
-    (parameters and states), empty without initial equations."""
+    (parameters and states), empty without initial equations (``System.initial_values``)."""
     p = np.array([system.model.parameter_values(params)[k] for k in system.param_names],
                  dtype=float)
     x0 = system.eq.initial(p)[0]

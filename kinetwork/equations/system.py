@@ -222,6 +222,12 @@ class System:
         derivatives, parameters solved from the start."""
         return InitialEquations(self)
 
+    def initial_values(self, params=None):
+        """What the model's initial equations solved for ``params``: {name: value} of the
+        unknown states and parameters (``Model.set_initial``); empty without them."""
+        from .initial import solved
+        return solved(self, params)
+
     @property
     def n_states(self) -> int:
         return len(self.state_names)

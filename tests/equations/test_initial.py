@@ -36,6 +36,7 @@ def test_init_spring_constant_on_a_rotational_spring():
     m.set_initial(steady=True, fixed=["rev.q"], solve=["c"])
     c = MASS * G * ARM * np.cos(0.3) / 0.3          # c (0 - q0) = m g l cos q0
     assert solved(m.compile()) == pytest.approx({"c": c, "rev.qd": 0.0}, rel=1e-12, abs=1e-12)
+    assert m.compile().initial_values({"c": 10.0})["c"] == pytest.approx(c, rel=1e-12)
     res = kn.simulate(m, t_end=1.0, n_points=5, rtol=1e-10, atol=1e-12, jit=False)
     assert np.max(abs(res["p.angle"] + 0.3)) < 1e-9 and np.max(abs(res["p.speed"])) < 1e-8
     # the same from a given derivative: no acceleration at the start, c the unknown
