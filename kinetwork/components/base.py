@@ -105,13 +105,15 @@ class Param:
     "#rrggbb".
 
     ``unit`` is the SI unit of the value ("1": dimensionless; "": any, as a signal block's
-    gain, in the unit of its signal), or one unit per entry of a vector (a tuple).
+    gain, in the unit of its signal), or one unit per entry of a vector (a tuple: kept in
+    ``entry_units``, while ``unit`` reads "rad, m" for whoever shows it).
     """
 
     def __init__(self, default=REQUIRED, *, unit="", min=None, max=None, shape=(), doc="",
                  time=False, optional=False, nonzero=False, kind="real", choices=None,
                  name=None, positive=False):
-        self.default, self.unit, self.min, self.max = default, unit, min, max
+        self.default, self.min, self.max = default, min, max
+        self._set_unit(unit)
         self.shape, self.doc, self.time, self.optional = tuple(shape), doc, time, optional
         self.nonzero, self.kind, self.choices = nonzero, kind, choices
         self.positive = positive
@@ -134,11 +136,15 @@ class Param:
     def required(self):
         return self.default is REQUIRED
 
+    def _set_unit(self, unit):
+        self.entry_units = tuple(unit) if isinstance(unit, (tuple, list)) else None
+        self.unit = ", ".join(unit) if self.entry_units else unit
+
     def unit_at(self, index=None):
-        """The unit of entry ``index`` of a vector (a tuple ``unit`` has one per entry), or of
-        the whole value."""
-        if isinstance(self.unit, tuple):
-            return self.unit[index] if index is not None else ", ".join(self.unit)
+        """The unit of entry ``index`` of a vector (with ``entry_units``, one per entry), or
+        of the whole value."""
+        if self.entry_units and index is not None:
+            return self.entry_units[index]
         return self.unit
 
     def describe(self):
@@ -149,7 +155,8 @@ class Param:
         """The declaration as data (JSON-ready): what the docs, the schema and the studio's
         palette show."""
         return {"name": self.name, "kind": self.kind,
-                "unit": list(self.unit) if isinstance(self.unit, tuple) else self.unit,
+                "unit": self.unit,
+                "entry_units": list(self.entry_units) if self.entry_units else None,
                 "shape": list(self.shape), "required": self.required,
                 "default": None if self.required else _plain(self.default),
                 "min": self.min, "max": self.max, "positive": self.positive,
@@ -165,7 +172,7 @@ class Param:
         if self.unit == RATES:
             coords = tuple(f"{u}/s" if u else "1/s" for u in coords)
         twin = copy.copy(self)
-        twin.unit = coords[0] if self.shape == () else coords
+        twin._set_unit(coords[0] if self.shape == () else coords)
         twin.__doc__ = twin.describe()
         return twin
 

@@ -103,7 +103,7 @@ def _value(value):
 def param_line(info):
     """The numpydoc type line of one parameter: ``kg, >= 0, required``."""
     parts = []
-    unit = ", ".join(info["unit"]) if isinstance(info["unit"], list) else info["unit"]
+    unit = info["unit"]
     if info["kind"] == "real":
         parts.append(unit if unit else "unit of the signal")
         shape = info["shape"]
