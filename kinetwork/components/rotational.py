@@ -126,7 +126,7 @@ class IdealGear(PartialRigid, library=LIB):
     gear_ratio = Param(unit="1", name="ratio", nonzero=True,
                        doc="flange_a angle / flange_b angle")
 
-    eta = Param(1.0, unit="", positive=True, max=1.0,
+    eta = Param(1.0, unit="1", positive=True, max=1.0,
                 doc="Efficiency (1: lossless, no mode; below 1: the loss of the driven side)")
 
     def ratio(self):
