@@ -24,6 +24,7 @@ from types import SimpleNamespace
 
 import numpy as np
 
+from ..errors import ModelError
 from .compiled import numeric
 from .methods import Failure
 
@@ -37,7 +38,8 @@ SAMPLES = 4
 MAX_EVENTS = 100_000
 #: mode changes at one instant at most (a cascade through coupled elements)
 MAX_CASCADE = 50
-#: events at the same instant (within this many seconds) at most before the run stops
+#: events closer than SAME_INSTANT seconds count as at one instant; ZENO_LIMIT of them in a
+#: row stop the run (modes chattering without time passing)
 SAME_INSTANT = 1e-13
 ZENO_LIMIT = 200
 #: trial intervals shorter than this (relative to the time) are stepped by RK4 directly
@@ -92,7 +94,6 @@ class Events:
             try:
                 mode, after, _ = comp.first_mode(self._numbers(t, x, i))
             except ValueError as exc:
-                from ..errors import ModelError
                 raise ModelError(f"{comp.name}: {exc} at the start") from None
             x[self.modes.mode_index[i]] = mode
             if after is not None:
@@ -167,7 +168,8 @@ class Events:
                     if best is None or t_i < best[0]:
                         best = (t_i, i)
                     continue
-            if g(t1) == 0.0:
+            if g(t1) >= 0.0:
+                # at t1 itself, or (integrated again from t0) just short of crossing there
                 t_i = t1
             else:
                 t_i = brentq(g, start, t1, xtol=1e-15, rtol=4 * np.finfo(float).eps,
