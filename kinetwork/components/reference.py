@@ -53,11 +53,14 @@ def _quantities(domain):
             for name, q in QUANTITIES.get(domain, {}).items()]
 
 
-def _description(doc):
-    """A written docstring without its "Parameters" section (generated instead) and without
-    its summary line."""
-    parts = doc.split("\n", 1)
-    body = parts[1].strip() if len(parts) > 1 else ""
+def _paragraphs(doc):
+    """(summary, description) of a written docstring: its first paragraph, and the rest
+    without its "Parameters" section (generated instead)."""
+    summary, _, body = doc.strip().partition("\n\n")
+    return summary, _description(body)
+
+
+def _description(body):
     headers = list(_SECTION.finditer(body))
     for i, header in enumerate(headers):
         if header["title"].strip() == "Parameters":
@@ -69,17 +72,18 @@ def _description(doc):
 
 def reference(cls):
     """Everything the declarations say about component type ``cls`` (a class; ``REGISTRY``
-    gives it for a file's type name "multibody.RigidBody"), as JSON-ready data: type, summary, description,
-    signature, parameters (unit, default, bounds, doc) and ports (domain, doc, and what a
-    probe wired there records). The docstring, the JSON Schema's descriptions and the
-    studio's palette are made from it.
+    gives it for a file's type name "multibody.RigidBody"), as JSON-ready data: type,
+    summary, description, signature, parameters (unit, default, bounds, doc) and ports
+    (domain, doc, and what a probe wired there records). The docstring, the JSON Schema's
+    descriptions, the documentation's component pages and the studio's palette are made
+    from it.
 
     A module function, not a method: a component may call a parameter anything."""
-    doc = cls._own_doc or ""
+    summary, description = _paragraphs(cls._own_doc or "")
     return {
         "type": cls.type_name,
-        "summary": doc.split("\n", 1)[0].strip(),
-        "description": _description(doc),
+        "summary": " ".join(summary.split()),
+        "description": description,
         "signature": f"{cls.__name__}{signature(cls)}",
         "params": [spec.info() for spec in cls.params.values()],
         "ports": [{"name": name, "domain": port.domain, "doc": port.doc,
@@ -136,7 +140,7 @@ def docstring(cls):
     """The docstring ``help(cls)`` shows: the written one, its parameters, ports and probe
     quantities generated from the declarations."""
     ref = reference(cls)
-    out = [ref["summary"]]
+    out = [_paragraphs(cls._own_doc or "")[0]]             # wrapped as written
     if ref["description"]:
         out += ["", ref["description"]]
     if ref["params"]:

@@ -75,7 +75,9 @@ def test_the_docstring_and_the_data_say_the_same(type_name):
     ref = reference(cls)
     json.dumps(ref)                                   # data, ready for the studio and docs
     doc = inspect.getdoc(cls)
-    assert doc.startswith(ref["summary"])
+    assert " ".join(doc.split()).startswith(ref["summary"])
+    assert ref["summary"] == " ".join(cls._own_doc.partition("\n\n")[0].split()), \
+        "the summary is the whole first paragraph"
     for info in ref["params"]:
         assert f"{info['name']} : {param_line(info)}\n    {info['doc']}" in doc
     for port in ref["ports"]:
