@@ -148,7 +148,8 @@ class Param:
         return self.unit
 
     def describe(self):
-        unit = self.unit_at()
+        unit = {COORDINATES: "unit of the joint coordinates",
+                RATES: "unit of their rates"}.get(self.unit, self.unit)
         return f"{self.doc} [{unit}]" if unit else self.doc
 
     def info(self):

@@ -148,7 +148,7 @@ def docstring(cls):
         for info in ref["params"]:
             out += [f"{info['name']} : {param_line(info)}", f"    {info['doc']}"]
         out += ["", "A value in another unit is written with it (\"5 mm\", \"30 deg\"): it "
-                "is converted to the unit above."]
+                "is converted to the unit above (1: dimensionless)."]
     if ref["ports"]:
         out += ["", "Ports", "-----"]
         for port in ref["ports"]:
