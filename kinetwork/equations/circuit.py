@@ -50,6 +50,7 @@ class Circuit:
         self.inputs = {}                           # placeholder -> signal set of its u
         self.sources = {}                          # component name -> its placeholder
         self.views = {}
+        self.summary = ""
 
     # -- building ---------------------------------------------------------------------------
     def build(self):
@@ -197,6 +198,13 @@ class Circuit:
             if assigned[i] != j:
                 dep.add_edge(owner_of[j], i)      # equation i needs what owner_of[j] gives
         dag = nx.condensation(dep)
+        sizes = sorted((len(dag.nodes[c]["members"]) for c in dag), reverse=True)
+        loops = [n for n in sizes if n > 1]
+        states = sum(len(v.x) for v in self.views.values())
+        self.summary = (f"circuits: {len(unknowns) - len(self.current)} node potentials and "
+                        f"{len(self.current)} pin currents in {len(sizes)} blocks solved "
+                        f"symbolically" + (f" (linear loops of {', '.join(map(str, loops))})"
+                                           if loops else "") + f", {states} states")
         solved = {}
         known_z, known_v = [], []
         for c in nx.topological_sort(dag):

@@ -69,6 +69,8 @@ class Network:
     prescribed: dict = field(default_factory=dict)
     #: elements with modes (friction, stops), in the order placed: ``Hybrid`` records
     hybrid: list = field(default_factory=list)
+    #: what structural analysis made of the circuits (``circuit.Circuit.summary``)
+    circuit: str = ""
 
     def summary(self, topo):
         """A line on what structural analysis made of the 1-D network and the blocks."""
@@ -91,6 +93,8 @@ class Network:
                 f"; nonlinear algebraic loops kept as algebraic variables: "
                 f"{len(self.loops_kept)} ({len(self.alg_z)} variables)" if self.loops_kept
                 else "")
+        if self.circuit:
+            out += ("; " if out else "") + self.circuit
         return out
 
 
@@ -181,6 +185,7 @@ class _Builder:
         # torques are known before any balance (``circuit.py``)
         self.circuit = Circuit(self).build()
         self.circuit.fill(self.net)
+        self.net.circuit = self.circuit.summary
         self._flows("compliant")               # springs and dampers need no signal
         self._passive = ca.SX.zeros(self.u.shape[0])
         for group in self.topo.oned:
