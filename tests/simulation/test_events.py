@@ -40,7 +40,7 @@ def test_a_ball_bounces_twenty_times_at_the_closed_form_times(method):
     e = 0.9
     times, _ = bounce_times(e, 21)
     res = kn.simulate(ball(e), t_end=float(times[19] + 0.05), n_points=151, method=method,
-                      rtol=1e-12, atol=1e-14, step=1e-3, jit=False)
+                      rtol=1e-12, atol=1e-14, step=1e-2, jit=False)
     events = res.stats["events"]
     assert [(ev["component"], ev["kind"]) for ev in events] == [("floor_stop", "impact")] * 20
     assert np.max(np.abs([ev["t"] for ev in events] - times[:20])) < 1e-9
@@ -69,9 +69,9 @@ def test_every_method_locates_a_stop_of_friction(method):
 
 
 def test_a_ball_without_a_rest_speed_comes_to_rest_where_its_bounces_accumulate():
-    # e = 0.3: the flights sum to t_inf = sqrt(2H/g) + 2 v1 e / (g (1 - e)); the bounces
+    # e = 0.2: the flights sum to t_inf = sqrt(2H/g) + 2 v1 e / (g (1 - e)); the bounces
     # beyond the tolerance end resting, not falling through the floor
-    e = 0.3
+    e = 0.2
     v1 = np.sqrt(2 * G * H)
     t_inf = np.sqrt(2 * H / G) + 2 * v1 * e / (G * (1 - e))
     res = kn.simulate(ball(e, v_rest=0.0), t_end=1.0, n_points=11, method="rk45",
