@@ -4,7 +4,7 @@ VENV   := .venv
 PY     := $(VENV)/bin/python
 OUT    := demo
 
-.PHONY: demo test bench frontend clean
+.PHONY: demo test docs bench frontend clean
 
 # the demo needs only the core; the tests add their extras (pinocchio, MuJoCo, the browser
 # tooling) to the same environment
@@ -26,6 +26,11 @@ demo: $(VENV)/.core
 test: $(VENV)/.installed
 	$(PY) -m pytest -q
 
+# the documentation site in site/, every warning an error (its code blocks run in make test)
+docs: $(VENV)/.installed
+	$(PY) -m pip install --quiet -e ".[docs]"
+	NO_MKDOCS_2_WARNING=1 $(PY) -m mkdocs build --strict -d site
+
 bench: $(VENV)/.installed
 	$(PY) bench/run.py
 
@@ -35,4 +40,4 @@ frontend:
 	cd frontend && npm ci && npm run build
 
 clean:
-	rm -rf $(VENV) $(OUT) .pytest_cache
+	rm -rf $(VENV) $(OUT) site .pytest_cache

@@ -1,0 +1,132 @@
+"""Every code block of the README and the documentation runs, so the docs cannot rot.
+
+A page's ``python`` blocks run in order in one namespace, in a fresh folder holding a copy of
+``models/`` (as a reader who cloned the repository, or ran ``kinetwork examples copy``, has).
+Setup a reader need not see goes in an HTML comment right before a block:
+
+    <!-- setup
+    model = kn.load("models/fourbar.json")
+    -->
+
+``sh`` blocks run their ``kinetwork ...`` lines through the CLI's ``main`` and must exit 0
+(or the code a trailing ``# exits N`` names); lines that set up a machine (``make``, ``pip``,
+``npm``, ``cd``) and ``kinetwork studio`` (a server that runs until stopped) are not run.
+``json`` blocks that are whole model files (``"format": "kinetwork.model"``) must load.
+"""
+
+import contextlib
+import io
+import json
+import os
+import pathlib
+import re
+import shlex
+import shutil
+import warnings
+
+import matplotlib
+import pytest
+
+ROOT = pathlib.Path(__file__).resolve().parents[1]
+PAGES = [ROOT / "README.md"] + sorted((ROOT / "docs").rglob("*.md"))
+BLOCK = re.compile(r"(?:<!--\s*setup\s*\n(?P<setup>.*?)-->\s*\n)?^```(?P<lang>[\w-]*)[^\n]*\n"
+                   r"(?P<code>.*?)^```\s*$", re.S | re.M)
+NOT_RUN = ("make", "pip", "npm", "cd", "git", "python", "open", "mkdocs")
+EXITS = re.compile(r"#\s*exits\s+(\d+)")
+
+matplotlib.use("Agg")
+
+
+def blocks(page):
+    return [(m.group("lang"), m.group("setup") or "", m.group("code"),
+             page.read_text()[:m.start()].count("\n") + 1)
+            for m in BLOCK.finditer(page.read_text())]
+
+
+def page_id(page):
+    return page.relative_to(ROOT).as_posix()
+
+
+@pytest.fixture
+def reader_folder(tmp_path, monkeypatch):
+    shutil.copytree(ROOT / "models", tmp_path / "models")
+    shutil.copytree(ROOT / "tests" / "data", tmp_path / "data")
+    shutil.copy(ROOT / "tests" / "data" / "industrial_arm.urdf", tmp_path / "robot.urdf")
+    monkeypatch.chdir(tmp_path)
+    return tmp_path
+
+
+@pytest.mark.parametrize("page", [p for p in PAGES if blocks(p)], ids=page_id)
+def test_page_runs(page, reader_folder):
+    import matplotlib.pyplot as plt
+
+    from kinetwork.cli import main
+    scope = {"__name__": "__docs__"}
+    for lang, setup, code, line in blocks(page):
+        where = f"{page_id(page)}:{line}"
+        if lang == "python":
+            source = setup + "\n" * max(1, line - setup.count("\n") - 1) + code
+            with warnings.catch_warnings():
+                warnings.simplefilter("ignore", UserWarning)     # our own idealised examples
+                exec(compile(source, page_id(page), "exec"), scope)  # our own docs
+            plt.close("all")
+        elif lang in ("sh", "bash", "console"):
+            for command in _commands(code):
+                expected = int(EXITS.search(command).group(1)) if EXITS.search(command) else 0
+                argv = shlex.split(command, comments=True)[1:]
+                target = None
+                if ">" in argv:                             # kinetwork schema > file.json
+                    target = argv[argv.index(">") + 1]
+                    argv = argv[:argv.index(">")]
+                with contextlib.redirect_stdout(io.StringIO()) as out, \
+                        contextlib.redirect_stderr(io.StringIO()) as err:
+                    try:
+                        code_ = main(argv)
+                    except SystemExit as exc:
+                        code_ = exc.code
+                if target:
+                    pathlib.Path(target).write_text(out.getvalue())
+                assert code_ == expected, (f"{where}: {command!r} exited {code_}:\n"
+                                           f"{out.getvalue()[-2000:]}{err.getvalue()[-2000:]}")
+        elif lang == "json":
+            data = json.loads(code)
+            if data.get("format") == "kinetwork.model":
+                import kinetwork as kn
+                kn.loads(code)
+
+
+def _commands(code):
+    for raw in code.splitlines():
+        line = raw.strip()
+        if not line or line.startswith("#"):
+            continue
+        if line.startswith("$ "):
+            line = line[2:]
+        word = line.split()[0]
+        if word in NOT_RUN or (word == "kinetwork" and line.split()[1:2] == ["studio"]):
+            continue
+        if word != "kinetwork":
+            raise AssertionError(f"a shell line the docs test does not know how to run: {line!r}"
+                                 f" (add it to NOT_RUN in tests/test_docs.py if it sets up a "
+                                 f"machine)")
+        yield line
+
+
+def test_every_page_is_in_the_site_navigation():
+    """mkdocs.yml lists every page of docs/, so none is built unreachable."""
+    config = (ROOT / "mkdocs.yml").read_text()
+    for page in (ROOT / "docs").rglob("*.md"):
+        rel = page.relative_to(ROOT / "docs").as_posix()
+        if not rel.startswith(("reference/generated", "includes/")):
+            assert rel in config, f"{rel} is not in mkdocs.yml's nav"
+
+
+def test_docs_build_without_warnings(tmp_path):
+    """``mkdocs build --strict``: a broken link, a missing page or a bad docstring fails."""
+    import subprocess
+    import sys
+    run = subprocess.run([sys.executable, "-m", "mkdocs", "build", "--strict", "-q", "-d",
+                          str(tmp_path / "site")], cwd=ROOT, capture_output=True, text=True,
+                         env={**os.environ, "NO_MKDOCS_2_WARNING": "1"})
+    assert run.returncode == 0, run.stdout[-3000:] + run.stderr[-3000:]
+    assert (tmp_path / "site" / "reference" / "components" / "index.html").is_file()
