@@ -28,23 +28,28 @@ import collections
 import itertools
 import math
 import os
+import tempfile
 import threading
 import time
-import tempfile
 
 import casadi as ca
 import numpy as np
 
 from ..equations.system import OVERFLOW, System, overflow_message
 from ..errors import ModelError, SimulationError
-from ..graph.model import evaluate
 from ..expr import parse
+from ..graph.model import evaluate
 from ..simulation import jit as _jit
 from ..simulation.capture import SOLVER_LOCK, solver_output
 from ..simulation.compiled import compiled
-from ..simulation.driver import DEFAULTS, _check as check_settings, simulate
-from ..simulation.methods import METHODS, solver_reason
-from ..simulation.methods import STIFF_HORIZON_STEPS, STIFF_RATIO
+from ..simulation.driver import DEFAULTS, simulate
+from ..simulation.driver import _check as check_settings
+from ..simulation.methods import (
+    METHODS,
+    STIFF_HORIZON_STEPS,
+    STIFF_RATIO,
+    solver_reason,
+)
 from ..util import suggest
 
 #: members per batch at most (the tolerances of a batch are divided by sqrt(B))
@@ -663,7 +668,7 @@ def _dask(job, values, batch, scheduler, outcome, done, report):
             idx = futures[fut]
             try:
                 part = fut.result()
-            except Exception as exc:       # the task itself failed (a worker lost): say so
+            except Exception as exc:  # noqa: BLE001  (a worker lost: the members say so)
                 part = Outcome(job, len(idx))
                 for k in range(len(idx)):
                     part.fail(k, f"the Dask task failed: {type(exc).__name__}: {exc}")
@@ -855,7 +860,7 @@ def run_command(args, model):
 def summary(ds):
     """A line per member: its parameter values, then the last value of each scalar probe
     signal, or its status and reason."""
-    dims = [d for d in ds.status.dims]
+    dims = list(ds.status.dims)
     probes = [n for n, v in ds.data_vars.items()
               if v.attrs.get("kind") == "probe" and v.dims == tuple(dims) + ("time",)]
     lines = ["  ".join(dims + probes)]
@@ -866,8 +871,8 @@ def summary(ds):
         if member.status.item() == "ok":
             lines.append("  ".join(head + [f"{member[p].values[-1]:.6g}" for p in probes]))
         else:
-            lines.append("  ".join(head + [f"{member.status.item()}: "
-                                           f"{member.reason.item()}"]))
+            why = f"{member.status.item()}: {member.reason.item()}"
+            lines.append("  ".join([*head, why]))
     return "\n".join(lines)
 
 

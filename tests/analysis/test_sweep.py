@@ -10,11 +10,11 @@ import pickle
 import numpy as np
 import pytest
 import scipy.stats
+from scenes import double_pendulum
+from scenes.reference import seed_reference
 
 import kinetwork as kn
 from kinetwork.analysis.sweep import Job, run_batch
-from scenes import double_pendulum
-from scenes.reference import seed_reference
 
 xr = pytest.importorskip("xarray")
 
