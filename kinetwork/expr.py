@@ -2,7 +2,9 @@
 
 Strings are parsed with :mod:`ast` and only numbers, names, arithmetic operators and a fixed
 set of functions are accepted; nothing from a string is ever executed. ``^`` is a power, as in
-Modelica and Maple (``"L^2"`` is ``L**2``). An expression is
+Modelica and Maple (``"L^2"`` is ``L**2``). Conditionals are a function, as CasADi's:
+``if_else(v < 0, a, b)`` with one comparison (``< <= > >= == !=``, true is 1 and false 0) as its
+condition, so a piecewise law such as MSL's GasForce2 is one expression. An expression is
 evaluated over any numeric type that supports arithmetic (floats, CasADi SX), so the same
 parsed tree serves validation with numbers and compilation with symbols.
 """
@@ -22,15 +24,20 @@ FUNCTIONS = {
     "sinh": math.sinh, "cosh": math.cosh, "tanh": math.tanh,
     "exp": math.exp, "log": math.log, "sqrt": math.sqrt, "abs": abs,
     "min": min, "max": max, "sign": lambda x: math.copysign(1.0, x) if x else 0.0,
+    "if_else": lambda cond, a, b: a if cond else b,
 }
 CONSTANTS = {"pi": math.pi, "e": math.e}
 #: how many arguments each function takes (CasADi's fmin/fmax take two, as does atan2)
-ARITY = {**{name: 1 for name in FUNCTIONS}, "atan2": 2, "min": 2, "max": 2}
+ARITY = {**{name: 1 for name in FUNCTIONS}, "atan2": 2, "min": 2, "max": 2, "if_else": 3}
 
 _BINARY = {ast.Add: lambda a, b: a + b, ast.Sub: lambda a, b: a - b,
            ast.Mult: lambda a, b: a * b, ast.Div: lambda a, b: a / b,
            ast.Pow: lambda a, b: a ** b}
 _UNARY = {ast.USub: lambda a: -a, ast.UAdd: lambda a: a}
+#: comparisons give 1 or 0 over numbers, a CasADi comparison over symbols
+_COMPARE = {ast.Lt: lambda a, b: a < b, ast.LtE: lambda a, b: a <= b,
+            ast.Gt: lambda a, b: a > b, ast.GtE: lambda a, b: a >= b,
+            ast.Eq: lambda a, b: a == b, ast.NotEq: lambda a, b: a != b}
 #: how a refused operator is written, to name it in the message
 _SYMBOLS = {ast.Mod: "%", ast.FloorDiv: "//", ast.MatMult: "@", ast.BitAnd: "&",
             ast.BitOr: "|", ast.LShift: "<<", ast.RShift: ">>", ast.Invert: "~",
@@ -46,7 +53,7 @@ _CONSTRUCTS = {ast.IfExp: "a conditional (x if c else y)", ast.Subscript: "index
                ast.ListComp: "a comprehension", ast.GeneratorExp: "a comprehension",
                ast.SetComp: "a comprehension", ast.DictComp: "a comprehension",
                ast.Slice: "a slice"}
-_ALLOWED = "numbers, parameter names, + - * / ** ^ and functions"
+_ALLOWED = "numbers, parameter names, + - * / ** ^, one comparison and functions"
 _MAX_LENGTH = 2000
 
 
@@ -96,6 +103,13 @@ class Expression:
             self._check(node.right)
         elif isinstance(node, ast.UnaryOp) and type(node.op) in _UNARY:
             self._check(node.operand)
+        elif (isinstance(node, ast.Compare) and len(node.ops) == 1
+              and type(node.ops[0]) in _COMPARE):
+            self._check(node.left)
+            self._check(node.comparators[0])
+        elif isinstance(node, ast.Compare) and all(type(op) in _COMPARE for op in node.ops):
+            raise ModelError(f"expression {text}: a chained comparison is not allowed; "
+                             f"nest if_else() with one comparison each")
         elif (isinstance(node, ast.Call) and isinstance(node.func, ast.Name)
               and node.func.id in FUNCTIONS and not node.keywords):
             name, given = node.func.id, len(node.args)
@@ -136,6 +150,9 @@ class Expression:
                 return _BINARY[type(node.op)](ev(node.left), ev(node.right))
             if isinstance(node, ast.UnaryOp):
                 return _UNARY[type(node.op)](ev(node.operand))
+            if isinstance(node, ast.Compare):
+                result = _COMPARE[type(node.ops[0])](ev(node.left), ev(node.comparators[0]))
+                return float(result) if isinstance(result, bool) else result
             return funcs[node.func.id](*[ev(a) for a in node.args])
 
         try:
@@ -201,7 +218,7 @@ def casadi_functions():
         "sin": ca.sin, "cos": ca.cos, "tan": ca.tan, "asin": ca.asin, "acos": ca.acos,
         "atan": ca.atan, "atan2": ca.atan2, "sinh": ca.sinh, "cosh": ca.cosh, "tanh": ca.tanh,
         "exp": ca.exp, "log": ca.log, "sqrt": ca.sqrt, "abs": ca.fabs, "min": ca.fmin,
-        "max": ca.fmax, "sign": ca.sign,
+        "max": ca.fmax, "sign": ca.sign, "if_else": ca.if_else,
     }
 
 

@@ -20,7 +20,7 @@ def test_expressions(text, value):
 
 @pytest.mark.parametrize("text", [
     "__import__('os').system('true')", "L1.real()", "L1[0].real", "[1, 2]", "lambda: 1", "x if y else z",
-    "open('f')", "'abc'", "L1[0]", "True", "a < b", "{1: 2}", "f'{x}'", "1 +",
+    "open('f')", "'abc'", "L1[0]", "True", "a < b < c", "{1: 2}", "f'{x}'", "1 +",
     "sin(x=1)", "x" * 3000,
 ])
 def test_expressions_refuse_anything_but_arithmetic(text):
@@ -47,9 +47,10 @@ def test_a_dotted_name_is_a_path_never_an_attribute():
     ("L1[0].real", r"an attribute \(\.\) is not allowed"),
     # the refused operator is named, and the message lists what is allowed (issue 19)
     ("L % 2", r"the operator '%' is not allowed \(only numbers, parameter names, \+ - \* / "
-              r"\*\* \^ and functions\)"),
+              r"\*\* \^, one comparison and functions\)"),
     ("L // 2", r"the operator '//' is not allowed"),
-    ("a < b", r"the operator '<' is not allowed"),
+    ("a < b <= c", r"a chained comparison is not allowed; nest if_else\(\)"),
+    ("a is b", r"the operator 'is' is not allowed"),
     ("a and b", r"the operator 'and' is not allowed"),
     ("a if b else c", r"a conditional \(x if c else y\) is not allowed"),
     ("L[1]", r"indexing \(\[\.\.\.\]\) is not allowed"),
@@ -103,6 +104,29 @@ def test_the_same_tree_evaluates_over_casadi_symbols():
     f = ca.Function("f", [a, t], [expr.evaluate({"a": a, "t": t}, casadi_functions())])
     assert float(f(3.0, 0.5)) == pytest.approx(expr.evaluate({"a": 3.0, "t": 0.5}))
     assert set(casadi_functions()) == set(FUNCTIONS)
+
+
+@pytest.mark.parametrize("v, x", [(-1.0, 0.5), (-1.0, 0.99), (0.0, 0.5), (2.0, 0.95)])
+def test_conditionals_pick_their_branch_over_numbers_and_symbols(v, x):
+    """MSL GasForce2's nested conditional, against Python's own if/else."""
+    text = ("if_else(v < 0, if_else(x < 0.986061, 1 + x, 2 + x), "
+            "if_else(x > 0.933, 3 + x, 4 + x))")
+    if v < 0:
+        expected = 1 + x if x < 0.986061 else 2 + x
+    else:
+        expected = 3 + x if x > 0.933 else 4 + x
+    expr = parse(text)
+    assert expr.evaluate({"v": v, "x": x}) == expected
+    sv, sx = ca.SX.sym("v"), ca.SX.sym("x")
+    f = ca.Function("f", [sv, sx], [expr.evaluate({"v": sv, "x": sx}, casadi_functions())])
+    assert float(f(v, x)) == expected
+
+
+@pytest.mark.parametrize("text, true", [("a < b", 1.0), ("a <= b", 1.0), ("a > b", 0.0),
+                                        ("a >= b", 0.0), ("a == b", 0.0), ("a != b", 1.0)])
+def test_a_comparison_is_one_or_zero(text, true):
+    assert parse(text).evaluate({"a": 1.0, "b": 2.0}) == true
+    assert parse(f"2*({text})").evaluate({"a": 1.0, "b": 2.0}) == 2 * true
 
 
 def test_parse_is_cached_per_text():
