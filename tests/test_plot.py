@@ -214,3 +214,9 @@ def test_component_legends_sit_outside_the_data(tip_results):
     for ax in visible(fig):
         legend = ax.get_legend().get_window_extent()
         assert legend.x0 >= ax.get_window_extent().x1
+
+
+def test_signal_panels_carry_the_unit_their_wires_give():
+    res = kn.simulate(kn.load("models/arm_pid.json"), t_end=0.1, n_points=11)
+    fig = res.plot("command_shoulder", "reference_shoulder")
+    assert [ax.get_ylabel() for ax in visible(fig)] == ["value [N\u00b7m]", "value [rad]"]

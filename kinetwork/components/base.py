@@ -379,6 +379,14 @@ class Component:
     #: 1-D ports whose position is a joint coordinate (port -> coordinate index) or zero
     coordinate_ports = {}
     zero_ports = ()
+    #: groups of signal ports that carry signals of one unit (an Add's inputs and output, a
+    #: PID's set point and measurement): how units spread along signal wires to the plots
+    same_unit_ports = ()
+
+    def signal_unit(self, port):
+        """The unit of the signal at signal port ``port`` when this component fixes it (an
+        angle sensor's output: "rad"; a torque source's input: "N*m"), else None."""
+        return None
 
     def __init_subclass__(cls, library=None, **kwargs):
         super().__init_subclass__(**kwargs)

@@ -111,6 +111,9 @@ class PartialSource(PartialTwoPin):
     def source_value(self, e):
         return self.value() if e.u is None else e.u
 
+    def signal_unit(self, port):
+        return self.params[self.reference_key].unit if port == "u" else None
+
 
 class VoltageSource(PartialSource, library=LIB):
     """Ideal voltage source: v = V (an expression in t, or the signal at u)."""
@@ -146,6 +149,9 @@ class VoltageSensor(Component, library=LIB):
     p = Port("electrical", "Positive pin")
     n = Port("electrical", "Negative pin")
     y = Port("signal_out", "Voltage v_p - v_n [V]", optional=True)
+
+    def signal_unit(self, port):
+        return "V" if port == "y" else None
     n_states = 0
     state_labels = state_units = ()
 
@@ -167,6 +173,9 @@ class CurrentSensor(PartialTwoPin, library=LIB):
     in series)."""
     quantity = "current"
     y = Port("signal_out", "Current into p [A]", optional=True)
+
+    def signal_unit(self, port):
+        return "A" if port == "y" else None
 
     def law(self, v, i, e):
         return v

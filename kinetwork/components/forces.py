@@ -38,6 +38,10 @@ class PartialFrameForce(Component):
     """
     role = "frame_force"
 
+    def signal_unit(self, port):
+        """Force components f1..f3 in N, torque components t1..t3 in N*m."""
+        return {"f": "N", "t": "N*m"}.get(port[:1]) if port[1:] in ("1", "2", "3") else None
+
     def wrenches(self, frames, inputs):
         raise NotImplementedError
 

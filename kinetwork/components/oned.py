@@ -8,6 +8,14 @@ parameters with its own names and units (``rel0`` is ``phi_rel0`` in rotational 
 import math
 
 from .base import ONED, Component, Port
+from .quantities import QUANTITIES
+
+
+def _unit(domain, which):
+    """The unit of a 1-D domain's position (0), speed (1), acceleration (2) or flow (3): the
+    units a probe on its flange records, in that order."""
+    quantities = list(QUANTITIES.get(domain, {}).values())
+    return quantities[which].unit if which < len(quantities) else None
 
 #: Modelica's second-order Bessel filter of a position source (Rotational.Sources.Position):
 #: the coefficients af, bf of phi_ref / (1 + af s / w_crit + bf s^2 / w_crit^2)
@@ -65,6 +73,9 @@ class PartialSource(Component):
     def applied(self):
         raise NotImplementedError
 
+    def signal_unit(self, port):
+        return _unit(self.domain, 3) if port == "u" else None
+
     def flows(self, pos, vel, t, u=None):
         f = self.applied() if u is None else u
         return {"flange": -f, "support": f}
@@ -115,11 +126,18 @@ class PartialSensor(Component):
     y = Port("signal_out", "Measured quantity", optional=True)
     quantity = None           # "position", "speed" or "acceleration"
 
+    def signal_unit(self, port):
+        which = ("position", "speed", "acceleration").index(self.quantity)
+        return _unit(self.domain, which) if port == "y" else None
+
 
 class PartialFlowSensor(PartialRigid):
     """Measures the flow through it (into flange_a) as a signal ``y``; rigid, massless."""
     y = Port("signal_out", "Flow through the sensor, into flange_a", optional=True)
     quantity = "flow"
+
+    def signal_unit(self, port):
+        return _unit(self.domain, 3) if port == "y" else None
 
 
 class PartialMotion(Component):
@@ -141,6 +159,9 @@ class PartialMotion(Component):
     flange = Port(ONED, "Flange moved")
     support = Port(ONED, "Reaction flange (unwired: the world)", optional=True)
     u = Port("signal_in", "Reference signal (instead of the parameter)", optional=True)
+
+    def signal_unit(self, port):
+        return _unit(self.domain, self.derivative) if port == "u" else None
 
     @property
     def n_states(self):

@@ -107,6 +107,7 @@ class Gain(PartialSISO, library=LIB):
 
 class Add(PartialBlock, library=LIB):
     """y = k1 u1 + k2 u2."""
+    same_unit_ports = (("u1", "u2", "y"),)
     u1 = Port("signal_in", "Input 1")
     u2 = Port("signal_in", "Input 2")
     k1 = Param(1.0, doc="Gain of u1")
@@ -118,6 +119,7 @@ class Add(PartialBlock, library=LIB):
 
 class Sum(PartialBlock, library=LIB):
     """y = u1 + u2 + u3 + u4 (unwired inputs count as zero)."""
+    same_unit_ports = (("u1", "u2", "u3", "u4", "y"),)
     u1 = Port("signal_in", "Input 1")
     u2 = Port("signal_in", "Input 2", optional=True)
     u3 = Port("signal_in", "Input 3", optional=True)
@@ -138,6 +140,7 @@ class Product(PartialBlock, library=LIB):
 
 class Limiter(PartialSISO, library=LIB):
     """y = u clipped to [u_min, u_max]."""
+    same_unit_ports = (("u", "y"),)
     u_max = Param(doc="Upper limit")
     u_min = Param(None, optional=True, doc="Lower limit (None: -u_max)")
 
@@ -223,6 +226,7 @@ class PID(PartialBlock, library=LIB):
     y = clip(k (e + I + D), y_min, y_max), dI/dt = (e + (y - y_unlimited) / (k Ni)) / Ti
     (back-calculation stops the integral winding up at the limits) and
     D = Td s / (1 + s Td / Nd) e. Ti = None drops the integral, Td = 0 the derivative."""
+    same_unit_ports = (("u_s", "u_m"),)
     u_s = Port("signal_in", "Set point")
     u_m = Port("signal_in", "Measurement")
     n_states = 2

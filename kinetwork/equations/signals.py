@@ -19,6 +19,7 @@ import casadi as ca
 
 from ..components.probe import QUANTITIES
 from ..errors import ModelError
+from ..graph.signal_units import signal_units
 from ..spatial import vee
 
 
@@ -59,20 +60,24 @@ class Signal:
 def probe_signals(asm, topo, net, bound, model):
     """The Signals of every probe of the model, in model order."""
     out = []
+    units = None
     for probe, target in topo.probes:
         where = model.place(probe)
+        unit = None
         if target.domain == "frame":
             view = FrameView(asm, topo, target, bound)
         elif target.domain in ("signal_in", "signal_out"):
             view = SignalView(net.signal.get(topo.set_of[target], ca.SX.nan()))
+            units = signal_units(model, topo) if units is None else units
+            unit = units.get(topo.set_of[target])
         elif target.domain == "electrical":
             view = PinView(net.pos[target], net.flow.get(target, ca.SX(0)))
         else:
             view = FlangeView(net, topo, target, where)
         for quantity in probe.asked(target.domain):
             spec = QUANTITIES[target.domain][quantity]
-            out.append(Signal(f"{probe.name}.{quantity}", spec.unit, spec.shape, probe.name,
-                              quantity, target.path, ca.SX(spec.formula(view))))
+            out.append(Signal(f"{probe.name}.{quantity}", unit or spec.unit, spec.shape,
+                              probe.name, quantity, target.path, ca.SX(spec.formula(view))))
     return out
 
 
