@@ -324,3 +324,94 @@ def test_a_gear_with_a_loss_on_a_joint_axis_is_refused_by_name():
         model.compile()
     gear.eta = 1.0                                   # lossless: the rotor is armature
     assert model.compile().state_names == ["joint.q", "joint.qd"]
+
+
+def msl_friction_reference(t_end):
+    """Mode changes of MSL's Rotational.Examples.Friction, written apart from kinetwork: the
+    three inertias' equations for each combination of modes, integrated by solve_ivp with
+    its own terminal events, phase by phase. Clutch: torque +-80 on inertia3 (-+ on
+    inertia2) while slipping, inertia3 and inertia2 together while stuck (the clutch holds
+    J3 a - T); brake: -+800 fn(t) on inertia1 while slipping, inertia1 at rest while stuck
+    (holding the spring). A holding torque beyond the limit slips the way it pushes."""
+    J3, J2, J1, c, d, clutch_limit = 1.0, 0.05, 1.0, 160.0, 1.0, 80.0
+    drive = lambda t: 200 * np.sin(100 * t) if t < 0.5 else 0.0      # noqa: E731
+    brake_limit = lambda t: 800.0 if t >= 0.5 else 0.0               # noqa: E731
+    spring = lambda y: c * (y[4] - y[2]) + d * (y[5] - y[3])         # noqa: E731
+
+    def rates(t, y, mc, mb):
+        if mc == 0:
+            a3 = a2 = (drive(t) + spring(y)) / (J3 + J2)
+        else:
+            a3, a2 = (drive(t) + mc * clutch_limit) / J3, (spring(y) - mc * clutch_limit) / J2
+        a1 = 0.0 if mb == 0 else (-spring(y) - mb * brake_limit(t)) / J1
+        return [y[1], a3, y[3], a2, y[5], a1]
+
+    def holds(t, y):
+        """The torques clutch and brake hold with, were they stuck."""
+        return J3 * (drive(t) + spring(y)) / (J3 + J2) - drive(t), -spring(y)
+
+    def settle(t, y, mc, mb, fired):
+        """The modes after the event of ``fired`` (or at a phase boundary: None)."""
+        for who in ("clutch", "brake"):
+            hold = holds(t, y)[who == "brake"]
+            limit = clutch_limit if who == "clutch" else brake_limit(t)
+            mode = mc if who == "clutch" else mb
+            if who == fired and mode != 0:          # its slipping speed reached zero
+                new = 0 if abs(hold) <= limit else np.sign(hold)
+            elif (who == fired and mode == 0) or (mode == 0 and abs(hold) > limit):
+                new = np.sign(hold)                 # its holding torque reached the limit
+            else:
+                continue
+            if new != mode:
+                found.append((t, who, new))
+                mc, mb = (new, mb) if who == "clutch" else (mc, new)
+        return mc, mb
+
+    y = np.array([0.0, 100.0, 0.0, 90.0, 0.0, 90.0])
+    t, mc, mb, found = 0.0, -1, 1, []          # slipping: w2 < w3, w1 > 0
+    while t < t_end:
+        stop = 0.5 if t < 0.5 else t_end
+        events = []
+        if mc:
+            ev = lambda t, y, *_: y[3] - y[1]                              # noqa: E731
+            ev.direction = -mc
+        else:
+            ev = lambda t, y, *_: clutch_limit - abs(holds(t, y)[0])       # noqa: E731
+            ev.direction = -1
+        events.append(ev)
+        if mb:
+            eb = lambda t, y, *_: y[5]                                     # noqa: E731
+            eb.direction = -mb
+        else:
+            eb = lambda t, y, *_: brake_limit(t) - abs(holds(t, y)[1])     # noqa: E731
+            eb.direction = -1
+        events.append(eb)
+        for e in events:
+            e.terminal = True
+        sol = solve_ivp(rates, (t, stop), y, args=(mc, mb), events=events, rtol=1e-12,
+                        atol=1e-12, method="DOP853")
+        t, y, fired = sol.t[-1], sol.y[:, -1].copy(), None
+        if sol.status == 1:
+            which = 0 if sol.t_events[0].size else 1
+            t, y = sol.t_events[which][0], sol.y_events[which][0].copy()
+            fired = ("clutch", "brake")[which]
+        mc, mb = settle(t, y, mc, mb, fired)
+        if fired == "clutch" and mc == 0:
+            y[1] = y[3] = (J3 * y[1] + J2 * y[3]) / (J3 + J2)     # stuck together exactly
+        if fired == "brake" and mb == 0:
+            y[5] = 0.0
+    return found
+
+
+def test_msl_friction_example_switches_at_the_reference_times():
+    import pathlib
+    path = pathlib.Path(__file__).resolve().parents[2] / "models" / "msl_friction.json"
+    res = kn.simulate(kn.load(path), t_end=2.0, n_points=201, method="cvodes", rtol=1e-11,
+                      atol=1e-12, **FAST)
+    ref = msl_friction_reference(2.0)
+    kind = {0: "stuck", 1: "sliding forward", -1: "sliding backward"}
+    assert [(e["component"], e["kind"]) for e in res.stats["events"]] == \
+        [(who, kind[m]) for _, who, m in ref]
+    assert len(ref) == 6
+    assert np.max(np.abs([e["t"] for e in res.stats["events"]] - np.array(
+        [t for t, _, _ in ref]))) < 1e-8
