@@ -23,8 +23,15 @@ from fractions import Fraction
 from .errors import ModelError
 
 #: one number, then a unit starting with a letter (or degree sign, percent, micro sign)
-_QUANTITY = re.compile(r"\s*[+-]?(?:\d+(?:\.\d*)?|\.\d+)(?:[eE][+-]?\d+)?\s*"
-                       r"(?P<unit>(?:[^\W\d]|[°%µ]).*?)\s*", re.S)
+_QUANTITY = re.compile(r"\s*(?P<number>[+-]?(?:\d+(?:\.\d*)?|\.\d+)(?:[eE](?P<exp>[+-]?\d+))?)"
+                       r"\s*(?P<unit>(?:[^\W\d]|[°%µ]).*?)\s*", re.S)
+#: the longest quantity read, and the largest decimal exponent of its number: exact
+#: arithmetic on 1e999999999 would take forever, and no physical value needs either
+MAX_LENGTH, MAX_EXPONENT = 200, 300
+#: what a unit may be written with (pint's parser reads more: "#" starts a comment there)
+_UNIT_TEXT = re.compile(r"[\w\s*/^().+\-°%µ]+")
+#: the largest number inside a unit (a power): km**999999999 would be computed exactly
+MAX_POWER = 100
 #: a number directly followed by a name, somewhere in a text: a unit inside an expression
 _UNIT_INSIDE = re.compile(r"(?<![\w.])\d+(?:\.\d*)?(?:[eE][+-]?\d+)?\s*[^\W\d]", re.S)
 
@@ -73,8 +80,21 @@ def to_si(text, unit):
     base units, "1" to a pure number). Raises ModelError (without a place: the caller adds
     it) for an unknown unit or a wrong dimension, naming both units."""
     import pint
-    ureg = registry()
     written = split(text)
+    if len(text) > MAX_LENGTH:
+        raise ModelError(f"a quantity longer than {MAX_LENGTH} characters ({len(text)})")
+    match = _QUANTITY.fullmatch(text)
+    if match is None:
+        raise ModelError(f"{text[:MAX_LENGTH]!r} is not a number with a unit")
+    if match["exp"] and abs(int(match["exp"][:6])) > MAX_EXPONENT:
+        raise ModelError(f"the number {match['number'][:40]!r} is out of range (exponent "
+                         f"beyond {MAX_EXPONENT})")
+    if not _UNIT_TEXT.fullmatch(written):
+        raise ModelError(f"cannot read the unit {written!r} in {text!r} (a unit is names, "
+                         f"numbers and * / ^ ( ))")
+    if any(float(n) > MAX_POWER for n in re.findall(r"\d+(?:\.\d*)?", written)):
+        raise ModelError(f"a power in the unit {written!r} is beyond {MAX_POWER}")
+    ureg = registry()
     try:
         quantity = ureg.Quantity(text.strip())
     except pint.UndefinedUnitError as exc:
@@ -97,7 +117,10 @@ def to_si(text, unit):
         target = ureg.Quantity(1, "dimensionless" if unit == "1" else unit)
         raise ModelError(f"{written} ({_dimension(quantity)}) does not convert to {unit} "
                          f"({_dimension(target)})") from None
-    return float(value)
+    try:
+        return float(value)
+    except OverflowError:
+        raise ModelError(f"{text!r} is out of range in {unit or 'SI units'}") from None
 
 
 def check_unit(unit):

@@ -106,6 +106,15 @@ REFUSED = [
      r"'degC' is a unit with an offset"),
     (lambda v: mb.FixedTranslation("f", r=[0, v, 0]), "L/2 + 5 mm",
      r"f\.r\[1\]: cannot parse expression 'L/2 \+ 5 mm'.*a unit goes after one number"),
+    # what exact arithmetic would take forever over is refused before it starts
+    (lambda v: mb.FixedTranslation("f", r=[0, v, 0]), "1e999999999 m",
+     r"the number '1e999999999' is out of range"),
+    (lambda v: kn.signals.Constant("k", k=v), "1 km**99999",
+     r"a power in the unit 'km\*\*99999' is beyond 100"),
+    (lambda v: mb.RigidBody("mass1", mass=v), "1 kg # note",
+     r"cannot read the unit 'kg # note'"),
+    (lambda v: mb.RigidBody("mass1", mass=v), "1e300 Tg",
+     r"'1e300 Tg' is out of range in kg"),
 ]
 
 
