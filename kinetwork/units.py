@@ -104,8 +104,8 @@ def to_si(text, unit):
         raise ModelError(f"{written!r} is a unit with an offset (a temperature scale); "
                          f"give the value in {unit or 'SI units'}") from None
     except Exception as exc:      # pint's parser raises several kinds on malformed units
-        why = str(exc) or type(exc).__name__
-        raise ModelError(f"cannot read the unit {written!r} in {text!r} ({why})") from None
+        raise ModelError(f"cannot read the unit {written!r} in {text!r} ({_why(exc)})") \
+            from None
     if not isinstance(quantity, ureg.Quantity):   # "2 pi" parses to a bare number
         quantity = ureg.Quantity(quantity)
     try:
@@ -117,10 +117,21 @@ def to_si(text, unit):
         target = ureg.Quantity(1, "dimensionless" if unit == "1" else unit)
         raise ModelError(f"{written} ({_dimension(quantity)}) does not convert to {unit} "
                          f"({_dimension(target)})") from None
+    except Exception as exc:      # an offset unit inside a product, and the like
+        raise ModelError(f"cannot convert {text!r} to {unit or 'SI units'} ({_why(exc)})") \
+            from None
     try:
         return float(value)
     except OverflowError:
         raise ModelError(f"{text!r} is out of range in {unit or 'SI units'}") from None
+
+
+def _why(exc):
+    """pint's own words for a refusal; some of its messages fail to format exact numbers."""
+    try:
+        return str(exc) or type(exc).__name__
+    except Exception:
+        return type(exc).__name__
 
 
 def check_unit(unit):
