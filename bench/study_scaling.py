@@ -1,4 +1,4 @@
-"""Scaling: what an N-link chain costs to build, to compile and to evaluate, N = 2 .. 128.
+"""Scaling: what an N-link chain costs to build, to compile and to evaluate, N = 2 .. 1024.
 
 For each chain (``scenes.chain(n)``: N uniform rods on revolute joints): states and
 right-hand-side operations (``system.size()``); model construction and build time (model ->
@@ -11,7 +11,16 @@ virtual machine, both through ``kinetwork.simulation.compiled.numeric`` (~0.5 us
 pinocchio's ``aba`` and MuJoCo's ``mj_forward`` on the peers' models of the same chain. Each
 per-evaluation time is the median over batches of repeated calls on one state.
 
-Exponents are log-log least-squares slopes from N = 8 to N = 128.
+Also per N: a cached run (a new System of the same model simulated for 1 s, 101 points, its
+library found in the cache: what a second process pays), and the study process's peak resident
+memory after that N (``ru_maxrss``: sizes go up, so each row's peak is its own N's).
+
+JIT strategies (``--strategies``, and in the full run): the 1024-link right-hand side and the
+eight-four-bar chain's DAE Jacobian compiled one file at -O1 (before), in parts at -O1 side by
+side (``jit.SPLIT_STATEMENTS``), and in parts at -O0; compiler CPU time, wall time, and the
+cost of one evaluation. And the eight-four-bar chain's first run from a cold cache.
+
+Exponents are log-log least-squares slopes from N = 8 to the largest N.
 
 Run: ``.venv/bin/python bench/study_scaling.py [--quick]``; writes results/study_scaling.csv,
 .md, study_scaling.png (evaluation cost) and study_scaling_build.png (build and JIT times).
@@ -19,7 +28,9 @@ Run: ``.venv/bin/python bench/study_scaling.py [--quick]``; writes results/study
 
 import argparse
 import os
+import resource
 import statistics
+import sys
 import tempfile
 import time
 
@@ -34,7 +45,7 @@ from kinetwork.graph.topology import analyze
 from kinetwork.simulation import jit
 from kinetwork.simulation.compiled import compiled as compiled_of, numeric
 
-SIZES = (2, 4, 8, 16, 32, 64, 128)
+SIZES = (2, 4, 8, 16, 32, 64, 128, 256, 512, 1024)
 FIT_FROM = 8
 BATCH_SECONDS = 0.02
 BATCHES = 11
@@ -87,8 +98,26 @@ def peers():
     return found
 
 
-def main(quick=False):
+def main(quick=False, only_strategies=False):
     clock = time.perf_counter()
+    if only_strategies:
+        saved_cache = os.environ.get("KINETWORK_CACHE")
+        try:
+            rows, loops = strategies(quick)
+        finally:
+            if saved_cache is None:
+                os.environ.pop("KINETWORK_CACHE", None)
+            else:
+                os.environ["KINETWORK_CACHE"] = saved_cache
+        first = {"function": loops["model"], "instructions": "",
+                 "strategy": "first run, cold cache", "compiler_cpu_s": "",
+                 "wall_s": loops["first_run_s"], "eval_us": ""}
+        write_csv("study_scaling_jit", rows + [first])
+        text = "\n".join([f"## JIT strategies{' (quick)' if quick else ''}", "",
+                          f"{machine()}; {load()}."] + strategy_lines(rows, loops))
+        write_markdown("study_scaling_jit", text)
+        print(f"study_scaling --strategies: {time.perf_counter() - clock:.1f} s")
+        return
     sizes = (2, 8, 16) if quick else SIZES
     tools = peers()
     rows = []
@@ -100,7 +129,9 @@ def main(quick=False):
             print(f"N={n:4d} ops {r['operations']:6d} build {r['build_s'] * 1e3:7.1f} ms "
                   f"jit cold {r['jit_cold_s']:6.2f} s warm {r['jit_warm_s'] * 1e3:6.1f} ms  "
                   f"C {r['rhs_c_us']:7.2f} us  VM {r['rhs_vm_us']:8.2f} us  "
-                  + "  ".join(f"{k} {r[_key(k)]:7.2f} us" for k in tools))
+                  + "  ".join(f"{k} {r[_key(k)]:7.2f} us" for k in tools), flush=True)
+        # the strategies take minutes at full size: their own run (--strategies)
+        extra = strategies(quick) if quick else None
     finally:
         if saved_cache is None:
             os.environ.pop("KINETWORK_CACHE", None)
@@ -110,8 +141,105 @@ def main(quick=False):
     fits = exponents(rows, tools)
     charts(rows, tools)
     total = time.perf_counter() - clock
-    report(rows, fits, tools, total, quick)
+    report(rows, fits, tools, total, quick, extra)
     print(f"study_scaling: {total:.1f} s")
+
+
+# -- JIT strategies on the largest functions ------------------------------------------------------
+def _evaluator(f):
+    """One call of ``f`` (any Function) on fixed random inputs, through its buffer."""
+    rng = np.random.default_rng(0)
+    buf, trigger = f.buffer()
+    keep = []
+    for i in range(f.n_in()):
+        keep.append(rng.uniform(-0.5, 0.5, f.nnz_in(i)))
+        buf.set_arg(i, memoryview(keep[-1]))
+    for i in range(f.n_out()):
+        keep.append(np.zeros(max(f.nnz_out(i), 1)))
+        buf.set_res(i, memoryview(keep[-1]))
+    return lambda _keep=(buf, keep): trigger()
+
+
+def _compile_with(f, jacobian, split, jacobian_o1):
+    """(compiler CPU s, wall s, us per evaluation, parts) of ``f`` compiled by ``jit`` in an
+    empty cache with the given splitting and -O0 thresholds."""
+    saved = (jit.SPLIT_STATEMENTS, jit.JACOBIAN_O1_STATEMENTS)
+    jit.SPLIT_STATEMENTS, jit.JACOBIAN_O1_STATEMENTS = split, jacobian_o1
+    try:
+        with tempfile.TemporaryDirectory() as folder:
+            os.environ["KINETWORK_CACHE"] = folder
+            before = resource.getrusage(resource.RUSAGE_CHILDREN)
+            start = time.perf_counter()
+            g = jit.external(f, jacobian, {}, required=True)
+            wall = time.perf_counter() - start
+            after = resource.getrusage(resource.RUSAGE_CHILDREN)
+            cpu = (after.ru_utime + after.ru_stime) - (before.ru_utime + before.ru_stime)
+            target = g.jacobian() if jacobian else g
+            cost = per_call(_evaluator(target), batches=5) * 1e6
+    finally:
+        jit.SPLIT_STATEMENTS, jit.JACOBIAN_O1_STATEMENTS = saved
+    return cpu, wall, cost
+
+
+def strategies(quick):
+    """The largest right-hand side and the largest Jacobian, each compiled three ways."""
+    from scenes import fourbar_chain
+    n, m = (128, 2) if quick else (1024, 8)
+    never = sys.maxsize
+    rhs = scenes.chain(n).compile().f_rhs
+    dae = fourbar_chain(m).compile().f_dae
+    cases = [(f"chain{n} right-hand side", rhs, False,
+              [("one file, -O1 (before)", never, never),
+               (f"parts of {jit.PART_STATEMENTS}, -O1, side by side (now)",
+                jit.SPLIT_STATEMENTS, never)]),
+             (f"fourbar_chain{m} DAE + exact Jacobian", dae, True,
+              [("one file each, -O1 (before)", never, never),
+               ("parts, -O1, side by side", jit.SPLIT_STATEMENTS, never),
+               ("parts, Jacobian at -O0, side by side (now)", jit.SPLIT_STATEMENTS,
+                jit.JACOBIAN_O1_STATEMENTS)])]
+    rows = []
+    for label, f, jacobian, ways in cases:
+        size = (f.jacobian() if jacobian else f).n_instructions()
+        for way, split, o1 in ways:
+            cpu, wall, cost = _compile_with(f, jacobian, split, o1)
+            rows.append({"function": label, "instructions": size, "strategy": way,
+                         "compiler_cpu_s": cpu, "wall_s": wall, "eval_us": cost})
+            print(f"  {label} ({size} instructions), {way}: compiler CPU {cpu:.1f} s, wall "
+                  f"{wall:.1f} s, one evaluation {cost:.1f} us", flush=True)
+    # the eight-four-bar chain's first run from a cold cache, as a user meets it
+    with tempfile.TemporaryDirectory() as folder:
+        os.environ["KINETWORK_CACHE"] = folder
+        start = time.perf_counter()
+        system = fourbar_chain(m).compile()
+        build = time.perf_counter() - start
+        start = time.perf_counter()
+        res = kn.simulate(system, t_end=2.0, n_points=201, method="idas", rtol=1e-6,
+                          atol=1e-8)
+        first = time.perf_counter() - start
+        start = time.perf_counter()
+        kn.simulate(system, t_end=2.0, n_points=201, method="idas", rtol=1e-6, atol=1e-8)
+        warm = time.perf_counter() - start
+    loops = {"model": f"fourbar_chain{m}", "build_s": build, "first_run_s": first,
+             "jit_s": res.stats.get("jit_seconds", float("nan")), "warm_run_s": warm}
+    print(f"  fourbar_chain{m}: build {build:.1f} s, first run {first:.1f} s "
+          f"(JIT {loops['jit_s']:.1f} s), warm run {warm:.2f} s", flush=True)
+    return rows, loops
+
+
+def strategy_lines(rows, loops):
+    if not rows:
+        return []
+    body = [[r["function"], r["instructions"], r["strategy"], f"{r['compiler_cpu_s']:.1f}",
+             f"{r['wall_s']:.1f}", f"{r['eval_us']:.1f}"] for r in rows]
+    return ["", "### JIT of the largest functions", "",
+            f"Each compiled by `jit.external` into an empty cache on {jit._cores()} cores; wall "
+            "time includes generating the C; compiler CPU is the compilers' user + system "
+            "time; one evaluation through the Function's buffer (median over batches).", "",
+            table(["function", "instructions", "strategy", "compiler CPU [s]", "wall [s]",
+                   "one evaluation [us]"], body), "",
+            f"{loops['model']} as a user meets it, cold cache: build {loops['build_s']:.1f} s, "
+            f"first run (2 s, idas, rtol 1e-6) {loops['first_run_s']:.1f} s of which JIT "
+            f"{loops['jit_s']:.1f} s; the same run again {loops['warm_run_s']:.2f} s."]
 
 
 def _key(tool):
@@ -123,18 +251,28 @@ def measure(n, tools):
     # validate and assemble afresh each time: model.compile() would hand back its System
     build_s, system = timed(lambda: kn.System(model, topology=analyze(model)), budget=1.0,
                             max_repeats=7)
+    cpu = time.process_time()
+    kn.System(model, topology=analyze(model))
+    build_cpu = time.process_time() - cpu
     size = system.size()
     with tempfile.TemporaryDirectory() as folder:
         os.environ["KINETWORK_CACHE"] = folder       # jit.cache_dir() reads it on each call
         start, stats = time.perf_counter(), {}
+        cpu, children = time.process_time(), _children_cpu()
         compiled = compiled_of(system).rhs({"stats": stats})
         cold = time.perf_counter() - start
+        cold_cpu = time.process_time() - cpu
+        cold_compilers = _children_cpu() - children
         gcc = stats.get("jit_seconds", float("nan"))
         again, stats = scenes.chain(n).compile(), {}       # a new model: a new System
         compiled_of(again).rhs({"stats": stats})
         assert stats.get("jit_cached"), "a new System missed the cache"
-        # what that call did, repeated for a median: generate and hash the C, load the library
+        # what that call did, repeated for a median: hash the serialisation, load the library
         warm, _ = timed(lambda: jit.external(again.f_rhs, False, {}), budget=0.3)
+        third = scenes.chain(n).compile()
+        start = time.perf_counter()
+        kn.simulate(third, t_end=1.0, n_points=101)
+        cached_run = time.perf_counter() - start
         p = system.param_vector()
         x = np.random.default_rng(0).uniform(-0.5, 0.5, 2 * n)
         c_rhs = numeric(compiled, p, system.n_states)
@@ -146,14 +284,23 @@ def measure(n, tools):
         empty = numeric(ca.Function("copy", [t_, x_, p_], [x_]), p, system.n_states)
         row = {"N": n, "states": size["states"], "operations": size["operations"],
                "model_s": model_s, "build_s": build_s, "jit_cold_s": cold,
-               "jit_cold_compiler_s": gcc, "jit_warm_s": warm,
+               "jit_cold_compiler_s": gcc, "jit_warm_s": warm, "cached_run_s": cached_run,
+               "build_cpu_s": build_cpu, "jit_cold_cpu_s": cold_cpu,
+               "jit_cold_compilers_cpu_s": cold_compilers,
                "rhs_c_us": per_call(lambda: c_rhs(0.0, x)) * 1e6,
                "call_overhead_us": per_call(lambda: empty(0.0, x)) * 1e6,
                "rhs_vm_us": per_call(lambda: vm_rhs(0.0, x)) * 1e6}
     spec = scenes.chain_spec(n)
     for tool, (build, evaluator) in tools.items():
         row[_key(tool)] = per_call(evaluator(build(spec))) * 1e6
+    row["peak_rss_mb"] = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024
     return row
+
+
+def _children_cpu():
+    """User + system CPU time of the finished child processes (the compilers)."""
+    usage = resource.getrusage(resource.RUSAGE_CHILDREN)
+    return usage.ru_utime + usage.ru_stime
 
 
 def slope(rows, key):
@@ -204,25 +351,41 @@ def charts(rows, tools):
           "of repeats; cold compile: one run)")
 
 
-def report(rows, fits, tools, total, quick):
+def report(rows, fits, tools, total, quick, extra=None):
     last = rows[-1]
     body = [[r["N"], r["states"], r["operations"], f"{r['model_s'] * 1e3:.1f}",
              f"{r['build_s'] * 1e3:.1f}", f"{r['jit_cold_s']:.2f}",
-             f"{r['jit_warm_s'] * 1e3:.1f}", f"{r['rhs_c_us']:.2f}", f"{r['rhs_vm_us']:.1f}",
+             f"{r['jit_warm_s'] * 1e3:.1f}", f"{r['build_s'] + r['jit_cold_s']:.2f}",
+             f"{r['build_cpu_s']:.2f} + {r['jit_cold_cpu_s']:.2f} + "
+             f"{r['jit_cold_compilers_cpu_s']:.2f}",
+             f"{r['cached_run_s']:.2f}", f"{r['peak_rss_mb']:.0f}",
+             f"{r['rhs_c_us']:.2f}", f"{r['rhs_vm_us']:.1f}",
              *(f"{r[_key(t)]:.2f}" for t in tools)] for r in rows]
     header = ["N", "states", "rhs operations", "model [ms]", "build [ms]", "JIT cold [s]",
-              "JIT hit [ms]", "rhs C [us]", "rhs VM [us]", *(f"{t} [us]" for t in tools)]
+              "JIT hit [ms]", "build + JIT cold [s]",
+              "CPU: build + JIT (Python) + compilers [s]", "cached run 1 s [s]", "peak RSS [MB]",
+              "rhs C [us]", "rhs VM [us]", *(f"{t} [us]" for t in tools)]
     lines = [f"## Scaling: chains of N rods{' (quick smoke run)' if quick else ''}", "",
              f"{machine()}; {load()}. Build: median of repeated `model.compile()` "
              f"(validate, assemble, "
              f"CasADi Functions; no C). JIT cold: `compiled(system).rhs(jit)` with an empty "
-             f"cache folder (code generation + gcc -O1); JIT hit: what the same call does "
-             f"for a new System of the same model (code generation and hashing, then loading "
-             f"the cached library), median of repeats. Per-evaluation times from Python, "
+             f"cache folder (code generation + gcc -O1, functions over "
+             f"{jit.SPLIT_STATEMENTS:,} statements in parts side by side); JIT hit: what the "
+             f"same call does for a new System of the same model (hashing the Function's "
+             f"serialisation, then loading the cached library), median of repeats. Cached run: "
+             f"a third System of the same model simulated 1 s (101 points, default method), "
+             f"JIT from the cache. Peak RSS: the study process's, after that N. CPU: the "
+             f"process's CPU time for one build and for the cold JIT (code generation), and the "
+             f"compilers' (children's) CPU time: on a shared machine whose load average is over "
+             f"its core count, wall times stretch and these say what the work itself costs. "
+             f"Per-evaluation times from Python, "
              f"median over batches of calls; they are noisy when the load average is over "
              f"the core count. "
              f"Study wall time {total:.0f} s.", "",
              table(header, body), "",
+             *(strategy_lines(*extra) + [""] if extra else
+               ["JIT of the largest functions, one file against parts, -O1 against -O0: "
+                "[study_scaling_jit.md](study_scaling_jit.md) (`--strategies`).", ""]),
              f"Log-log slopes from N = {FIT_FROM} to {last['N']}:", "",
              table(["quantity", "exponent"], [[k, f"{v:.2f}"] for k, v in fits.items()]), "",
              "![evaluation cost](study_scaling.png)", "",
@@ -239,14 +402,25 @@ def report(rows, fits, tools, total, quick):
              f"connecting {3 * last['N'] + 1} components): {last['model_s'] * 1e3:.0f} ms, "
              f"exponent {fits['model construction']:.2f}.",
              f"- JIT at N = {last['N']}: {last['jit_cold_s']:.2f} s cold "
-             f"({last['jit_cold_compiler_s']:.2f} s of it in the compiler), "
+             f"({last['jit_cold_compiler_s']:.2f} s of it in jit: code generation and the "
+             f"compilers), "
              f"{last['jit_warm_s'] * 1e3:.0f} ms on a cache hit "
-             f"({last['jit_warm_s'] / last['build_s'] * 100:.0f} % of the build); the hit's "
-             f"cost is regenerating and hashing the C source, not the lookup."]
+             f"({last['jit_warm_s'] / last['build_s'] * 100:.0f} % of the build): the "
+             f"serialisation and its hash, no C generated.",
+             f"- Build + cold JIT at N = {last['N']}: "
+             f"{last['build_s'] + last['jit_cold_s']:.1f} s wall (target < 30 s); CPU "
+             f"{last['build_cpu_s'] + last['jit_cold_cpu_s']:.1f} s in Python and "
+             f"{last['jit_cold_compilers_cpu_s']:.1f} s in the compilers, which run "
+             f"{jit._cores()} at a time; a cached run of "
+             f"1 s {last['cached_run_s']:.1f} s; peak memory {last['peak_rss_mb']:.0f} MB."]
     write_markdown("study_scaling", "\n".join(lines))
 
 
 if __name__ == "__main__":
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--quick", action="store_true", help="smoke test: N = 2, 8, 16")
-    main(parser.parse_args().quick)
+    parser.add_argument("--strategies", action="store_true",
+                        help="only the JIT strategies on the largest functions "
+                             "(results/study_scaling_jit.md)")
+    args = parser.parse_args()
+    main(args.quick, args.strategies)

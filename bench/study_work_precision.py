@@ -41,6 +41,7 @@ from common import machine, max_error, table, timed, write_csv, write_markdown
 from scenes.reference import seed_reference
 
 sys.path.insert(0, str(common.HERE / "peers"))
+import casadi_peer
 import mujoco_peer
 import pinocchio_peer
 import sympy_peer
@@ -72,8 +73,12 @@ LEFT_OUT_LARGE = {
     "midpoint": "CasADi's Newton rootfinder with the 256x256 Jacobian in its VM (too large "
                 "to JIT-compile): 0.44 s per 0.1 s at step 1e-2, ~45 s a run",
 }
-#: peers: pinocchio in oranges, MuJoCo in greens, sympy in red
-PEER_COLOUR = {"pinocchio+scipy DOP853": "#e6550d", "pinocchio+scipy RK45": "#fdae6b",
+#: the scenes of the hand-written route (``casadi_peer``), and the accuracies it is compared at
+CASADI_SCENES = ("chain2", "chain16", "chain128")
+CASADI_ACCURACIES = tuple(10.0 ** -k for k in range(4, 11))
+#: peers: pinocchio in oranges, MuJoCo in greens, sympy in red, the hand-written route in purple
+PEER_COLOUR = {casadi_peer.NAME: "#6a3d9a",
+               "pinocchio+scipy DOP853": "#e6550d", "pinocchio+scipy RK45": "#fdae6b",
                "MuJoCo RK4": "#006d2c", "MuJoCo implicit": "#41ab5d",
                "MuJoCo implicitfast": "#a1d99b", "sympy+DOP853": "#cb181d"}
 
@@ -136,6 +141,9 @@ def peer_curves(built, n, quick):
                                            if i != "RK4" or h >= 5e-5],
                      runner(mujoco_peer, built["mujoco"]))
                for i in ("RK4", "implicit", "implicitfast")]
+    if built.get("casadi") is not None:
+        curves.append(Curve(casadi_peer.NAME, "Adams", [{"rtol": r} for r in rtols],
+                            runner(casadi_peer, built["casadi"]), label=casadi_peer.NAME))
     sym = Curve(sympy_peer.NAME, "DOP853", [{"method": "DOP853", "rtol": r} for r in rtols],
                 runner(sympy_peer, built["sympy"]), label=sympy_peer.NAME)
     if isinstance(built["sympy"], str):
@@ -192,7 +200,8 @@ def prepare(names, quick):
         start = time.perf_counter()
         system = builder().compile()
         pin = pinocchio_peer.build(spec)
-        built = {"t": t, "pinocchio": pin, "mujoco": mujoco_peer.build(spec)}
+        built = {"t": t, "pinocchio": pin, "mujoco": mujoco_peer.build(spec),
+                 "casadi": casadi_peer.build(spec) if name in CASADI_SCENES else None}
         q_pin = pinocchio_peer.run(pin, t, method="DOP853", rtol=REF_RTOL, atol=REF_RTOL * 1e-2)
         info = {"horizon": horizon, "n": spec.n, "first_calls": {}}
         if name in ("seed", "chaotic"):
@@ -445,10 +454,169 @@ def default_against_peers(prepared):
     return lines
 
 
+def against_hand_written(curves_of):
+    """kinetwork's default against the same route by hand (``casadi_peer``), side by side:
+    time to each accuracy 1e-4..1e-10 of both and their ratio (target: auto/peer <= 1.2)."""
+    rows, worst = [], []
+    for name in CASADI_SCENES:
+        if name not in curves_of:
+            continue
+        curves = {c.label: c for c in curves_of[name]}
+        peer, auto = curves.get(casadi_peer.NAME), curves.get("kinetwork auto (JIT)")
+        if peer is None or auto is None:
+            continue
+        adams = curves.get("kinetwork cvodes-adams")
+        for e in CASADI_ACCURACIES:
+            mine, theirs = time_to(auto.points(), e), time_to(peer.points(), e)
+            ratio = mine / theirs if mine and theirs else None
+            if ratio is not None:
+                worst.append((ratio, name, e))
+            rows.append([name, f"{e:.0e}", fmt_time(mine), fmt_time(theirs),
+                         f"{ratio:.2f}" if ratio else "—",
+                         fmt_time(time_to(adams.points(), e)) if adams else "—"])
+    if not rows:
+        return []
+    lines = ["## kinetwork's default against the same route by hand", "",
+             f"`{casadi_peer.NAME}` (``peers/casadi_peer.py``): Featherstone's ABA in CasADi SX, "
+             "compiled by gcc -O1, one CVODES Adams call over the whole output grid. Time to "
+             "each accuracy on each curve's Pareto front; ratio = auto / by hand (target "
+             "<= 1.2; below 1: kinetwork is faster).", "",
+             table(["scene", "accuracy", "auto (JIT)", "by hand", "auto / by hand",
+                    "kinetwork cvodes-adams"], rows), ""]
+    if worst:
+        r, name, e = max(worst)
+        lines.append(f"Worst ratio: {r:.2f} ({name}, {e:.0e}); "
+                     f"{sum(1 for w in worst if w[0] <= 1.2)} of {len(worst)} within 1.2.")
+        lines.append("")
+    return lines
+
+
+def counts_table(scene, system, built, horizon, rtols):
+    """Per rtol, one run of auto (JIT) and of the hand-written route: wall time, steps and
+    right-hand-side evaluations, so that a difference in time reads as a difference in count
+    or in cost per evaluation."""
+    t = built["t"]
+    rows = []
+    for r in rtols:
+        start = time.perf_counter()
+        res = kn.simulate(system, t_end=horizon, n_points=len(t), rtol=r, atol=r * 1e-2,
+                          jit=True)
+        mine = time.perf_counter() - start
+        integ = casadi_peer.integrator(built["casadi"], t, r, r * 1e-2)
+        start = time.perf_counter()
+        integ(x0=built["casadi"].x0)
+        theirs = time.perf_counter() - start
+        st = integ.stats()
+        n_k, n_p = res.stats.get("rhs_evaluations", 0), int(st["nfevals"])
+        rows.append([scene, f"{r:.0e}", res.settings["method"], fmt_time(mine),
+                     res.stats.get("steps", ""), n_k,
+                     f"{mine / n_k * 1e6:.2f}" if n_k else "—", fmt_time(theirs),
+                     int(st["nsteps"]), n_p, f"{theirs / n_p * 1e6:.2f}" if n_p else "—"])
+    return rows
+
+
+def paired_sweep(curves, ref, cap, repeats):
+    """Every curve's k-th setting in turn, round robin, ``repeats`` times; each keeps the
+    least wall time of its repeats. Curves compared side by side share the machine's load
+    alike (a shared machine's load changes over the minutes a curve-by-curve sweep takes);
+    a curve stops after a run over ``cap`` s."""
+    active = list(curves)
+    for k in range(max(len(c.settings) for c in curves)):
+        best, values = {}, {}
+        for _ in range(repeats):
+            for c in active:
+                start = time.perf_counter()
+                try:
+                    values[c] = c.run(c.settings[k])
+                except Exception as exc:  # noqa: BLE001 -- a failed run is a result
+                    values[c] = exc
+                best[c] = min(best.get(c, math.inf), time.perf_counter() - start)
+        for c in curves:
+            row = {"setting": setting_text(c.settings[k]), "time_s": math.nan,
+                   "error": math.nan, "status": "skipped: a looser setting took over "
+                                                f"{cap:g} s"}
+            if c in best:
+                if isinstance(values[c], Exception):
+                    row["status"] = f"failed: {str(values[c]).strip()[:160]}"
+                else:
+                    row.update(time_s=best[c], error=max_error(values[c], ref), status="ok")
+            c.rows.append(row)
+        active = [c for c in active if best[c] <= cap]
+
+
+def casadi_study(quick):
+    """``--casadi``: chain2, chain16, chain128; auto (JIT), cvodes-adams (JIT) and the
+    hand-written route at every decade of rtol; writes ``results/work_precision_casadi.md``."""
+    start = time.perf_counter()
+    rtols = [1e-4, 1e-8] if quick else common.TOLERANCES
+    names = CASADI_SCENES[:2] if quick else CASADI_SCENES
+    curves_of, counts, notes_of = {}, [], []
+    for name in names:
+        builder, spec_of, horizon = scenes.SCENES[name]
+        spec = spec_of()
+        t = np.linspace(0.0, horizon, round(horizon / SPACING) + 1)
+        system = builder().compile()
+        t0 = time.perf_counter()
+        built = {"t": t, "casadi": casadi_peer.build(spec)}
+        build_s = time.perf_counter() - t0
+        ref = pinocchio_peer.run(pinocchio_peer.build(spec), t, method="DOP853", rtol=REF_RTOL,
+                                 atol=REF_RTOL * 1e-2)
+        agree = max_error(casadi_peer.run(built["casadi"], t, rtol=1e-12), ref)
+        curves = [c for c in kinetwork_curves(system, horizon, spec.n, quick)
+                  if c.method in ("auto (JIT)", "cvodes-adams")]
+        curves.append(Curve(casadi_peer.NAME, "Adams", [],
+                            lambda s, b=built["casadi"], t=t: casadi_peer.run(b, t, **s),
+                            label=casadi_peer.NAME))
+        for c in curves:
+            c.settings = [{"rtol": r, "atol": r * 1e-2} for r in rtols]
+            if c.tool != "kinetwork":
+                c.settings = [{"rtol": r} for r in rtols]
+            c.run(c.settings[0])                 # JIT compilation, integrator creation
+        cap = CAP_LARGE if spec.n >= 64 else CAP
+        paired_sweep(curves, ref, cap, repeats=3 if spec.n >= 64 else 7)
+        curves_of[name] = curves
+        counts += counts_table(name, system, built, horizon, rtols)
+        notes_of.append(f"{name}: the hand-written route built (SX, C, gcc) in {build_s:.1f} s; "
+                        f"at rtol 1e-12 it is {agree:.1e} rad from the pinocchio reference")
+        print(f"  {name}: {time.perf_counter() - t0:.1f} s", flush=True)
+    total = time.perf_counter() - start
+    lines = ["# Work-precision: kinetwork's default against its own route by hand", "",
+             f"{machine()}; {common.load()}. Study run time {total:.0f} s. Error: max "
+             f"joint-angle difference from pinocchio ABA + DOP853 at rtol {REF_RTOL:g} on the "
+             f"{SPACING:g} s grid over 10 s; time: the least wall time of repeated runs (7, "
+             f"3 at N = 128) after a first call, the curves' runs of one setting taken in "
+             f"turn; rtol 1e-3..1e-12, atol = rtol * 1e-2 for both."
+             + (" Quick mode: chain2 and chain16, rtol 1e-4 and 1e-8." if quick else ""), ""]
+    lines += ["- " + n for n in notes_of] + [""]
+    lines += against_hand_written(curves_of)
+    lines += ["## Where the time goes", "",
+              "One run each per rtol: steps and right-hand-side evaluations (kinetwork's "
+              "counted by CVODES over all chunks), and wall time per evaluation (the whole run "
+              "divided by the evaluations: integration, chunking and per-run overhead).", "",
+              table(["scene", "rtol", "auto ran", "auto", "steps", "rhs evals", "us/eval",
+                     "by hand", "steps", "rhs evals", "us/eval"], counts), ""]
+    rows = []
+    for name, curves in curves_of.items():
+        for c in curves:
+            rows += [[name, c.label, r["setting"], fmt_time(r["time_s"])
+                      if np.isfinite(r["time_s"]) else "—",
+                      f"{r['error']:.1e}" if np.isfinite(r["error"]) else "—", r["status"]]
+                     for r in c.rows]
+    lines += ["## Every run", "", table(["scene", "curve", "setting", "time", "error",
+                                          "status"], rows)]
+    write_markdown(f"{NAME}_casadi", "\n".join(lines))
+    print(f"done in {total:.0f} s", flush=True)
+
+
 def main():
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--quick", action="store_true", help="seed only, two settings per curve")
+    parser.add_argument("--casadi", action="store_true",
+                        help="only kinetwork's default against the hand-written route "
+                             "(chain2, chain16, chain128; results/work_precision_casadi.md)")
     args = parser.parse_args()
+    if args.casadi:
+        return casadi_study(args.quick)
     names = ("seed",) if args.quick else SCENES
     budget = 0.03 if args.quick else 0.06
     start = time.perf_counter()
@@ -497,6 +665,7 @@ def main():
     for name in names:
         lines += scene_section(name, prepared[name])
     lines += default_against_peers(prepared)
+    lines += [""] + against_hand_written({n: p["curves"] for n, p in prepared.items()})
     write_markdown(NAME, "\n".join(lines))
     print(f"done in {total:.0f} s", flush=True)
 

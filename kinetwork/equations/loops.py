@@ -47,6 +47,8 @@ four-bar whose crank is driven) is still integrated by IDAS, which solves its ot
 at every step.
 """
 
+import itertools
+import math
 from dataclasses import dataclass
 
 import casadi as ca
@@ -70,6 +72,9 @@ CLOSED = 1e-10
 SEARCH_STARTS = 24
 #: singular values below this fraction of the largest mark redundant closure equations
 RANK_TOL = 1e-8
+#: a re-partition compares every choice of dependent speeds when there are at most this many
+#: (a planar five-bar: 10); beyond, it takes the pivoted-QR choice
+PARTITION_CHOICES = 200
 
 
 @dataclass
@@ -100,14 +105,22 @@ class Equations:
     dependent_names: list = None    # the dependent speeds, by name
     prescribed: int = 0             # joint speeds a motion source gives (no states)
     clock: int = None               # index of the state ``time``, when there is one
+    #: the kept closure rows and the dependent speeds, by index (``_Loops.partitions_at``
+    #: chooses others where this partition turns singular)
+    partition: tuple = None
+    loops: object = None            # the _Loops that made these equations
+    rate: float = None              # Baumgarte's rate, as the formulation was built
 
 
-def formulate(asm, topo, values, formulation="partition", rate=BAUMGARTE_RATE):
+def formulate(asm, topo, values, formulation="partition", rate=BAUMGARTE_RATE,
+              partition=None):
     """The Equations of an assembled model; ``values`` are the model's parameter values,
     at which loops are analysed (rows kept, speeds partitioned). The states of the 1-D
     network and the signal blocks (free rotors, controller integrals) follow the mechanism's.
+    ``partition`` (closure rows kept, dependent speeds; indices) replaces the partition
+    chosen at the initial configuration: a run re-partitions where that one turns singular.
     """
-    eq = _mechanism(asm, topo, values, formulation, rate)
+    eq = _mechanism(asm, topo, values, formulation, rate, partition)
     net = asm.net
     if net is None or not (net.x or net.alg_z):
         return eq
@@ -152,7 +165,7 @@ def formulate(asm, topo, values, formulation="partition", rate=BAUMGARTE_RATE):
     return eq
 
 
-def _mechanism(asm, topo, values, formulation, rate):
+def _mechanism(asm, topo, values, formulation, rate, partition=None):
     if formulation not in FORMULATIONS:
         raise ModelError(f"loops={formulation!r}: unknown formulation; choose from "
                          f"{', '.join(FORMULATIONS)}")
@@ -175,7 +188,7 @@ def _mechanism(asm, topo, values, formulation, rate):
         return Equations(ca.vertcat(q, u), ca.SX(0, 1), ca.vertcat(asm.qdot, asm.udot_tree),
                          ca.SX(0, 1), names, units, [], [], u, asm.udot_tree, "tree", note,
                          initial=initial, lam=ca.SX(0, 1))
-    eq = _Loops(asm, topo, values).equations(formulation, rate)
+    eq = _Loops(asm, topo, values, partition).equations(formulation, rate)
     return _prescribe(asm, eq, loops=True) if asm.prescribed else eq
 
 
@@ -259,7 +272,7 @@ def _prescribe(asm, eq, loops):
 class _Loops:
     """Closure equations of every cut joint, their independent rows and the partition."""
 
-    def __init__(self, asm, topo, values):
+    def __init__(self, asm, topo, values, partition=None):
         self.asm, self.topo = asm, topo
         p_nom = np.array([values[k] for k in asm.param_names], dtype=float)
         self.phi = ca.vertcat(*[r for _, r in asm.cuts])
@@ -286,9 +299,13 @@ class _Loops:
         self.f_jac = ca.Function("closure_jacobian", [q, asm.p],
                                  [ca.jacobian(self.phi, q)[:, self.free]])
         self.f_start = asm.start_function()
+        self.f_J = ca.Function("J", [q, asm.p], [ca.densify(self.J)])
+        self.loop_coords = loop_coords
+        if partition is not None:        # a run re-partitions: no initial configuration
+            self.rows, self.dep = (sorted(int(i) for i in part) for part in partition)
+            return
         q0 = self.close(p_nom)
-        Jn = np.asarray(ca.Function("J", [q, asm.p], [self.J])(q0, p_nom))
-        self.rows, self.dep = self._partition(Jn, loop_coords)
+        self.rows, self.dep = self._partition(np.asarray(self.f_J(q0, p_nom)), loop_coords)
 
     # -- consistent initial configuration ---------------------------------------------------
     def close(self, p):
@@ -474,6 +491,54 @@ class _Loops:
                    if driven else ""))
         return rows, sorted(dep)
 
+    def candidates(self):
+        """The speeds that may be dependent: of the regular coordinates on a loop, less the
+        prescribed ones."""
+        asm = self.asm
+        return sorted(asm.speed_of[k] for k in self.loop_coords
+                      if asm.regular[k] and asm.speed_of[k] not in asm.prescribed)
+
+    def partitions_at(self, q, p):
+        """The partitions possible at the configuration ``q``: (health, choices), or None
+        where the closure has lost rank.
+
+        ``health`` is the ratio of the smallest to the largest singular value of the kept
+        closure rows' Jacobian in the candidate speeds: it goes to zero at a change point,
+        where two branches of the mechanism's configurations cross (a rhombus folding
+        flat) and no partition is regular. ``choices`` are (rows, dependent speeds,
+        condition number of the Jacobian in them, quality): the rows by pivoted QR as at
+        the start, every choice of as many candidate speeds as rows (or, beyond
+        PARTITION_CHOICES of them, the pivoted-QR one); quality is the smallest singular
+        value of the rows of the independent speeds in an orthonormal basis of the
+        closure's null space (the tangent of the configurations): how well the independent
+        coordinates describe the motion, through a change point too."""
+        J = np.asarray(self.f_J(q, p), dtype=float)
+        if not np.all(np.isfinite(J)):
+            return None
+        s = np.linalg.svd(J, compute_uv=False)
+        rank = int(np.sum(s > RANK_TOL * max(s[0], 1.0))) if s.size else 0
+        if rank < len(self.rows):
+            return None
+        _, _, piv = scipy.linalg.qr(J.T, pivoting=True)
+        rows = sorted(piv[:rank].tolist())
+        cand = self.candidates()
+        Jc = J[rows][:, cand]
+        _, sc, vt = np.linalg.svd(Jc)
+        health = float(sc[-1] / sc[0]) if sc.size and sc[0] > 0 else 0.0
+        N = vt[rank:].T                              # null space, one row per candidate
+        if math.comb(len(cand), rank) <= PARTITION_CHOICES:
+            choices = itertools.combinations(range(len(cand)), rank)
+        else:
+            _, _, piv = scipy.linalg.qr(Jc, pivoting=True)
+            choices = [sorted(piv[:rank].tolist())]
+        out = []
+        for dep in choices:
+            ind = [j for j in range(len(cand)) if j not in dep]
+            quality = np.linalg.svd(N[ind], compute_uv=False)[-1] if ind else 1.0
+            out.append((rows, [cand[j] for j in dep], condition(Jc[:, list(dep)]),
+                        float(quality)))
+        return health, out
+
     # -- the equations --------------------------------------------------------------------------
     def _projected(self, x, zg, ode, keep_q, dep_q, ind, sub, u_full, udot, udot_i, phi, lam,
                    initial, note_rows):
@@ -507,6 +572,11 @@ class _Loops:
 
 
     def equations(self, formulation, rate):
+        eq = self._equations(formulation, rate)
+        eq.partition, eq.loops, eq.rate = (list(self.rows), list(self.dep)), self, rate
+        return eq
+
+    def _equations(self, formulation, rate):
         asm = self.asm
         q, u = asm.q, asm.u
         nv = u.shape[0]
@@ -631,6 +701,14 @@ class _Loops:
                          dependent_jacobian=JD if dep else None,
                          dependent_names=[unames[k] for k in dep])
 
+
+
+def condition(A):
+    """The 2-norm condition number of a square matrix (inf when singular)."""
+    if not A.size:
+        return 1.0
+    s = np.linalg.svd(A, compute_uv=False)
+    return float(s[0] / s[-1]) if s[-1] > 0 else np.inf
 
 
 def _wrapped(d, scale):

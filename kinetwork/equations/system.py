@@ -35,13 +35,18 @@ class System:
         What the probes record: name, unit, shape of each quantity.
     """
 
-    def __init__(self, model, loops="partition", baumgarte_rate=None, topology=None):
+    def __init__(self, model, loops="partition", baumgarte_rate=None, topology=None,
+                 partition=None, assembly=None):
+        # partition, assembly: the same model with other independent coordinates (a run
+        # re-partitions a loop where its partition turns singular), on the same assembly
         self.model = model
         self.topology = topology if topology is not None else model.validate()
         values = model.parameter_values()
-        self.asm = asm = assemble(model, self.topology, values)
+        self.asm = asm = assembly if assembly is not None else \
+            assemble(model, self.topology, values)
         self.eq = eq = formulate(asm, self.topology, values, loops,
-                                 BAUMGARTE_RATE if baumgarte_rate is None else baumgarte_rate)
+                                 BAUMGARTE_RATE if baumgarte_rate is None else baumgarte_rate,
+                                 partition)
         if asm.junctions is not None:
             junctions.extend(eq, asm, self.topology)
         #: friction and stops: their holding forces solved, their events (``modes.py``)
@@ -84,7 +89,7 @@ class System:
         if self.formulation in ("tree", "hybrid") and self.speed_names and \
                 not self.n_algebraic:
             self._check_mass_matrix()
-        else:                  # initial values that contradict the loops: refused now
+        elif partition is None:  # initial values that contradict the loops: refused now
             self.initial_full_p(self.param_vector())
         self._z_last = None
 

@@ -35,7 +35,7 @@ from . import jit as _jit
 from .capture import SOLVER_LOCK, last_words, solver_output
 from .compiled import compiled
 from .events import EVENT_CHUNK, Events
-from .loopwatch import near_singular, watch
+from .loopwatch import Partitions, near_singular
 from .methods import METHODS, Failure, choose, shift_times
 from .results import Results
 
@@ -135,7 +135,8 @@ def simulate(model: Model | System, t_end: float | None = None, n_points: int | 
              params: Mapping[str, float] | None = None, t_start: float = 0.0,
              step: float | None = None, jit: bool | None = None, max_steps: int | None = None,
              time_limit: float | None = None, progress: Callable[[float], object] | None = None,
-             cancel: Callable[[], object] | None = None, restart: bool = False) -> Results:
+             cancel: Callable[[], object] | None = None, restart: bool = False,
+             repartition: bool = True) -> Results:
     """Integrate ``model`` (a Model or a compiled System) and record its probes.
 
     Settings not given come from the model's ``simulation`` block, then from DEFAULTS.
@@ -177,6 +178,12 @@ def simulate(model: Model | System, t_end: float | None = None, n_points: int | 
         MAX_RESTARTS times), if that state is sound: finite, the loops closed, and the
         restarted run continuing it without a jump. Each restart is in ``stats["restarts"]``.
         Off by default: a failure is a SimulationError.
+    repartition : bool, optional
+        With kinematic loops: where the partition of the speeds into independent and
+        dependent ones nears a singular configuration (a dead point of the independent
+        coordinates, or a change point of the mechanism), choose another partition there and
+        go on (``kinetwork.simulation.loopwatch``); ``stats["repartitions"]`` counts them,
+        ``stats["repartition_times"]`` says when. False: stop there with a SimulationError.
 
     Returns
     -------
@@ -208,6 +215,7 @@ def simulate(model: Model | System, t_end: float | None = None, n_points: int | 
     stats = {}
     jit_on = _jit.enabled(jit) and system.n_states > 0
     run = Run(system, p, x0, grid, settings, None, cancel, progress, restart)
+    run.repartition = bool(repartition)
     if system.modes is not None:       # modes consistent with the start, before any method
         run.events = Events(run)
         run.x0 = run.events.start(float(grid[0]), run.x0)
@@ -228,9 +236,13 @@ def simulate(model: Model | System, t_end: float | None = None, n_points: int | 
         stats["events"] = run.events.log
     stats["jit"] = bool(run.jit) and not stats.get("jit_fallback")
     t = grid[:len(X)]
-    X = system.polish(X, p)
-    f_out = compiled(system).outputs(run.jit)
-    outputs = system.outputs_p(t, X, p, f_out) if len(t) else np.zeros((0, 0))
+    parts = getattr(run, "partitions", None)
+    if parts is not None and parts.events:     # re-partitioned: each part by its equations
+        X, outputs = parts.finish(t, X)
+    else:
+        X = system.polish(X, p)
+        f_out = compiled(system).outputs(run.jit)
+        outputs = system.outputs_p(t, X, p, f_out) if len(t) else np.zeros((0, 0))
     results = Results(t, X, system.state_names + system.algebraic_names, outputs,
                       system.signals, stats=stats,
                       state_units=system.state_units + system.algebraic_units,
@@ -323,6 +335,7 @@ def _integrate(run, method):
     """States on the grid from ``method``, chunk by chunk: (X, failure or None, stats)."""
     grid, n = run.grid, len(run.grid)
     X = _Rows(run.x0)
+    parts = Partitions(run)            # the loops' partitions the run goes through
     stats, restarts = {}, []           # stats: of the steppers replaced by restarts
     if method.fixed and run.max_steps and run.steps_per_interval > run.max_steps:
         return np.array(X), (f"the step budget of {run.max_steps} steps per output interval "
@@ -367,12 +380,19 @@ def _integrate(run, method):
                 stepper = method.start(run, *restart_at)
             except Failure as exc:
                 failure = exc.reason
+        turn = None
         if run.system.f_dependent is not None:
-            new, failure = watch(run, X, new, failure)
+            new, failure, turn = parts.watch(X, new, failure)
         X.extend(new)
         k = len(X) - 1
         if run.progress is not None and len(new):
             run.progress(float(grid[k]))
+        if turn is not None and run.stop_reason() is None:
+            switched = parts.switch(method, X, turn)
+            if switched is not None:       # the loops re-partitioned: on from there
+                stats = _merge(stats, stepper.stats)
+                stepper, failure, chunk = switched, None, 1
+                continue
         if failure is not None:
             if run.stop_reason() is None and _restart(run, method, X, restarts, failure):
                 stats = _merge(stats, stepper.stats)
@@ -383,6 +403,7 @@ def _integrate(run, method):
         if not method.stepper:
             chunk = _next_chunk(run, m, _work(run, stepper.stats) - work_before, n - 1 - k)
             chunk = chunk if run.events is None else min(chunk, EVENT_CHUNK)
+            chunk = parts.limit(chunk)
         elif run.events is not None:
             chunk = 1
     if failure is not None and run.system.f_dependent is not None and \
@@ -391,6 +412,7 @@ def _integrate(run, method):
     stats = _merge(stats, stepper.stats)
     if restarts:
         stats["restarts"] = [{"t": r["t"], "after": r["after"]} for r in restarts]
+    stats.update(parts.done())
     return np.array(X), failure, stats
 
 
@@ -434,6 +456,11 @@ class _Rows:
 
     def append(self, row):
         self.extend(np.asarray(row)[None, :])
+
+    def replace_last(self, row):
+        block = self.blocks[-1].copy()        # the first block may be a view of x0
+        block[-1] = row
+        self.blocks[-1] = block
 
     def __array__(self, dtype=None, copy=None):
         out = np.vstack(self.blocks)

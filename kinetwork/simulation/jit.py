@@ -5,8 +5,9 @@ into a shared library named by the hash of the Function's serialisation (and com
 and CasADi version), and loaded back with ``casadi.external``. The key is found without
 generating any C: a cache hit costs the serialisation and a hash (N = 128 chain: 0.09 s
 against 0.26 s for generating the C, and no Jacobian is built when the library holds one).
-A long function is compiled in parts (``_split``), several compilers at once. The library is kept in the cache folder, so a model compiled once is
-loaded in milliseconds by every later run, in any process. A right-hand side compiled this way
+A long function is compiled in parts (``_split``), several compilers at once. The library is
+kept in the cache folder, so a model compiled once is loaded in milliseconds by every later
+run, in any process. A right-hand side compiled this way
 costs ~1.2 us per evaluation at 16 links, against ~11 us in CasADi's SX virtual machine.
 
 The cache folder is ``$KINETWORK_CACHE``, else ``$XDG_CACHE_HOME/kinetwork``, else
@@ -17,7 +18,7 @@ Trust model. Loading a library runs its code (constructors run on load), so the 
 cache, never a way for others to run code in kinetwork's process:
 
 - a library is loaded only if kinetwork built it for this exact code. Beside
-  ``<name>_<source hash>.so`` it writes ``.so.sha256``, the sha256 of the bytes the compiler
+  ``<name>_<key>.so`` it writes ``.so.sha256``, the sha256 of the bytes the compiler
   produced, both moved into place atomically; a library with no record, or whose bytes differ
   from it (planted, truncated by a full disk, damaged), is rebuilt over, never loaded;
 - the record proves the bytes are the ones written, not who wrote them: the folder settles
@@ -55,7 +56,7 @@ import casadi as ca
 from ..errors import ModelError
 
 #: -O1 runs as fast as -O2/-O3 on CasADi's straight-line code and compiles 30 % sooner
-#: (N = 128 chain: 2.5 s against 3.6 s); -O0 compiles 4x sooner but runs 2.7x slower
+#: (N = 128 chain: 2.5 s against 3.6 s); -O0 compiles 4x sooner but runs 2.7x slower there
 CFLAGS = ("-O1", "-fPIC", "-shared")
 #: a function of more statements than SPLIT_STATEMENTS is compiled as parts of about
 #: PART_STATEMENTS each, each in its own translation unit, as many compilers at once as there
@@ -304,7 +305,7 @@ def _sources(name, f, optimise):
 
 # -- long functions in parts ---------------------------------------------------------------------
 _HEAD = re.compile(r"^static int (casadi_f\d+)\(const casadi_real\*\* arg, casadi_real\*\* res, "
-                   r"casadi_int\* iw, casadi_real\* w, int mem\) \{\n", re.M)
+                   r"casadi_int\* iw, casadi_real\* w, int mem\) \{\n", re.MULTILINE)
 _END = "\n  return 0;\n}\n"
 _DECLARE = re.compile(r"  casadi_real (a\d+(?:, a\d+)*);\Z")
 _STATEMENT = re.compile(r"  (?:(a\d+)=([^;{}]*);|if \(res\[\d+\]!=0\) res\[\d+\]\[\d+\]=(a\d+);)\Z")
@@ -352,7 +353,7 @@ def _split(source, size):
         slots = {}
         calls = []
         for j, part in enumerate(parts):
-            loads, written, used = [], set(), []
+            loads, written = [], set()
             for m in part:
                 reads = [m.group(3)] if m.group(3) else _VARIABLE.findall(m.group(2))
                 for v in reads:
@@ -369,8 +370,8 @@ def _split(source, size):
             files[f"{fn}.c"] = "".join([
                 preamble.replace(prefix.group(0),
                                  f"#define CASADI_PREFIX(ID) {fn}_ ## ID"),
-                f"\n__attribute__((visibility(\"hidden\")))\n"
-                f"void {fn}(const casadi_real** arg, casadi_real** res, casadi_real* s) {{\n",
+                (f"\n__attribute__((visibility(\"hidden\")))\n"
+                 f"void {fn}(const casadi_real** arg, casadi_real** res, casadi_real* s) {{\n"),
                 "".join(f"  casadi_real {', '.join(names[i:i + 12])};\n"
                         for i in range(0, len(names), 12)),
                 "".join(f"  {v}=s[{slots[v]}];\n" for v in loads),
@@ -420,8 +421,8 @@ def _build_folder(folder):
 
 
 def _build(cc, name, sources, lib, deadline, cancelled):
-    """Compile ``sources`` ({file name: (C, flags)}) into ``lib`` and write its record, both moved into
-    place whole."""
+    """Compile ``sources`` ({file name: (C, flags)}) into ``lib`` and write its record, both
+    moved into place whole."""
     try:
         # the build folder goes on every way out (a KeyboardInterrupt included): the
         # compilers are stopped first, then the folder removed

@@ -5,9 +5,9 @@ Each checked against CasADi's virtual machine on the same Function."""
 import casadi as ca
 import numpy as np
 import pytest
+from scenes import build_kinetwork, random_mechanism
 
 from kinetwork.simulation import jit
-from scenes import build_kinetwork, random_mechanism
 
 pytestmark = pytest.mark.skipif(jit.compiler() is None, reason="no C compiler")
 
@@ -38,7 +38,7 @@ def test_a_long_function_in_parts_computes_what_the_virtual_machine_does(cache, 
     sources = jit._plan(f.name(), [f], jit.compiler(), jacobian=True)[0]()
     parts = [name for name in sources if "_p" in name]
     assert len(parts) >= f.n_instructions() // 150 + f.jacobian().n_instructions() // 150
-    assert {tuple(flags)[0] for _, flags in sources.values()} == {"-O1", "-O0"}
+    assert {flags[0] for _, flags in sources.values()} == {"-O1", "-O0"}
     stats = {}
     g = jit.external(f, jacobian=True, stats=stats)
     assert stats["jit_cached"] is False and g is not f
@@ -80,7 +80,7 @@ def test_a_cache_hit_generates_no_c(cache, monkeypatch, system):
 def test_the_key_follows_the_function_and_the_jacobian(system):
     cc = jit.compiler()
     f = system.f_rhs
-    name = lambda g, jac=False: jit._plan("rhs", [g], cc, jac)[1]   # noqa: E731
+    name = lambda g, jac=False: jit._plan("rhs", [g], cc, jac)[1]
     # a rebuilt model has the same serialisation: the same library
     rebuilt = build_kinetwork(*random_mechanism(3, 3)).compile().f_rhs
     assert name(f) == name(rebuilt)
