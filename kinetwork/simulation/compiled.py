@@ -115,6 +115,35 @@ class Compiled:
                                [ode, alg, empty, empty], ca.dyn_in(), ca.dyn_out())
         return self._get(("dae", jacobian), build)
 
+    def dae_scaled(self, jit=None, jacobian=False):
+        """The equations over a stretch of any length dt, in s = (t - t0) / dt from 0 to 1
+        (d/ds = dt d/dt): parameters [p; t0; dt], so one integrator to s = 1 reaches any time
+        (the events' trial times). As ``dae``: SX, or an MX Function around compiled code."""
+        system = self.system
+        eq, a = system.eq, system.asm
+        if not jit:
+            def build_sx():
+                s, t0, dt = ca.SX.sym("s"), ca.SX.sym("t0"), ca.SX.sym("dt")
+                shift = lambda e: ca.substitute(e, a.t, t0 + s * dt)  # noqa: E731
+                return {"x": eq.x, "z": eq.z, "p": ca.vertcat(a.p, t0, dt), "t": s,
+                        "ode": dt * shift(eq.ode), "alg": shift(eq.alg)}
+            return self._get("dae_scaled_sx", build_sx)
+        jacobian = jacobian and self.jacobian_small()
+
+        def build():
+            s, x = ca.MX.sym("s"), ca.MX.sym("x", system.n_states)
+            z = ca.MX.sym("z", system.n_algebraic)
+            pt, empty = ca.MX.sym("p", len(system.param_names) + 2), ca.MX(0, 1)
+            p, dt = pt[:-2], pt[-1]
+            t = pt[-2] + s * dt
+            if system.n_algebraic:
+                ode, alg = self._external(system.f_dae, jacobian, jit)(t, x, z, p)
+            else:
+                ode, alg = self.rhs(jit, jacobian)(t, x, p), empty
+            return ca.Function("dae_scaled", [s, x, z, pt, ca.MX.sym("u", 0)],
+                               [dt * ode, alg, empty, empty], ca.dyn_in(), ca.dyn_out())
+        return self._get(("dae_scaled", jacobian), build)
+
     def integrator(self, key, build):
         """A CasADi integrator built once for ``key`` (its grid and options): the same chunks
         of the same run, again, reuse it. Only the most recent INTEGRATORS_KEPT are kept."""

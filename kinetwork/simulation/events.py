@@ -144,13 +144,17 @@ class Events:
         """The earliest crossing in (t0, t1]: (time, state, element)."""
         from scipy.optimize import brentq          # 0.3 s to import: only with events
 
-        cache = {}
+        cache, from_t0 = {}, []
 
         def state(t):
             if t not in cache:
                 if t - t0 < SHORT * max(1.0, abs(t0)):
                     # CasADi's integrators do not step over a tiny interval (they return x0)
                     cache[t] = self._rk4(t0, x0, t - t0)
+                elif hasattr(method, "plugin"):        # CasADi's: one integrator for all
+                    if not from_t0:
+                        from_t0.append(method.start(self.run, t0, x0))
+                    cache[t] = from_t0[0].state_at(t)
                 else:
                     cache[t] = method.start(self.run, t0, x0).advance(np.array([t]),
                                                                       exact=True)[0]

@@ -187,6 +187,30 @@ class _CasadiRun:
         self.t, self.x = float(times[-1]), X[-1]
         return X
 
+    def state_at(self, t):
+        """The state at one time ``t`` after the start, not advancing: by one integrator over
+        a stretch of any length (``Compiled.dae_scaled``), built once for all the times an
+        event is looked for at (an integrator for each costs ~10 ms of CasADi's set-up)."""
+        m, run = self.method, self.run
+        if m.plugin == "idas":          # its options hold the state's rate: not reusable
+            return self.advance(np.array([t]), exact=True)[0]
+        nx = run.system.n_states
+        opts = self.options([t])
+        key = ("stretch", m.plugin, tuple(sorted(opts.items())), bool(run.jit))
+        integ = run.compiled.integrator(key, lambda: ca.integrator(
+            "locate", m.plugin, run.compiled.dae_scaled(run.jit, m.newton), 0.0, [1.0], opts))
+        try:
+            with run.solver_section(self.t):
+                out = integ(x0=self.x[:nx], z0=self.x[nx:],
+                            p=np.concatenate([run.p, [self.t, t - self.t]]))
+        except RuntimeError as exc:
+            run.said.append(shift_times(solver_words(str(exc)), self.t))
+            raise Failure(solver_reason(str(exc))) from None
+        x = np.concatenate([np.asarray(out["xf"]).ravel(), np.asarray(out["zf"]).ravel()])
+        if not np.all(np.isfinite(x)):
+            raise Failure("the state became non-finite (Inf or NaN)")
+        return x
+
 
 # -- scipy's steppers -------------------------------------------------------------------------
 class Scipy(Method):
