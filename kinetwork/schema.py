@@ -130,6 +130,8 @@ def _param(spec, info):
     elif spec.kind == "table2d":           # grids in the first row and column
         out = {"type": "array", "minItems": 3, "items": {
             "type": "array", "minItems": 3, "items": NUMBER}}
+    elif spec.kind == "vector":             # one number per axis
+        out = {"anyOf": [NUMBER, {"type": "array", "minItems": 1, "items": NUMBER}]}
     elif spec.kind == "table":
         out = {"type": "array", "minItems": 2, "items": {
             "type": "array", "minItems": 2, "maxItems": 2, "items": NUMBER}}

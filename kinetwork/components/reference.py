@@ -13,7 +13,7 @@ from .quantities import QUANTITIES
 #: a numpydoc section header: a title line over a line of dashes
 _SECTION = re.compile(r"^(?P<title>\S[^\n]*)\n-{3,}\s*$", re.M)
 _ANNOTATIONS = {"bool": bool, "name": str, "choice": str, "color": str,
-                "names": list[str], "table": list[list[float]]}
+                "names": list[str], "table": list[list[float]], "vector": list[float]}
 
 
 def _annotation(spec):
@@ -125,7 +125,8 @@ def param_line(info):
         parts.append("list of " + (", ".join(info["choices"]) if info["choices"] else "names"))
     else:
         parts.append({"bool": "true or false", "name": "component name",
-                      "color": "colour '#rrggbb'", "table": "rows [x, y]"}.get(
+                      "color": "colour '#rrggbb'", "table": "rows [x, y]",
+                      "vector": "one number per axis"}.get(
                           info["kind"], info["kind"]))
     bounds = [f">= {_number(info['min'])}" if info["min"] is not None else "",
               f"<= {_number(info['max'])}" if info["max"] is not None else "",

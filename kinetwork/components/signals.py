@@ -432,3 +432,89 @@ def _hats(at, grid):
     sum to one): a linear interpolant is their product with the values."""
     eye = np.eye(len(grid))
     return ca.vertcat(*[ca.pw_lin(at, ca.DM(grid), ca.DM(eye[k])) for k in range(len(grid))])
+
+
+class VectorParam(Param):
+    """One number per axis (a list of any length, or one number for one axis)."""
+
+    def __init__(self, default=REQUIRED, *, unit="", positive=False, doc=""):
+        super().__init__(default, unit=unit, kind="vector", doc=doc)
+        self.positive = positive
+
+    def normalize(self, value, where):
+        if isinstance(value, np.ndarray):
+            value = value.tolist()
+        if not isinstance(value, (list, tuple)):
+            value = [value]
+        if not value or len(value) > 100:
+            raise ModelError(f"{where}: must be 1 to 100 numbers (one per axis), got "
+                             f"{quote(value)}")
+        out = [float(check_number(v, f"{where}[{i}]")) for i, v in enumerate(value)]
+        bad = [i for i, v in enumerate(out) if self.positive and not v > 0]
+        if bad:
+            raise ModelError(f"{where}[{bad[0]}]: must be > 0, got {out[bad[0]]}")
+        return out
+
+
+class KinematicPTP(PartialBlock, library=LIB):
+    """Point-to-point motion of one or several axes as MSL's Blocks.Sources.KinematicPTP:
+    each axis moves from q_begin to q_end, accelerating at its limit, coasting at its speed
+    limit, braking at its limit, all axes on one normalised path (the slowest sets the
+    timing, so they start and stop together). The output is axis ``axis``'s angle
+    (``quantity`` "q"), speed ("qd") or acceleration ("qdd"); exact, piecewise polynomial in
+    t, so an exact Position may follow it."""
+    q_begin = VectorParam(doc="Start positions, one per axis")
+    q_end = VectorParam(doc="End positions, one per axis")
+    qd_max = VectorParam(positive=True, doc="Largest speeds (> 0), one per axis")
+    qdd_max = VectorParam(positive=True, doc="Largest accelerations (> 0), one per axis")
+    start_time = Param(0.0, unit="s", doc="Start of the motion")
+    axis = Param(1, unit="1", min=1, doc="Which axis the output is (1: the first)")
+    quantity = Param("q", kind="choice", choices=("q", "qd", "qdd"),
+                     doc="The output: the axis's position, speed or acceleration")
+
+    def check_values(self, values, place):
+        n = len(values["q_begin"])
+        for key in ("q_end", "qd_max", "qdd_max"):
+            if len(values[key]) != n:
+                return [f"{place(key)}: {len(values[key])} axes, but q_begin has {n}"]
+        axis = values["axis"]
+        if isinstance(axis, (int, float)) and not (1 <= axis <= n and axis == int(axis)):
+            return [f"{place('axis')} = {axis}: must be a whole number from 1 to {n}"]
+        return []
+
+    def timing(self):
+        """MSL's KinematicPTP: the normalised path's largest speed and acceleration and its
+        phase ends (acceleration, coasting, end), after start_time; or None at rest."""
+        delta = np.subtract(self.q_end, self.q_begin)
+        sd_inv = max(abs(delta / np.array(self.qd_max)))
+        sdd_inv = max(abs(delta / np.array(self.qdd_max)))
+        if sd_inv <= 1e-15 or sdd_inv <= 1e-15:
+            return None
+        sd, sdd = 1 / sd_inv, 1 / sdd_inv
+        ta1, ta2 = np.sqrt(1 / sdd), sd / sdd
+        if ta2 >= ta1:                     # no coasting: the speed limit is never reached
+            return sdd * ta1, sdd, ta1, ta1, 2 * ta1
+        return sd, sdd, ta2, 1 / sd, 1 / sd + ta2
+
+    def output(self, u, x, t):
+        k = int(float(ca.DM(self.axis))) - 1         # a number: it picks an axis
+        delta = self.q_end[k] - self.q_begin[k]
+        base = self.q_begin[k] if self.quantity == "q" else 0.0
+        timing = self.timing()
+        if timing is None:
+            return ca.SX(base)
+        sd, sdd, ta, tv, te = timing
+        tau = t - self.start_time
+        # r, r', r'' of the normalised path in its phases (accelerate, coast, brake, rest)
+        r_a = [sdd / 2 * tau**2, sdd * tau, sdd]
+        ra = sdd / 2 * ta**2
+        r_c = [ra + sd * (tau - ta), sd, 0.0]
+        rv = ra + sd * (tv - ta)
+        r_b = [rv + sd * (tau - tv) - sdd / 2 * (tau - tv)**2, sd - sdd * (tau - tv), -sdd]
+        r_e = [rv + sd * (te - tv) - sdd / 2 * (te - tv)**2, 0.0, 0.0]
+        which = ("q", "qd", "qdd").index(self.quantity)
+        r = ca.if_else(tau < 0, 0.0,
+                       ca.if_else(tau < ta, r_a[which],
+                                  ca.if_else(tau < tv, r_c[which],
+                                             ca.if_else(tau < te, r_b[which], r_e[which]))))
+        return base + delta * r
