@@ -100,7 +100,7 @@ def build():
                  ("gasForce.support", "cylinder.support"), ("crank.port", "bearing.axis"),
                  ("stroke.port", "cylinder.axis")]:
         m.connect(a, b)
-    m.settings = {"t_end": 0.5, "n_points": 501, "method": "auto", "rtol": 1e-8,
+    m.simulation = {"t_end": 0.5, "n_points": 501, "method": "auto", "rtol": 1e-8,
                   "atol": 1e-10}
     return m
 

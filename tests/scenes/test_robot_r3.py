@@ -1,0 +1,180 @@
+"""MSL's RobotR3 (``models/robot_r3``; builders in ``tests/scenes/robot_r3.py``) against
+references written apart from kinetwork.
+
+OneAxis: an event-driven scipy model of the same drive written from MSL's equations: the
+motor's current controller reduced by nodal analysis (the power stage's gain 1 + Rp1/Rp2 = 5,
+the op-amp integrator's Ri C, as in tests/components/test_electrical.py), the cascade
+controller, the motor rotor with bearing friction that sticks (exactly: the rotor held,
+the holding torque k i - tau_spring checked against peak Rv0) and slides (Rv0 sign(w) +
+Rv1 w), the gear's spring-damper and the load through the ratio, and MSL's KinematicPTP
+written out in its phases; integrated by LSODA (stiff: the current loop) from event to event (sticking where the motor
+speed crosses zero with the holding torque within the static limit, breaking away where it
+reaches it) and across the path's phase changes."""
+
+import math
+
+import numpy as np
+import pytest
+from scipy.integrate import solve_ivp
+
+import kinetwork as kn
+from scenes import robot_r3
+
+OPT = {"rtol": 1e-10, "atol": 1e-10, "jit": False}
+METHOD, RTOL = "LSODA", 1e-11
+
+
+
+
+def path(t, q0, q1, v, a):
+    """Trapezoidal speed profile (acceleration a up to speed v, then braking): q, qd."""
+    dq = q1 - q0
+    ta = min(v / a, math.sqrt(abs(dq) / a))
+    v = a * ta
+    tv = abs(dq) / v
+    te = tv + ta
+    sgn = math.copysign(1.0, dq)
+    if t < ta:
+        s, sd = a * t * t / 2, a * t
+    elif t < tv:
+        s, sd = a * ta * ta / 2 + v * (t - ta), v
+    elif t < te:
+        s, sd = abs(dq) - a * (te - t)**2 / 2, a * (te - t)
+    else:
+        s, sd = abs(dq), 0.0
+    return q0 + sgn * s, sgn * sd, (ta, tv, te)
+
+
+class OneAxis:
+    """The drive of RobotR3.OneAxis as an ODE in (i, v_C, phi_m, w_m, phi_L, w_L, x_PI) with
+    the friction's mode (+1, -1 sliding, 0 stuck)."""
+
+    def __init__(self):
+        p, a, m = robot_r3.ONE_AXIS, robot_r3.AXIS1, robot_r3.MOTOR
+        self.kp, self.ks, self.Ts = p["kp"], p["ks"], p["Ts"]
+        self.n, self.c, self.d = a["ratio"], a["c"], a["cd"]
+        self.Rv0, self.Rv1, self.peak = a["Rv0"], a["Rv1"], 1.0
+        D, w = m["D"], a["w"]
+        self.k, self.J = m["k"], m["J"]
+        self.La, self.Ra, self.C, self.Ri = 250 / (2 * D * w), 250.0, 0.004 * D / w, 10.0
+        self.JL = 1.3 * p["mLoad"]
+        self.q = (math.radians(p["startAngle"]), math.radians(p["endAngle"]),
+                  p["refSpeedMax"], p["refAccMax"])
+
+    def parts(self, t, x):
+        pm, wm, pL, wL, xi = x[2:]
+        q, qd, _ = path(t, *self.q)
+        e = self.n * qd + self.kp * (self.n * q - pm) - wm
+        i_ref = self.ks * (e + xi)
+        tau_s = self.c * (pm - self.n * pL) + self.d * (wm - self.n * wL)
+        return e, i_ref, tau_s
+
+    def rhs(self, t, x, mode):
+        i, vC, wm, wL = x[0], x[1], x[3], x[5]
+        e, i_ref, tau_s = self.parts(t, x)
+        if mode == 0:
+            dwm = 0.0
+        else:
+            dwm = (self.k * i - tau_s - mode * self.Rv0 - self.Rv1 * wm) / self.J
+        return [(-5 * vC - self.Ra * i - self.k * wm) / self.La,
+                (i - i_ref) / (self.Ri * self.C), wm if mode else 0.0, dwm, wL,
+                self.n * tau_s / self.JL, e / self.Ts]
+
+    def holding(self, t, x):
+        return self.k * x[0] - self.parts(t, x)[2]
+
+    def solve(self, t_out):
+        """The states at ``t_out`` and the events (t, new mode)."""
+        breaks = list(path(0.0, *self.q)[2])
+        x, t0, mode, events, out = np.zeros(7), 0.0, 0, [], []
+        t_end = t_out[-1]
+        while t0 < t_end:
+            t1 = min([b for b in breaks if b > t0 + 1e-12] + [t_end])
+            if mode == 0:
+                def ev(t, x, mode):
+                    return abs(self.holding(t, x)) - self.peak * self.Rv0
+                ev.direction = 1
+            else:
+                def ev(t, x, mode):
+                    return x[3]
+                ev.direction = -mode
+            ev.terminal = True
+            sol = solve_ivp(self.rhs, (t0, t1), x, method=METHOD, rtol=RTOL, atol=1e-12,
+                            args=(mode,), events=ev, dense_output=True)
+            te = sol.t[-1]
+            out += [(tk, *sol.sol(tk)) for tk in t_out if t0 <= tk <= te
+                    and (not out or tk > out[-1][0])]
+            x, t0 = sol.y[:, -1].copy(), te
+            if sol.status == 1:
+                if mode == 0:
+                    mode = 1 if self.holding(t0, x) > 0 else -1
+                else:
+                    x[3] = 0.0
+                    hold = self.holding(t0, x)
+                    mode = 0 if abs(hold) <= self.peak * self.Rv0 else (1 if hold > 0 else -1)
+                events.append((t0, mode))
+        return np.array(out), events
+
+
+@pytest.fixture(scope="module")
+def one_axis():
+    system = kn.load(robot_r3.FOLDER / "OneAxis.json").compile()
+    t = np.linspace(0.0, 1.6, 33)
+    res = kn.simulate(system, t_end=1.6, n_points=33, **OPT)
+    return res, OneAxis().solve(t)
+
+
+def test_one_axis_load_angle_and_motor_current_match_the_event_driven_reference(one_axis):
+    res, (ref, events) = one_axis
+    angle, current = res["load_angle.angle"], res["axis.motor.current.value"]
+    assert angle[-1] == pytest.approx(math.radians(120), abs=2e-3)   # where the path ends
+    scale = np.max(np.abs(ref[:, 1]))
+    np.testing.assert_allclose(angle, ref[:, 5], atol=1e-6 * np.max(np.abs(ref[:, 5])))
+    np.testing.assert_allclose(current, ref[:, 1], atol=1e-6 * scale)
+    got = [(e["t"], e["kind"]) for e in res.stats["events"]]
+    names = {1: "sliding forward", -1: "sliding backward", 0: "stuck"}
+    assert [k for _, k in got] == [names[m] for _, m in events]
+    np.testing.assert_allclose([t for t, _ in got], [t for t, _ in events], atol=1e-8)
+
+
+def test_the_robot_files_are_what_the_builders_write(tmp_path):
+    robot_r3.write_models(tmp_path)
+    for path in robot_r3.FOLDER.glob("*.json"):
+        assert (tmp_path / path.name).read_bytes() == path.read_bytes(), path.name
+
+
+def _ptp_run(**params):
+    m = kn.Model("ptp")
+    for q in ("q", "qd", "qdd"):
+        m.add(kn.signals.KinematicPTP(f"p_{q}", quantity=q, **params))
+        m.add(kn.Probe(f"pr_{q}", quantities=["value"]))
+        m.connect(f"p_{q}.y", f"pr_{q}.port")
+    return kn.simulate(m, t_end=1.5, n_points=151, method="rk45", jit=False)
+
+
+def test_kinematic_ptp_is_the_trapezoidal_profile_and_synchronises_axes():
+    """One axis: the profile written out by hand (``path``); with a second, slower axis the
+    first follows the second's timing scaled to its own distance, as MSL's KinematicPTP."""
+    res = _ptp_run(q_begin=[0.0], q_end=[2.0944], qd_max=[3.0], qdd_max=[10.0])
+    ref = np.array([path(t, 0.0, 2.0944, 3.0, 10.0)[:2] for t in res.t])
+    np.testing.assert_allclose(res["pr_q.value"], ref[:, 0], atol=1e-12)
+    np.testing.assert_allclose(res["pr_qd.value"], ref[:, 1], atol=1e-12)
+    acc = np.gradient(ref[:, 1], res.t)
+    inside = np.abs(res["pr_qdd.value"] - acc) < 1e-9
+    assert inside.sum() > 100                        # the acceleration, away from its jumps
+    # axis 2 of a pair: 1 -> 0.5 limited by 3 rad/s and 10 rad/s^2 alone, but axis 1 (2 rad
+    # at 1 rad/s, 2 rad/s^2) is slower: both move on axis 1's normalised path
+    res = _ptp_run(q_begin=[0.0, 1.0], q_end=[2.0, 0.5], qd_max=[1.0, 3.0],
+                   qdd_max=[2.0, 10.0], axis=2)
+    slow = np.array([path(t, 0.0, 2.0, 1.0, 2.0)[:2] for t in res.t])
+    np.testing.assert_allclose(res["pr_q.value"], 1.0 - 0.25 * slow[:, 0], atol=1e-12)
+    np.testing.assert_allclose(res["pr_qd.value"], -0.25 * slow[:, 1], atol=1e-12)
+
+
+def test_kinematic_ptp_refuses_axes_that_do_not_match():
+    with pytest.raises(kn.ModelError, match=r"ptp.qd_max\[0\]: must be > 0"):
+        kn.signals.KinematicPTP("ptp", q_begin=0, q_end=1, qd_max=0, qdd_max=1)
+    m = kn.Model("m")
+    m.add(kn.signals.KinematicPTP("ptp", q_begin=[0, 0], q_end=[1], qd_max=1, qdd_max=1))
+    with pytest.raises(kn.ModelError, match=r"q_end: 1 axes, but q_begin has 2"):
+        m.validate()
