@@ -664,11 +664,12 @@ def _dask(job, values, batch, scheduler, outcome, done, report):
             idx = np.arange(start, min(len(values), start + batch))
             fut = client.submit(run_batch, remote_job, values[idx], batch, pure=False)
             futures[fut] = idx
-        for fut in as_completed(list(futures)):
+        # results fetched in the background as tasks finish (a fetch per future, one after
+        # another, waited a round trip each)
+        for fut, part in as_completed(list(futures), with_results=True, raise_errors=False):
             idx = futures[fut]
-            try:
-                part = fut.result()
-            except Exception as exc:  # noqa: BLE001  (a worker lost: the members say so)
+            if fut.status != "finished":       # a worker lost, a task failed: say so
+                exc = fut.exception()
                 part = Outcome(job, len(idx))
                 for k in range(len(idx)):
                     part.fail(k, f"the Dask task failed: {type(exc).__name__}: {exc}")
