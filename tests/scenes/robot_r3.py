@@ -31,15 +31,15 @@ def _wire(model, pairs):
 
 def motor():
     """Utilities.Motor: the motor of one axis with its current controller."""
-    m = kn.Model("Motor", parameters=dict(MOTOR), description=(
+    m = kn.Model("Motor", parameters={**MOTOR, "phi0": 0.0}, description=(
         "Modelica.Mechanics.MultiBody.Examples.Systems.RobotR3.Utilities.Motor, part for part: "
         "the reference current (port current_ref, through convert2 into the voltage source "
         "Vs) against the measured one (hall1, through convert1 into hall2) in the difference "
         "amplifier diff, integrated by OpI with C, amplified by the power stage (1 + Rp1/Rp2) "
         "into Ra, La and the EMF (k) turning the rotor Jmotor; the motor angle (phi) and "
         "speed (speed) measured on the EMF's flange. Ports: flange_motor, current_ref, "
-        "motorAngle, motorSpeed. Starts at rest with no current, which is MSL's steady start "
-        "(der(C.v) = der(La.i) = 0) for a zero reference."))
+        "motorAngle, motorSpeed. Starts at rest at angle phi0 with no current, which is MSL's "
+        "steady start (der(C.v) = der(La.i) = 0) for a zero reference."))
     for c in [E.VoltageSource("Vs"), E.IdealOpAmp("power"), E.IdealOpAmp("diff"),
               E.EMF("emf", k="k"), E.Inductor("La", L="250/(2*D*w)"), E.Resistor("Ra", R=250),
               E.Resistor("Rd2", R=100), E.Capacitor("C", C="0.004*D/w"), E.IdealOpAmp("OpI"),
@@ -47,7 +47,8 @@ def motor():
               E.Resistor("Rp2", R=50), E.Resistor("Rd4", R=100), E.VoltageSource("hall2"),
               E.Resistor("Rd3", R=100), E.CurrentSensor("hall1"),
               *[E.Ground(f"g{i}") for i in range(1, 6)],
-              rot.AngleSensor("phi"), rot.SpeedSensor("speed"), rot.Inertia("Jmotor", J="J"),
+              rot.AngleSensor("phi"), rot.SpeedSensor("speed"),
+              rot.Inertia("Jmotor", J="J", phi0="phi0"),
               sig.Gain("convert1", k=1.0), sig.Gain("convert2", k=1.0),
               kn.Probe("current", quantities=["value"])]:
         m.add(c)
@@ -113,16 +114,18 @@ def controller():
 def axis_type1(motor_def, gear_def, controller_def):
     """Utilities.AxisType1: controller, motor and GearType1."""
     params = {"kp": 10.0, "ks": 1.0, "Ts": 0.01, **MOTOR, "ratio": -105.0, "Rv0": 0.4,
-              "Rv1": 0.13 / 160, "peak": 1.0, "c": 43.0, "cd": 0.005}
+              "Rv1": 0.13 / 160, "peak": 1.0, "c": 43.0, "cd": 0.005, "q_start": 0.0}
     m = kn.Model("AxisType1", parameters=params, description=(
         "Modelica.Mechanics.MultiBody.Examples.Systems.RobotR3.Utilities.AxisType1 (AxisType2 "
         "with GearType1): controller, motor and gear wired as MSL's, the axis bus as ports: "
         "flange (the gear's output), angle_ref, speed_ref. MSL's InitializeFlange and the "
-        "sensors of the output flange that only feed the bus are left out; the axis starts at "
-        "rest at angle 0, where MSL's references start it."))
+        "sensors of the output flange that only feed the bus are left out; the motor starts at "
+        "rest at ratio q_start, the spring relaxed, for a joint starting at q_start (as "
+        "InitializeFlange puts it on its reference)."))
     m.add(kn.Subsystem("controller", controller_def, params={
         "kp": "kp", "ks": "ks", "Ts": "Ts", "ratio": "ratio"}))
-    m.add(kn.Subsystem("motor", motor_def, params={k: k for k in MOTOR}))
+    m.add(kn.Subsystem("motor", motor_def, params={**{k: k for k in MOTOR},
+                                                   "phi0": "ratio*q_start"}))
     m.add(kn.Subsystem("gear", gear_def, params={
         "i": "ratio", "c": "c", "d": "cd", "Rv0": "Rv0", "Rv1": "Rv1", "peak": "peak"}))
     _wire(m, [("motor.flange_motor", "gear.flange_a"),
@@ -167,16 +170,162 @@ def one_axis(axis_def):
     return m
 
 
+def gear_type2():
+    """Utilities.GearType2: the ideal gear, bearing friction on the joint side."""
+    m = kn.Model("GearType2", parameters={"i": -99.0, "Rv0": 21.8, "Rv1": 9.8,
+                                          "peak": 26.7 / 21.8}, description=(
+        "Modelica.Mechanics.MultiBody.Examples.Systems.RobotR3.Utilities.GearType2: the "
+        "IdealGear gear (ratio i) and, on its output, bearingFriction (Coulomb Rv0, viscous "
+        "Rv1, static peak*Rv0, with stiction). Ports: flange_a (motor), flange_b (joint)."))
+    m.add(rot.IdealGear("gear", ratio="i"))
+    m.add(rot.BearingFriction("bearingFriction", tau_c="Rv0", d="Rv1", peak="peak"))
+    m.connect("gear.flange_b", "bearingFriction.flange")
+    m.expose("flange_a", "gear.flange_a")
+    m.expose("flange_b", "gear.flange_b")
+    return m
+
+
+def axis_type2(motor_def, gear_def, controller_def):
+    """Utilities.AxisType2: controller, motor and GearType2."""
+    params = {"kp": 10.0, "ks": 1.0, "Ts": 0.01, **MOTOR, "ratio": -105.0, "Rv0": 0.4,
+              "Rv1": 0.13 / 160, "peak": 1.0}
+    m = kn.Model("AxisType2", parameters=params, description=(
+        "Modelica.Mechanics.MultiBody.Examples.Systems.RobotR3.Utilities.AxisType2: "
+        "controller, motor and GearType2 (no elasticity: the motor's rotor is geared rigidly "
+        "to the joint) wired as MSL's, the axis bus as ports: flange, angle_ref, speed_ref."))
+    m.add(kn.Subsystem("controller", controller_def, params={
+        "kp": "kp", "ks": "ks", "Ts": "Ts", "ratio": "ratio"}))
+    m.add(kn.Subsystem("motor", motor_def, params={k: k for k in MOTOR}))
+    m.add(kn.Subsystem("gear", gear_def, params={
+        "i": "ratio", "Rv0": "Rv0", "Rv1": "Rv1", "peak": "peak"}))
+    _wire(m, [("motor.flange_motor", "gear.flange_a"),
+              ("controller.current_ref", "motor.current_ref"),
+              ("motor.motorAngle", "controller.motorAngle"),
+              ("motor.motorSpeed", "controller.motorSpeed")])
+    m.expose("flange", "gear.flange_b")
+    m.expose("angle_ref", "controller.angle_ref")
+    m.expose("speed_ref", "controller.speed_ref")
+    return m
+
+
+#: MechanicalStructure.mo: (joint axis, body r, r_CM, m, [I_11, I_22, I_33, I_21]) per link
+#: b0 .. b6 (BodyShape's inertia defaults to 0.001 on the diagonal). b1's I_11 and I_33
+#: (0.001 in MSL) are 0 here: b1 turns about y alone, so they never act, and MSL's values
+#: break the triangle inequality (kinetwork warns of such idealised bodies)
+BODIES = [
+    (None, [0, 0.351, 0], [0, 0, 0], 1.0, [0.001, 0.001, 0.001, 0.0]),
+    ([0, 1, 0], [0, 0.324, 0.3], [0, 0, 0], 1.0, [0.0, 1.16, 0.0, 0.0]),
+    ([1, 0, 0], [0, 0.65, 0], [0.172, 0.205, 0], 56.5, [2.58, 0.64, 2.73, -0.46]),
+    ([1, 0, 0], [0, 0.414, -0.155], [0.064, -0.034, 0], 26.4, [0.279, 0.245, 0.413, -0.070]),
+    ([0, 1, 0], [0, 0.186, 0], [0, 0, 0], 28.7, [1.67, 0.081, 1.67, 0.0]),
+    ([1, 0, 0], [0, 0.125, 0], [0, 0, 0], 5.2, [1.25, 0.81, 1.53, 0.0]),
+    ([0, 1, 0], [0, 0, 0], [0.05, 0.05, 0.05], 0.5, [0.001, 0.001, 0.001, 0.0]),
+]
+#: FullRobot.mo: load, start and end angles [deg], reference limits, and the axes' values
+FULL = {"mLoad": 15.0, "rLoad": [0.1, 0.25, 0.1], "g": 9.81,
+        "start": [-60, 20, 90, 0, -110, 0], "end": [60, -70, -35, 45, 110, 45],
+        "speed": [3, 1.5, 5, 3.1, 3.1, 4.1], "acc": [15, 15, 15, 60, 60, 60]}
+AXES = [
+    {"w": 4590, "ratio": -105, "c": 43, "cd": 0.005, "Rv0": 0.4, "Rv1": 0.13 / 160},
+    {"w": 5500, "ratio": 210, "c": 8, "cd": 0.01, "Rv0": 0.5, "Rv1": 0.1 / 130},
+    {"w": 5500, "ratio": 60, "c": 58, "cd": 0.04, "Rv0": 0.7, "Rv1": 0.2 / 130},
+    {"k": 0.2365, "w": 6250, "D": 0.55, "J": 1.6e-4, "ratio": -99, "Rv0": 21.8, "Rv1": 9.8,
+     "peak": 26.7 / 21.8},
+    {"k": 0.2608, "w": 6250, "D": 0.55, "J": 1.8e-4, "ratio": 79.2, "Rv0": 30.1, "Rv1": 0.03,
+     "peak": 39.6 / 30.1},
+    {"k": 0.0842, "w": 7400, "D": 0.27, "J": 4.3e-5, "ratio": -99, "Rv0": 10.9, "Rv1": 3.92,
+     "peak": 16.8 / 10.9},
+]
+
+
+def mechanical_structure():
+    """Utilities.MechanicalStructure: the r3 robot's six revolutes and seven bodies + load."""
+    mb = kn.multibody
+    m = kn.Model("MechanicalStructure", parameters={
+        "mLoad": 15.0, "rLoad_x": 0.0, "rLoad_y": 0.25, "rLoad_z": 0.0, "g": 9.81,
+        **{f"q{k}_start": 0.0 for k in range(1, 7)}},
+        description=(
+        "Modelica.Mechanics.MultiBody.Examples.Systems.RobotR3.Utilities.MechanicalStructure: "
+        "world (gravity g along -y), b0 .. b6 as BodyShape (r, r_CM, m and inertia from MSL; "
+        "b1's I_11 and I_33 are 0, not 0.001: b1 turns about y alone), "
+        "revolutes r1 .. r6 (axes y, x, x, y, x, y) and the load (mLoad at rLoad from b6). "
+        "Ports: axis1 .. axis6 (the joints' flanges); the joints start at rest at qk_start."))
+    m.add(mb.Ground("world", gravity=[0, "-g", 0]))
+    prev = "world.frame"
+    for k, (axis, r, r_cm, mass, (i11, i22, i33, i21)) in enumerate(BODIES):
+        if axis is not None:
+            m.add(mb.Revolute(f"r{k}", axis=axis, q0=f"q{k}_start", qd0=0.0))
+            m.connect(prev, f"r{k}.frame_a")
+            prev = f"r{k}.frame_b"
+        m.add(mb.BodyShape(f"b{k}", r=r, r_cm=r_cm, mass=mass,
+                           inertia=[[i11, i21, 0], [i21, i22, 0], [0, 0, i33]]))
+        m.connect(prev, f"b{k}.frame_a")
+        prev = f"b{k}.frame_b"
+    m.add(mb.BodyShape("load", r=[0, 0, 0], r_cm=["rLoad_x", "rLoad_y", "rLoad_z"],
+                       mass="mLoad", inertia=[0.001, 0.001, 0.001]))
+    m.connect(prev, "load.frame_a")
+    m.add(kn.Probe("tool", quantities=["position"]))
+    m.connect("tool.port", "load.frame_a")
+    for k in range(1, 7):
+        m.expose(f"axis{k}", f"r{k}.axis")
+    return m
+
+
+def full_robot(mechanics_def, axis1_def, axis2_def):
+    """RobotR3.FullRobot: PathPlanning6's KinematicPTP, six axes, the mechanics."""
+    f = FULL
+    m = kn.Model("FullRobot", description=(
+        "Modelica.Mechanics.MultiBody.Examples.Systems.RobotR3.FullRobot: the r3 robot "
+        "(MechanicalStructure.json, mLoad = 15 kg at rLoad = {0.1, 0.25, 0.1}) driven by six "
+        "axes, AxisType1 (elastic GearType1, stiction on the motor side) on joints 1-3 and "
+        "AxisType2 (GearType2, stiction on the joint side) on joints 4-6, with MSL's motor, "
+        "gear and controller values, along PathPlanning6's KinematicPTP (the six axes "
+        "synchronised) from (-60, 20, 90, 0, -110, 0) deg to (60, -70, -35, 45, 110, 45) deg; "
+        "StopTime 2 s. Reproduces MSL's fullRobotPlot.mos figure (axis 3: joint angle, probe "
+        "joint3, and motor current axis3.motor.current) and the six joint angles "
+        "(probes joint1 .. joint6). The start differs from MSL's initial equations: the joints "
+        "start at rest on their references with relaxed springs and no motor current (MSL "
+        "starts every motor in steady state holding the robot), so the arm first settles "
+        "under gravity."))
+    path = {"q_begin": [math.radians(a) for a in f["start"]],
+            "q_end": [math.radians(a) for a in f["end"]], "qd_max": f["speed"],
+            "qdd_max": f["acc"]}
+    rl = f["rLoad"]
+    m.add(kn.Subsystem("mechanics", mechanics_def, params={
+        "mLoad": f["mLoad"], "rLoad_x": rl[0], "rLoad_y": rl[1], "rLoad_z": rl[2],
+        "g": f["g"], **{f"q{k + 1}_start": path["q_begin"][k] for k in range(6)}}))
+    for k, values in enumerate(AXES):
+        n = k + 1
+        m.add(ptp(f"path_q{n}", "q", axis=n, **path))
+        m.add(ptp(f"path_qd{n}", "qd", axis=n, **path))
+        params = {**values, "kp": 5.0, "ks": 0.5, "Ts": 0.05}
+        if k < 3:
+            params["q_start"] = path["q_begin"][k]
+        m.add(kn.Subsystem(f"axis{n}", axis1_def if k < 3 else axis2_def, params=params))
+        m.add(kn.Probe(f"joint{n}", quantities=["angle", "speed"]))
+        _wire(m, [(f"path_q{n}.y", f"axis{n}.angle_ref"), (f"path_qd{n}.y", f"axis{n}.speed_ref"),
+                  (f"axis{n}.flange", f"mechanics.axis{n}"),
+                  (f"joint{n}.port", f"mechanics.axis{n}")])
+    m.simulation = {"t_end": 2.0, "n_points": 201, "method": "auto", "rtol": 1e-6,
+                    "atol": 1e-8}
+    return m
+
+
 def write_models(folder=FOLDER):
     folder = pathlib.Path(folder)
     folder.mkdir(parents=True, exist_ok=True)
-    for build in (motor, gear_type1, controller):
+    for build in (motor, gear_type1, gear_type2, controller, mechanical_structure):
         model = build()
         model.save(folder / f"{model.name}.json")
-    load = {n: kn.load(folder / f"{n}.json") for n in ("Motor", "GearType1", "Controller")}
+    load = {n: kn.load(folder / f"{n}.json") for n in (
+        "Motor", "GearType1", "GearType2", "Controller", "MechanicalStructure")}
     axis_type1(load["Motor"], load["GearType1"], load["Controller"]).save(
         folder / "AxisType1.json")
+    axis_type2(load["Motor"], load["GearType2"], load["Controller"]).save(
+        folder / "AxisType2.json")
     one_axis(kn.load(folder / "AxisType1.json")).save(folder / "OneAxis.json")
+    full_robot(load["MechanicalStructure"], kn.load(folder / "AxisType1.json"),
+               kn.load(folder / "AxisType2.json")).save(folder / "FullRobot.json")
     return folder
 
 

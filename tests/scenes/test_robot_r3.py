@@ -178,3 +178,46 @@ def test_kinematic_ptp_refuses_axes_that_do_not_match():
     m.add(kn.signals.KinematicPTP("ptp", q_begin=[0, 0], q_end=[1], qd_max=1, qdd_max=1))
     with pytest.raises(kn.ModelError, match=r"q_end: 1 axes, but q_begin has 2"):
         m.validate()
+
+
+def pinocchio_r3(m_load, r_load):
+    """MSL's MechanicalStructure built in Pinocchio from MSL's numbers (``BODIES``): joint k
+    at the end of body k - 1 (frames are never rotated in it), body k and, on the last
+    joint, the load."""
+    import pinocchio as pin
+    model = pin.Model()
+    model.gravity.linear = np.array([0.0, -9.81, 0.0])
+    parent, offset = 0, np.array(robot_r3.BODIES[0][1], float)
+    kinds = {(0, 1, 0): pin.JointModelRY, (1, 0, 0): pin.JointModelRX}
+    for k, (axis, r, r_cm, mass, (i11, i22, i33, i21)) in enumerate(robot_r3.BODIES[1:], 1):
+        joint = model.addJoint(parent, kinds[tuple(axis)](), pin.SE3(np.eye(3), offset),
+                               f"r{k}")
+        inertia = np.array([[i11, i21, 0], [i21, i22, 0], [0, 0, i33]])
+        model.appendBodyToJoint(joint, pin.Inertia(mass, np.array(r_cm, float), inertia),
+                                pin.SE3.Identity())
+        parent, offset = joint, np.array(r, float)
+    model.appendBodyToJoint(parent, pin.Inertia(m_load, np.array(r_load, float),
+                                                np.eye(3) * 0.001), pin.SE3.Identity())
+    return model
+
+
+def test_r3_mechanics_match_pinocchio():
+    """Mass matrix, Coriolis and gravity terms of MechanicalStructure.json (FullRobot's load)
+    against Pinocchio's CRBA and RNEA at random states."""
+    import pinocchio as pin
+    load = robot_r3.FULL["rLoad"]
+    params = {"mLoad": 15.0, "rLoad_x": load[0], "rLoad_y": load[1], "rLoad_z": load[2]}
+    system = kn.load(robot_r3.FOLDER / "MechanicalStructure.json").compile()
+    model = pinocchio_r3(15.0, load)
+    data = model.createData()
+    rng = np.random.default_rng(3)
+    for _ in range(5):
+        q, qd = rng.uniform(-2, 2, 6), rng.uniform(-2, 2, 6)
+        M, V, G = system.dynamics_terms(q, qd, params)
+        M_pin = pin.crba(model, data, q)
+        M_pin = np.triu(M_pin) + np.triu(M_pin, 1).T
+        G_pin = pin.computeGeneralizedGravity(model, data, q)
+        C_pin = pin.rnea(model, data, q, qd, np.zeros(6)) - G_pin
+        np.testing.assert_allclose(M, M_pin, atol=1e-10)
+        np.testing.assert_allclose(G, G_pin, atol=1e-9)
+        np.testing.assert_allclose(V, C_pin, atol=1e-9)
