@@ -6,35 +6,76 @@ coordinates, :func:`simulate` it and read the probes from the :class:`Results`.
 Layers, each importing only those before it: ``errors``, ``util``, ``expr``, ``spatial``
 (helpers) -> ``components`` (what a user places) -> ``graph`` (model, topology, files) ->
 ``equations`` (the System) -> ``simulation`` (driver, methods, JIT cache, Results) -> the
-faces: ``plot``, ``schema``, ``symbolic``, ``cli``.
+faces: ``plot``, ``schema``, ``symbolic``, ``animation``, ``diagram``, ``analysis``, ``cli``.
+
+``import kinetwork`` is quick: the names below are imported on first use (PEP 562), so a
+script pays for CasADi, networkx and scipy when it builds a model, not when it imports the
+package. The first use also installs the faces on the core classes (``Model.compile`` from
+``equations``, ``Results.plot``, ``Results.animate``, ``Model._repr_svg_``).
 """
 
-from . import animation as _animation  # noqa: F401  (installs Results.animate)
-from . import diagram as _diagram  # noqa: F401  (installs Model._repr_svg_ for Jupyter)
-from . import plot as _plot  # noqa: F401  (installs Results.plot)
-from . import examples
-from .analysis.sweep import normal, sample, sweep, uniform
-from .components import electrical, multibody, rotational, signals, translational
-from .components.probe import Probe
-from .equations.system import System
+import importlib
+
 from .errors import IdealisedInertiaWarning, ModelError, SimulationError
-from .graph.io import dumps, load, loads
-from .graph.model import Model
-from .graph.subsystem import Subsystem
-from .schema import schema
-from .simulation.driver import simulate
-from .simulation.methods import METHODS
-from .simulation.results import Results
-from .urdf import from_urdf
-from .analysis import bode, equilibrium, fit, linearize, modes, plot_bode, sensitivity
-# kn.plot is the function (kn.plot([res_a, res_b])), not its module
-from .plot import plot  # noqa: E402  isort: skip
 
 __version__ = "0.1.0"
 
-__all__ = ["IdealisedInertiaWarning", "METHODS", "Model", "ModelError", "Probe", "Results",
-           "SimulationError", "Subsystem", "System", "dumps", "examples", "from_urdf", "load",
-           "loads", "electrical", "multibody", "plot", "rotational", "schema", "signals",
-           "simulate", "translational"]
-__all__ += ["bode", "equilibrium", "fit", "linearize", "modes", "plot_bode", "sensitivity"]
-__all__ += ["normal", "sample", "sweep", "uniform"]
+#: public name -> (module below kinetwork, attribute; None: the module itself)
+_LAZY = {
+    "Model": ("graph.model", "Model"),
+    "Subsystem": ("graph.subsystem", "Subsystem"),
+    "load": ("graph.io", "load"),
+    "loads": ("graph.io", "loads"),
+    "dumps": ("graph.io", "dumps"),
+    "Probe": ("components.probe", "Probe"),
+    "multibody": ("components.multibody", None),
+    "rotational": ("components.rotational", None),
+    "translational": ("components.translational", None),
+    "electrical": ("components.electrical", None),
+    "signals": ("components.signals", None),
+    "System": ("equations.system", "System"),
+    "simulate": ("simulation.driver", "simulate"),
+    "METHODS": ("simulation.methods", "METHODS"),
+    "Results": ("simulation.results", "Results"),
+    "schema": ("schema", "schema"),
+    "from_urdf": ("urdf", "from_urdf"),
+    "examples": ("examples", None),
+    "plot": ("plot", None),           # the module, callable: kn.plot([res_a, res_b])
+    "linearize": ("analysis.linear", "linearize"),
+    "equilibrium": ("analysis.equilibria", "equilibrium"),
+    "modes": ("analysis.modal", "modes"),
+    "bode": ("analysis.modal", "bode"),
+    "plot_bode": ("analysis.modal", "plot_bode"),
+    "sensitivity": ("analysis.sensitivities", "sensitivity"),
+    "fit": ("analysis.fitting", "fit"),
+    "sweep": ("analysis.sweep", "sweep"),
+    "sample": ("analysis.sweep", "sample"),
+    "normal": ("analysis.sweep", "normal"),
+    "uniform": ("analysis.sweep", "uniform"),
+}
+
+__all__ = ["IdealisedInertiaWarning", "ModelError", "SimulationError", *_LAZY]
+
+#: modules that install themselves on the core classes when imported
+_FACES = ("equations", "plot", "animation", "diagram")
+
+
+def _install():
+    for module in _FACES:
+        importlib.import_module(f"{__name__}.{module}")
+
+
+def __getattr__(name):
+    try:
+        module, attribute = _LAZY[name]
+    except KeyError:
+        raise AttributeError(f"module 'kinetwork' has no attribute {name!r}") from None
+    _install()
+    found = importlib.import_module(f"{__name__}.{module}")
+    value = found if attribute is None else getattr(found, attribute)
+    globals()[name] = value       # the next use is a plain lookup
+    return value
+
+
+def __dir__():
+    return sorted(set(globals()) | set(_LAZY))

@@ -8,6 +8,7 @@ kinetwork`` stays fast and never touches a display.
 
 import os
 import sys
+import types
 
 import numpy as np
 
@@ -329,3 +330,16 @@ def _event_marks(ax, runs):
         for event in (getattr(run, "stats", None) or {}).get("events", ()):
             ax.axvline(event["t"], color=f"C{r}" if len(runs) > 1 else "0.55",
                        linewidth=0.6, linestyle=":", gid=f"event:{event['component']}")
+
+
+class _CallableModule(types.ModuleType):
+    """This module, callable: ``kn.plot([res_a, res_b])`` is :func:`plot`, while
+    ``kinetwork.plot.save_plot`` and the rest stay reachable (a package attribute named like
+    a submodule is the submodule once it is imported, so the module itself is made the
+    function)."""
+
+    def __call__(self, *args, **kwargs):
+        return plot(*args, **kwargs)
+
+
+sys.modules[__name__].__class__ = _CallableModule

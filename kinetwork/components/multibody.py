@@ -773,5 +773,4 @@ class BodySphere(Component, library=MB):
 from .loopjoints import JointRRR, SphericalSpherical, UniversalSpherical  # noqa: E402,F401
 from .forces import (Damper, Force, ForceAndTorque, LineForceWithTwoMasses,  # noqa: E402,F401
                      Spring, SpringDamper, Torque, WorldForce, WorldTorque)
-from .rolling import RollingWheel, RollingWheelJoint  # noqa: E402,F401
 from .rotor import Rotor1D  # noqa: E402,F401
