@@ -69,19 +69,34 @@ def motor():
     return m
 
 
-def gear_type1():
-    """Utilities.GearType1: bearing friction, gear elasticity and the ideal gear."""
+def smooth_friction(m, name, flange, w_s):
+    """In place of BearingFriction ``name``: its law regularised, -(Rv0 tanh(w / w_s) +
+    Rv1 w), an Expression of the flange's speed driving a Torque (for bench/study_robot.py)."""
+    m.add(rot.SpeedSensor(f"{name}_w"))
+    m.add(sig.Expression(f"{name}_law", expression=f"-(Rv0*tanh(w/{w_s!r}) + Rv1*w)",
+                         names=["w"]))
+    m.add(rot.Torque(name))
+    _wire(m, [(f"{name}_w.flange", flange), (f"{name}_w.y", f"{name}_law.u1"),
+              (f"{name}_law.y", f"{name}.u"), (f"{name}.flange", flange)])
+
+
+def gear_type1(w_s=None):
+    """Utilities.GearType1: bearing friction, gear elasticity and the ideal gear (``w_s``: the
+    friction regularised by tanh at that speed instead)."""
     m = kn.Model("GearType1", parameters={"i": -105.0, "c": 43.0, "d": 0.005, "Rv0": 0.4,
                                           "Rv1": 0.13 / 160, "peak": 1.0}, description=(
         "Modelica.Mechanics.MultiBody.Examples.Systems.RobotR3.Utilities.GearType1: "
         "bearingFriction on the motor side (MSL's tau_pos = [0, Rv0; 1, Rv0 + Rv1]: Coulomb "
         "Rv0 and viscous Rv1, static peak*Rv0, with stiction), the gear's elasticity spring "
         "(c, d) and the IdealGear gear (ratio i). Ports: flange_a (motor), flange_b (joint)."))
-    m.add(rot.BearingFriction("bearingFriction", tau_c="Rv0", d="Rv1", peak="peak"))
     m.add(rot.SpringDamper("spring", c="c", d="d"))
     m.add(rot.IdealGear("gear", ratio="i"))
-    _wire(m, [("bearingFriction.flange", "spring.flange_a"),
-              ("spring.flange_b", "gear.flange_a")])
+    m.connect("spring.flange_b", "gear.flange_a")
+    if w_s is None:
+        m.add(rot.BearingFriction("bearingFriction", tau_c="Rv0", d="Rv1", peak="peak"))
+        m.connect("bearingFriction.flange", "spring.flange_a")
+    else:
+        smooth_friction(m, "bearingFriction", "spring.flange_a", w_s)
     m.expose("flange_a", "spring.flange_a")
     m.expose("flange_b", "gear.flange_b")
     return m
@@ -170,16 +185,20 @@ def one_axis(axis_def):
     return m
 
 
-def gear_type2():
-    """Utilities.GearType2: the ideal gear, bearing friction on the joint side."""
+def gear_type2(w_s=None):
+    """Utilities.GearType2: the ideal gear, bearing friction on the joint side (``w_s``: the
+    friction regularised by tanh at that speed instead)."""
     m = kn.Model("GearType2", parameters={"i": -99.0, "Rv0": 21.8, "Rv1": 9.8,
                                           "peak": 26.7 / 21.8}, description=(
         "Modelica.Mechanics.MultiBody.Examples.Systems.RobotR3.Utilities.GearType2: the "
         "IdealGear gear (ratio i) and, on its output, bearingFriction (Coulomb Rv0, viscous "
         "Rv1, static peak*Rv0, with stiction). Ports: flange_a (motor), flange_b (joint)."))
     m.add(rot.IdealGear("gear", ratio="i"))
-    m.add(rot.BearingFriction("bearingFriction", tau_c="Rv0", d="Rv1", peak="peak"))
-    m.connect("gear.flange_b", "bearingFriction.flange")
+    if w_s is None:
+        m.add(rot.BearingFriction("bearingFriction", tau_c="Rv0", d="Rv1", peak="peak"))
+        m.connect("gear.flange_b", "bearingFriction.flange")
+    else:
+        smooth_friction(m, "bearingFriction", "gear.flange_b", w_s)
     m.expose("flange_a", "gear.flange_a")
     m.expose("flange_b", "gear.flange_b")
     return m
@@ -309,6 +328,15 @@ def full_robot(mechanics_def, axis1_def, axis2_def):
     m.simulation = {"t_end": 2.0, "n_points": 201, "method": "auto", "rtol": 1e-6,
                     "atol": 1e-8}
     return m
+
+
+def full_robot_regularised(w_s, folder=FOLDER):
+    """FullRobot with every bearing friction regularised by tanh at speed ``w_s`` (motor side
+    on axes 1-3, joint side on 4-6): the scene that needs no events."""
+    motor_def, controller_def = kn.load(folder / "Motor.json"), kn.load(folder / "Controller.json")
+    return full_robot(kn.load(folder / "MechanicalStructure.json"),
+                      axis_type1(motor_def, gear_type1(w_s), controller_def),
+                      axis_type2(motor_def, gear_type2(w_s), controller_def))
 
 
 def write_models(folder=FOLDER):
