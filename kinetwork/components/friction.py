@@ -69,6 +69,9 @@ class PartialFriction(PartialHybrid):
     together, up to peak * f_kinetic in either direction."""
     modes = {-1: "sliding backward", 0: "stuck", 1: "sliding forward"}
     hold_mode = 0
+    #: the modes an element at rest may take, decided together with the others at rest at
+    #: the same instant (``simulation/events.py``): stuck, or sliding the way it accelerates
+    at_rest_modes = (0, 1, -1)
 
     def kinetic(self, u):
         raise NotImplementedError

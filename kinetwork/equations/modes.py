@@ -20,8 +20,9 @@ import casadi as ca
 from ..errors import ModelError
 
 #: columns of ``Modes.f_values``: the indicator, the relative position and speed, the holding
-#: force, and the element's two numbers (a static limit, a restitution)
-COLUMNS = ("indicator", "rel", "w_rel", "force", "value0", "value1")
+#: force, the element's two numbers (a static limit, a restitution), and the relative
+#: acceleration (which way an element at rest starts to slide: ``simulation/events.py``)
+COLUMNS = ("indicator", "rel", "w_rel", "force", "value0", "value1", "a_rel")
 
 
 @dataclass
@@ -77,7 +78,7 @@ def close(asm, eq, model):
         power = at(net.flow, h.a) * at(net.vel, h.a)      # into the element at flange a
         g = h.bound.indicator(h.mode, rel[i], w_rel[i], F[i], values, power)
         rows.append(ca.horzcat(g, rel[i], w_rel[i], F[i], *values))
-    table = ca.substitute(in_states(ca.vertcat(*rows)), F, solution)
+    table = ca.substitute(ca.horzcat(in_states(ca.vertcat(*rows)), a_rel), F, solution)
     zero = ca.SX.zeros(F.shape[0])
     response = [ca.substitute(ca.jacobian(a_rel, F), F, zero),
                 ca.substitute(ca.jacobian(eq.ode, F), F, zero)]

@@ -20,6 +20,7 @@ follows an event in a chunk is computed again; a fixed-step method steps each sa
 interval, so its steps are SAMPLES times shorter than without events.
 """
 
+import itertools
 from types import SimpleNamespace
 
 import numpy as np
@@ -38,6 +39,9 @@ SAMPLES = 4
 MAX_EVENTS = 100_000
 #: mode changes at one instant at most (a cascade through coupled elements)
 MAX_CASCADE = 50
+#: frictions at rest at one instant whose modes are tried in every combination at most, when
+#: changing the worst violation one at a time cycles (3**MAX_TOGETHER combinations)
+MAX_TOGETHER = 8
 #: events closer than SAME_INSTANT seconds count as at one instant; ZENO_LIMIT of them in a
 #: row stop the run (modes chattering without time passing)
 SAME_INSTANT = 1e-13
@@ -210,8 +214,24 @@ class Events:
         if count > ZENO_LIMIT:
             raise Failure(f"{ZENO_LIMIT} events at t = {t:.15g} s without time passing: "
                           f"the modes of {self.modes.comps[i].name} chatter")
-        x = self._change(t, np.array(x, dtype=float), i)
-        return self._settle(t, x, i)
+        n, before = len(self.log), np.array(x, dtype=float)[self.modes.mode_index]
+        x = self._settle(t, self._change(t, np.array(x, dtype=float), i), i)
+        self._tidy(n, before, x[self.modes.mode_index])
+        return x
+
+    def _tidy(self, n, before, after):
+        """The log from entry n on (one instant) with one entry per friction: its last mode,
+        if not the one it had (a friction's first guess that the others overruled goes)."""
+        names = [c.name for c in self.modes.comps]
+        entries, kept = self.log[n:], []
+        for j, e in enumerate(entries):
+            i = names.index(e["component"])
+            if getattr(type(self.modes.comps[i]), "at_rest_modes", None):
+                later = any(f["component"] == e["component"] for f in entries[j + 1:])
+                if later or after[i] == before[i]:
+                    continue
+            kept.append(e)
+        self.log[n:] = kept
 
     def _change(self, t, x, i):
         comp = self.modes.comps[i]
@@ -225,9 +245,11 @@ class Events:
         return x
 
     def _settle(self, t, x, first):
-        """Modes made inconsistent by a change at the same instant change too (a stuck
-        element whose holding force now exceeds its limit)."""
+        """Modes made inconsistent by a change at the same instant change too: the frictions
+        at rest together (``_together``), then any other element whose indicator the change
+        put below zero (a resting stop that would have to pull)."""
         for _ in range(MAX_CASCADE):
+            x = self._together(t, x, first)
             g = self.values(t, x)[:, 0]
             wrong = [i for i in np.flatnonzero(g < -self.run.atol) if i != first]
             if not wrong:
@@ -236,6 +258,68 @@ class Events:
             first = None
         names = ", ".join(c.name for c in self.modes.comps)
         raise Failure(f"the modes of {names} do not settle at t = {t:.15g} s")
+
+    def _together(self, t, x, first):
+        """The modes of all frictions at rest at t, decided as one problem (MSL's mixed-mode
+        iteration): each is stuck with its holding force within its static limit, or slides
+        the way its relative acceleration goes (mode * a_rel >= 0), given the others. From the
+        modes they have, the worst violation is changed until none is left; a set of modes
+        met twice (a cycle) falls back to trying every combination, fewest changes first.
+        ``first``: the element whose event this is, whose new mode stands unless the others
+        contradict it."""
+        comps, index = self.modes.comps, self.modes.mode_index
+        table = self.values(t, x)
+        rest = [i for i, comp in enumerate(comps) if getattr(type(comp), "at_rest_modes", None)
+                and abs(table[i, 2]) <= self.run.atol]
+        if not rest:
+            return x
+        start = tuple(int(round(x[index[i]])) for i in rest)
+
+        def with_modes(modes):
+            y = np.array(x, dtype=float)
+            y[[index[i] for i in rest]] = modes
+            return y
+
+        def violations(modes):
+            """(size, position, mode it should take) of each violated condition."""
+            tab = self.values(t, with_modes(modes))
+            if not np.all(np.isfinite(tab[rest])):      # held redundantly: singular
+                return [(np.inf, 0, modes[0])]
+            a_tol = 1e-9 * (1.0 + np.max(np.abs(tab[rest, 6])))
+            out = []
+            for k, (i, m) in enumerate(zip(rest, modes)):
+                if m == 0 and tab[i, 0] < (0.0 if i == first else -self.run.atol):
+                    out.append((-tab[i, 0], k, 1 if tab[i, 3] > 0 else -1))
+                elif m != 0 and m * tab[i, 6] < -a_tol:
+                    out.append((-m * tab[i, 6] / a_tol * self.run.atol, k, 0))
+            return out
+
+        modes, seen = start, set()
+        while modes not in seen:
+            seen.add(modes)
+            wrong = violations(modes)
+            if not wrong:
+                break
+            _, k, m = max(wrong)
+            modes = modes[:k] + (m,) + modes[k + 1:]
+        else:
+            choices = sorted(itertools.product(*[comps[i].at_rest_modes for i in rest]),
+                             key=lambda c: sum(a != b for a, b in zip(c, start)))
+            if len(rest) > MAX_TOGETHER:
+                choices = []
+            modes = next((c for c in choices if not violations(c)), None)
+            if modes is None:
+                names = ", ".join(comps[i].name for i in rest)
+                raise Failure(f"no consistent modes for {names}, at rest together at "
+                              f"t = {t:.15g} s")
+        x = with_modes(modes)
+        for i, old, new in zip(rest, start, modes):
+            if new != old:
+                self.log.append({"t": float(t), "component": comps[i].name,
+                                 "kind": comps[i].modes[new]})
+        if any(m == 0 for m in modes):      # the stuck ones exactly at rest
+            x = self._impulse(t, x, {})
+        return x
 
     def _impulse(self, t, x, targets):
         """The state whose relative speeds are ``targets`` (element -> speed) while the held
