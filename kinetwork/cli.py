@@ -34,14 +34,19 @@ SHOWN_CHARACTERS, SHOWN_ITEMS = 500, 20
 
 
 def _parameter(text):
-    """argparse type of ``--param NAME=VALUE``."""
+    """argparse type of ``--param NAME=VALUE``: a number, or a number with a unit
+    (``c="2 N*m/rad"``: converted and checked by the model, which knows where it is used)."""
+    from .graph.quantities import is_quantity
     name, sep, value = text.partition("=")
     try:
         if not sep or not name.strip():
             raise ValueError
         number = float(value)
     except ValueError:
-        raise argparse.ArgumentTypeError(f"expected NAME=VALUE with a number, got "
+        if sep and name.strip() and is_quantity(value.strip()):
+            return name.strip(), value.strip()
+        raise argparse.ArgumentTypeError(f"expected NAME=VALUE with a number or a number "
+                                         f"with a unit ('2 N*m/rad'), got "
                                          f"{quote(text)}") from None
     if not finite(number):
         raise argparse.ArgumentTypeError(f"{quote(name.strip())}: must be a finite number, "
@@ -115,8 +120,12 @@ def build_parser():
     run.add_argument("--n-points", type=int, metavar="N", help="points on the output grid")
     run.add_argument("--param", type=_parameter, action="append", default=[],
                      metavar="NAME=VALUE",
-                     help="set a model parameter for this run (repeat for several); a path "
-                          "(cyl1.phi0) sets a value of a subsystem")
+                     help="set a model parameter for this run (repeat for several), a number "
+                          "in SI or with a unit (c='2 N*m/rad'); a path (cyl1.phi0) sets a "
+                          "value of a subsystem")
+    run.add_argument("--error-estimate", action="store_true",
+                     help="estimate each probe signal's global error (two more runs at "
+                          "tighter tolerances) and show it in the summary")
     run.add_argument("--max-steps", type=_positive(int), metavar="N",
                      help="step budget per output interval of the variable-step methods")
     run.add_argument("--time-limit", type=_positive(float), metavar="S",
@@ -391,7 +400,7 @@ def _run(args):
                                   method=args.method, rtol=args.rtol, atol=args.atol,
                                   step=args.step, jit=args.jit, params=params,
                                   max_steps=args.max_steps, time_limit=args.time_limit,
-                                  progress=progress)
+                                  progress=progress, error_estimate=args.error_estimate)
     except kn.SimulationError as exc:
         _error(exc)
         stopped = exc.signal in STOPPING
@@ -419,6 +428,9 @@ def _run(args):
     print(f"simulated t = {t[0]:g} .. {t[-1]:g} s ({len(t)} points) with {results.method} "
           f"({code}{'; ' + work if work else ''}) in {done - compiled:.3g} s wall time "
           f"(build {compiled - start:.3g} s)")
+    if "error_estimate" in stats:
+        from .simulation.estimate import summary
+        print("\n".join(summary(stats["error_estimate"], results.signal_names)))
     _outputs(args, results, model.name)
     return 0
 

@@ -31,6 +31,7 @@ from ..equations.system import OVERFLOW, System, overflow_message
 from ..errors import ModelError, SimulationError
 from ..graph.settings import check_output, check_settings
 from ..util import quote, suggest
+from . import estimate
 from . import jit as _jit
 from .capture import SOLVER_LOCK, last_words, solver_output
 from .compiled import compiled
@@ -132,11 +133,11 @@ class Run:
 
 def simulate(model: Model | System, t_end: float | None = None, n_points: int | None = None,
              method: str | None = None, rtol: float | None = None, atol: float | None = None,
-             params: Mapping[str, float] | None = None, t_start: float = 0.0,
+             params: Mapping[str, float | str] | None = None, t_start: float = 0.0,
              step: float | None = None, jit: bool | None = None, max_steps: int | None = None,
              time_limit: float | None = None, progress: Callable[[float], object] | None = None,
              cancel: Callable[[], object] | None = None, restart: bool = False,
-             repartition: bool = True) -> Results:
+             repartition: bool = True, error_estimate: bool = False) -> Results:
     """Integrate ``model`` (a Model or a compiled System) and record its probes.
 
     Settings not given come from the model's ``simulation`` block, then from DEFAULTS.
@@ -157,7 +158,8 @@ def simulate(model: Model | System, t_end: float | None = None, n_points: int | 
         Largest step [s] of the fixed-step methods (``rk``, ``collocation``, ``midpoint``);
         default: the output spacing.
     params : dict, optional
-        Model parameter values for this run; no recompilation.
+        Model parameter values for this run, numbers (SI) or numbers with a unit
+        (``{"c": "2 N*m/rad"}``, see ``Model.parameter_values``); no recompilation.
     jit : bool, optional
         Compile the equations to C (cached on disk, see ``kinetwork.simulation.jit``). True
         insists (a ModelError when it cannot be done); None (default) compiles when a C
@@ -184,6 +186,10 @@ def simulate(model: Model | System, t_end: float | None = None, n_points: int | 
         coordinates, or a change point of the mechanism), choose another partition there and
         go on (``kinetwork.simulation.loopwatch``); ``stats["repartitions"]`` counts them,
         ``stats["repartition_times"]`` says when. False: stop there with a SimulationError.
+    error_estimate : bool, optional
+        Run again at tighter tolerances on the same compiled System and put an estimate of
+        each probe signal's and state's global error in ``stats["error_estimate"]``, with the
+        time after which it means nothing on chaotic motion (``estimate.py``).
 
     Returns
     -------
@@ -262,6 +268,14 @@ def simulate(model: Model | System, t_end: float | None = None, n_points: int | 
                               + (f" (the solver said: {said})" if said else ""),
                               results=results, t_reached=reached, reason=failure,
                               signal=run.signal)
+    if error_estimate:
+        again = {"t_end": settings["t_end"], "n_points": settings["n_points"],
+                 "method": key if key in METHODS else None,
+                 "rtol": settings["rtol"], "atol": settings["atol"], "step": settings["step"],
+                 "params": params, "t_start": t_start, "jit": jit, "max_steps": max_steps,
+                 "time_limit": time_limit, "cancel": cancel, "restart": restart,
+                 "repartition": repartition}
+        estimate.attach(results, lambda **tighter: simulate(system, **{**again, **tighter}))
     return results
 
 

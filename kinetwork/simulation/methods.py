@@ -18,6 +18,7 @@ import numpy as np
 
 from ..errors import ModelError
 from .compiled import numeric
+from .tolerance import solver_tolerances
 
 
 class Failure(Exception):
@@ -128,8 +129,9 @@ class _CasadiRun:
     def options(self, times):
         m, run = self.method, self.run
         opts = dict(m.options)
-        if m.sundials:
-            opts.update(reltol=run.rtol, abstol=run.atol)
+        if m.sundials:      # tighter than asked: see tolerance.py
+            opts.update(zip(("reltol", "abstol", "max_num_steps"),
+                            solver_tolerances(m, run.system, run.rtol, run.atol)))
             if run.max_steps:
                 opts["max_num_steps"] = int(run.max_steps)
         else:       # fixed steps: counted over the chunk; a blow-up is reported once, below
