@@ -32,7 +32,11 @@ minimum of the potential (the mechanism at rest hanging in its stable position),
 ``study_long_run``. The whole study uses an empty JIT cache folder of its own, so "first
 call" always includes the C compiler.
 
-Run: ``.venv/bin/python bench/study_loops.py [--quick]``; writes results/study_loops.csv
+5. The Pareto front at 1e-6 (issue 18, item 3; ``--pareto``, its own report): for the four-bar,
+   the slider-crank and the spatial four-bar, every formulation + method's cheapest run whose
+   crank-angle error over 10 s is within 1e-6, with the tolerances as a user asks them.
+
+Run: ``.venv/bin/python bench/study_loops.py [--quick] [--pareto]``; writes results/study_loops.csv
 (one row per run, column ``part`` = models, formulations, drift, chain), study_loops.md,
 study_loops_precision.png, study_loops_drift.png and study_loops_chain.png.
 """
@@ -799,8 +803,120 @@ def main(quick=False):
     print(f"study_loops: {total:.1f} s")
 
 
+# -- part 5: the Pareto front at 1e-6 (issue 18, item 3) --------------------------------------
+PARETO_TARGET = 1e-6
+PARETO_RTOLS = tuple(10.0 ** -k for k in range(3, 12))
+PARETO_STEPS = (0.05, 0.025, 0.0125, 0.00625, 0.003125)
+#: (formulation, method): every kinetwork combination that runs the loops
+PARETO_COMBOS = (("partition", "idas"), ("partition", "collocation"),
+                 ("projected", "cvodes-adams"), ("projected", "cvodes"), ("projected", "dop853"),
+                 ("projected", "idas"), ("baumgarte", "cvodes-adams"), ("baumgarte", "idas"))
+
+
+def _pareto_references(t):
+    """Crank angle on ``t`` per model: the sympy-derived references for the planar loops; the
+    spatial four-bar has none, so kinetwork's projected ODE under scipy's DOP853 at 1e-13."""
+    spatial = kn.simulate(ls.spatial_fourbar(probes=False).compile(loops="projected"),
+                          t_end=t[-1], n_points=len(t), method="dop853", rtol=1e-13,
+                          atol=1e-15, jit=True)
+    return {"fourbar": ("A.q", rl.fourbar_simulate(THETA0, 0.0, t, rtol=1e-13,
+                                                   atol=1e-13)["theta"]),
+            "slider_crank": ("O.q", rl.slider_crank_simulate(0.5, 3.0, t, rtol=1e-13,
+                                                             atol=1e-13)["theta"]),
+            "spatial_fourbar": ("A.q", spatial["A.q"])}
+
+
+def part_pareto(quick):
+    """For each loop model and combination: the cheapest run whose crank-angle error over
+    10 s is within PARETO_TARGET (rtol swept 1e-3 .. 1e-11, atol = rtol / 100, or the
+    collocation step halved), its wall time (median of repeats after a warm-up), closure
+    residual and state count. The tolerances are the user's: ``simulate`` maps them
+    (``tolerance.py``)."""
+    t_end, n = T_PRECISION, int(round(T_PRECISION / SPACING)) + 1
+    t = np.linspace(0.0, t_end, n)
+    refs = _pareto_references(t)
+    builders = {"fourbar": lambda: ls.fourbar(THETA0, probes=False),
+                "slider_crank": lambda: ls.slider_crank(probes=False),
+                "spatial_fourbar": lambda: ls.spatial_fourbar(probes=False)}
+    rows = []
+    for model, build in builders.items():
+        joint, ref = refs[model]
+        for form, method in PARETO_COMBOS:
+            system = build().compile(loops=form)
+            fixed = method == "collocation"
+            sweep = [dict(step=h) for h in PARETO_STEPS] if fixed else \
+                [dict(rtol=r, atol=r / 100) for r in PARETO_RTOLS]
+            run_once(system, 1.0, 21, method, **(sweep[0] if fixed else
+                                                  dict(rtol=1e-6, atol=1e-8)))
+            best = None
+            for settings in sweep:
+                wall, (res, failure) = timed(
+                    lambda: run_once(system, t_end, n, method, **settings), budget=0.3,
+                    max_repeats=3 if quick else 5)
+                ok = failure is None and len(res.t) == n
+                err = finite_max(res[joint] - ref) if ok else float("inf")
+                if err <= PARETO_TARGET:
+                    size = system.size()
+                    best = {"part": "pareto", "model": model, "formulation": form,
+                            "method": method, "setting": ", ".join(
+                                f"{k} {_tol(v) if k != 'step' else f'{v:g} s'}"
+                                for k, v in settings.items() if k != "atol"),
+                            "wall_s": wall, "max_error": err,
+                            "max_residual": float(system.constraint_residual(res.states).max()),
+                            "states": size["states"], "algebraic": size["algebraic"]}
+                    break
+                if wall > (0.5 if quick else 3.0):
+                    break
+            rows.append(best or {"part": "pareto", "model": model, "formulation": form,
+                                 "method": method, "setting": "not reached", "wall_s": "",
+                                 "max_error": "", "max_residual": "",
+                                 "states": system.size()["states"],
+                                 "algebraic": system.size()["algebraic"]})
+            r = rows[-1]
+            print(f"{model:16s} {form:10s} {method:13s} {r['setting']:14s} "
+                  f"{_g(r['wall_s'])} s error {_g(r['max_error'])}", flush=True)
+    return rows
+
+
+def report_pareto(rows, wall):
+    body = [[r["model"], r["formulation"], r["method"], r["states"], r["algebraic"],
+             r["setting"], f"{r['wall_s'] * 1e3:.1f}" if r["wall_s"] != "" else "—",
+             _g(r["max_error"]), _g(r["max_residual"])] for r in rows]
+    lines = ["## Loops on the Pareto front: the cheapest run to 1e-6", "",
+             f"{machine()}; {load()}. Study wall time {wall:.0f} s. Each loop model over "
+             f"{T_PRECISION:g} s, output every {SPACING:g} s, no probes, JIT on. For every "
+             f"formulation + method: the first run of the sweep (rtol 1e-3 .. 1e-11, atol = "
+             f"rtol / 100, as a user asks them: `simulate` tightens them for CVODES and IDAS, "
+             f"`kinetwork/simulation/tolerance.py`; collocation: step 0.05 s halved) whose "
+             f"max crank-angle error is within {PARETO_TARGET:g} rad of the reference "
+             f"(`reference_loops` for the planar two; for the spatial four-bar, which has "
+             f"none, kinetwork's projected ODE under DOP853 at 1e-13), its wall time (median "
+             f"of repeats after a warm-up) and max closure residual at the outputs.", "",
+             table(["model", "formulation", "method", "states", "algebraic", "reached at",
+                    "wall [ms]", "max crank error", "max residual"], body), ""]
+    out = ["Fastest to 1e-6 per model:", ""]
+    for model in dict.fromkeys(r["model"] for r in rows):
+        done = [r for r in rows if r["model"] == model and r["wall_s"] != ""]
+        best = min(done, key=lambda r: r["wall_s"])
+        default = next(r for r in rows if r["model"] == model
+                       and (r["formulation"], r["method"]) == ("partition", "idas"))
+        out.append(f"- {model}: {best['formulation']} + {best['method']} "
+                   f"{best['wall_s'] * 1e3:.1f} ms; the default (partition + idas) "
+                   + (f"{default['wall_s'] * 1e3:.1f} ms ({default['wall_s'] / best['wall_s']:.1f}"
+                      f" x)" if default["wall_s"] != "" else "did not reach it") + ".")
+    write_markdown("study_loops_pareto", "\n".join(lines + out))
+
+
 if __name__ == "__main__":
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--quick", action="store_true",
                         help="smoke test: rtol 1e-4 and 1e-8, 20 s drift run, N = 1, 2")
-    main(parser.parse_args().quick)
+    parser.add_argument("--pareto", action="store_true",
+                        help="only part 5: the cheapest run of each formulation + method to "
+                             "1e-6 on the three loop models (results/study_loops_pareto.md)")
+    args = parser.parse_args()
+    if args.pareto:
+        clock = time.perf_counter()
+        report_pareto(part_pareto(args.quick), time.perf_counter() - clock)
+    else:
+        main(args.quick)
