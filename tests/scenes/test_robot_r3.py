@@ -285,13 +285,147 @@ class FullRobotSmooth:
 
 
 def test_full_robot_with_regularised_friction_follows_the_independent_model():
-    """The whole scene's coupling (six drives on Pinocchio's mechanics) over its first 0.15 s,
+    """The whole scene's coupling (six drives on Pinocchio's mechanics) over its first 0.06 s,
     where every axis accelerates from rest; the friction regularised (w_s = 0.1 rad/s) so
     the reference is smooth."""
-    t = np.linspace(0.0, 0.15, 16)
-    res = kn.simulate(robot_r3.full_robot_regularised(0.1).compile(), t_end=0.15, n_points=16,
+    t = np.linspace(0.0, 0.06, 7)
+    res = kn.simulate(robot_r3.full_robot_regularised(0.1).compile(), t_end=0.06, n_points=7,
                       **OPT)
     ref = FullRobotSmooth(0.1).solve(t)
     angles = np.array([res[f"joint{k}.angle"] for k in range(1, 7)]).T
-    assert np.max(np.abs(angles[-1] - angles[0])) > 0.05           # the robot moves
+    assert np.max(np.abs(angles[-1] - angles[0])) > 0.01           # the robot moves
     np.testing.assert_allclose(angles, ref, atol=1e-6 * np.max(np.abs(ref)))
+
+
+class FullRobotStiction(FullRobotSmooth):
+    """FullRobot as written, with stiction, event-driven as ``OneAxis``: each bearing's mode
+    +1 / -1 (sliding) or 0 (stuck: the motor held on axes 1-3; the joint held on axes 4-6,
+    its acceleration zero and the others from the reduced mass matrix); the holding torque
+    against peak Rv0 decides break-away and sticking, and the start's modes settle as the
+    friction helper's do (every element stuck unless it cannot hold)."""
+
+    def __init__(self):
+        super().__init__(1.0)
+
+    def terms(self, t, x, modes):
+        q, qd = x[:6], x[6:12]
+        motor, elec, pi = x[12:18].reshape(3, 2), x[18:30].reshape(6, 2), x[30:36]
+        r, rd, _ = path(t, 0.0, 1.0, self.sd, self.sdd)
+        q_ref, qd_ref = self.q0 + self.dq * r, self.dq * rd
+        dx, tau, hold = np.zeros(36), np.zeros(6), np.zeros(6)
+        for k, a in enumerate(self.axes):
+            n = a["ratio"]
+            pm, wm = motor[k] if k < 3 else (n * q[k], n * qd[k])
+            e = n * qd_ref[k] + 5.0 * (n * q_ref[k] - pm) - wm
+            i, vC = elec[k]
+            La, C = 250 / (2 * a["D"] * a["w"]), 0.004 * a["D"] / a["w"]
+            dx[18 + 2 * k] = (-5 * vC - 250 * i - a["k"] * wm) / La
+            dx[19 + 2 * k] = (i - 0.5 * (e + pi[k])) / (10 * C)
+            dx[30 + k] = e / 0.05
+            if k < 3:
+                tau_s = a["c"] * (pm - n * q[k]) + a["cd"] * (wm - n * qd[k])
+                hold[k] = a["k"] * i - tau_s
+                if modes[k]:
+                    dx[12 + 2 * k] = wm
+                    dx[13 + 2 * k] = (hold[k] - modes[k] * a["Rv0"] - a["Rv1"] * wm) / a["J"]
+                tau[k] = n * tau_s
+            else:
+                tau[k] = n * a["k"] * i
+                if modes[k]:
+                    tau[k] -= modes[k] * a["Rv0"] + a["Rv1"] * qd[k]
+        pin = self.pin
+        M = pin.crba(self.model, self.data, q)
+        M = np.triu(M) + np.triu(M, 1).T + np.diag(self.rotor)
+        rhs = tau - pin.rnea(self.model, self.data, q, qd, np.zeros(6))
+        free = [k for k in range(6) if k < 3 or modes[k]]
+        qdd = np.zeros(6)
+        qdd[free] = np.linalg.solve(M[np.ix_(free, free)], rhs[free])
+        for k in range(3, 6):
+            if not modes[k]:
+                hold[k] = rhs[k] - M[k] @ qdd
+        dx[:6], dx[6:12] = qd, qdd
+        for k in range(3, 6):
+            if not modes[k]:
+                dx[k] = 0.0
+        return dx, hold
+
+    def speed(self, x, k):
+        return x[13 + 2 * k] if k < 3 else x[6 + k]
+
+    def solve(self, t_out):
+        x = np.zeros(36)
+        x[:6] = self.q0
+        x[12:18] = np.ravel([[a["ratio"] * q, 0.0] for a, q in zip(self.axes, self.q0)][:3])
+        modes, t0, out, events = [0] * 6, 0.0, [], []
+        limit = [a["peak"] * a["Rv0"] for a in self.axes]
+
+        def settle(t, x):
+            for _ in range(12):
+                _, hold = self.terms(t, x, modes)
+                change = [k for k in range(6) if modes[k] == 0 and abs(hold[k]) > limit[k]]
+                if not change:
+                    return
+                k = change[0]
+                modes[k] = 1 if hold[k] > 0 else -1
+                events.append((t, k, modes[k]))
+        settle(0.0, x)
+        while t0 < t_out[-1]:
+            evs = []
+            for k in range(6):
+                if modes[k]:
+                    f = lambda t, x, k=k, t0=t0: (self.speed(x, k) if t > t0 + 1e-9
+                                                  else float(modes[k]))
+                    f.direction = -modes[k]
+                else:
+                    f = lambda t, x, k=k: abs(self.terms(t, x, modes)[1][k]) - limit[k]
+                    f.direction = 1
+                f.terminal = True
+                evs.append(f)
+            breaks = [b for b in path(0.0, 0.0, 1.0, self.sd, self.sdd)[2] if b > t0 + 1e-12]
+            t1 = min(breaks + [t_out[-1]])
+            sol = solve_ivp(lambda t, x: self.terms(t, x, modes)[0], (t0, t1), x,
+                            method="LSODA", rtol=1e-11, atol=1e-12, events=evs,
+                            dense_output=True)
+            te = sol.t[-1]
+            out += [(tk, *sol.sol(tk)[:6]) for tk in t_out if t0 <= tk <= te
+                    and (not out or tk > out[-1][0])]
+            x, t0 = sol.y[:, -1].copy(), te
+            if sol.status == 1:
+                k = next(j for j in range(6) if len(sol.t_events[j]))
+                if modes[k] == 0:
+                    _, hold = self.terms(t0, x, modes)
+                    modes[k] = 1 if hold[k] > 0 else -1
+                    events.append((t0, k, modes[k]))
+                    settle(t0, x)
+                    continue
+                if modes[k]:
+                    if k < 3:
+                        x[13 + 2 * k] = 0.0
+                    else:
+                        x[6 + k] = 0.0
+                    modes[k] = 0
+                    _, hold = self.terms(t0, x, modes)
+                    if abs(hold[k]) > limit[k]:
+                        modes[k] = 1 if hold[k] > 0 else -1
+                    events.append((t0, k, modes[k]))
+                settle(t0, x)
+        return np.array(out)[:, 1:], events
+
+
+def test_full_robot_breaks_away_as_the_event_driven_model():
+    """FullRobot as written (stiction): its first 10 ms, in which the six bearings break away
+    or stick again (seven mode changes), against ``FullRobotStiction``: event times to 1e-9 s,
+    joint angles to 1e-9 rad."""
+    system = kn.load(robot_r3.FOLDER / "FullRobot.json").compile()
+    t = np.linspace(0.0, 0.01, 11)
+    res = kn.simulate(system, t_end=0.01, n_points=11, **OPT)
+    ref, events = FullRobotStiction().solve(t)
+    angles = np.array([res[f"joint{k}.angle"] for k in range(1, 7)]).T
+    np.testing.assert_allclose(angles, ref, atol=1e-9)
+    names = {1: "sliding forward", -1: "sliding backward", 0: "stuck"}
+    expected = [(t_e, f"axis{k + 1}.gear.bearingFriction", names[m])
+                for t_e, k, m in events if t_e > 0]      # the start's modes are no events
+    got = [(e["t"], e["component"], e["kind"]) for e in res.stats["events"]]
+    assert [g[1:] for g in got] == [e[1:] for e in expected]
+    np.testing.assert_allclose([g[0] for g in got], [e[0] for e in expected], atol=1e-9)
+    assert len(got) >= 6
