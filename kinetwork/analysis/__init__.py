@@ -2,13 +2,32 @@
 response, parameter sensitivities and fitting, sweeps and Monte Carlo.
 
 Every derivative here is CasADi's algorithmic differentiation of the compiled System, never a
-finite difference. Each public name is imported on its own line, so that modules written side
-by side each add one line.
+finite difference. Names are imported on first use.
 """
 
-from .equilibria import Equilibrium, equilibrium
-from .fitting import Fit, fit
-from .linear import Linearization, linearize
-from .modal import Mode, bode, modes, plot_bode
-from .sensitivities import Sensitivity, sensitivity
-from .sweep import Distribution, normal, sample, sweep, uniform
+import importlib
+
+#: public name -> its module here; imported on first use (PEP 562), so the command line's
+#: parsers, which live beside them, do not load every analysis to run a simulation
+_NAMES = {
+    "Equilibrium": "equilibria", "equilibrium": "equilibria",
+    "Fit": "fitting", "fit": "fitting",
+    "Linearization": "linear", "linearize": "linear",
+    "Mode": "modal", "bode": "modal", "modes": "modal", "plot_bode": "modal",
+    "Sensitivity": "sensitivities", "sensitivity": "sensitivities",
+    "Distribution": "sweep", "normal": "sweep", "sample": "sweep", "sweep": "sweep",
+    "uniform": "sweep",
+}
+__all__ = list(_NAMES)
+
+
+def __getattr__(name):
+    try:
+        module = importlib.import_module(f"{__name__}.{_NAMES[name]}")
+    except KeyError:
+        raise AttributeError(f"module {__name__!r} has no attribute {name!r}") from None
+    return getattr(module, name)
+
+
+def __dir__():
+    return sorted(set(globals()) | set(_NAMES))

@@ -9,9 +9,6 @@ import sys
 import numpy as np
 
 from ..errors import ModelError
-from .fitting import fit
-from .linear import linearize
-from .modal import modes
 
 
 def add_commands(sub):
@@ -88,6 +85,8 @@ def _bounded(text):
 
 
 def run_linearize(args, model):
+    from .linear import linearize
+    from .modal import modes
     """``kinetwork linearize``: prints A, B, C, D (and the modes)."""
     at = args.at_time
     if args.at_state:
@@ -124,6 +123,7 @@ def run_linearize(args, model):
 
 
 def run_fit(args, model):
+    from .fitting import fit
     """``kinetwork fit``: prints the estimates and their intervals."""
     result = fit(model, args.data, dict(args.params), columns=args.columns,
                  values=dict(args.param))

@@ -38,7 +38,6 @@ from dataclasses import dataclass, field
 
 import casadi as ca
 import numpy as np
-import scipy.optimize
 
 from ..errors import ModelError
 from ..spatial import line_length
@@ -198,6 +197,7 @@ def extend(eq, asm, topo):
 
         def jac(v):
             return np.asarray(f_balance(v, kn)[1], dtype=float)
+        import scipy.optimize                # only models with junctions pay for it
         sol = scipy.optimize.least_squares(fun, guess, jac=jac, method="lm", xtol=1e-15,
                                            ftol=1e-15, gtol=1e-15)
         if not np.all(np.isfinite(sol.x)) or np.max(np.abs(fun(sol.x)), initial=0) > BALANCED:

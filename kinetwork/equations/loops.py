@@ -53,10 +53,15 @@ from dataclasses import dataclass
 
 import casadi as ca
 import numpy as np
-import scipy.linalg
 
 from ..errors import ModelError
 from .newton_euler import aba, rnea
+
+def _qr(*args, **kwargs):
+    """scipy's pivoted QR, imported when a model has loops (scipy.linalg is slow to load)."""
+    import scipy.linalg
+    return scipy.linalg.qr(*args, **kwargs)
+
 
 FORMULATIONS = ("partition", "projected", "baumgarte")
 #: Newton steps of the projected formulation (from a start within the integrator's tolerance
@@ -440,7 +445,7 @@ class _Loops:
             return [], []
         s = np.linalg.svd(J, compute_uv=False)
         rank = int(np.sum(s > RANK_TOL * max(s[0], 1.0)))
-        _, _, piv = scipy.linalg.qr(J.T, pivoting=True)
+        _, _, piv = _qr(J.T, pivoting=True)
         rows = sorted(piv[:rank].tolist())
         Jr = J[rows]
         # speeds that may be dependent: of regular loop coordinates; preference tiers
@@ -467,7 +472,7 @@ class _Loops:
             if basis.shape[1]:                 # what the chosen columns do not reach yet
                 Qb, _ = np.linalg.qr(basis)
                 cols = cols - Qb @ (Qb.T @ cols)
-            _, R, piv = scipy.linalg.qr(cols, pivoting=True, mode="economic")
+            _, R, piv = _qr(cols, pivoting=True, mode="economic")
             diag = np.abs(np.diag(R)) if R.size else np.zeros(0)
             for j, d in zip(piv, diag):
                 if len(dep) == rank or d <= RANK_TOL * max(np.abs(Jr).max(), 1.0):
@@ -519,7 +524,7 @@ class _Loops:
         rank = int(np.sum(s > RANK_TOL * max(s[0], 1.0))) if s.size else 0
         if rank < len(self.rows):
             return None
-        _, _, piv = scipy.linalg.qr(J.T, pivoting=True)
+        _, _, piv = _qr(J.T, pivoting=True)
         rows = sorted(piv[:rank].tolist())
         cand = self.candidates()
         Jc = J[rows][:, cand]
@@ -529,7 +534,7 @@ class _Loops:
         if math.comb(len(cand), rank) <= PARTITION_CHOICES:
             choices = itertools.combinations(range(len(cand)), rank)
         else:
-            _, _, piv = scipy.linalg.qr(Jc, pivoting=True)
+            _, _, piv = _qr(Jc, pivoting=True)
             choices = [sorted(piv[:rank].tolist())]
         out = []
         for dep in choices:
