@@ -608,13 +608,106 @@ def casadi_study(quick):
     print(f"done in {total:.0f} s", flush=True)
 
 
+def overheads(rtols=(1e-4, 1e-7)):
+    """``--overheads``: where a run of ``auto`` spends the time the hand-written route does not.
+
+    For chain2, chain16 and chain128 at each rtol: one ``simulate`` (least of 3), its
+    integrator calls (``advance``, the driver's chunks: how many, the evaluations they took),
+    the output evaluation on the grid (``System.outputs_p``), the rest (settings, checks,
+    results); then kinetwork's own compiled DAE in one CasADi integrator call over the whole
+    grid at the same solver tolerances (no chunks) and the hand-written route there. The
+    kinetwork functions are wrapped to be timed: a diagnostic, not a benchmark."""
+    import casadi as ca
+    from kinetwork.equations import system as system_module
+    from kinetwork.simulation import methods
+    from kinetwork.simulation.compiled import compiled
+    from kinetwork.simulation.tolerance import solver_tolerances
+    clocks = {}
+
+    def wrap(owner, name):
+        inner = getattr(owner, name)
+
+        def timed_call(*args, **kwargs):
+            start = time.perf_counter()
+            try:
+                return inner(*args, **kwargs)
+            finally:
+                clocks.setdefault(name, []).append(time.perf_counter() - start)
+        setattr(owner, name, timed_call)
+        return inner
+    saved = [(methods._CasadiRun, "advance", wrap(methods._CasadiRun, "advance")),
+             (system_module.System, "outputs_p", wrap(system_module.System, "outputs_p"))]
+    rows = []
+    try:
+        for name in CASADI_SCENES:
+            builder, spec_of, horizon = scenes.SCENES[name]
+            spec, system = spec_of(), builder().compile()
+            t = np.linspace(0.0, horizon, round(horizon / SPACING) + 1)
+            hand = casadi_peer.build(spec)
+            adams = kn.METHODS["cvodes-adams"]
+            for rtol in rtols:
+                kw = {"t_end": horizon, "n_points": len(t), "rtol": rtol, "atol": rtol * 1e-2,
+                      "jit": True, "method": "cvodes-adams"}
+                kn.simulate(system, **kw)
+                best = None
+                for _ in range(3):
+                    clocks.clear()
+                    start = time.perf_counter()
+                    res = kn.simulate(system, **kw)
+                    total = time.perf_counter() - start
+                    if best is None or total < best[0]:
+                        best = (total, {k: list(v) for k, v in clocks.items()}, res.stats)
+                total, spent, stats = best
+                srt, sat = solver_tolerances(adams, system, rtol, rtol * 1e-2)[:2]
+                dae = compiled(system).dae({"stats": {}}, False)
+                whole = ca.integrator("whole", "cvodes", dae, 0.0, (t[1:] - t[0]).tolist(),
+                                      {**adams.options, "reltol": srt, "abstol": sat})
+                p = np.append(system.param_vector(), t[0])
+                one = min(timed(lambda w=whole, x=system.x0, p=p:
+                                np.asarray(w(x0=x, z0=[], p=p)["xf"]), budget=0.0)[0]
+                          for _ in range(3))
+                hand_s = min(timed(lambda h=hand, t=t, r=srt, a=sat:
+                                   casadi_peer.run(h, t, rtol=r, atol=a), budget=0.0)[0]
+                             for _ in range(3))
+                integ = casadi_peer.integrator(hand, t, srt, sat)
+                advance, outputs = sum(spent.get("advance", [])), sum(spent.get("outputs_p", []))
+                rows.append([name, f"{rtol:.0e} ({srt:.0e})", fmt_time(total),
+                             f"{len(spent.get('advance', []))}: {fmt_time(advance)}",
+                             stats.get("rhs_evaluations", ""), fmt_time(outputs),
+                             fmt_time(total - advance - outputs),
+                             f"{fmt_time(one)}, {int(whole.stats()['nfevals'])}",
+                             f"{fmt_time(hand_s)}, {int(integ.stats()['nfevals'])}"])
+                print("  ", rows[-1], flush=True)
+    finally:
+        for owner, name, inner in saved:
+            setattr(owner, name, inner)
+    lines = ["# Where kinetwork's run spends what the hand-written route does not", "",
+             f"{machine()}; {common.load()}. Per scene and rtol (the solver's, tightened by "
+             "kinetwork, in brackets; both routes at that one): one `simulate` with "
+             "cvodes-adams (what `auto` runs on these undamped chains; least of 3), its "
+             "integrator calls (the driver's chunks: number and time), CVODES' "
+             "right-hand-side evaluations over them, the probes' evaluation on the output "
+             "grid (`System.outputs_p`; these chains have no probe), the rest; then "
+             "kinetwork's own compiled DAE in one integrator call over the whole grid, and the "
+             "hand-written route (time, evaluations).", "",
+             table(["scene", "rtol (solver)", "simulate", "chunks: time", "evaluations",
+                    "outputs_p", "rest", "one call: time, evaluations",
+                    "by hand: time, evaluations"], rows)]
+    write_markdown(f"{NAME}_casadi_overheads", "\n".join(lines))
+
+
 def main():
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--quick", action="store_true", help="seed only, two settings per curve")
     parser.add_argument("--casadi", action="store_true",
                         help="only kinetwork's default against the hand-written route "
                              "(chain2, chain16, chain128; results/work_precision_casadi.md)")
+    parser.add_argument("--overheads", action="store_true",
+                        help="where auto's run spends the time the hand-written route does "
+                             "not (results/work_precision_casadi_overheads.md)")
     args = parser.parse_args()
+    if args.overheads:
+        return overheads()
     if args.casadi:
         return casadi_study(args.quick)
     names = ("seed",) if args.quick else SCENES
