@@ -8,6 +8,7 @@ import weakref
 import casadi as ca
 import numpy as np
 
+from ..equations.modes import operating_modes
 from ..equations.system import System
 from ..errors import ModelError, SimulationError
 from ..util import quote, suggest
@@ -105,6 +106,7 @@ def equilibrium(model, at=None, inputs=(), free=(), fix=None, params=None, t=0.0
     X = X.copy()
     for k, v in fix.items():
         X[states.index(k)] = float(v)
+    X = operating_modes(s, t, X, p, check=False)     # frictions at rest: stuck
     f = _residual(s, tuple(where))
     v0 = np.concatenate([X[unknown], p[where]])
 
@@ -120,6 +122,7 @@ def equilibrium(model, at=None, inputs=(), free=(), fix=None, params=None, t=0.0
         _, R, J, norm, more = _trust_region(evaluate, v0, tol, max_iter)
         it += more
     if norm <= tol:
+        operating_modes(s, t, X, p)          # a stuck friction holds within its limit
         return _done(pl, t, X, p, states, where, norm, it, J, unknown)
     worst = np.argsort(-np.abs(R))[:3] if n else []
     rates = ", ".join(f"d({states[k]})/dt = {R[k]:.3g}" if k < s.n_states else

@@ -11,6 +11,7 @@ import weakref
 import casadi as ca
 import numpy as np
 
+from ..equations.modes import operating_modes
 from ..errors import ModelError
 from .channels import output_channels, output_expression, plant
 
@@ -126,8 +127,13 @@ def linearize(model, at=None, inputs=(), outputs=None, params=None):
     t, X = pl.operating_state(at, p)
     if t != _time_of(at):
         p = pl.param_vector(params, t=t)
+    X = operating_modes(s, t, X, p)         # friction and stops: in the modes there
     names, units, rows = output_channels(s, outputs)
     A, B, C, D, y = _matrices(s, tuple(pl.input_index), tuple(rows), t, X, p)
+    if s.modes is not None:                 # a mode stays what it is under a perturbation
+        A, C = A.copy(), C.copy()
+        A[:, s.modes.mode_index] = 0.0
+        C[:, s.modes.mode_index] = 0.0
     return Linearization(A, B, C, D, (list(s.state_names), list(s.state_units)),
                          (list(pl.inputs), list(pl.input_units)), (names, units), t,
                          X[:s.n_states], np.array([p[k] for k in pl.input_index]), y, pl)

@@ -41,6 +41,11 @@ class PartialHybrid(Component):
         """The force into flange b when not held."""
         return ca.SX(0)
 
+    def free_mode(self, rel, w_rel):
+        """The mode the state itself gives, without events (the equations shown as M, V, G:
+        ``equations/modes.py``)."""
+        return ca.SX(0)
+
     def values(self, t, u):
         """Two numbers the events read (a static limit, a restitution), as SX."""
         return ca.SX(0), ca.SX(0)
@@ -81,6 +86,9 @@ class PartialFriction(PartialHybrid):
 
     def law(self, rel, w_rel, mode, u):
         return mode * self.kinetic(u) + self.d * w_rel
+
+    def free_mode(self, rel, w_rel):
+        return ca.sign(w_rel)
 
     def values(self, t, u):
         return self.peak * self.kinetic(u), ca.SX(0)
@@ -133,6 +141,7 @@ class PartialElastoGap(PartialHybrid):
     """MSL's ElastoGap: a linear spring and damper acting only while the gap is closed
     (rel < rel0); the damping force is limited so that it never pulls (MSL 4.0's law)."""
     modes = {0: "open", 1: "contact"}
+    state_mode = True        # contact exactly while closed: a function of the state
     flange_a = Port(ONED, "Flange a")
     flange_b = Port(ONED, "Flange b")
 
@@ -143,6 +152,9 @@ class PartialElastoGap(PartialHybrid):
 
     def indicator(self, mode, rel, w_rel, force, values, power=None):
         return (1 - 2 * mode) * (rel - self.rel0)
+
+    def free_mode(self, rel, w_rel):
+        return ca.if_else(rel < self.rel0, 1, 0)
 
     def first_mode(self, ev):
         return (1 if ev.indicator < 0 else 0), None, None     # ev: read in mode 0 (open)

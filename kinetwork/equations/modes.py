@@ -16,6 +16,7 @@ the indicators and numbers of ``f_values`` and applies impulses with ``f_respons
 from dataclasses import dataclass
 
 import casadi as ca
+import numpy as np
 
 from ..errors import ModelError
 
@@ -92,3 +93,68 @@ def close(asm, eq, model):
                  [eq.state_names.index(f"{n}.mode") for n in names], F, solution,
                  ca.Function("mode_values", args, [ca.densify(table)]),
                  ca.Function("mode_response", args, [ca.densify(r) for r in response]))
+
+
+def free_terms(asm, exprs):
+    """``exprs`` (the seed's M, V, G of ``asm``) with every element with modes in the law
+    that the state itself gives: no holding force (a stuck friction's, a resting stop's is a
+    constraint force, not a term), a friction sliding the way its relative speed goes (the
+    sign of it: at rest it adds nothing), an elastic gap in contact while closed, a stop free.
+    A gear with losses, whose mode is which flange drives, has no such law: refused."""
+    net = asm.net
+    if net is None or not net.hybrid:
+        return exprs
+
+    def at(d, ref):
+        return ca.SX(0) if ref is None else ca.SX(d.get(ref, 0))
+
+    modes = []
+    for h in net.hybrid:
+        free = getattr(h.bound, "free_mode", None)
+        if free is None:
+            raise ModelError(f"{h.comp.name}: its mode (which flange drives) is not a function "
+                             f"of the state, so M, V, G cannot show it: give it eta = 1 to see "
+                             f"the equations")
+        modes.append(free(at(net.pos, h.b) - at(net.pos, h.a),
+                          at(net.vel, h.b) - at(net.vel, h.a)))
+    symbols = ca.vertcat(*[h.mode for h in net.hybrid], *[h.F for h in net.hybrid])
+    values = ca.vertcat(*modes, ca.SX.zeros(len(net.hybrid)))
+    return tuple(ca.substitute(ca.SX(e), symbols, values) for e in exprs)
+
+
+#: relative speeds below this count as at rest at an operating point (an equilibrium's speeds
+#: are zero to its tolerance)
+AT_REST = 1e-8
+
+
+def operating_modes(system, t, X, p, check=True):
+    """The full state ``X`` (numpy) with the modes that its numbers give, for analyses at one
+    point (``kn.linearize``, ``kn.equilibrium``): a friction slides the way its relative speed
+    goes, or at rest is stuck, and with ``check`` its holding force must be within its static
+    limit (else a ModelError naming it: no smooth model holds there); an elastic gap is in
+    contact while closed. Stops and gears keep the modes ``X`` gives."""
+    modes = system.modes
+    if modes is None:
+        return X
+    X = np.array(X, dtype=float)
+    n = system.n_states
+    x = X[:n]
+    table = np.asarray(modes.f_values(t, x, p)).reshape(len(modes.comps), -1)
+    for i, comp in enumerate(modes.comps):
+        k = modes.mode_index[i]
+        if getattr(type(comp), "at_rest_modes", None):
+            w = table[i, 2]
+            x[k] = 0 if abs(w) <= AT_REST else np.sign(w)
+        elif getattr(type(comp), "state_mode", False) and table[i, 0] < 0:
+            x[k] = 1 - x[k]                 # a gap closed and open by its numbers alone
+    if check:
+        table = np.asarray(modes.f_values(t, x, p)).reshape(len(modes.comps), -1)
+        for i, comp in enumerate(modes.comps):
+            if getattr(type(comp), "at_rest_modes", None) and x[modes.mode_index[i]] == 0 \
+                    and table[i, 0] < 0:
+                raise ModelError(f"{comp.name}: at rest there, it would have to hold "
+                                 f"{abs(table[i, 3]):.6g} beyond its static limit "
+                                 f"{table[i, 4]:.6g}, so it slides, and friction is not smooth "
+                                 f"at zero speed: take a point where it holds or slides")
+    X[:n] = x
+    return X

@@ -19,7 +19,7 @@ from . import junctions
 from .assemble import assemble
 from .initial import InitialEquations
 from .loops import BAUMGARTE_RATE, formulate, newton
-from .modes import close as close_modes
+from .modes import close as close_modes, free_terms
 
 
 class System:
@@ -282,7 +282,9 @@ class System:
         """(M, V, G) as numpy with M qdd + V + G = 0, in the form of the seed paper.
 
         V holds the Coriolis and centripetal terms minus the generalized forces of the 1-D
-        elements (so a shoulder spring-damper adds c*q + d*qd); G holds gravity.
+        elements (so a shoulder spring-damper adds c*q + d*qd); G holds gravity. Friction
+        there slides the way its speed goes (at rest it adds nothing: a stuck friction's
+        holding force is a constraint force, not a term; ``modes.free_terms``).
         """
         f = self._f_terms
         M, V, G = f(t, self._vector(q, len(self.coordinate_names), "q"),
@@ -295,7 +297,7 @@ class System:
         ``x``, the states of 1-D networks and signal blocks V depends on (a PID's
         integral), named in ``x_names``."""
         a = self.asm
-        M, V, G = a.terms()
+        M, V, G = free_terms(a, a.terms())
         known = {ca.SX(v).name() for v in (a.q, a.u, a.p, a.t) for v in ca.vertsplit(v)}
         x = [v for v in ca.symvar(ca.veccat(M, V, G)) if v.name() not in known]
         return {"M": M, "V": V, "G": G, "q": a.q, "qd": a.u, "p": a.p, "t": a.t,
@@ -382,7 +384,7 @@ class System:
     @functools.cached_property
     def _f_terms(self):
         a = self.asm
-        return ca.Function("terms", [a.t, a.q, a.u, a.p], list(a.terms()))
+        return ca.Function("terms", [a.t, a.q, a.u, a.p], list(free_terms(a, a.terms())))
 
     @staticmethod
     def _vector(v, n, what):
