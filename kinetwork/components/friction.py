@@ -116,11 +116,19 @@ class PartialFriction(PartialHybrid):
         return (1 if ev.stuck_force > 0 else -1), None, None
 
 
-class PartialBearingFriction(PartialFriction):
+class PartialTwoFlanges(PartialFriction):
+    """MSL's port layout of a friction between a shaft and its housing: flange_a and flange_b
+    rigidly joined (one node: ``joined_ports``), so a drive train wires through it one to one
+    as in MSL's diagrams; ``flange`` is that node too (wire it alone, as before)."""
     side_a, side_b = "support", "flange"
-    flange = Port(ONED, "Flange (wire the shaft's elements to it: MSL's flange_a and flange_b "
-                        "are one here)")
+    flange = Port(ONED, "The shaft (flange_a and flange_b are this node too)", optional=True)
+    flange_a = Port(ONED, "Flange a, rigidly joined to flange_b", optional=True)
+    flange_b = Port(ONED, "Flange b, rigidly joined to flange_a", optional=True)
     support = Port(ONED, "Housing (unwired: the world)", optional=True)
+    joined_ports = (("flange", "flange_a"), ("flange", "flange_b"))
+
+
+class PartialBearingFriction(PartialTwoFlanges):
 
     def kinetic(self, u):
         return self.f_kinetic

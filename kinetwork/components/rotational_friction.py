@@ -2,7 +2,7 @@
 
 from .base import ONED, Param, Port
 from .friction import (PartialBearingFriction, PartialElastoGap, PartialNormalForceFriction,
-                       PartialStop, stop_check)
+                       PartialStop, PartialTwoFlanges, stop_check)
 
 class BearingFriction(PartialBearingFriction, library="rotational"):
     """Bearing friction with stiction (MSL's Rotational.Components.BearingFriction, Coulomb and
@@ -14,13 +14,11 @@ class BearingFriction(PartialBearingFriction, library="rotational"):
     d = Param(0.0, unit="N*m*s/rad", min=0.0, doc="Viscous friction coefficient")
 
 
-class Brake(PartialNormalForceFriction, library="rotational"):
+class Brake(PartialTwoFlanges, PartialNormalForceFriction, library="rotational"):
     """Brake with stiction (MSL's Rotational.Components.Brake, constant mu): friction torque
-    mu * cgeo * fn_max * f_normalized between the flange and its support."""
+    mu * cgeo * fn_max * f_normalized between the flange (flange_a and flange_b, rigidly
+    joined) and its support."""
     domain = "rotational"
-    side_a, side_b = "support", "flange"
-    flange = Port(ONED, "Braked flange")
-    support = Port(ONED, "Housing (unwired: the world)", optional=True)
     mu = Param(unit="1", min=0.0, doc="Coefficient of kinetic friction")
     peak = Param(1.0, unit="1", min=1.0, doc="Static over kinetic friction coefficient")
     cgeo = Param(1.0, unit="m", min=0.0, doc="Geometry constant: torque = cgeo * mu * force")

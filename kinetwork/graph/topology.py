@@ -108,6 +108,10 @@ def analyze(model):
                          f"(remove its connections too)")
         else:
             graph.add_edge(a, b)
+    for comp in model.components.values():
+        # ports one node inside their component (MSL's Brake: flange_a and flange_b joined)
+        for a, b in getattr(type(comp), "joined_ports", ()):
+            graph.add_edge(comp.port_ref(a), comp.port_ref(b))
     if stale:
         raise ModelError(problems + stale)
     order = _order(model)                      # once: it ranks every component
