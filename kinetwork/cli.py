@@ -34,14 +34,19 @@ SHOWN_CHARACTERS, SHOWN_ITEMS = 500, 20
 
 
 def _parameter(text):
-    """argparse type of ``--param NAME=VALUE``."""
+    """argparse type of ``--param NAME=VALUE``: a number, or a number with a unit
+    (``c="2 N*m/rad"``: converted and checked by the model, which knows where it is used)."""
+    from .graph.quantities import is_quantity
     name, sep, value = text.partition("=")
     try:
         if not sep or not name.strip():
             raise ValueError
         number = float(value)
     except ValueError:
-        raise argparse.ArgumentTypeError(f"expected NAME=VALUE with a number, got "
+        if sep and name.strip() and is_quantity(value.strip()):
+            return name.strip(), value.strip()
+        raise argparse.ArgumentTypeError(f"expected NAME=VALUE with a number or a number "
+                                         f"with a unit ('2 N*m/rad'), got "
                                          f"{quote(text)}") from None
     if not finite(number):
         raise argparse.ArgumentTypeError(f"{quote(name.strip())}: must be a finite number, "
@@ -115,8 +120,9 @@ def build_parser():
     run.add_argument("--n-points", type=int, metavar="N", help="points on the output grid")
     run.add_argument("--param", type=_parameter, action="append", default=[],
                      metavar="NAME=VALUE",
-                     help="set a model parameter for this run (repeat for several); a path "
-                          "(cyl1.phi0) sets a value of a subsystem")
+                     help="set a model parameter for this run (repeat for several), a number "
+                          "in SI or with a unit (c='2 N*m/rad'); a path (cyl1.phi0) sets a "
+                          "value of a subsystem")
     run.add_argument("--error-estimate", action="store_true",
                      help="estimate each probe signal's global error (two more runs at "
                           "tighter tolerances) and show it in the summary")

@@ -36,7 +36,10 @@ def schema():
     body = {
         "description": {"type": "string"},
         "parameters": {"type": "object", "propertyNames": {"pattern": IDENT},
-                       "additionalProperties": NUMBER},
+                       "additionalProperties": {"anyOf": [NUMBER, {
+                           "type": "string", "minLength": 1,
+                           "description": "a number with a unit ('500 mm'), in SI base "
+                                          "units, checked where a component uses it"}]}},
         "ports": {"type": "object", "propertyNames": {"pattern": IDENT},
                   "additionalProperties": PORT_PATH,
                   "description": "ports shown when the model is placed as a subsystem: "

@@ -213,7 +213,8 @@ def _body(model, data, problems, context):
         problems.append(f"description: {problem}")
     parameters = data.get("parameters", {})
     if not isinstance(parameters, dict):
-        problems.append(f"parameters: must be an object of numbers, got {_kind(parameters)}")
+        problems.append(f"parameters: must be an object of numbers (or numbers with "
+                        f"units, '500 mm'), got {_kind(parameters)}")
     else:
         for key, value in parameters.items():
             if not _NAME.fullmatch(key):     # said here with the name cut

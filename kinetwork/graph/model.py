@@ -12,7 +12,8 @@ from typing import TYPE_CHECKING, Any, TypeVar
 import numpy as np
 
 from ..components.base import ANY, Component, PortRef
-from ..util import check_number, quote, suggest
+from ..util import quote, suggest
+from . import quantities
 from .subsystem import Subsystem, check_placement, check_port_name, flatten, has_subsystems
 from .writer import save
 from ..errors import ModelError
@@ -54,7 +55,10 @@ class Model:
     name : str
         Model name.
     parameters : dict, optional
-        Model parameters (name -> number); component parameters may be expressions in them.
+        Model parameters (name -> number, or a number with a unit: ``"500 mm"``, kept in SI
+        base units, checked against the units of the component parameters that use it, and
+        saved as written; see ``kinetwork.graph.quantities``); component parameters may be
+        expressions in them.
     description : str, optional
         Free text.
     simulation : dict, optional
@@ -62,7 +66,7 @@ class Model:
         step).
     """
 
-    def __init__(self, name: str, parameters: Mapping[str, float] | None = None,
+    def __init__(self, name: str, parameters: Mapping[str, float | str] | None = None,
                  description: str = "", simulation: Mapping[str, Any] | None = None):
         if (problem := model_name_problem(name)) is not None:
             raise ModelError(f"model name: {problem}")
@@ -72,6 +76,8 @@ class Model:
         self.connections = []
         self._wired = set()            # the connections as unordered pairs, for O(1) checks
         self.parameters = {}
+        #: name -> the quantity a parameter was given as ("500 mm"), its SI value in parameters
+        self.parameter_text = {}
         self.simulation = dict(simulation or {})
         #: initial conditions as equations (``set_initial``; ``kinetwork.graph.initial``)
         self.initial = {}
@@ -90,6 +96,7 @@ class Model:
         self._validated = None         # (content key, parameter values, Topology)
         self._compiled = {}            # (content key, loops, rate) -> System
         self._flat = None              # (content key, flat model) of a model of subsystems
+        self._source = None            # for a flat model: the model of subsystems it expands
         for key, value in (parameters or {}).items():
             self.set_parameter(key, value)
 
@@ -100,11 +107,14 @@ class Model:
                        simulation=model.simulation)
         self.parameters = dict(model.parameters)
         self.initial = model.initial
+        self._source = model
 
     # -- building -----------------------------------------------------------------------
     def set_parameter(self, name: str, value: float | str) -> None:
-        """Add or change a model parameter; a path (``"cyl1.phi0"``) sets the value given to
-        a parameter of a subsystem placed here (as ``model.components["cyl1"].phi0 = v``)."""
+        """Add or change a model parameter: a number (SI) or a number with a unit (``"500 mm"``,
+        converted to SI base units, saved as written). A path (``"cyl1.phi0"``) sets the value
+        given to a parameter of a subsystem placed here (as ``model.components["cyl1"].phi0 =
+        v``)."""
         if isinstance(name, str) and "." in name:
             instance, _, key = name.partition(".")
             comp = self.components.get(instance)
@@ -120,7 +130,24 @@ class Model:
             raise ModelError(f"parameter name {quote(name, 60)}: must be an identifier")
         if name in RESERVED:
             raise ModelError(f"parameter name {name!r} is reserved (time, constants, functions)")
-        self.parameters[name] = check_number(value, f"parameters.{name}")
+        self.parameters[name] = quantities.to_si(value, f"parameters.{name}")
+        if isinstance(value, str):
+            self.parameter_text[name] = value
+        else:
+            self.parameter_text.pop(name, None)
+
+    def written_parameters(self) -> dict[str, float | str]:
+        """The model parameters as written: a quantity's text ("500 mm") while the number
+        in ``parameters`` is still its value, else the number."""
+        out = {}
+        for name, value in self.parameters.items():
+            text = self.parameter_text.get(name)
+            try:
+                same = text is not None and quantities.to_si(text, name) == value
+            except ModelError:
+                same = False
+            out[name] = text if same else value
+        return out
 
     def add(self, component: C) -> C:
         """Add ``component`` and return it."""
@@ -217,12 +244,15 @@ class Model:
             self._flat = (key, flatten(self))
         flat = self._flat[1]
         flat.parameters.update(self.parameters)
+        flat.parameter_text = dict(self.parameter_text)     # the check of validate()'s key
         flat.initial = self.initial          # current, as the parameter values
         return flat
 
-    def parameter_values(self, overrides: Mapping[str, float] | None = None
+    def parameter_values(self, overrides: Mapping[str, float | str] | None = None
                          ) -> dict[str, float]:
-        """Model parameters with ``overrides`` applied and checked."""
+        """Model parameters with ``overrides`` applied and checked; an override may be a
+        number with a unit (``{"c": "2 N*m/rad"}``), in SI base units, checked against the
+        units of the component parameters that use it."""
         values = dict(self.parameters)
         for key, value in (overrides or {}).items():
             if key not in values and "." in key:
@@ -236,7 +266,12 @@ class Model:
                 raise ModelError(f"params: unknown model parameter {key!r}"
                                  f"{suggest(key, values)}; parameters are "
                                  f"{', '.join(values) or 'none'}")
-            values[key] = check_number(value, f"params.{key}")
+            values[key] = quantities.to_si(value, f"params.{key}")
+            if isinstance(value, str):
+                problems = quantities.check_use(value, quantities.uses(self, key),
+                                                f"params.{key}")
+                if problems:
+                    raise ModelError(problems)
         return values
 
     def numeric_values(self, overrides: Mapping[str, float] | None = None
@@ -251,7 +286,10 @@ class Model:
             return self.flat().numeric_values(overrides)
         env = self.parameter_values(overrides)
         env_t = {**env, "t": 0.0}
-        out, problems = {}, []
+        out = {}
+        # quantities given to model parameters (here, in definitions, to subsystems) against
+        # the units of their uses: a flat model checks the model it expands
+        problems = quantities.problems(self._source or self)
         for comp in self.components.values():
             vals = {}
             for key, spec in comp.params.items():
@@ -285,7 +323,7 @@ class Model:
         from .topology import analyze
         if has_subsystems(self):
             return self.flat().validate()
-        key, values = self.content_key(), dict(self.parameters)
+        key, values = self.content_key(), (dict(self.parameters), dict(self.parameter_text))
         if self._validated is not None and self._validated[:2] == (key, values):
             return self._validated[2]
         topology = analyze(self)

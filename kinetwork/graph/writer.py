@@ -95,7 +95,7 @@ def _body(model, problems, where):
         components.append({"name": comp.name, "type": comp.type_name,
                            "params": copy.deepcopy(comp.given)})
     body = {"description": "" if model.description is None else model.description,
-            "parameters": dict(model.parameters),
+            "parameters": model.written_parameters(),     # "500 mm" as written
             "ports": {name: ref.path for name, ref in model.exposed.items()},
             "components": components,
             "connections": [[a.path, b.path] for a, b in model.connections],

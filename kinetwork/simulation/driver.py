@@ -133,7 +133,7 @@ class Run:
 
 def simulate(model: Model | System, t_end: float | None = None, n_points: int | None = None,
              method: str | None = None, rtol: float | None = None, atol: float | None = None,
-             params: Mapping[str, float] | None = None, t_start: float = 0.0,
+             params: Mapping[str, float | str] | None = None, t_start: float = 0.0,
              step: float | None = None, jit: bool | None = None, max_steps: int | None = None,
              time_limit: float | None = None, progress: Callable[[float], object] | None = None,
              cancel: Callable[[], object] | None = None, restart: bool = False,
@@ -158,7 +158,8 @@ def simulate(model: Model | System, t_end: float | None = None, n_points: int | 
         Largest step [s] of the fixed-step methods (``rk``, ``collocation``, ``midpoint``);
         default: the output spacing.
     params : dict, optional
-        Model parameter values for this run; no recompilation.
+        Model parameter values for this run, numbers (SI) or numbers with a unit
+        (``{"c": "2 N*m/rad"}``, see ``Model.parameter_values``); no recompilation.
     jit : bool, optional
         Compile the equations to C (cached on disk, see ``kinetwork.simulation.jit``). True
         insists (a ModelError when it cannot be done); None (default) compiles when a C
