@@ -128,9 +128,9 @@ def test_uses_that_are_not_a_name_times_numbers_are_not_checked():
 
 def test_bad_quantities_are_refused_naming_the_parameter():
     model = kn.Model("m", parameters={"L": 1.0})
-    for value, said in [("1 foo", "unknown unit 'foo'"), ("L/2", "must be a number or a "
-                        "number with a unit"), ("1.0", "must be a number or a number with "
-                        "a unit"), ("20 degC", "offset")]:
+    not_a_quantity = "must be a number or a number with a unit"
+    for value, said in [("1 foo", "unknown unit 'foo'"), ("L/2", not_a_quantity),
+                        ("1.0", not_a_quantity), ("20 degC", "offset")]:
         with pytest.raises(kn.ModelError, match="parameters.L") as err:
             model.set_parameter("L", value)
         assert said in str(err.value)
@@ -159,7 +159,7 @@ def test_the_command_line_takes_parameters_with_units(seed_file, tmp_path, capsy
         assert main(["run", str(seed_file), "--t-end", "0.3", "--n-points", "4", "--param",
                      value, "--param", "L1=80 cm", "--out", str(out), "--quiet"]) == 0
         runs[label] = out.read_text()
-    # the same numbers; the SI run spelt L1 in cm too, so the files must be equal
+    # c in N*mm/rad and in SI (both with L1 in cm): the same numbers, the same file
     assert runs["units"] == runs["si"]
     reference = kn.simulate(double_pendulum(), t_end=0.3, n_points=4,
                             params={"c": 2.0, "L1": 0.8})
@@ -205,8 +205,8 @@ def test_subsystems_take_and_check_quantities_at_every_level():
     saved = json.loads(kn.dumps(arm))
     assert saved["parameters"] == {"Lo": "700 mm"}
     for arm, said in [
-            (_arm(_link(L="2 kg"), {}), "definition 'link': parameters.L = '2 kg' is used "
-                                        "as rod.r[0] [m]"),
+            (_arm(_link(L="2 kg"), {}),
+             "definition 'link': parameters.L = '2 kg' is used as rod.r[0] [m]"),
             (_arm(_link(), {"L": "700 g"}), "upper.L = '700 g' is used as upper/rod.r[0] [m]"),
             (_arm(_link(), {"L": "-Lo/2"}, parameters={"Lo": "1 s"}),
              "parameters.Lo = '1 s' is used as upper/rod.r[0] [m]")]:
