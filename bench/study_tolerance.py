@@ -34,20 +34,19 @@ import argparse
 import sys
 import time
 
-import numpy as np
-
 import common
+import numpy as np
 from common import machine, table, write_csv, write_markdown
-
-import kinetwork as kn
-from kinetwork.simulation import tolerance
 from scenes import chains, drives
 from scenes import loops as ls
 from scenes import reference_loops as rl
 from scenes.reference import seed_reference
 
+import kinetwork as kn
+from kinetwork.simulation import tolerance
+
 sys.path.insert(0, str(common.HERE / "peers"))
-import pinocchio_peer  # noqa: E402
+import pinocchio_peer
 
 T_END = 10.0
 N_POINTS = 1001

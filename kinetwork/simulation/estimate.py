@@ -17,6 +17,8 @@ estimated error is SATURATED of the signal's range, it is only a lower bound (an
 grow past the motion's size): from there too the estimate means nothing.
 """
 
+import itertools
+
 import numpy as np
 
 from .methods import METHODS
@@ -47,7 +49,7 @@ def attach(results, again):
     settings = results.settings
     if settings.get("step") is not None or settings.get("method") in ("rk", "collocation",
                                                                      "midpoint"):
-        h = settings.get("step") or (results.t[1] - results.t[0])
+        h = float(settings.get("step") or (results.t[1] - results.t[0]))
         runs = [{"step": h / 2}, {"step": h / 4}]
     else:
         runs = [{"rtol": settings["rtol"] / TIGHTER ** k, "atol": settings["atol"] / TIGHTER ** k}
@@ -105,7 +107,7 @@ def _tighter(results, runs):
     asked = [(results.settings["rtol"], results.settings["atol"]),
              *((r["rtol"], r["atol"]) for r in runs)]
     given = [solver_tolerances(method, results.system, *a)[0] for a in asked]
-    return tuple(b <= a / TIGHTER * (1 + 1e-9) for a, b in zip(given, given[1:]))
+    return tuple(b <= a / TIGHTER * (1 + 1e-9) for a, b in itertools.pairwise(given))
 
 
 def _difference(a, b):
