@@ -211,7 +211,10 @@ class _Flat:
             for key, spec in comp.params.items():
                 value = comp._values[key]
                 if spec.kind in ("real", "expression") and value is not None:
-                    value = _map(value, lambda text: _constant(rename(text, scope)))
+                    # signal outputs a force law reads ("pos.y") are named by path too
+                    local = {**scope, **_read_signals(value, prefix)} \
+                        if spec.signals and prefix else scope
+                    value = self.constant(value, local, m, comp, shown, key)
                 elif spec.kind == "name" and value is not None and prefix:
                     value = prefix + value
                 values[key] = value
@@ -229,6 +232,20 @@ class _Flat:
             pa, pb = self.port(m, prefix, a, depth), self.port(m, prefix, b, depth)
             if pa is not None and pb is not None:
                 self.flat.connections.append((pa, pb))
+
+    def constant(self, value, scope, m, comp, shown, key):
+        """``value`` (a parameter of a component inside a subsystem) in flat names, its
+        expressions without free names as numbers; one that cannot be evaluated (a division
+        by zero, a root of a negative number once the instance's numbers are in) is a
+        problem naming its place, and stays as it was."""
+        try:
+            return _map(value, lambda text: _constant(rename(text, scope)))
+        except (ZeroDivisionError, ValueError, OverflowError, TypeError) as exc:
+            where = m.place(comp, key)
+            place = f"{shown}.{key}" + ("" if where == f"{comp.name}.{key}" else f" ({where})")
+            self.problems.append(f"{place} = {quote(value, 60)}: cannot be evaluated with "
+                                 f"this instance's parameters ({exc})")
+            return value
 
     def scope_of(self, m, sub, path, scope):
         """The inner parameters of subsystem ``sub`` in flat names: a number becomes the flat
@@ -288,6 +305,14 @@ def flatten(model):
     if walker.problems:
         raise ModelError(walker.problems)
     return flat
+
+
+def _read_signals(value, prefix):
+    """Dotted name -> its flat path, for the signal outputs ("pos.y") that ``value`` (an
+    expression or a vector of them) reads inside a subsystem placed at ``prefix``."""
+    texts = [value] if isinstance(value, str) else [
+        v for v in value if isinstance(v, str)] if isinstance(value, list) else []
+    return {n: prefix + n for text in texts for n in parse(text).names if "." in n}
 
 
 def _constant(text):
