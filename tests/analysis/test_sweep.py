@@ -3,7 +3,7 @@ to the integrator's tolerance, and the seed's members equal the paper's closed f
 integrated by scipy; failures, refusals and interruptions keep the other members.
 
 In CasADi's virtual machine (jit=False) and on short horizons: the compiled path is the
-same code with a compiled right-hand side, measured in bench/sweep.py."""
+same code with a compiled right-hand side, measured in bench/study_sweep.py."""
 
 import pickle
 

@@ -23,7 +23,7 @@ over the first ``CHECKED`` members: the closed form of the paper (numpy M, V, G,
 rtol 1e-13) for the seed, pinocchio's ABA with DOP853 at rtol 1e-13 for the chain. Memory:
 bytes of the result per member (the Dataset: every state and probe signal on the grid).
 
-Run: ``python bench/sweep.py [--quick]``; writes ``results/sweep.md``.
+Run: ``python bench/study_sweep.py [--quick]``; writes ``results/study_sweep.md``.
 """
 
 import argparse
@@ -258,7 +258,7 @@ def main():
         print(section(result), flush=True)
         print(f"  ({time.perf_counter() - start:.0f} s)", flush=True)
     out.append(f"\n{load()}.\n")
-    write_markdown("sweep", "\n".join(out))
+    write_markdown("study_sweep", "\n".join(out))
 
 
 if __name__ == "__main__":
