@@ -37,8 +37,16 @@ def solver_tolerances(method, system, rtol, atol):
     failed before (a dead point the loop watch names) and not earlier."""
     adams = method.options.get("linear_multistep_method") == "adams"
     name = "cvodes-adams" if adams else method.plugin
-    factor = TIGHTEN.get((name, system.formulation != "tree"), 1.0) if ENABLED else 1.0
+    factor = TIGHTEN.get((name, _closes_loops(system)), 1.0) if ENABLED else 1.0
     if factor == 1.0:
         return rtol, atol, MXSTEP
     tight = max(rtol / factor, min(rtol, RTOL_FLOOR[name]))
     return tight, atol * tight / rtol, int(MXSTEP * (rtol / tight) ** 0.2)
+
+
+def _closes_loops(system):
+    """Whether ``system`` has loop constraints: its formulation is not the tree's, and a
+    partition has algebraic variables (a cut free joint constrains nothing: a tree's run)."""
+    if system.formulation == "partition":
+        return system.n_algebraic > 0
+    return system.formulation != "tree"
