@@ -122,10 +122,17 @@ def main(quick=False, only_strategies=False, sizes=None):
     tools = peers()
     rows = []
     saved_cache = os.environ.get("KINETWORK_CACHE")
+    # on a loaded machine the N = 1024 compilers outlast jit's 300 s: the study waits
+    jit.COMPILE_TIMEOUT = max(jit.COMPILE_TIMEOUT, 1800.0)
     try:
         for n in sizes:
             rows.append(measure(n, tools))
+            write_csv("study_scaling", rows)            # what is measured survives a crash
             r = rows[-1]
+            print(f"N={n:4d} CPU build {r['build_cpu_s']:.1f} s, JIT (Python) "
+                  f"{r['jit_cold_cpu_s']:.1f} s, compilers {r['jit_cold_compilers_cpu_s']:.1f} s;"
+                  f" cached run {r['cached_run_s']:.2f} s; peak RSS {r['peak_rss_mb']:.0f} MB",
+                  flush=True)
             print(f"N={n:4d} ops {r['operations']:6d} build {r['build_s'] * 1e3:7.1f} ms "
                   f"jit cold {r['jit_cold_s']:6.2f} s warm {r['jit_warm_s'] * 1e3:6.1f} ms  "
                   f"C {r['rhs_c_us']:7.2f} us  VM {r['rhs_vm_us']:8.2f} us  "
