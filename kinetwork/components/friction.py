@@ -24,6 +24,11 @@ import casadi as ca
 
 from .base import ONED, Component, Port
 
+#: a stuck friction holds up to its static limit and at it, to rounding: a load that keeps
+#: it exactly at the limit (a ramp that levels off there, a controller's steady torque)
+#: holds it, rather than starting a slide that stops at once (modes chattering)
+EDGE = 1e-12
+
 
 class PartialHybrid(Component):
     """An element with modes between its ``side_b`` flange and its ``side_a`` flange."""
@@ -94,8 +99,10 @@ class PartialFriction(PartialHybrid):
         return self.peak * self.kinetic(u), ca.SX(0)
 
     def indicator(self, mode, rel, w_rel, force, values, power=None):
-        # sliding: the speed in the direction of sliding; stuck: the margin to the limit
-        return mode * mode * (mode * w_rel) + (1 - mode * mode) * (values[0] - ca.fabs(force))
+        # sliding: the speed in the direction of sliding; stuck: the margin to the limit,
+        # which holds up to and at the limit itself (MSL: stuck while |f| <= f_static)
+        margin = values[0] * (1 + EDGE) - ca.fabs(force)
+        return mode * mode * (mode * w_rel) + (1 - mode * mode) * margin
 
     def first_mode(self, ev):
         if abs(ev.w_rel) > ev.tiny:
@@ -111,7 +118,7 @@ class PartialFriction(PartialHybrid):
     def _at_rest(ev):
         """At zero relative speed: stuck if the force that holds is within the static limit,
         else sliding the way that force pushes."""
-        if abs(ev.stuck_force) <= ev.values[0]:
+        if abs(ev.stuck_force) <= ev.values[0] * (1 + EDGE):
             return 0, 0.0, None
         return (1 if ev.stuck_force > 0 else -1), None, None
 

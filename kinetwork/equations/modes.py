@@ -22,8 +22,10 @@ from ..errors import ModelError
 
 #: columns of ``Modes.f_values``: the indicator, the relative position and speed, the holding
 #: force, the element's two numbers (a static limit, a restitution), and the relative
-#: acceleration (which way an element at rest starts to slide: ``simulation/events.py``)
-COLUMNS = ("indicator", "rel", "w_rel", "force", "value0", "value1", "a_rel")
+#: acceleration (which way an element at rest starts to slide: ``simulation/events.py``),
+#: and the indicator's rate along the motion (an indicator that dips to zero and back between
+#: two sampled points has a minimum there: ``simulation/events.py`` looks for it)
+COLUMNS = ("indicator", "rel", "w_rel", "force", "value0", "value1", "a_rel", "rate")
 
 
 @dataclass
@@ -88,6 +90,9 @@ def close(asm, eq, model):
         value = getattr(eq, key)
         if value is not None:
             setattr(eq, key, ca.substitute(value, F, solution))
+    g = table[:, 0]
+    rate = ca.jtimes(g, eq.x, ca.densify(eq.ode)) + ca.jacobian(g, asm.t)
+    table = ca.horzcat(table, rate)
     args = [asm.t, eq.x, asm.p]
     return Modes([h.comp for h in net.hybrid],
                  [eq.state_names.index(f"{n}.mode") for n in names], F, solution,

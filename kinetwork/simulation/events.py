@@ -21,6 +21,7 @@ interval, so its steps are SAMPLES times shorter than without events.
 """
 
 import itertools
+import math
 from types import SimpleNamespace
 
 import numpy as np
@@ -35,6 +36,11 @@ EVENT_CHUNK = 8
 #: points per output interval where the indicators are looked at (two crossings between two
 #: of them, which cancel out, are not seen)
 SAMPLES = 4
+#: the column of the indicator's rate in ``Modes.f_values`` (``equations/modes.py``)
+RATE = 7
+#: points over a run, at least, where the indicators are looked at (however sparse its
+#: output grid: the events found must not depend on it)
+LATTICE = 1000
 #: events in one run at most: beyond, the run stops (a stop bouncing ever faster, chattering)
 MAX_EVENTS = 100_000
 #: mode changes at one instant at most (a cascade through coupled elements)
@@ -112,7 +118,10 @@ class Events:
         events at SAMPLES points in each interval: (rows at the output times up to the first
         event, the (t, x) to start again from or None). A Failure keeps its rows at the
         output times."""
-        fine, output = _refined(origin[0], times)
+        # as often over a run whatever its output grid (a sparse grid must not miss a short
+        # stick that a dense one sees); a fixed-step method keeps its own steps
+        spacing = None if method.fixed else (self.run.t_end - self.run.t_start) / LATTICE
+        fine, output = _refined(origin[0], times, spacing)
         try:
             rows = stepper.advance(fine)
         except Failure as exc:
@@ -128,24 +137,33 @@ class Events:
         (a gap just closed, a speed just zero) that count as positive: they leave zero
         rising, and one that is at or below zero at the next output fell back in between."""
         t_prev, x_prev = before
-        g_prev = self.values(t_prev, x_prev)[:, 0]
+        g_prev, r_prev = self.values(t_prev, x_prev)[:, [0, RATE]].T
         if restarted:
             g_prev = np.where(g_prev <= 0, np.inf, g_prev)
         for j, (t, x) in enumerate(zip(times, rows)):
-            g = self.values(t, x)[:, 0]
+            g, r = self.values(t, x)[:, [0, RATE]].T
             crossed = np.flatnonzero((g_prev > 0) & (g <= 0))
-            found = self._locate(method, t_prev, x_prev, t, crossed) if len(crossed) else None
+            # above zero at both points but falling, then rising: a minimum between them,
+            # which may reach zero (a friction sticking for less than the sampled interval)
+            dipped = np.flatnonzero(np.isfinite(g_prev) & (g_prev > 0) & (g > 0)
+                                    & (r_prev < 0) & (r > 0))
+            found = self._locate(method, t_prev, x_prev, t, crossed, dipped) \
+                if len(crossed) or len(dipped) else None
             if found is not None:
                 t_ev, x_ev, i = found
                 after = self.apply(t_ev, x_ev, i)
                 if t_ev >= t:                 # at the output time itself: it shows the after
                     return np.vstack([rows[:j], after[None, :]]), (t, after)
+                if j > 0 and t_ev - t_prev <= SAME_INSTANT:
+                    # at the sampled point before, to rounding: that one shows the after
+                    return np.vstack([rows[:j - 1], after[None, :]]), (t_ev, after)
                 return rows[:j], (t_ev, after)
-            t_prev, x_prev, g_prev = t, x, g
+            t_prev, x_prev, g_prev, r_prev = t, x, g, r
         return rows, None
 
-    def _locate(self, method, t0, x0, t1, crossed):
-        """The earliest crossing in (t0, t1]: (time, state, element)."""
+    def _locate(self, method, t0, x0, t1, crossed, dipped=()):
+        """The earliest crossing in (t0, t1]: (time, state, element). ``dipped``: elements
+        above zero at both ends with a minimum between, which cross if it reaches zero."""
         from scipy.optimize import brentq          # 0.3 s to import: only with events
 
         cache, from_t0 = {}, []
@@ -165,6 +183,21 @@ class Events:
             return cache[t]
 
         best = None
+        for i in dipped:
+            def rate(t, i=i):
+                return self.values(t, state(t))[i, RATE]
+            if not rate(t0) < 0 < rate(t1):     # integrated again: not quite as sampled
+                continue
+            t_min = brentq(rate, t0, t1, xtol=1e-15, rtol=4 * np.finfo(float).eps,
+                           maxiter=200)
+            if self.values(t_min, state(t_min))[i, 0] > 0:
+                continue                    # a minimum above zero: no event
+            t_i = brentq(lambda t, i=i: self.values(t, state(t))[i, 0], t0, t_min,
+                         xtol=1e-15, rtol=4 * np.finfo(float).eps, maxiter=200)
+            if self.values(t_i, state(t_i))[i, 0] > 0:
+                t_i = min(t_min, t_i + max(abs(t_i), 1.0) * 4 * np.finfo(float).eps)
+            if best is None or t_i < best[0]:
+                best = (t_i, i)
         for i in crossed:
             def g(t, i=i):
                 return self.values(t, state(t))[i, 0]
@@ -347,13 +380,16 @@ def numeric_pair(f, p):
     return call
 
 
-def _refined(t0, times):
+def _refined(t0, times, spacing=None):
     """The output ``times`` after ``t0`` with SAMPLES - 1 points between each and the one
-    before, and which of them are outputs."""
+    before, or more, to look at least every ``spacing`` seconds, and which of them are
+    outputs."""
     edges = np.concatenate([[t0], times])
-    fine = np.concatenate([np.linspace(a, b, SAMPLES + 1)[1:] for a, b in
-                           zip(edges[:-1], edges[1:])])
-    output = np.zeros(len(fine), dtype=bool)
-    output[SAMPLES - 1::SAMPLES] = True
-    fine[output] = times                    # exactly the output times, not rounded
-    return fine, output
+    parts, output = [], []
+    for a, b in zip(edges[:-1], edges[1:]):
+        n = SAMPLES if not spacing else max(SAMPLES, math.ceil((b - a) / spacing - 1e-9))
+        part = np.linspace(a, b, n + 1)[1:]
+        part[-1] = b                        # exactly the output time, not rounded
+        parts.append(part)
+        output.append(np.arange(n) == n - 1)
+    return np.concatenate(parts), np.concatenate(output)
