@@ -2,22 +2,26 @@
 mode, found, located and applied between the integrator's outputs.
 
 The driver advances a method with ``Events.advance``: to the output times and to SAMPLES - 1
-points between each two, where the indicators (compiled with the model:
+points between each two, or more, so that they are looked at LATTICE times a run at least
+whatever its output grid, where the indicators (compiled with the model:
 ``equations/modes.py``) are looked at. An event is an indicator going from positive to zero
-or below between two of those points. It is located by Brent's method on the indicator of the state
-integrated by the same method from the row before it to the trial time (so the time is as
-exact as the integration, to about 1e-14 s in the bracketing itself), the element says what
-its new mode is (``next_mode``) and whether its relative speed jumps (an impact, a
-sticking: an impulse through the mechanism, along the response of the state's rates to the
-element's force), modes that the change makes inconsistent follow at the same instant, and
-the method starts afresh there. Events are logged (time, component, kind) for
-``res.stats["events"]``.
+or below between two of those points, or one above zero at both but falling, then rising,
+whose minimum between them (where its rate, a column of the same table, is zero) reaches
+zero: a friction sticking for less than the sampled interval. It is located by Brent's
+method on the indicator of the state integrated by the same method from the row before it
+to the trial time (so the time is as exact as the integration, to about 1e-14 s in the
+bracketing itself), the element says what its new mode is (``next_mode``) and whether its
+relative speed jumps (an impact, a sticking: an impulse through the mechanism, along the
+response of the state's rates to the element's force), modes that the change makes
+inconsistent follow at the same instant, and the method starts afresh there. Events are
+logged (time, component, kind) for ``res.stats["events"]``.
 
-Two crossings between two sampled points, which cancel out, are not seen (right after an
-event, an indicator at zero counts as positive, so a bounce within the first interval is
-found). Runs with events go in short chunks of at most EVENT_CHUNK output intervals, as what
-follows an event in a chunk is computed again; a fixed-step method steps each sampled
-interval, so its steps are SAMPLES times shorter than without events.
+Two crossings between two sampled points, which cancel out, are seen when the indicator has
+one minimum between them, not when it also has a maximum there (right after an event, an
+indicator at zero counts as positive, so a bounce within the first interval is found). Runs
+with events go in short chunks of at most EVENT_CHUNK output intervals, as what follows an
+event in a chunk is computed again; a fixed-step method steps each sampled interval, so its
+steps are SAMPLES times shorter than without events.
 """
 
 import itertools
@@ -33,8 +37,7 @@ from .methods import Failure
 #: output intervals per chunk at most, in a run with events (what follows an event in a
 #: chunk is computed again from it)
 EVENT_CHUNK = 8
-#: points per output interval where the indicators are looked at (two crossings between two
-#: of them, which cancel out, are not seen)
+#: points per output interval at least where the indicators are looked at
 SAMPLES = 4
 #: the column of the indicator's rate in ``Modes.f_values`` (``equations/modes.py``)
 RATE = 7
@@ -386,7 +389,7 @@ def _refined(t0, times, spacing=None):
     outputs."""
     edges = np.concatenate([[t0], times])
     parts, output = [], []
-    for a, b in zip(edges[:-1], edges[1:]):
+    for a, b in itertools.pairwise(edges):
         n = SAMPLES if not spacing else max(SAMPLES, math.ceil((b - a) / spacing - 1e-9))
         part = np.linspace(a, b, n + 1)[1:]
         part[-1] = b                        # exactly the output time, not rounded

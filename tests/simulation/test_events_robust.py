@@ -2,7 +2,6 @@
 friction that sticks for less than the sampled interval is seen on any grid, against the
 closed form; a friction kept at the edge of its static limit decides its modes once."""
 
-import numpy as np
 import pytest
 
 import kinetwork as kn
