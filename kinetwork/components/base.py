@@ -111,8 +111,11 @@ class Param:
 
     def __init__(self, default=REQUIRED, *, unit="", min=None, max=None, shape=(), doc="",
                  time=False, optional=False, nonzero=False, kind="real", choices=None,
-                 name=None, positive=False):
+                 name=None, positive=False, signals=False):
         self.default, self.min, self.max = default, min, max
+        # ``signals``: the expression may also read signal outputs of the model's components
+        # by dotted name ("pos.y", "cyl1.pos.y"), as a force law in sensor signals
+        self.signals = signals
         self._set_unit(unit)
         self.shape, self.doc, self.time, self.optional = tuple(shape), doc, time, optional
         self.nonzero, self.kind, self.choices = nonzero, kind, choices
@@ -162,6 +165,7 @@ class Param:
                 "default": None if self.required else _plain(self.default),
                 "min": self.min, "max": self.max, "positive": self.positive,
                 "nonzero": self.nonzero, "optional": self.optional, "time": self.time,
+                "signals": self.signals,
                 "choices": list(self.choices) if self.choices else None, "doc": self.doc}
 
     def resolved(self, owner):
@@ -287,7 +291,7 @@ class Param:
             except ModelError as exc:
                 raise ModelError(f"{where}: {exc}{units.hint(value)}") from None
             dotted = sorted(n for n in expr.names if "." in n)
-            if dotted:
+            if dotted and not self.signals:
                 raise ModelError(f"{where}: {quote(dotted[0])} is not a parameter here: "
                                  f"expressions use the parameters of their own model (give a "
                                  f"subsystem's parameters with its params)")

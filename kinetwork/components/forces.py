@@ -241,12 +241,12 @@ class Force(PartialResolved, library=MB):
     Parameters
     ----------
     f : N, 3 values, default [0, 0, 0]
-        Force, resolved in ``resolve_in``; expressions in t allowed; a wired f1, f2, f3
-        replaces its entry.
+        Force, resolved in ``resolve_in``; expressions in t and in signal outputs by dotted
+        name ("pos.y") allowed; a wired f1, f2, f3 replaces its entry.
     resolve_in : "world", "frame_a", "frame_b" or "frame_resolve", default "frame_b"
         Frame the force is resolved in.
     """
-    f = Param([0.0, 0.0, 0.0], unit="N", shape=(3,), time=True,
+    f = Param([0.0, 0.0, 0.0], unit="N", shape=(3,), time=True, signals=True,
               doc="Force on frame_b, resolved in resolve_in (a wired f1, f2, f3 replaces "
                   "its entry)")
     f1, f2, f3 = _signals("f", "Force component")
@@ -269,7 +269,7 @@ class Torque(PartialResolved, library=MB):
     resolve_in : "world", "frame_a", "frame_b" or "frame_resolve", default "frame_b"
         Frame the torque is resolved in.
     """
-    t = Param([0.0, 0.0, 0.0], unit="N*m", shape=(3,), time=True,
+    t = Param([0.0, 0.0, 0.0], unit="N*m", shape=(3,), time=True, signals=True,
               doc="Torque on frame_b, resolved in resolve_in (a wired t1, t2, t3 replaces "
                   "its entry)")
     t1, t2, t3 = _signals("t", "Torque component")
@@ -307,7 +307,7 @@ class WorldForce(PartialFrameForce, library=MB):
     """A force at the origin of frame_b, resolved in the world (default) or in frame_b
     (MSL's Forces.WorldForce); expressions in t allowed, or the signals f1, f2, f3."""
     frame_b = Port("frame", "Frame the force acts on")
-    force = Param(unit="N", shape=(3,), time=True,
+    force = Param(unit="N", shape=(3,), time=True, signals=True,
                   doc="Force, resolved in resolve_in (a wired f1, f2, f3 replaces its entry)")
     resolve_in = Param("world", kind="choice", choices=RESOLVE_B,
                        doc="Frame the force is resolved in: world or frame_b")
@@ -324,7 +324,7 @@ class WorldTorque(PartialFrameForce, library=MB):
     """A torque on frame_b, resolved in the world (default) or in frame_b (MSL's
     Forces.WorldTorque); expressions in t allowed, or the signals t1, t2, t3."""
     frame_b = Port("frame", "Frame the torque acts on")
-    torque = Param(unit="N*m", shape=(3,), time=True,
+    torque = Param(unit="N*m", shape=(3,), time=True, signals=True,
                    doc="Torque, resolved in resolve_in (a wired t1, t2, t3 replaces its "
                        "entry)")
     resolve_in = Param("world", kind="choice", choices=RESOLVE_B,

@@ -30,9 +30,10 @@ class Damper(PartialDamper, library=LIB):
 
 
 class Torque(PartialSource, library=LIB):
-    """Torque source: a constant or an expression in time t and model parameters."""
+    """Torque source: a constant or an expression in time t, model parameters and signal
+    outputs named by path (``"if_else(w.y > 0, -c, c)"`` with a speed sensor w)."""
     domain = LIB
-    tau = Param(0.0, unit="N*m", time=True, doc="Torque applied to flange (when u is not wired)")
+    tau = Param(0.0, unit="N*m", time=True, signals=True, doc="Torque applied to flange (when u is not wired)")
 
     def applied(self):
         return self.tau

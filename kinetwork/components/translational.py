@@ -30,9 +30,10 @@ class Damper(PartialDamper, library=LIB):
 
 
 class Force(PartialSource, library=LIB):
-    """Force source: a constant or an expression in time t and model parameters."""
+    """Force source: a constant or an expression in time t, model parameters and signal
+    outputs named by path (``"-k*pos.y"`` with a position sensor pos)."""
     domain = LIB
-    f = Param(0.0, unit="N", time=True, doc="Force applied to flange (when u is not wired)")
+    f = Param(0.0, unit="N", time=True, signals=True, doc="Force applied to flange (when u is not wired)")
 
     def applied(self):
         return self.f

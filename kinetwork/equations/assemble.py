@@ -172,8 +172,16 @@ def assemble(model, topo, values):
     env = {name: p[i] for i, name in enumerate(names)}
     env_t = {**env, "t": t}
     funcs = casadi_functions()
-    bound = {name: comp.bound({k: _symbolic(v, env_t, funcs) if comp.params[k].kind == "real"
-                               else v for k, v in comp._values.items()})
+    reads = _signal_reads(model, topo)
+    # a value that reads signals ("-k*pos.y") holds a placeholder per signal until the
+    # network has the signal's expression (``network.py`` substitutes it; frame forces are
+    # bound again below)
+    env_r = {**env_t, **{n: sym for r in reads.values() for n, (sym, _) in r.items()}}
+
+    def bind(comp, env):
+        return comp.bound({k: _symbolic(v, env, funcs) if comp.params[k].kind == "real"
+                           else v for k, v in comp._values.items()})
+    bound = {name: bind(comp, env_r if name in reads else env_t)
              for name, comp in model.components.items()}
 
     coord_names, coord_units, speed_names, speed_units = [], [], [], []
@@ -208,7 +216,12 @@ def assemble(model, topo, values):
         tree = rnea(bodies, u, a, a_grav, armature) - passive
         return tree + extra.mass_times(a) - extra.Q if n else tree
     net = network.build(model, topo, bound, q, u, udot, qindex, uindex, t, inverse, p,
-                        [values[k] for k in names])
+                        [values[k] for k in names], reads)
+    for name in reads:
+        if model.components[name].role != "source":       # a force on frames
+            bound[name] = bind(model.components[name],
+                               {**env_t, **{n: net.signal[s] for n, (_, s) in
+                                            reads[name].items()}})
     Q = net.Q
 
     starts, given, u_start, u_given = [], [], [], []
@@ -373,6 +386,26 @@ def _place_cut_frames(asm, topo, bound):
         k, R, pos = asm.place[cut.set_a]
         for port, (Rp, pp) in comp.frames(Ra.T @ Rb, Ra.T @ (pb - pa)).items():
             asm.place[topo.set_of[cut.component.port_ref(port)]] = (k, R @ Rp, pos + R @ pp)
+
+
+def _signal_reads(model, topo):
+    """Component name -> {signal it reads by name ("pos.y"): (placeholder, signal set)}, for
+    the values (a force law) that read signal outputs."""
+    reads = {}
+    for comp in model.components.values():
+        for key, spec in comp.params.items():
+            value = comp._values[key]
+            if not spec.signals or value is None:
+                continue
+            for text in value if isinstance(value, list) else [value]:
+                for n in parse(text).names if isinstance(text, str) else ():
+                    if "." not in n:
+                        continue
+                    path, port = n.rsplit(".", 1)
+                    ref = model.components[path].port_ref(port)
+                    sym = ca.SX.sym("signal_" + n.replace(".", "_"))
+                    reads.setdefault(comp.name, {}).setdefault(n, (sym, topo.set_of[ref]))
+    return reads
 
 
 def _symbolic(value, env, funcs):

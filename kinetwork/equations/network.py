@@ -99,14 +99,18 @@ class Network:
 
 
 def build(model, topo, bound, q, u, udot, qindex, uindex, t, inverse=None, p=None,
-          p_values=None):
+          p_values=None, reads=None):
     """The Network of a validated model, in the symbols of the Assembly.
 
     ``inverse(a, armature, Q)`` is the tree's inverse dynamics (for InverseDynamics blocks):
     the generalized forces for speeds' rates ``a`` with the given armature, less ``Q``.
+    ``reads``: component name -> {signal name: (placeholder, signal set)} for the values
+    that read signals (a source's force law), the placeholders replaced by the signals.
     """
-    return _Builder(model, topo, bound, q, u, udot, qindex, uindex, t, inverse, p,
-                    p_values).run()
+    builder = _Builder(model, topo, bound, q, u, udot, qindex, uindex, t, inverse, p,
+                       p_values)
+    builder.reads = reads or {}
+    return builder.run()
 
 
 @dataclass
@@ -421,6 +425,11 @@ class _Builder:
                     g.add_edge(source, comp.name)
                 elif comp.role in ("source", "prescribed"):
                     g.add_edge(source, MECHANICS)
+        for name, read in self.reads.items():
+            # a law reading signals is part of the mechanics (a source's flow, or a force
+            # on frames: its generalized force), needing the signals first
+            for _, s in read.values():
+                g.add_edge(self.topo.signal_source[s].component.name, MECHANICS)
         self._circuit_edges(g)
         # block-lower-triangular order: the strongly connected components (Tarjan) of the
         # graph, each solved as one block, in topological order of the condensation
@@ -607,6 +616,10 @@ class _Builder:
         net = self.net
         for placeholder, s in self.circuit.inputs.items():
             self.pending[placeholder] = net.signal[s]
+        for name, read in self.reads.items():
+            if self.model.components[name].role == "source":
+                for placeholder, s in read.values():
+                    self.pending[placeholder] = net.signal[s]
         for joint_ports in self._axis_ports():
             ref, u = joint_ports
             net.axis_flow[u] += net.flow.get(ref, 0)

@@ -295,7 +295,8 @@ class Model:
             for key, spec in comp.params.items():
                 where = self.place(comp, key)
                 try:
-                    vals[key] = evaluate(comp._values[key], spec, env_t, where)
+                    vals[key] = evaluate(comp._values[key], spec, env_t, where,
+                                         signal_outputs(self) if spec.signals else None)
                 except ModelError as exc:
                     problems.extend(exc.problems)
             out[comp.name] = vals
@@ -367,30 +368,49 @@ class Model:
                 f"{len(self.connections)} connections>")
 
 
-def evaluate(value, spec, env, where):
-    """A normalized parameter value evaluated with numbers; bounds checked."""
+def evaluate(value, spec, env, where, signals=None):
+    """A normalized parameter value evaluated with numbers; bounds checked. ``signals`` are
+    the signal outputs (``"pos.y"``) it may read (None: not checked here, the model was
+    validated): a value that reads one has no number before the simulation, so it evaluates
+    to nan."""
     if value is None or spec.kind != "real":
         return value
     if spec.shape == ():
-        return _scalar(value, spec, env, where)
+        return _scalar(value, spec, env, where, signals=signals)
     arr = np.array([[_scalar(v, spec, env, f"{where}[{i}][{j}]", bounds=False)
                      for j, v in enumerate(row)] for i, row in enumerate(value)]
                    if len(spec.shape) == 2 else
-                   [_scalar(v, spec, env, f"{where}[{i}]", bounds=False)
+                   [_scalar(v, spec, env, f"{where}[{i}]", bounds=False, signals=signals)
                     for i, v in enumerate(value)])
     if spec.nonzero and not np.any(arr):
         raise ModelError(f"{where}: must not be the zero vector")
     return arr
 
 
-def _scalar(value, spec, env, where, bounds=True):
+def signal_outputs(model):
+    """The signal outputs of a (flat) model's components by dotted name: what a parameter
+    with ``signals`` may read ("pos.y")."""
+    return sorted(f"{c.name}.{pname}" for c in model.components.values()
+                  for pname, port in c.ports.items() if port.domain == "signal_out")
+
+
+def _scalar(value, spec, env, where, bounds=True, signals=None):
     if isinstance(value, str):
         expr = parse(value)
-        unknown = sorted(expr.names - set(env))
+        read = sorted(n for n in expr.names if "." in n)
+        if read:
+            wrong = [n for n in read if signals is not None and n not in signals]
+            if wrong:
+                raise ModelError(f"{where} = {value!r}: {wrong[0]!r} is not a signal output "
+                                 f"of this model{suggest(wrong[0], signals)}; signal outputs "
+                                 f"are {', '.join(signals) or 'none'}")
+        unknown = sorted(expr.names - set(env) - set(read))
         if unknown:
             raise ModelError(f"{where} = {value!r}: unknown name {unknown[0]!r}"
                              f"{suggest(unknown[0], env)}; model parameters are "
                              f"{', '.join(k for k in env if k != 't') or 'none'}")
+        if read:
+            return math.nan
         try:
             number = float(expr.evaluate(env))
         except (ZeroDivisionError, ValueError, OverflowError, TypeError) as exc:

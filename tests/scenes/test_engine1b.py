@@ -1,7 +1,9 @@
 """MSL's Engine1b (``models/engine1b.json``): Engine1a's mechanism, restructured as MSL's
 Engine1b (piston pin b1, rod1, the crank-pin revolute b2 cut), with MSL's GasForce2 between
-the cylinder's support and axis as one expression with conditionals (an ``Expression`` of the
-sensed piston position and speed driving a ``Force``).
+the cylinder's support and axis as one ``Force`` whose law is an expression with conditionals
+in the sensed piston position and speed (``build(blocks=True)`` writes it as MSL's diagram
+does, an ``Expression`` block driving the Force's input: tests/components/
+test_force_expressions.py checks the two agree).
 
 The reference is written apart from kinetwork: the slider-crank's Lagrangian in the crank
 angle, derived by sympy from the parts' masses and inertias (MSL's BodyBox / BodyCylinder
@@ -29,19 +31,21 @@ EXPANSION = ("-3929704*x^4 + 14748765*x^3 - 20747000*x^2 + 12964477*x - 3036495"
              "145.930*x^4 - 131.707*x^3 + 17.3438*x^2 + 17.9272*x + 2.4")
 
 
-def gas_law():
+def gas_law(s="s", v="v"):
     """GasForce2's force on the piston along the cylinder (towards larger s) [N], as one
-    expression in the piston's position s and speed v and the parameters L and d."""
+    expression in the piston's position s and speed v (names of an Expression's inputs, or
+    signal outputs "pistonPosition.y") and the parameters L and d."""
     def poly(text):
-        return "(" + text.replace("x", "(1 - s/L)") + ")"
-    return (f"1e5*if_else(v < 0, if_else(1 - s/L < 0.986061, {poly(COMPRESSION[0])}, "
-            f"{poly(COMPRESSION[1])}), if_else(1 - s/L > 0.933, {poly(EXPANSION[0])}, "
+        return "(" + text.replace("x", f"(1 - {s}/L)") + ")"
+    return (f"1e5*if_else({v} < 0, if_else(1 - {s}/L < 0.986061, {poly(COMPRESSION[0])}, "
+            f"{poly(COMPRESSION[1])}), if_else(1 - {s}/L > 0.933, {poly(EXPANSION[0])}, "
             f"{poly(EXPANSION[1])}))*pi*d^2/4")
 
 
-def build():
+def build(blocks=False):
     """Engine1b wired part for part as MSL 4's Examples.Loops.Engine1b (Engine1Base +
-    Engine1bBase)."""
+    Engine1bBase); the gas force one Force with its law in the sensed signals, or with
+    ``blocks`` an Expression block (gasLaw) driving the Force's input, as MSL's diagram."""
     mb, rot, tr, sig = kn.multibody, kn.rotational, kn.translational, kn.signals
     m = kn.Model("Engine1b", parameters={"L": L_CYL, "d": BORE})
     m.description = (
@@ -51,12 +55,12 @@ def build():
         "the crank-pin revolute b2 as the cut joint (MSL's RevolutePlanarLoopConstraint), and "
         "MSL's GasForce2(L = 0.35, d = 0.1) between the cylinder's support and axis: its "
         "pressure polynomials in x = 1 - s/L, chosen by v < 0 (compression) and x, are one "
-        "expression with if_else (gasLaw, fed by the sensed piston position and speed, "
-        "driving gasForce). The load inertia starts at 10 rad/s as Engine1Base starts it "
+        "expression with if_else, the law of one Force (gasForce) in the sensed piston "
+        "position and speed (pistonPosition.y, pistonSpeed.y). The load inertia starts at 10 rad/s as Engine1Base starts it "
         "(MSL 4's Engine1b sets w(start = 0): at the top dead centre the gas force has no "
         "lever and the crank stays there). Reproduces the crank speed (probe crank.speed) "
         "and the gas force cycle over the piston position (MSL's figure gasForceCycle.png: "
-        "probe stroke with gasLaw's law), checked against an independent sympy/scipy "
+        "probe stroke with gasForce's law), checked against an independent sympy/scipy "
         "slider-crank with the gas force in tests/scenes/test_engine1b.py.")
     add = m.add
     add(mb.Ground("world", gravity=[0, -G, 0]))
@@ -80,8 +84,11 @@ def build():
     add(mb.Revolute("b2", axis=[1, 0, 0], cut=True))
     add(tr.PositionSensor("pistonPosition"))
     add(tr.SpeedSensor("pistonSpeed"))
-    add(sig.Expression("gasLaw", expression=gas_law(), names=["s", "v"]))
-    add(tr.Force("gasForce"))
+    if blocks:
+        add(sig.Expression("gasLaw", expression=gas_law(), names=["s", "v"]))
+        add(tr.Force("gasForce"))
+    else:
+        add(tr.Force("gasForce", f=gas_law("pistonPosition.y", "pistonSpeed.y")))
     add(kn.Probe("crank", quantities=["angle", "speed"]))
     add(kn.Probe("stroke", quantities=["position", "velocity"]))
     for a, b in [("world.frame", "bearing.frame_a"), ("crank2.frame_a", "crank1.frame_b"),
@@ -95,8 +102,9 @@ def build():
                  ("b2.frame_b", "rod1.frame_b"), ("b1.frame_b", "rod1.frame_a"),
                  ("pistonPosition.flange", "cylinder.axis"),
                  ("pistonSpeed.flange", "cylinder.axis"),
-                 ("pistonPosition.y", "gasLaw.u1"), ("pistonSpeed.y", "gasLaw.u2"),
-                 ("gasLaw.y", "gasForce.u"), ("gasForce.flange", "cylinder.axis"),
+                 *([("pistonPosition.y", "gasLaw.u1"), ("pistonSpeed.y", "gasLaw.u2"),
+                    ("gasLaw.y", "gasForce.u")] if blocks else []),
+                 ("gasForce.flange", "cylinder.axis"),
                  ("gasForce.support", "cylinder.support"), ("crank.port", "bearing.axis"),
                  ("stroke.port", "cylinder.axis")]:
         m.connect(a, b)
