@@ -117,10 +117,11 @@ class PartialFriction(PartialHybrid):
     @staticmethod
     def _at_rest(ev):
         """At zero relative speed: stuck if the force that holds is within the static limit,
-        else sliding the way that force pushes."""
+        else sliding the way that force pushes, from a speed of exactly zero (one a rounding
+        the other way would read as the slide stopping at once, again and again)."""
         if abs(ev.stuck_force) <= ev.values[0] * (1 + EDGE):
             return 0, 0.0, None
-        return (1 if ev.stuck_force > 0 else -1), None, None
+        return (1 if ev.stuck_force > 0 else -1), 0.0, None
 
 
 class PartialTwoFlanges(PartialFriction):

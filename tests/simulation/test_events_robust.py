@@ -69,3 +69,18 @@ def test_a_slide_that_stops_where_holding_takes_exactly_the_limit_sticks():
     (event,) = res.stats["events"]
     assert event["kind"] == "stuck" and abs(event["t"] - 0.25) < 1e-8
     assert abs(res["block.s"][-1] + 1 / 16) < 1e-8 and res["block.v"][-1] == 0.0
+
+
+@pytest.mark.parametrize("method", ["cvodes", "rk45"])
+def test_a_slide_that_touches_zero_speed_at_the_limit_goes_on(method):
+    # v0 = 1/4: v = (t - 1/2)^2 touches zero at t = 1/2, where holding would take exactly the
+    # limit and the push then exceeds it: whether a method sees the touch (stuck, then
+    # sliding forward, both at 1/2) or not, the motion is the closed form's, s = ((t - 1/2)^3
+    # + 1/8) / 3, and no slide restarts at rest again and again
+    res = kn.simulate(pushed_block(0.25), t_end=1.9, n_points=3, method=method, rtol=1e-10,
+                      atol=1e-12, jit=False)
+    events = res.stats["events"]
+    assert [e["kind"] for e in events] in ([], ["stuck", "sliding forward"])
+    assert all(abs(e["t"] - 0.5) < 1e-7 for e in events)
+    assert abs(res["block.v"][-1] - 1.4 ** 2) < 1e-9
+    assert abs(res["block.s"][-1] - (1.4 ** 3 + 0.125) / 3) < 1e-9
