@@ -425,7 +425,7 @@ class _Builder:
                     g.add_edge(source, comp.name)
                 elif comp.role in ("source", "prescribed"):
                     g.add_edge(source, MECHANICS)
-        for name, read in self.reads.items():
+        for read in self.reads.values():
             # a law reading signals is part of the mechanics (a source's flow, or a force
             # on frames: its generalized force), needing the signals first
             for _, s in read.values():

@@ -8,10 +8,10 @@ import math
 
 import numpy as np
 import pytest
+from scenes.test_engine1b import build as engine1b
 from scipy.integrate import solve_ivp
 
 import kinetwork as kn
-from scenes.test_engine1b import build as engine1b
 
 K, M, S0 = 4.0, 0.5, 0.3
 TOL = {"rtol": 1e-10, "atol": 1e-12, "jit": False}
