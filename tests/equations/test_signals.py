@@ -46,7 +46,7 @@ EXPECTED = [
     Signal("frame.orientation", "", (3, 3), "frame", "orientation", "body.frame_a"),
     Signal("frame.angular_velocity", "rad/s", (3,), "frame", "angular_velocity",
            "body.frame_a"),
-    Signal("signal.value", "", (), "signal", "value", "sensor.y"),
+    Signal("signal.value", "rad", (), "signal", "value", "sensor.y"),     # an angle sensor's
 ]
 
 
