@@ -37,7 +37,7 @@ _LAZY = {
     "simulate": ("simulation.driver", "simulate"),
     "METHODS": ("simulation.methods", "METHODS"),
     "Results": ("simulation.results", "Results"),
-    "schema": ("schema", "schema"),
+    "schema": ("schema", None),       # the module, callable: kn.schema()
     "from_urdf": ("urdf", "from_urdf"),
     "examples": ("examples", None),
     "plot": ("plot", None),           # the module, callable: kn.plot([res_a, res_b])

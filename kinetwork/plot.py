@@ -8,11 +8,10 @@ kinetwork`` stays fast and never touches a display.
 
 import os
 import sys
-import types
 
 import numpy as np
 
-from .util import atomic_write, suggest
+from .util import atomic_write, callable_module, suggest
 from .errors import ModelError
 from .simulation.results import install_plotter
 
@@ -337,14 +336,4 @@ def _event_marks(ax, runs):
                        linewidth=0.6, linestyle=":", gid=f"event:{event['component']}")
 
 
-class _CallableModule(types.ModuleType):
-    """This module, callable: ``kn.plot([res_a, res_b])`` is :func:`plot`, while
-    ``kinetwork.plot.save_plot`` and the rest stay reachable (a package attribute named like
-    a submodule is the submodule once it is imported, so the module itself is made the
-    function)."""
-
-    def __call__(self, *args, **kwargs):
-        return plot(*args, **kwargs)
-
-
-sys.modules[__name__].__class__ = _CallableModule
+callable_module(__name__, plot)

@@ -14,6 +14,7 @@ from .components.reference import param_line, reference
 from .graph.io import DEFINITION_KEYS, FORMAT, KEYS, KEYS_V2, VERSION
 from .graph.settings import SIMULATION_KEYS
 from .simulation.methods import METHODS
+from .util import callable_module
 
 IDENT = "^[A-Za-z_][A-Za-z0-9_]*$"
 NUMBER = {"type": "number"}
@@ -188,3 +189,6 @@ def _simulation():
     out["n_points"] = {"type": "integer", "minimum": 2}
     out["method"] = {"type": "string", "enum": sorted(METHODS)}
     return out
+
+
+callable_module(__name__, schema)

@@ -75,3 +75,18 @@ def atomic_write(path, write, mode=0o666):
         if os.path.exists(tmp):
             os.unlink(tmp)
         raise
+
+
+def callable_module(name, function):
+    """Make the module ``name`` callable as ``function``: ``kn.plot(...)`` and ``kn.schema()``
+    are functions named like their modules, and once a submodule is imported the package's
+    attribute of that name is the module, so the module itself is made the function (its
+    other names stay reachable: ``kinetwork.plot.save_plot``)."""
+    import sys
+    import types
+
+    class CallableModule(types.ModuleType):
+        __call__ = staticmethod(function)
+        __doc__ = function.__doc__
+
+    sys.modules[name].__class__ = CallableModule
