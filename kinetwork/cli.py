@@ -299,14 +299,9 @@ def _load(path, library=None, validate=True):
     if not os.path.exists(path):
         if _example_name(path):
             path = str(examples.path(path))
-        elif not path.endswith(".json") or "/" not in path:
-            try:
-                examples.path(path)
-            except kn.ModelError as exc:
-                hint = str(exc).split("(", 1)[1].rstrip(")")
-                if "did you mean" in hint:
-                    raise kn.ModelError(f"{path}: no such file, nor an example of that name "
-                                        f"({hint})") from None
+        elif (not path.endswith(".json") or "/" not in path) and examples.close_names(path):
+            raise kn.ModelError(f"{path}: no such file, nor an example of that name (did you "
+                                f"mean {' or '.join(examples.close_names(path))}?)")
     try:
         return kn.load(path, library=library, validate=validate)
     except OSError as exc:

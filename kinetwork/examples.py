@@ -158,9 +158,15 @@ def _references(data, here):
                 yield here / f"{kind}{SUFFIX}"
 
 
-def _suggest(key, known):
+def close_names(name):
+    """Up to three example names close to ``name`` (a typo's likely meaning), best first."""
     import difflib
-    close = difflib.get_close_matches(key, list(known), n=3, cutoff=0.5)
+    key = str(name)[:-len(SUFFIX)] if str(name).endswith(SUFFIX) else str(name)
+    return difflib.get_close_matches(key, list(names()), n=3, cutoff=0.5)
+
+
+def _suggest(key, known):
+    close = close_names(key)
     if close:
         return "did you mean " + " or ".join(close) + "?"
     return ("'kinetwork examples' lists them" if known else

@@ -215,7 +215,7 @@ class Results:
         figure = ""
         if self.signals and _plotter is not None and len(self.t) > 1:
             try:
-                figure = _svg(_plotter(self))
+                figure = _svg(_plotter(self, _detached=True))
             except Exception as exc:        # a display must never raise in a notebook
                 figure = f"<p>(no plot: {html.escape(str(exc))})</p>"
         return f"<div class='kinetwork-results'><p>{text}</p>{table}{figure}</div>"
@@ -252,13 +252,9 @@ def _optional(module, what):
 
 
 def _svg(fig):
-    """A matplotlib figure as inline SVG text, the figure closed."""
-    import matplotlib.pyplot as plt
+    """A figure pyplot never saw (nothing to close, nothing shown twice) as inline SVG."""
     buffer = io.StringIO()
-    try:
-        fig.savefig(buffer, format="svg")
-    finally:
-        plt.close(fig)
+    fig.savefig(buffer, format="svg")
     text = buffer.getvalue()
     return text[text.index("<svg"):]
 
