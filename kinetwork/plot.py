@@ -252,7 +252,8 @@ def _fit_margins(fig, axes, rows, heading, legend, note):
     """Place the panels of a figure drawn without a layout engine: margins and gaps are the
     measured sizes of what surrounds the panels (titles, tick labels, axis labels, legends),
     so nothing overlaps and little space is lost, at the cost of laying out a few texts
-    instead of a whole drawing pass. Panels keep one size (a regular grid)."""
+    instead of a whole drawing pass. Panels keep one size; each gap between them is as wide
+    as what it holds."""
     import matplotlib as mpl
     from matplotlib.backends.backend_agg import FigureCanvasAgg
     from matplotlib.font_manager import FontProperties
@@ -313,14 +314,19 @@ def _fit_margins(fig, axes, rows, heading, legend, note):
     bottom = _EDGE + (size(note)[1] + _GAP if note is not None else 0.0)
     x0, x1 = left[0] + _EDGE, width - right[-1] - _EDGE
     y1, y0 = height - top - above[0], bottom + below[-1]
-    wspace = max([right[j] + left[j + 1] + _GAP for j in range(n_cols - 1)], default=0.0)
-    hspace = max([below[i] + above[i + 1] + _GAP for i in range(n_rows - 1)], default=0.0)
-    panel_w = (x1 - x0 - wspace * (n_cols - 1)) / n_cols
-    panel_h = (y1 - y0 - hspace * (n_rows - 1)) / n_rows
+    # each gap as wide as what fills it: a column with x/y/z legends does not widen the rest
+    wgaps = [right[j] + left[j + 1] + _GAP for j in range(n_cols - 1)] + [0.0]
+    hgaps = [below[i] + above[i + 1] + _GAP for i in range(n_rows - 1)] + [0.0]
+    panel_w = (x1 - x0 - sum(wgaps)) / n_cols
+    panel_h = (y1 - y0 - sum(hgaps)) / n_rows
     if panel_w <= 0 or panel_h <= 0:            # a figure too small for its texts
         return
-    fig.subplots_adjust(left=x0 / width, right=x1 / width, bottom=y0 / height,
-                        top=y1 / height, wspace=wspace / panel_w, hspace=hspace / panel_h)
+    lefts = [x0 + j * panel_w + sum(wgaps[:j]) for j in range(n_cols)]
+    tops = [y1 - i * panel_h - sum(hgaps[:i]) for i in range(n_rows)]
+    for i in range(n_rows):
+        for j in range(n_cols):
+            axes[i, j].set_position([lefts[j] / width, (tops[i] - panel_h) / height,
+                                     panel_w / width, panel_h / height])
     edge = 1.0 - _EDGE / height
     if heading is not None:
         heading.set_y(edge)
