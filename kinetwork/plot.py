@@ -270,7 +270,7 @@ def _fit_margins(fig, axes, rows, heading, legend, note):
 
     def tick_labels(axis, name):
         """Width and height [points] of the widest tick label the axis will draw."""
-        axis.axes.viewLim                       # brings the view limits up to date
+        _ = axis.axes.viewLim                   # brings the view limits up to date
         low, high = sorted(axis.get_view_interval())
         span = (high - low) * 1e-10
         locs = [x for x in axis.get_major_locator()() if low - span <= x <= high + span]

@@ -68,7 +68,7 @@ def test_run_with_plot_draws_in_its_own_process(seed_file, tmp_path):
     blowup.add(kn.rotational.Torque("blowup", tau="1/(1-t)**3"))
     blowup.connect("blowup.flange", "shoulder.axis")
     blowup.save(tmp_path / "blowup.json")
-    code, out, err = python(f"""
+    _, out, err = python(f"""
         import json, os, signal, sys
         from kinetwork import cli, plotworker
 
