@@ -14,6 +14,7 @@ Standard library only at import: this module runs before numpy is loaded.
 
 import os
 import pickle
+import select
 import signal
 import sys
 from dataclasses import dataclass
@@ -137,7 +138,8 @@ def _serve(jobs, answers):
     """The child: import and warm up the plotting, wait for the job, draw, answer."""
     try:
         from .plot import save_plot, warm_up
-        warm_up()
+        if not select.select([jobs], [], [], 0)[0]:     # the job is not here yet: warm up
+            warm_up()
     except BaseException:           # pragma: no cover - the parent draws itself
         save_plot = None
     data = _read_all(jobs)
