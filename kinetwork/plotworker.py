@@ -93,9 +93,14 @@ class PlotWorker:
             save_plot(results, path, *names, title=title, hide_flat=hide_flat)
 
     def close(self):
-        """Let the child go without a job (a refused model, a usage error) and reap it."""
+        """End the child without a job (a refused model, a usage error) and reap it: it has
+        written nothing yet, and waiting for its imports would delay the command's exit."""
         self._close_jobs()
         if self._answers is not None:
+            try:
+                os.kill(self.pid, signal.SIGKILL)
+            except ProcessLookupError:                 # pragma: no cover (already gone)
+                pass
             self._answer()
 
     def _close_jobs(self):
