@@ -354,8 +354,7 @@ def _outputs(args, results, title):
     if args.plot:
         from .plot import save_plot
         worker = getattr(args, "plot_worker", None)
-        draw = save_plot if worker is None else \
-            lambda res, path, *names, **options: worker.save(res, path, names, **options)
+        draw = save_plot if worker is None else worker.save     # the same call, elsewhere
         _write(args.plot, lambda path: draw(results, path, *args.plot_signals, title=title,
                                             hide_flat=args.hide_flat), "probe plots to", quiet)
 

@@ -75,8 +75,8 @@ class PlotWorker:
         os.close(answers_w)
         return cls(pid, jobs_w, answers_r)
 
-    def save(self, results, path, names, title, hide_flat):
-        """Draw ``save_plot(results, path, *names, title=, hide_flat=)`` in the child and wait
+    def save(self, results, path, *names, title=None, hide_flat=False):
+        """``save_plot(results, path, *names, title=, hide_flat=)``, drawn in the child; waits
         for it. Raises what ``save_plot`` raised there; draws here if the child is gone."""
         from .plot import save_plot
         job = pickle.dumps({"results": _portable(results), "path": os.fspath(path),

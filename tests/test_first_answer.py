@@ -85,7 +85,7 @@ def test_run_with_plot_draws_in_its_own_process(seed_file, tmp_path):
         os.kill(worker.pid, signal.SIGKILL)
         import kinetwork as kn
         res = kn.simulate(kn.load({str(seed_file)!r}), t_end=0.5, n_points=11)
-        worker.save(res, "e.png", [], title="fallback", hide_flat=False)
+        worker.save(res, "e.png", title="fallback")
         print(json.dumps([codes, in_parent]))
     """, tmp_path)
     codes, in_parent = json.loads(out.splitlines()[-1])
