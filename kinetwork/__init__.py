@@ -57,12 +57,30 @@ _LAZY = {
 __all__ = ["IdealisedInertiaWarning", "ModelError", "SimulationError", *_LAZY]
 
 #: modules that install themselves on the core classes when imported
-_FACES = ("equations", "plot", "animation", "diagram")
+_FACES = ("equations", "plot")
 
 
 def _install():
     for module in _FACES:
         importlib.import_module(f"{__name__}.{module}")
+    # the animation and the diagram (with urllib, xml and their own code, 50 ms of every
+    # ``kinetwork run``) are imported when first used, not when the first model is built
+    graph = importlib.import_module(f"{__name__}.graph.model")
+    if "_repr_svg_" not in vars(graph.Model):
+        graph.Model._repr_svg_ = _repr_svg_
+    results = importlib.import_module(f"{__name__}.simulation.results")
+    if results._animator is None:
+        results.install_animator(_animate)
+
+
+def _repr_svg_(model):
+    """A model's diagram, for Jupyter: ``kinetwork.diagram`` replaces this when imported."""
+    return importlib.import_module(f"{__name__}.diagram")._repr_svg_(model)
+
+
+def _animate(results, path=None, **kwargs):
+    """``Results.animate`` until ``kinetwork.animation`` is imported, which installs itself."""
+    return importlib.import_module(f"{__name__}.animation").animate(results, path, **kwargs)
 
 
 def __getattr__(name):

@@ -18,13 +18,12 @@ import time
 
 import kinetwork as kn
 
-from . import examples
-from .analysis.sweep import add_command as add_sweep, run_command as run_sweep
-from .analysis import commands as analysis_commands
-from .graph.settings import check_output, check_settings
-from .graph.subsystem import subsystem_instances
-from .simulation.driver import DEFAULTS, METHODS
+from . import plotworker
 from .util import finite, quote
+
+# The rest of kinetwork (numpy, CasADi, networkx, the model layers) is imported where a
+# command needs it: ``kinetwork run --plot`` forks its drawing process before that (see
+# plotworker), and ``--help`` or ``--version`` answer at once.
 
 EXIT_MODEL, EXIT_USAGE, EXIT_SIMULATION = 1, 2, 3
 #: signals that stop a run with its partial results written, exiting 128 + the signal
@@ -89,6 +88,10 @@ class _HelpFormatter(argparse.HelpFormatter):
 
 def build_parser():
     """The argument parser of the ``kinetwork`` command."""
+    from .analysis import commands as analysis_commands
+    from .analysis.sweep import add_command as add_sweep
+    from .simulation.methods import METHODS
+
     parser = argparse.ArgumentParser(
         prog="kinetwork",
         description="Acausal multibody models: simulate a model file, check it, or print "
@@ -253,7 +256,20 @@ def build_parser():
 
 def main(argv=None):
     """Run the ``kinetwork`` command; returns the exit code."""
+    # the command line's own process (not a call from Python): draw its plots in a second
+    # process, importing matplotlib while this one loads and runs the model
+    worker = plotworker.PlotWorker.start() if argv is None and \
+        plotworker.wanted(sys.argv[1:]) else None
+    try:
+        return _main(argv, worker)
+    finally:
+        if worker is not None:
+            worker.close()
+
+
+def _main(argv, worker):
     args = build_parser().parse_args(argv)
+    args.plot_worker = worker
     command = {"run": _run, "validate": _validate, "equations": _equations,
                "methods": _methods, "bench": _bench, "schema": _schema,
                "cache": _cache, "animate": _animate, "diagram": _diagram,
@@ -275,19 +291,22 @@ def main(argv=None):
 
 
 def _linearize(args):
-    return analysis_commands.run_linearize(args, _load(args.model, args.library))
+    from .analysis import commands
+    return commands.run_linearize(args, _load(args.model, args.library))
 
 
 def _fit(args):
+    from .analysis import commands
     try:
-        return analysis_commands.run_fit(args, _load(args.model, args.library))
+        return commands.run_fit(args, _load(args.model, args.library))
     except kn.SimulationError as exc:
         _error(exc)
         return EXIT_SIMULATION
 
 
 def _sweep(args):
-    return run_sweep(args, _load(args.model, args.library))
+    from .analysis.sweep import run_command
+    return run_command(args, _load(args.model, args.library))
 
 
 def _error(message):
@@ -296,6 +315,7 @@ def _error(message):
 
 def _load(path, library=None, validate=True):
     """The model in the file ``path``, or the shipped example of that name (a file wins)."""
+    from . import examples
     if not os.path.exists(path):
         if _example_name(path):
             path = str(examples.path(path))
@@ -310,6 +330,7 @@ def _load(path, library=None, validate=True):
 
 def _example_name(text):
     """Whether ``text`` names a shipped example (``double_pendulum``, ``engine_v6/EngineV6``)."""
+    from . import examples
     key = text[:-len(".json")] if text.endswith(".json") else text
     return key in examples.names()
 
@@ -332,9 +353,10 @@ def _outputs(args, results, title):
                f"{len(results.t)} points x {len(results.columns()[0])} columns to", quiet)
     if args.plot:
         from .plot import save_plot
-        _write(args.plot, lambda path: save_plot(results, path, *args.plot_signals,
-                                                 title=title, hide_flat=args.hide_flat), "probe plots to",
-               quiet)
+        worker = getattr(args, "plot_worker", None)
+        draw = save_plot if worker is None else worker.save     # the same call, elsewhere
+        _write(args.plot, lambda path: draw(results, path, *args.plot_signals, title=title,
+                                            hide_flat=args.hide_flat), "probe plots to", quiet)
 
 
 @contextlib.contextmanager
@@ -369,6 +391,9 @@ def _run(args):
         check_plot_path(args.plot)
     # a subsystem's value by path ("cyl1.phi0") is a constant of its instance: set on the
     # model before it is compiled; model parameters go to the integrator
+    from .graph.settings import check_output, check_settings
+    from .simulation.driver import DEFAULTS
+
     params = {}
     for name, value in args.param:
         if "." in name:
@@ -515,6 +540,7 @@ def _validate(args):
 def _subsystems_summary(model):
     """Lines naming each subsystem definition, where it comes from and its instances by
     path; nothing for a flat model."""
+    from .graph.subsystem import subsystem_instances
     placed = subsystem_instances(model)
     if not placed:
         return []
@@ -600,6 +626,7 @@ def _import(args):
 
 
 def _examples(args):
+    from . import examples
     if args.action == "copy":
         written = examples.copy(args.name, args.folder)
         print(f"copied {args.name} to {written[0]}"
@@ -644,7 +671,7 @@ def _cache(args):
 
 
 def _methods(args):
-    from .simulation.driver import DEFAULTS
+    from .simulation.driver import DEFAULTS, METHODS
     width = max(map(len, METHODS))
     print(f"default: {DEFAULTS['method']}, rtol {DEFAULTS['rtol']:g}, atol {DEFAULTS['atol']:g}")
     for name, method in METHODS.items():

@@ -2,13 +2,10 @@
 input in messages, and atomic file writes. The bottom layer: it imports nothing of kinetwork
 but the errors."""
 
-import difflib
 import math
 import os
-import secrets
 import stat
-
-import numpy as np
+import sys
 
 from .errors import ModelError
 
@@ -26,7 +23,8 @@ def finite(value):
 
 def check_number(value, where, what="a number"):
     """A finite real number, or a ModelError naming ``where``."""
-    if isinstance(value, np.generic):
+    numpy = sys.modules.get("numpy")        # a numpy scalar exists only once numpy is loaded
+    if numpy is not None and isinstance(value, numpy.generic):
         value = value.item()
     if isinstance(value, bool) or not isinstance(value, (int, float)):
         raise ModelError(f"{where}: must be {what}, got {quote(value)}")
@@ -39,6 +37,7 @@ def check_number(value, where, what="a number"):
 
 def suggest(name, choices):
     """' (did you mean 'x'?)' for the closest of ``choices``, or ''."""
+    import difflib                      # here: the command line starts without it
     close = difflib.get_close_matches(str(name)[:QUOTE_LIMIT], list(choices), n=1)
     return f" (did you mean {close[0]!r}?)" if close else ""
 
@@ -59,6 +58,7 @@ def atomic_write(path, write, mode=0o666):
 
     A symbolic link is followed, not replaced; the old file's permissions are kept.
     """
+    import secrets
     path = os.path.realpath(os.fspath(path))
     folder, base = os.path.split(path)
     tmp = os.path.join(folder, f".{base}.{secrets.token_hex(4)}.tmp")
@@ -82,7 +82,6 @@ def callable_module(name, function):
     are functions named like their modules, and once a submodule is imported the package's
     attribute of that name is the module, so the module itself is made the function (its
     other names stay reachable: ``kinetwork.plot.save_plot``)."""
-    import sys
     import types
 
     class CallableModule(types.ModuleType):
