@@ -121,6 +121,11 @@ def build_parser():
                      help="compile the equations to C with the system's compiler, cached on "
                           "disk (default: when a compiler is found)")
     run.add_argument("--n-points", type=int, metavar="N", help="points on the output grid")
+    run.add_argument("--loops", choices=["projected", "partition", "baumgarte"],
+                     default="projected",
+                     help="formulation of kinematic loops: projected (default: an ODE, "
+                          "CVODES Adams), partition (the fewest states: a DAE for IDAS) or "
+                          "baumgarte")
     run.add_argument("--param", type=_parameter, action="append", default=[],
                      metavar="NAME=VALUE",
                      help="set a model parameter for this run (repeat for several), a number "
@@ -155,6 +160,11 @@ def build_parser():
     val.add_argument("--compile", action="store_true",
                      help="also build the equations and summarise them: states, algebraic "
                           "variables, equation size (takes longer on large models)")
+    val.add_argument("--loops", choices=["projected", "partition", "baumgarte"],
+                     default="projected",
+                     help="formulation of kinematic loops: projected (default: an ODE, "
+                          "CVODES Adams), partition (the fewest states: a DAE for IDAS) or "
+                          "baumgarte")
 
     sub.add_parser("schema", help="print the JSON Schema of model files",
                    description="Print the JSON Schema (draft 2020-12) of the model format, "
@@ -408,7 +418,7 @@ def _run(args):
     if problems:
         raise kn.ModelError(problems)
     start = time.perf_counter()
-    system = model.compile()
+    system = model.compile(loops=args.loops)
     compiled = time.perf_counter()
     n_values = 1 + system.n_states + system.n_algebraic + sum(sig.size for sig in system.signals)
     problem = check_output(settings["n_points"], n_values)
@@ -513,7 +523,7 @@ def _validate(args):
         for cut in topo.cuts[:SHOWN_ITEMS]) + (
         f"\n  ... ({len(topo.cuts)} in all)" if len(topo.cuts) > SHOWN_ITEMS else "")
     if args.compile:
-        lines += _compiled_summary(model.compile(), topo, loops)
+        lines += _compiled_summary(model.compile(loops=args.loops), topo, loops)
     else:
         # the joints' degrees of freedom and the free 1-D groups' are exact without the
         # equations; loops take away as many as their independent closure equations

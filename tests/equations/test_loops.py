@@ -223,6 +223,14 @@ def test_validate_states_the_reason_for_the_state_count(tmp_path, capsys):
     assert "degrees of freedom: 1" in out and "projected formulation: 5 states for 1 degree " \
         "of" in out and "3 dependent coordinates are states only to" in out
     assert "loops: 1\n  coupler - B - crank - A - base - D - rocker - C (cut at C)" in out
+    # the partition keeps the fewest states, the dependent angles algebraic variables
+    assert cli.main(["validate", "--compile", "--loops", "partition", str(path)]) == 0
+    out = capsys.readouterr().out
+    assert "states: 2 (A.q [rad], A.qd [rad/s])" in out and "algebraic: 3" in out
+    assert "coordinate partitioning" in out
+    assert cli.main(["run", str(path), "--loops", "partition", "--t-end", "0.2", "--no-jit",
+                     "--out", str(tmp_path / "fb.csv")]) == 0
+    assert "idas" in capsys.readouterr().out
 
 
 def _wire(model, pairs):
