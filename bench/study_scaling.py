@@ -137,6 +137,9 @@ def main(quick=False, only_strategies=False, sizes=None):
                   f"jit cold {r['jit_cold_s']:6.2f} s warm {r['jit_warm_s'] * 1e3:6.1f} ms  "
                   f"C {r['rhs_c_us']:7.2f} us  VM {r['rhs_vm_us']:8.2f} us  "
                   + "  ".join(f"{k} {r[_key(k)]:7.2f} us" for k in tools), flush=True)
+        fourbars = fourbar_rows(2 if quick else 8)
+        write_csv("study_scaling_fourbar", fourbars)
+        cost = o0_cost(16 if quick else 256)
         # the strategies take minutes at full size: their own run (--strategies)
         extra = strategies(quick) if quick else None
     finally:
@@ -148,7 +151,7 @@ def main(quick=False, only_strategies=False, sizes=None):
     fits = exponents(rows, tools)
     charts(rows, tools)
     total = time.perf_counter() - clock
-    report(rows, fits, tools, total, quick, extra)
+    report(rows, fits, tools, total, quick, extra, fourbar_lines(fourbars, cost))
     print(f"study_scaling: {total:.1f} s")
 
 
@@ -265,6 +268,90 @@ def strategy_lines(rows, loops):
             f"{loops['jit_s']:.1f} s; the same run again {loops['warm_run_s']:.2f} s."]
 
 
+# -- the eight-four-bar chain, and what -O0 costs at run time -------------------------------------
+def fourbar_rows(m=8):
+    """The chain of ``m`` four-bar loops in each loop formulation, as a user meets it: build,
+    then a first run (2 s, default method, rtol 1e-6) from an empty cache, whose JIT time
+    ``jit_seconds`` is the cold JIT of what that run compiles, then the same run again."""
+    from scenes import fourbar_chain
+    rows = []
+    for loops in ("projected", "partition"):
+        with tempfile.TemporaryDirectory() as folder:
+            os.environ["KINETWORK_CACHE"] = folder
+            cpu, start = time.process_time(), time.perf_counter()
+            system = fourbar_chain(m).compile(loops=loops)
+            build, build_cpu = time.perf_counter() - start, time.process_time() - cpu
+            children, start = _children_cpu(), time.perf_counter()
+            res = kn.simulate(system, t_end=2.0, n_points=201, rtol=1e-6, atol=1e-8)
+            first = time.perf_counter() - start
+            compilers = _children_cpu() - children
+            start = time.perf_counter()
+            kn.simulate(system, t_end=2.0, n_points=201, rtol=1e-6, atol=1e-8)
+            again = time.perf_counter() - start
+            f = system.f_rhs or system.f_dae
+        rows.append({"model": f"fourbar_chain{m}", "loops": loops, "states": system.n_states,
+                     "algebraic": system.n_algebraic, "instructions": f.n_instructions(),
+                     "build_s": build, "build_cpu_s": build_cpu, "first_run_s": first,
+                     "jit_cold_s": res.stats.get("jit_seconds", float("nan")),
+                     "jit_compilers_cpu_s": compilers, "run_again_s": again,
+                     "method": res.stats.get("method", "")})
+        r = rows[-1]
+        print(f"  fourbar_chain{m} loops={loops}: build {build:.2f} s, first run {first:.2f} s "
+              f"(JIT {r['jit_cold_s']:.2f} s, compilers {compilers:.1f} s CPU), again "
+              f"{again:.2f} s", flush=True)
+    return rows
+
+
+def o0_cost(n=256):
+    """One right-hand-side evaluation of an ``n``-link chain compiled at -O1 and at -O0 (us),
+    and each compiler's CPU time (s): what ``jit.O1_STATEMENTS`` trades."""
+    system = scenes.chain(n).compile()
+    p, x = system.param_vector(), np.random.default_rng(0).uniform(-0.5, 0.5, 2 * n)
+    out, saved = {}, jit.O1_STATEMENTS
+    try:
+        for label, limit in (("-O1", sys.maxsize), ("-O0", 0)):
+            jit.O1_STATEMENTS = limit
+            with tempfile.TemporaryDirectory() as folder:
+                os.environ["KINETWORK_CACHE"] = folder
+                children = _children_cpu()
+                f = jit.external(system.f_rhs, False, {}, required=True)
+                cpu = _children_cpu() - children
+                call = numeric(f, p, system.n_states)
+                out[label] = (per_call(lambda: call(0.0, x)) * 1e6, cpu)
+    finally:
+        jit.O1_STATEMENTS = saved
+    print(f"  chain{n}: -O1 {out['-O1'][0]:.1f} us ({out['-O1'][1]:.1f} s CPU to compile), "
+          f"-O0 {out['-O0'][0]:.1f} us ({out['-O0'][1]:.1f} s)", flush=True)
+    return {"N": n, "instructions": system.f_rhs.n_instructions(), **{
+        f"{k}_{what}": v[i] for k, v in out.items() for i, what in enumerate(("us", "cpu_s"))}}
+
+
+def fourbar_lines(rows, cost):
+    from kinetwork.graph.model import Model
+    import inspect
+    default = inspect.signature(Model.compile).parameters["loops"].default
+    body = [[r["loops"] + (" (default)" if r["loops"] == default else ""), r["states"],
+             r["algebraic"], r["instructions"], f"{r['build_s']:.2f}", f"{r['jit_cold_s']:.2f}",
+             f"{r['jit_compilers_cpu_s']:.1f}", f"{r['first_run_s']:.2f}",
+             f"{r['run_again_s']:.2f}"] for r in rows]
+    mine = next((r for r in rows if r["loops"] == default), rows[0])
+    return ["", f"### {rows[0]['model']}: a chain of eight four-bar loops", "",
+            "Each formulation built, then run 2 s (default method, rtol 1e-6) from an empty "
+            "cache: JIT cold is what that first run spends in `jit` (code generation and the "
+            "compilers, whose CPU time is given beside it), then the same run again.", "",
+            table(["loops", "states", "algebraic", "instructions (rhs or DAE)", "build [s]",
+                   "JIT cold [s]", "compilers CPU [s]", "first run [s]", "run again [s]"],
+                  body), "",
+            f"The default formulation ({default}): cold JIT {mine['jit_cold_s']:.1f} s "
+            f"(target < 5 s).", "",
+            f"What -O0 costs at run time (functions over {jit.O1_STATEMENTS:,} statements): "
+            f"the {cost['N']}-link chain's right-hand side ({cost['instructions']:,} "
+            f"instructions) evaluates in {cost['-O1_us']:.1f} us at -O1 and "
+            f"{cost['-O0_us']:.1f} us at -O0 ({cost['-O0_us'] / cost['-O1_us']:.1f}x), and "
+            f"compiles in {cost['-O1_cpu_s']:.1f} s and {cost['-O0_cpu_s']:.1f} s of compiler "
+            f"CPU ({cost['-O1_cpu_s'] / max(cost['-O0_cpu_s'], 1e-9):.1f}x)."]
+
+
 def _key(tool):
     return {"pinocchio aba": "aba_us", "MuJoCo mj_forward": "mj_forward_us"}[tool]
 
@@ -272,11 +359,12 @@ def _key(tool):
 def measure(n, tools):
     model_s, model = timed(lambda: scenes.chain(n), budget=0.3, max_repeats=7)
     # validate and assemble afresh each time: model.compile() would hand back its System
-    build_s, system = timed(lambda: kn.System(model, topology=analyze(model)), budget=1.0,
-                            max_repeats=7)
-    cpu = time.process_time()
-    kn.System(model, topology=analyze(model))
-    build_cpu = time.process_time() - cpu
+    cpu, start = time.process_time(), time.perf_counter()
+    system = kn.System(model, topology=analyze(model))
+    build_s, build_cpu = time.perf_counter() - start, time.process_time() - cpu
+    if build_s < 1.0:                   # short: the median of repeats
+        build_s, system = timed(lambda: kn.System(model, topology=analyze(model)),
+                                budget=1.0, max_repeats=7)
     size = system.size()
     with tempfile.TemporaryDirectory() as folder:
         os.environ["KINETWORK_CACHE"] = folder       # jit.cache_dir() reads it on each call
@@ -306,6 +394,7 @@ def measure(n, tools):
                       for i, name in enumerate("txp"))
         empty = numeric(ca.Function("copy", [t_, x_, p_], [x_]), p, system.n_states)
         row = {"N": n, "states": size["states"], "operations": size["operations"],
+               "opt": "-O1" if system.f_rhs.n_instructions() <= jit.O1_STATEMENTS else "-O0",
                "model_s": model_s, "build_s": build_s, "jit_cold_s": cold,
                "jit_cold_compiler_s": gcc, "jit_warm_s": warm, "cached_run_s": cached_run,
                "build_cpu_s": build_cpu, "jit_cold_cpu_s": cold_cpu,
@@ -378,9 +467,9 @@ def charts(rows, tools):
           "of repeats; cold compile: one run)")
 
 
-def report(rows, fits, tools, total, quick, extra=None):
+def report(rows, fits, tools, total, quick, extra=None, loops=()):
     last = rows[-1]
-    body = [[r["N"], r["states"], r["operations"], f"{r['model_s'] * 1e3:.1f}",
+    body = [[r["N"], r["states"], r["operations"], r["opt"], f"{r['model_s'] * 1e3:.1f}",
              f"{r['build_s'] * 1e3:.1f}", f"{r['jit_cold_s']:.2f}",
              f"{r['jit_warm_s'] * 1e3:.1f}", f"{r['build_s'] + r['jit_cold_s']:.2f}",
              f"{r['build_cpu_s']:.2f} + {r['jit_cold_cpu_s']:.2f} + "
@@ -388,7 +477,7 @@ def report(rows, fits, tools, total, quick, extra=None):
              f"{r['cached_run_s']:.2f}", f"{r['peak_rss_mb']:.0f}",
              f"{r['rhs_c_us']:.2f}", f"{r['rhs_vm_us']:.1f}",
              *(f"{r[_key(t)]:.2f}" for t in tools)] for r in rows]
-    header = ["N", "states", "rhs operations", "model [ms]", "build [ms]", "JIT cold [s]",
+    header = ["N", "states", "rhs operations", "C", "model [ms]", "build [ms]", "JIT cold [s]",
               "JIT hit [ms]", "build + JIT cold [s]",
               "CPU: build + JIT (Python) + compilers [s]", "cached run 1 s [s]", "peak RSS [MB]",
               "rhs C [us]", "rhs VM [us]", *(f"{t} [us]" for t in tools)]
@@ -396,7 +485,8 @@ def report(rows, fits, tools, total, quick, extra=None):
              f"{machine()}; {load()}. Build: median of repeated `model.compile()` "
              f"(validate, assemble, "
              f"CasADi Functions; no C). JIT cold: `compiled(system).rhs(jit)` with an empty "
-             f"cache folder (code generation + gcc -O1, functions over "
+             f"cache folder (code generation + gcc at the level in column C: -O1, -O0 "
+             f"for functions over {jit.O1_STATEMENTS:,} statements; functions over "
              f"{jit.SPLIT_STATEMENTS:,} statements in parts side by side); JIT hit: what the "
              f"same call does for a new System of the same model (hashing the Function's "
              f"serialisation, then loading the cached library), median of repeats. Cached run: "
@@ -413,6 +503,7 @@ def report(rows, fits, tools, total, quick, extra=None):
              *(strategy_lines(*extra) + [""] if extra else
                ["JIT of the largest functions, one file against parts, -O1 against -O0: "
                 "[study_scaling_jit.md](study_scaling_jit.md) (`--strategies`).", ""]),
+             *loops, "",
              f"Log-log slopes from N = {FIT_FROM} to {last['N']}:", "",
              table(["quantity", "exponent"], [[k, f"{v:.2f}"] for k, v in fits.items()]), "",
              "![evaluation cost](study_scaling.png)", "",

@@ -24,7 +24,19 @@ def skew(v):
 
 def vee(m):
     """Inverse of skew, from the antisymmetric part of ``m``."""
+    if isinstance(m, ca.SX) and m.shape == (3, 3):
+        return _vee()(m)                   # one call, not ten (see ``rotation``)
+    return _antisymmetric(m)
+
+
+def _antisymmetric(m):
     return ca.vertcat(m[2, 1] - m[1, 2], m[0, 2] - m[2, 0], m[1, 0] - m[0, 1]) / 2
+
+
+@functools.lru_cache(maxsize=1)
+def _vee():
+    m = ca.SX.sym("m", 3, 3)
+    return ca.Function("vee", [m], [_antisymmetric(m)])
 
 
 def unit(v):
