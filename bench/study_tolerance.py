@@ -11,11 +11,13 @@ seed, seed_large  the seed's double pendulum at q0 = (0.05, 0.05) and (2.5, 2.0)
 chain2/16/128,    pinocchio's ABA with DOP853 at 1e-13 (``peers/pinocchio_peer``), built from
 spatial6          the plain data of ``scenes.chains``
 fourbar,          the reduced one-coordinate Lagrangian derived by sympy, DOP853 at 1e-13
-slider_crank      (``scenes.reference_loops``): the crank angle
-"... projected"   the same three loops compiled with ``loops="projected"`` (an ODE, run by
-                  CVODES Adams), against the same references
-spatial_fourbar   no closed form: kinetwork's projected ODE (another formulation: 5 states,
-                  no algebraic variables) under scipy's DOP853 at 1e-13: the crank angle
+slider_crank      (``scenes.reference_loops``): the crank angle. The default compiles loops
+                  as the projected ODE, run by CVODES Adams
+"... partition"   the same three loops compiled with ``loops="partition"`` (the default until
+                  this study: a DAE for IDAS), against the same references
+spatial_fourbar   no closed form: kinetwork's Baumgarte ODE (another formulation: all 8
+                  coordinates and speeds, no projection) under scipy's DOP853 at 1e-13, its
+                  closure residual below 2e-13: the crank angle
 chaotic           the seed undamped at (2.5, 2.0) rad: outside the criterion (its errors grow
                   tenfold every ~2.2 s), there for the error estimate's "until"
 arm_pid,          the closed loops written by hand from the seed's closed form
@@ -80,7 +82,7 @@ def _seed_reference(x0):
 
 
 def _spatial_fourbar_reference(t):
-    system = ls.spatial_fourbar(probes=False).compile(loops="projected")
+    system = ls.spatial_fourbar(probes=False).compile(loops="baumgarte")
     res = kn.simulate(system, t_end=t[-1], n_points=len(t), method="dop853", rtol=REF_RTOL,
                       atol=REF_RTOL * 1e-2, jit=True)
     return res["A.q"][:, None]
@@ -107,7 +109,7 @@ def _drive_train_reference(t):
 
 
 #: name -> (build the System, independent reference on t -> (n, k), the names of the results'
-#: k columns compared with it). "projected": the loops compiled as ODEs (``loops="projected"``)
+#: k columns compared with it). "partition": the loops compiled as DAEs (``loops="partition"``)
 SCENES = {
     "seed": (lambda: chains.seed().compile(), _seed_reference((0.05, 0.05, 0, 0)), _angles),
     "seed_large": (lambda: chains.seed(q0=(2.5, 2.0)).compile(),
@@ -132,17 +134,17 @@ SCENES = {
                      _states(["O.q"])),
     "spatial_fourbar": (lambda: ls.spatial_fourbar(probes=False).compile(),
                         _spatial_fourbar_reference, _states(["A.q"])),
-    "fourbar projected": (lambda: ls.fourbar(probes=False).compile(loops="projected"),
+    "fourbar partition": (lambda: ls.fourbar(probes=False).compile(loops="partition"),
                           lambda t: rl.fourbar_simulate(1.0, 0.0, t, rtol=REF_RTOL,
                                                         atol=REF_RTOL)["theta"][:, None],
                           _states(["A.q"])),
-    "slider_crank projected": (
-        lambda: ls.slider_crank(probes=False).compile(loops="projected"),
+    "slider_crank partition": (
+        lambda: ls.slider_crank(probes=False).compile(loops="partition"),
         lambda t: rl.slider_crank_simulate(0.5, 3.0, t, rtol=REF_RTOL,
                                            atol=REF_RTOL)["theta"][:, None],
         _states(["O.q"])),
-    "spatial_fourbar projected": (
-        lambda: ls.spatial_fourbar(probes=False).compile(loops="projected"),
+    "spatial_fourbar partition": (
+        lambda: ls.spatial_fourbar(probes=False).compile(loops="partition"),
         _spatial_fourbar_reference, _states(["A.q"])),
     "arm_pid": (lambda: drives.arm_pid().compile(), _pid_reference,
                 _states(["shoulder.q", "elbow.q"])),
@@ -226,7 +228,8 @@ def report(rows, rtols, wall):
             body.append([s, by[s, rtols[0]]["method"], *cells])
         return table(["scene", "method", *[f"{r:.0e}" for r in rtols]], body)
 
-    worst = max(r["after_ratio"] for r in rows if r["scene"] not in CHAOTIC)
+    worst = max(r["after_ratio"] for r in rows if _judged(r))
+    old = [r["after_ratio"] for r in rows if r["scene"].endswith(" partition")]
     factors = ", ".join(f"{m}{' (loops)' if loops else ''} {v:g}"
                         for (m, loops), v in tolerance.TIGHTEN.items())
     floors = ", ".join(f"{m} {v:g}" for m, v in tolerance.RTOL_FLOOR.items())
@@ -247,7 +250,7 @@ TIGHTEN: {factors}; the solvers' rtol floors: {floors}.
 
 {grid("after_ratio", lambda v: f"{v:.3g}")}
 
-Largest entry after, the chaotic seed left out: {worst:.3g}.
+Largest entry after of the default, the chaotic seed left out: {worst:.3g}.{f" The loops as the partition's DAE under IDAS (the default before this study, there to compare): up to {max(old):.3g}, past 100 below rtol 1e-8, where IDAS meets its floor." if old else ""}
 {estimates(rows, rtols, scenes, by)}
 ### Wall time of one run [ms], after (before)
 
@@ -255,6 +258,12 @@ Largest entry after, the chaotic seed left out: {worst:.3g}.
        [[s, *[f"{by[s, r]['after_wall_s'] * 1e3:.1f} ({by[s, r]['before_wall_s'] * 1e3:.1f})"
               for r in rtols]] for s in scenes])}
 """
+
+
+def _judged(row):
+    """Whether the issue's criteria apply to a row: the default's runs on non-chaotic scenes
+    (not the chaotic seed, nor the loops compiled as partitions to compare)."""
+    return row["scene"] not in CHAOTIC and not row["scene"].endswith(" partition")
 
 
 def estimates(rows, rtols, scenes, by):
@@ -267,7 +276,7 @@ def estimates(rows, rtols, scenes, by):
             return "none (floor)"
         until = f" (until {r['estimate_until']:g} s)" if r["estimate_until"] else ""
         return f"{r['estimate_ratio']:.2g}{until}"
-    ratios = [r["estimate_ratio"] for r in rows if r["estimate_ratio"] is not None]
+    ratios = [r["estimate_ratio"] for r in rows if r["estimate_ratio"] is not None and _judged(r)]
     return f"""
 ### The error estimate (`error_estimate=True`): estimated / true global error, after
 
@@ -279,7 +288,7 @@ within a factor 10 (0.1 .. 10); "until": the estimate says it means nothing afte
 {table(["scene", *[f"{r:.0e}" for r in rtols]],
        [[s, *[cell(by[s, r]) for r in rtols]] for s in scenes])}
 
-Range of estimated / true: {min(ratios):.2g} .. {max(ratios):.2g}.
+Range of estimated / true of the default, the chaotic seed left out: {min(ratios):.2g} .. {max(ratios):.2g}.
 """
 
 

@@ -132,7 +132,7 @@ def plant(model, inputs=()):
     if isinstance(model, System):
         base = model.model
         if model.formulation in ("projected", "baumgarte"):
-            model = base.compile()
+            model = base.compile(loops="partition")
     elif isinstance(model, Model):
         base = model
     else:
@@ -142,7 +142,7 @@ def plant(model, inputs=()):
     inputs = list(inputs or [])
     if len(set(inputs)) != len(inputs):
         raise ModelError(f"inputs: named twice in {inputs}")
-    source = model if isinstance(model, System) else base.compile()
+    source = model if isinstance(model, System) else base.compile(loops="partition")
     if not inputs:
         return Plant(source, source)
     flat = base.flat()
@@ -153,7 +153,7 @@ def plant(model, inputs=()):
         twins[key] = _twin(flat, inputs)
     twin, names, nominal = twins[key]
     twin.parameters.update(flat.parameters)
-    system = twin.compile()
+    system = twin.compile(loops="partition")
     units = [_input_unit(flat, name) for name in inputs]
     return Plant(system, source, inputs, units, [system.param_names.index(d) for d in names],
                  nominal)

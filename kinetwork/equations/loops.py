@@ -3,7 +3,7 @@
 A model without loops is an ODE in all its coordinates and speeds. A model with kinematic
 loops has more coordinates than degrees of freedom; three formulations are offered:
 
-``partition`` (the default): coordinate partitioning written as a semi-explicit index-1 DAE.
+``partition``: coordinate partitioning written as a semi-explicit index-1 DAE.
     At the initial configuration the independent closure equations (rows of the loop
     Jacobian, chosen by pivoted QR so that redundant ones, such as the out-of-plane rows of
     a planar four-bar built from 3-D revolutes, drop out) split the speeds into dependent ones
@@ -18,12 +18,16 @@ loops has more coordinates than degrees of freedom; three formulations are offer
     ``simulate`` Newton-polishes the algebraic variables at the output points (IDAS holds
     them to its tolerance; the outputs hold them to round-off).
 
-``projected``: the same partition as an ODE that any method integrates. The dependent
-    coordinates are carried as states too, but only as the start of a Newton projection onto
-    the closure inside every evaluation (three steps from within the integrator's tolerance:
-    round-off); the dynamics and the probes see the projected values. More states (a
-    four-bar: 5), no drift, and Adams or DOP853 instead of BDF: on the four-bar 2-3x faster
-    than ``partition`` with IDAS for the same error.
+``projected`` (the default): the same partition as an ODE that any method integrates. The
+    dependent coordinates are carried as states too, but only as the start of a Newton
+    projection onto the closure inside every evaluation (three steps from within the
+    integrator's tolerance: round-off); the dynamics and the probes see the projected
+    values. More states (a four-bar: 5 for the partition's 2 and 3 algebraic variables), no
+    drift, and CVODES Adams instead of IDAS: 2-4x faster to the same error on the loop
+    study's mechanisms, and its error stays proportional to the tolerance down to rtol
+    1e-10, where IDAS meets its floor (``bench/results/study_loops_pareto.md``,
+    ``study_tolerance.md``). The linearisation still works in the partition's independent
+    coordinates (``analysis.channels.plant``).
 
 ``baumgarte``: an ODE in all coordinates and speeds, index-reduced to the acceleration
     level with Baumgarte stabilisation J udot + (dJ/dt) u + 2 a J u + a^2 Phi = 0. Any ODE
@@ -563,7 +567,7 @@ class _Loops:
         names = [qn[k] for k in keep_q] + [qn[k] for k in dep_q] + [un[k] for k in ind]
         units = [qu[k] for k in keep_q] + [qu[k] for k in dep_q] + [uu[k] for k in ind]
         note = (f"kinematic loops, projected formulation: {x.shape[0]} states for {len(ind)} "
-                f"degrees of freedom; the {len(dep_q)} dependent coordinates are states only to "
+                f"degree{'s' * (len(ind) != 1)} of freedom; the {len(dep_q)} dependent coordinates are states only to "
                 f"start a Newton projection onto {note_rows} in every evaluation (an ODE that "
                 f"holds the closure to round-off)")
         out = Equations(x, ca.SX(0, 1), ode, ca.SX(0, 1), names, units, [], [],

@@ -50,7 +50,7 @@ def close(asm, eq, model):
         raise ModelError(f"{', '.join(names)}: friction and stops are handled by events, which "
                          f"need the equations as ODEs; this model has algebraic variables "
                          f"({', '.join(eq.algebraic_names)}): compile it with "
-                         f"loops='projected'")
+                         f"loops='projected' (the default)")
     q = asm.q if eq.q is None else eq.q
     lam = eq.lam if eq.lam is not None else ca.SX(0, 1)
 

@@ -35,7 +35,7 @@ class System:
         What the probes record: name, unit, shape of each quantity.
     """
 
-    def __init__(self, model, loops="partition", baumgarte_rate=None, topology=None,
+    def __init__(self, model, loops="projected", baumgarte_rate=None, topology=None,
                  partition=None, assembly=None):
         # partition, assembly: the same model with other independent coordinates (a run
         # re-partitions a loop where its partition turns singular), on the same assembly

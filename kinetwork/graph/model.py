@@ -331,14 +331,16 @@ class Model:
         self._validated = (key, values, topology)
         return topology
 
-    def compile(self, loops: str = "partition", baumgarte_rate: float | None = None
+    def compile(self, loops: str = "projected", baumgarte_rate: float | None = None
                 ) -> System:
         """Validate and build the equations: a ``kn.System``.
 
         ``loops`` chooses the formulation of kinematic loops (see ``kinetwork.equations.loops``):
-        "partition" (default; independent coordinates, dependent ones solved exactly at every
-        step: a DAE for IDAS), "projected" (an ODE for any method, its dependent coordinates
-        Newton-projected onto the closure in every evaluation) or "baumgarte" (an ODE in all
+        "projected" (default: an ODE for any method, its dependent coordinates carried only
+        to start a Newton projection onto the closure in every evaluation; CVODES Adams runs
+        it), "partition" (independent coordinates as the only differential states, the
+        dependent ones algebraic variables solved exactly at every step: a DAE for IDAS,
+        fewer states but slower and, below rtol 1e-8, less accurate) or "baumgarte" (an ODE in all
         coordinates, stabilised at ``baumgarte_rate`` [1/s], default 10; 0 leaves the drift
         unchecked). A model whose content has not changed since its last compilation gives
         the same System back, without building it again. A model of subsystems is compiled

@@ -151,7 +151,8 @@ def simulate(model: Model | System, t_end: float | None = None, n_points: int | 
     method : str
         One of METHODS (``kinetwork methods`` lists them). ``auto`` (default): CVODES Adams,
         or CVODES BDF when the stiffness test finds the problem stiff at the start, or when
-        Adams fails on it; IDAS for models with loops.
+        Adams fails on it; IDAS for models with algebraic variables (loops compiled with
+        ``loops="partition"``, massless junctions).
     rtol, atol : float
         Tolerances of the variable-step methods.
     step : float, optional

@@ -409,8 +409,9 @@ def stiffness(rhs, t_start, t_end, x0):
 
 def choose(run):
     """What ``auto`` runs: (method names to try in order, why). IDAS for models with
-    algebraic variables; else Adams unless the stiffness test says BDF, and BDF again when
-    Adams fails.
+    algebraic variables (loops compiled with ``loops="partition"``, massless junctions); else
+    Adams (loops too: their default formulation is the projected ODE) unless the stiffness
+    test says BDF, and BDF again when Adams fails.
 
     A model without damping (generalized forces independent of the speeds) is conservative
     up to its time-dependent drives: its eigenvalues come in ±λ pairs and it is never stiff by

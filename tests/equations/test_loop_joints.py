@@ -74,7 +74,7 @@ def test_a_rod_closes_the_planar_fourbar_with_one_equation(kind):
     """Crank angle and speed are the states, the rocker angle is solved from the rod's one
     closure equation, and the rocker follows the closed-form closure of the crank angle."""
     model = rod_fourbar(kind)
-    system = model.compile()
+    system = model.compile(loops="partition")
     assert [c.component.name for c in system.topology.cuts] == ["rod"]
     assert system.state_names == ["A.q", "A.qd"] and system.algebraic_names == ["D.q"]
     assert (system.eq.loop_rows, system.eq.loop_redundant) == (1, 0)
@@ -148,7 +148,7 @@ def test_a_pressed_rod_reads_a_positive_rod_force():
                  ("foot.frame_b", "prop.frame_a"), ("prop.frame_b", "arm.frame_b"),
                  ("p.port", "prop.frame_b")]:
         m.connect(a, b)
-    system = m.compile()
+    system = m.compile(loops="partition")
     assert system.state_names == [] and system.algebraic_names == ["A.q"]
     force = kn.simulate(system, t_end=1.0, n_points=11)["p.force"]
     e = np.array([0.0, 1.0, 0.0])                     # from the foot (frame_a) up to the arm
@@ -216,7 +216,7 @@ def rssr():
 def test_an_rssr_spatial_fourbar_follows_the_closed_form_of_its_coupler():
     """The crank turns fully (under gravity along -z, started at 2 rad/s); at every output
     the rocker angle is the closed form's, on the branch of the start (psi = 0)."""
-    system = rssr().compile()
+    system = rssr().compile(loops="partition")
     assert system.algebraic_names == ["D.q"] and system.eq.loop_rows == 1
     res = kn.simulate(system, t_end=5.0, n_points=501, rtol=1e-10, atol=1e-12)
     theta, psi = res["crank_probe.angle"], res["rocker_probe.angle"]
@@ -326,7 +326,7 @@ def fourbar2_runs():
 
 
 def test_fourbar2_has_one_closure_equation():
-    system = kn.load(ROOT / "models" / "fourbar2.json").compile()
+    system = kn.load(ROOT / "models" / "fourbar2.json").compile(loops="partition")
     assert system.state_names == ["j1.q", "j1.qd"] and system.algebraic_names == ["j2.q"]
     assert system.eq.loop_rows == 1
     assert system.z0[0] == pytest.approx(-0.2, abs=1e-12)      # MSL's j2.s start
@@ -350,7 +350,7 @@ def test_frame_ia_turns_as_the_universal_joint_of_the_chain(fourbar2_runs):
 
 
 def test_fourbar1_is_msls_six_revolute_loop():
-    system = kn.load(ROOT / "models" / "fourbar1.json").compile()
+    system = kn.load(ROOT / "models" / "fourbar1.json").compile(loops="partition")
     assert system.state_names == ["j1.q", "j1.qd"] and len(system.algebraic_names) == 6
     assert (system.eq.loop_rows, system.eq.loop_redundant) == (6, 6)
     res = kn.simulate(system, t_end=0.5, n_points=51)
@@ -388,7 +388,7 @@ def rrr_fourbar(theta0=1.0, masses=(1.0, 2.0, 1.5)):
 
 
 def test_joint_rrr_is_three_revolutes_with_the_last_one_cut():
-    system = rrr_fourbar().compile()
+    system = rrr_fourbar().compile(loops="partition")
     assert system.state_names == ["A.q", "A.qd"]
     assert system.algebraic_names == ["rrr.rev1.q", "rrr.rev2.q", "rrr.rev3.q"]
     assert [c.component.name for c in system.topology.cuts] == ["rrr.rev3"]
@@ -415,7 +415,7 @@ def test_joint_rrr_round_trips_through_a_file(tmp_path):
     again = kn.load(tmp_path / "rrr.json")
     assert again.components["rrr"].type_name == "multibody.JointRRR"
     assert list(again.components) == list(model.components)
-    np.testing.assert_array_equal(again.compile().z0, model.compile().z0)
+    np.testing.assert_array_equal(again.compile(loops="partition").z0, model.compile(loops="partition").z0)
 
 
 def test_joint_rrr_in_a_subsystem_takes_its_parameters():
@@ -426,9 +426,9 @@ def test_joint_rrr_in_a_subsystem_takes_its_parameters():
     outer.add(kn.Subsystem("fb", link, params={"b": "coupler"}))
     outer.add(kn.Probe("p", quantities=["angle"]))
     outer.connect("p.port", "fb.crank_axis")
-    system = outer.compile()
+    system = outer.compile(loops="partition")
     assert "fb.rrr.rev1.q" in system.algebraic_names
-    np.testing.assert_allclose(system.z0, rrr_fourbar().compile().z0, atol=1e-12)
+    np.testing.assert_allclose(system.z0, rrr_fourbar().compile(loops="partition").z0, atol=1e-12)
 
 
 # -- refusals -----------------------------------------------------------------------------------

@@ -22,7 +22,7 @@ T = np.linspace(0.0, 10.0, 1001)
 
 @pytest.fixture(scope="module")
 def fourbar_run():
-    system = scenes.fourbar(theta0=1.0).compile()
+    system = scenes.fourbar(theta0=1.0).compile(loops="partition")
     return system, kn.simulate(system), ref.fourbar_simulate(1.0, 0.0, T)
 
 
@@ -85,7 +85,7 @@ def test_fourbar_coupler_point_and_pivot_force(fourbar_run):
 
 
 def test_slider_crank_follows_the_one_dof_reference():
-    system = scenes.slider_crank(theta0=0.5, thetad0=3.0).compile()
+    system = scenes.slider_crank(theta0=0.5, thetad0=3.0).compile(loops="partition")
     res = kn.simulate(system)
     r = ref.slider_crank_simulate(0.5, 3.0, T)
     assert system.n_states == 2
@@ -141,7 +141,7 @@ def test_baumgarte_formulation_agrees_and_drifts_little():
 
 
 def test_ode_methods_refuse_the_dae_with_a_way_out():
-    system = scenes.fourbar().compile()
+    system = scenes.fourbar().compile(loops="partition")
     with pytest.raises(kn.ModelError, match="loops='baumgarte'"):
         kn.simulate(system, method="rk45")
 
@@ -156,7 +156,7 @@ def test_collocation_integrates_the_dae():
 def test_user_chosen_cut_gives_the_same_motion():
     model = scenes.fourbar(probes=False)
     model.components["D"].cut = True
-    system = model.compile()
+    system = model.compile(loops="partition")
     assert "D.q" not in system.state_names
     res = kn.simulate(system, t_end=2.0, n_points=201)
     r = ref.fourbar_simulate(1.0, 0.0, T[:201])
@@ -179,17 +179,17 @@ def test_a_given_angle_that_cannot_be_reached_is_refused():
 
 
 def test_assembly_branch_follows_the_guess():
-    up = scenes.fourbar(probes=False).compile()
+    up = scenes.fourbar(probes=False).compile(loops="partition")
     down_guess = scenes.fourbar_guesses(1.0)
     model = scenes.fourbar(probes=False, guesses=(-1.2, -1.0, 2.5))
-    down = model.compile()
+    down = model.compile(loops="partition")
     zu, zd = up.z0, down.z0
     assert zu[1] > 0 and zd[1] < 0                        # rocker above / below the ground
     assert abs(zu[0] - down_guess[0]) < 1e-9
 
 
 def test_spatial_loop_with_ball_joint_cut():
-    system = scenes.spatial_fourbar().compile()
+    system = scenes.spatial_fourbar().compile(loops="partition")
     assert system.n_states == 2 and system.n_algebraic == 3
     cut = system.topology.cuts[0].component.name
     assert cut == "S"                                     # the ball joint is cut
@@ -218,8 +218,10 @@ def test_validate_states_the_reason_for_the_state_count(tmp_path, capsys):
     scenes.fourbar().save(path)
     assert cli.main(["validate", "--compile", str(path)]) == 0
     out = capsys.readouterr().out
-    assert "states: 2 (A.q [rad], A.qd [rad/s])" in out and "algebraic: 3" in out
-    assert "degrees of freedom: 1" in out and "coordinate partitioning" in out
+    # the default formulation: the dependent angles are carried only to start the projection
+    assert "states: 5 (A.q [rad], B.q [rad], D.q [rad], C.q [rad], A.qd [rad/s])" in out
+    assert "degrees of freedom: 1" in out and "projected formulation: 5 states for 1 degree " \
+        "of" in out and "3 dependent coordinates are states only to" in out
     assert "loops: 1\n  coupler - B - crank - A - base - D - rocker - C (cut at C)" in out
 
 
@@ -288,7 +290,7 @@ def test_a_locked_loop_has_no_states_and_holds_its_shape():
               ("ab.frame_b", "B.frame_a"), ("B.frame_b", "bc.frame_a"),
               ("ground.frame", "base.frame_a"), ("base.frame_b", "C.frame_a"),
               ("C.frame_b", "bc.frame_b"), ("A.frame_b", "body.frame_a")])
-    system = m.compile()
+    system = m.compile(loops="partition")
     assert system.dof == 0 and system.n_states == 0 and system.n_algebraic == 3
     res = kn.simulate(system, t_end=1.0, n_points=5)
     inner = np.mod(np.pi - np.abs(np.mod(res.states[:, 1] + np.pi, 2 * np.pi) - np.pi), np.pi)
@@ -313,7 +315,7 @@ def test_projected_formulation_is_an_ode_that_holds_the_closure():
 def test_rhs_of_the_dae_solves_the_closure_first():
     """system.rhs(t, x) of a partition model: the closure solved by Newton from the last
     solution, then the reduced dynamics; against the reference's Lagrange equation."""
-    system = scenes.fourbar(probes=False).compile()
+    system = scenes.fourbar(probes=False).compile(loops="partition")
     for theta in np.linspace(1.0, -3.0, 9):              # walk round, each from the last
         for thetad in (0.0, 2.5):
             x = np.array([theta, thetad])
@@ -372,7 +374,7 @@ def test_a_slider_crank_assembles_at_its_dead_centres_from_zero_guesses(theta0):
     scene.add(kn.multibody.Ground("ground", gravity=[0, -9.81, 0]))
     scene.add(kn.Subsystem("sc", _slider_crank_definition(), params={"theta0": theta0}))
     scene.connect("ground.frame", "sc.base")
-    system = scene.compile()
+    system = scene.compile(loops="partition")
     _, z = system.initial_full_p(system.param_vector())
     slider = z[system.algebraic_names.index("sc.slider.q")]
     r, l = 0.2, 0.6

@@ -48,9 +48,9 @@ def fourbar(theta0=1.0, thetad0=0.0, a=0.3, b=1.0, c=0.8, d=1.0, masses=(1.0, 2.
     (D.q = psi), C closes the loop between coupler and rocker (cut)."""
     m = kn.Model("fourbar", parameters={"a": a, "b": b, "c": c, "d": d, "g": g},
                  description="A planar crank-rocker four-bar (Grashof) released under gravity; "
-                             "the loop is closed by joint C, cut automatically. Two states "
-                             "(crank angle and speed); the other joint angles are solved from "
-                             "the closure at every step.",
+                             "the loop is closed by joint C, cut automatically. One degree of "
+                             "freedom (crank angle and speed); the other joint angles are "
+                             "projected onto the closure in every evaluation.",
                  simulation={"t_end": 10.0, "n_points": 1001, "method": "auto",
                              "rtol": 1e-12, "atol": 1e-12})
     guesses = guesses or fourbar_guesses(theta0, a, b, c, d)

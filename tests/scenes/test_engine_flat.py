@@ -84,7 +84,7 @@ def test_engine_validates_with_one_degree_of_freedom():
     # each loop is cut where MSL cuts it (its RevolutePlanarLoopConstraint b1)
     assert sorted(c.component.name for c in topology.cuts) == [f"cyl{i}_b1"
                                                                for i in range(1, 7)]
-    system = model.compile()
+    system = model.compile(loops="partition")
     assert system.dof == 1
     # the crankshaft angle and speed, and the two filter stages of the engine torque
     assert system.state_names == ["bearing.q", "bearing.qd", "filter1.x", "filter2.x"]
