@@ -326,6 +326,46 @@ def o0_cost(n=256):
         f"{k}_{what}": v[i] for k, v in out.items() for i, what in enumerate(("us", "cpu_s"))}}
 
 
+def integrator_setup(sizes=(64, 128, 256, 512)):
+    """What CasADi's CVODES costs to set up around a chain's compiled right-hand side, as the
+    default method (Adams, functional iteration) makes it: it builds the DAE's Jacobian
+    function at creation whether or not it will use it, by finite differences of the compiled
+    code over a dense pattern. A run makes one per output-grid chunk length."""
+    from kinetwork.simulation.methods import METHODS
+    rows = []
+    for n in sizes:
+        system = scenes.chain(n).compile()
+        with tempfile.TemporaryDirectory() as folder:
+            os.environ["KINETWORK_CACHE"] = folder
+            dae = compiled_of(system).dae({"stats": {}})
+            start = time.perf_counter()
+            dae.jacobian()
+            jac = time.perf_counter() - start
+            opts = {**METHODS["cvodes-adams"].options, "reltol": 1e-7, "abstol": 1e-9}
+            start = time.perf_counter()
+            ca.integrator("setup", "cvodes", dae, 0.0, [0.01 * k for k in range(1, 11)], opts)
+            made = time.perf_counter() - start
+        rows.append({"N": n, "states": system.n_states, "jacobian_s": jac,
+                     "integrator_s": made})
+        print(f"  chain{n}: the DAE's Jacobian function {jac:.2f} s, a CVODES integrator "
+              f"{made:.2f} s", flush=True)
+    return rows
+
+
+def setup_lines(rows):
+    fit = slope(rows, "integrator_s") if len(rows) > 1 else float("nan")
+    return ["## Setting up CVODES around a large compiled right-hand side", "",
+            f"{machine()}; {load()}. CasADi builds the DAE's Jacobian function when it "
+            "creates a CVODES integrator, even for Adams with functional iteration (the default "
+            "method), which never evaluates it: by finite differences of the compiled code over "
+            "a dense pattern, whose colouring grows as N^3. A run creates one integrator per "
+            "length of its output-grid chunks (two or three for a plain run).", "",
+            table(["N", "states", "DAE Jacobian function [s]", "CVODES integrator [s]"],
+                  [[r["N"], r["states"], f"{r['jacobian_s']:.2f}",
+                    f"{r['integrator_s']:.2f}"] for r in rows]), "",
+            f"Log-log slope of the integrator's set-up from N = {FIT_FROM}: {fit:.2f}."]
+
+
 def fourbar_lines(rows, cost):
     from kinetwork.graph.model import Model
     import inspect
@@ -541,5 +581,13 @@ if __name__ == "__main__":
                         help="only the JIT strategies on the largest functions "
                              "(results/study_scaling_jit.md)")
     parser.add_argument("--sizes", type=int, nargs="+", help="these N only")
+    parser.add_argument("--setup", action="store_true",
+                        help="only what CVODES costs to set up around chains of --sizes "
+                             "(results/study_scaling_setup.md)")
     args = parser.parse_args()
-    main(args.quick, args.strategies, args.sizes)
+    if args.setup:
+        found = integrator_setup(args.sizes or (64, 128, 256, 512))
+        write_csv("study_scaling_setup", found)
+        write_markdown("study_scaling_setup", "\n".join(setup_lines(found)))
+    else:
+        main(args.quick, args.strategies, args.sizes)
