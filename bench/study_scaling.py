@@ -15,7 +15,15 @@ Also per N: a cached run (a new System of the same model simulated for 1 s, 101 
 library found in the cache: what a second process pays), and the study process's peak resident
 memory after that N (``ru_maxrss``: sizes go up, so each row's peak is its own N's).
 
-JIT strategies (``--strategies``, and in the full run): the 1024-link right-hand side and the
+The chain of eight four-bar loops in both loop formulations (build, the first run's cold JIT
+from an empty cache, the run again; the default formulation is marked), and what -O0 costs at
+run time: a 256-link chain's right-hand side compiled at -O1 and at -O0 (``jit.O1_STATEMENTS``).
+
+Setting up CVODES (``--setup``, its own run: results/study_scaling_setup.md): the time CasADi
+takes to build the DAE's Jacobian function and a CVODES integrator around a chain's compiled
+right-hand side, which the default method hides its derivatives from (``Compiled.dae``).
+
+JIT strategies (``--strategies``, and in the quick run): the 1024-link right-hand side and the
 eight-four-bar chain's DAE Jacobian compiled one file at -O1 (before), in parts at -O1 side by
 side (``jit.SPLIT_STATEMENTS``), and in parts at -O0; compiler CPU time, wall time, and the
 cost of one evaluation. And the eight-four-bar chain's first run from a cold cache.
@@ -27,6 +35,7 @@ Run: ``.venv/bin/python bench/study_scaling.py [--quick]``; writes results/study
 """
 
 import argparse
+import multiprocessing
 import os
 import resource
 import statistics
@@ -327,43 +336,57 @@ def o0_cost(n=256):
 
 
 def integrator_setup(sizes=(64, 128, 256, 512)):
-    """What CasADi's CVODES costs to set up around a chain's compiled right-hand side, as the
-    default method (Adams, functional iteration) makes it: it builds the DAE's Jacobian
+    """What CasADi's CVODES costs to set up around a chain's compiled right-hand side with the
+    default method's options (Adams, functional iteration): it builds the DAE's Jacobian
     function at creation whether or not it will use it, by finite differences of the compiled
-    code over a dense pattern. A run makes one per output-grid chunk length."""
+    code over a dense pattern. Before: the equations as they were handed over; now:
+    ``Compiled.dae`` without Newton, its derivatives in x hidden (``stop_diff``)."""
     from kinetwork.simulation.methods import METHODS
+    opts = {**METHODS["cvodes-adams"].options, "reltol": 1e-7, "abstol": 1e-9}
+    grid = [0.01 * k for k in range(1, 11)]
     rows = []
     for n in sizes:
         system = scenes.chain(n).compile()
         with tempfile.TemporaryDirectory() as folder:
             os.environ["KINETWORK_CACHE"] = folder
-            dae = compiled_of(system).dae({"stats": {}})
-            start = time.perf_counter()
-            dae.jacobian()
-            jac = time.perf_counter() - start
-            opts = {**METHODS["cvodes-adams"].options, "reltol": 1e-7, "abstol": 1e-9}
-            start = time.perf_counter()
-            ca.integrator("setup", "cvodes", dae, 0.0, [0.01 * k for k in range(1, 11)], opts)
-            made = time.perf_counter() - start
-        rows.append({"N": n, "states": system.n_states, "jacobian_s": jac,
-                     "integrator_s": made})
-        print(f"  chain{n}: the DAE's Jacobian function {jac:.2f} s, a CVODES integrator "
-              f"{made:.2f} s", flush=True)
+            c = compiled_of(system)
+            rhs = c.rhs({"stats": {}})
+            tau, x, pt = ca.MX.sym("tau"), ca.MX.sym("x", system.n_states), ca.MX.sym("p", 1)
+            empty = ca.MX(0, 1)
+            before = ca.Function("dae", [tau, x, ca.MX.sym("z", 0), pt, ca.MX.sym("u", 0)],
+                                 [rhs(tau + pt[0], x, empty), empty, empty, empty],
+                                 ca.dyn_in(), ca.dyn_out())
+            row = {"N": n, "states": system.n_states}
+            for label, dae in (("before", before), ("now", c.dae({"stats": {}}))):
+                start = time.perf_counter()
+                integ = ca.integrator("setup", "cvodes", dae, 0.0, grid, opts)
+                row[f"{label}_s"] = time.perf_counter() - start
+                out = np.asarray(integ(x0=system.x0, p=[0.0])["xf"])
+                row[f"{label}_x"] = out
+        row["same"] = float(np.max(np.abs(row.pop("before_x") - row.pop("now_x"))))
+        rows.append(row)
+        print(f"  chain{n}: a CVODES integrator set up in {row['before_s']:.2f} s before, "
+              f"{row['now_s']:.3f} s now; largest difference of the states "
+              f"{row['same']:.1e}", flush=True)
     return rows
 
 
 def setup_lines(rows):
-    fit = slope(rows, "integrator_s") if len(rows) > 1 else float("nan")
+    fit = slope(rows, "before_s") if len(rows) > 1 else float("nan")
     return ["## Setting up CVODES around a large compiled right-hand side", "",
             f"{machine()}; {load()}. CasADi builds the DAE's Jacobian function when it "
             "creates a CVODES integrator, even for Adams with functional iteration (the default "
             "method), which never evaluates it: by finite differences of the compiled code over "
             "a dense pattern, whose colouring grows as N^3. A run creates one integrator per "
-            "length of its output-grid chunks (two or three for a plain run).", "",
-            table(["N", "states", "DAE Jacobian function [s]", "CVODES integrator [s]"],
-                  [[r["N"], r["states"], f"{r['jacobian_s']:.2f}",
-                    f"{r['integrator_s']:.2f}"] for r in rows]), "",
-            f"Log-log slope of the integrator's set-up from N = {FIT_FROM}: {fit:.2f}."]
+            "length of its output-grid chunks (two or three for a plain run). Before: the "
+            "equations handed over as they are; now: their derivatives in x hidden "
+            "(`stop_diff`, `Compiled.dae` for a method without Newton). Both run the same "
+            "0.1 s (the largest difference of the final states is given).", "",
+            table(["N", "states", "set-up before [s]", "set-up now [s]",
+                   "largest state difference"],
+                  [[r["N"], r["states"], f"{r['before_s']:.2f}", f"{r['now_s']:.3f}",
+                    f"{r['same']:.1e}"] for r in rows]), "",
+            f"Log-log slope of the set-up before, from N = {FIT_FROM}: {fit:.2f}."]
 
 
 def fourbar_lines(rows, cost):
@@ -442,15 +465,33 @@ def measure(n, tools):
                "rhs_c_us": per_call(lambda: c_rhs(0.0, x)) * 1e6,
                "call_overhead_us": per_call(lambda: empty(0.0, x)) * 1e6,
                "rhs_vm_us": per_call(lambda: vm_rhs(0.0, x)) * 1e6}
-    spec = scenes.chain_spec(n)
-    for tool, (build, evaluator) in tools.items():
+    row["peak_rss_mb"] = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024
+    # the peers in a child process, so that their memory is not the study's peak
+    with multiprocessing.get_context("fork").Pool(1) as pool:
+        row.update(pool.apply(_peer_times, (n, list(tools))))
+    return row
+
+
+#: pinocchio's Data holds four nv^3 tensors of second-order derivatives (1 GB each at 512
+#: links, 8 GB at 1024: the study's 24 GB before it measured the peers apart): not above this N
+PEER_MAX_N = {"pinocchio aba": 256}
+
+
+def _peer_times(n, names):
+    """{row key: us per evaluation} of the peers ``names`` on the ``n``-link chain."""
+    tools, spec, out = peers(), scenes.chain_spec(n), {}
+    for tool in names:
+        build, evaluator = tools[tool]
+        if n > PEER_MAX_N.get(tool, n):
+            print(f"  {tool} at N = {n}: not measured (memory, see PEER_MAX_N)", flush=True)
+            out[_key(tool)] = float("nan")
+            continue
         try:
-            row[_key(tool)] = per_call(evaluator(build(spec))) * 1e6
+            out[_key(tool)] = per_call(evaluator(build(spec))) * 1e6
         except ValueError as exc:       # MuJoCo's XML parser nests at most ~500 bodies
             print(f"  {tool} at N = {n}: {str(exc).strip().splitlines()[-1]}", flush=True)
-            row[_key(tool)] = float("nan")
-    row["peak_rss_mb"] = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024
-    return row
+            out[_key(tool)] = float("nan")
+    return out
 
 
 def _children_cpu():
