@@ -472,8 +472,9 @@ def measure(n, tools):
     return row
 
 
-#: pinocchio's Data holds four nv^3 tensors of second-order derivatives (1 GB each at 512
-#: links, 8 GB at 1024: the study's 24 GB before it measured the peers apart): not above this N
+#: pinocchio's Data holds nv^3 tensors of second-order derivatives (the process grew by 1.2 GB
+#: at 256 links, 8.6 GB at 512: N^3; the study's 24 GB at 1024 before it measured the peers
+#: apart): not above this N
 PEER_MAX_N = {"pinocchio aba": 256}
 
 
@@ -542,7 +543,10 @@ def charts(rows, tools):
              "JIT compile, cold cache": dict(x=N, y=[r["jit_cold_s"] for r in rows],
                                              style=dict(color="C3")),
              "JIT, cache hit (new System)": dict(x=N, y=[r["jit_warm_s"] for r in rows],
-                                                 style=dict(color="C3", linestyle="--"))}
+                                                 style=dict(color="C3", linestyle="--")),
+             "build + JIT cold (target < 30 s at N = 1024)": dict(
+                 x=N, y=[r["build_s"] + r["jit_cold_s"] for r in rows],
+                 style=dict(color="k", linestyle=":"))}
     chart(RESULTS / "study_scaling_build.png", build, "links N", "wall time [s]",
           "Chain of N rods: build and JIT compilation time\n(build and cache hit: medians "
           "of repeats; cold compile: one run)")
@@ -594,10 +598,13 @@ def report(rows, fits, tools, total, quick, extra=None, loops=()):
              f"{last['call_overhead_us']:.1f} us of the Python call is taken off), "
              f"N^{fits['rhs CasADi VM']:.2f} in CasADi's VM, operations "
              f"N^{fits['operations']:.2f}; target exponent ≤ 1.2. At N = {last['N']}: "
-             f"{last['rhs_c_us']:.1f} us compiled, {last['rhs_vm_us']:.0f} us in the VM"
-             + "".join(f", {last[_key(t)]:.1f} us {t}" for t in tools) + ".",
-             f"- Build at N = {last['N']}: {last['build_s']:.2f} s (target < 1 s), "
-             f"exponent {fits['build']:.2f}; constructing the model itself (adding and "
+             f"{last['rhs_c_us']:.1f} us compiled ({last['opt']}), {last['rhs_vm_us']:.0f} us "
+             f"in the VM" + "".join(f", {last[_key(t)]:.1f} us {t}" for t in tools
+                                    if np.isfinite(last[_key(t)])) + ".",
+             f"- Build at N = {last['N']}: {last['build_s']:.2f} s ({last['build_cpu_s']:.1f} s "
+             f"of CPU)" + "".join(f"; at N = 128: {r['build_s']:.2f} s ({r['build_cpu_s']:.2f} s "
+                                  f"of CPU; target < 1 s)" for r in rows if r["N"] == 128)
+             + f"; exponent {fits['build']:.2f}; constructing the model itself (adding and "
              f"connecting {3 * last['N'] + 1} components): {last['model_s'] * 1e3:.0f} ms, "
              f"exponent {fits['model construction']:.2f}.",
              f"- JIT at N = {last['N']}: {last['jit_cold_s']:.2f} s cold "
@@ -611,7 +618,15 @@ def report(rows, fits, tools, total, quick, extra=None, loops=()):
              f"{last['build_cpu_s'] + last['jit_cold_cpu_s']:.1f} s in Python and "
              f"{last['jit_cold_compilers_cpu_s']:.1f} s in the compilers, which run "
              f"{jit._cores()} at a time; a cached run of "
-             f"1 s {last['cached_run_s']:.1f} s; peak memory {last['peak_rss_mb']:.0f} MB."]
+             f"1 s {last['cached_run_s']:.1f} s; peak memory {last['peak_rss_mb']:.0f} MB.",
+             "- Memory: the study process's peak is kinetwork's alone since the peers run in a "
+             "child process: pinocchio's Data holds nv^3 tensors of second-order derivatives "
+             "(1.2 GB at 256 links, 8.6 GB at 512), which were the 24 GB at which the 1024-link "
+             "row was killed before; pinocchio is measured up to "
+             f"{PEER_MAX_N['pinocchio aba']} links, MuJoCo's XML up to ~500 nested bodies.",
+             "- The CVODES set-up that a run pays per chunk length (it built the DAE's Jacobian "
+             "function, N^3, for Adams that never uses it): "
+             "[study_scaling_setup.md](study_scaling_setup.md) (`--setup`)."]
     write_markdown("study_scaling", "\n".join(lines))
 
 
