@@ -148,9 +148,9 @@ class Compiled:
         Without ``newton`` the states enter through ``stop_diff``: a CVODES integrator builds
         its DAE's Jacobian function when it is created, even for Adams' functional iteration
         that never evaluates it, and that Jacobian, by finite differences of the compiled code
-        over a dense pattern, cost N^3 to set up (a 1024-link chain: minutes per integrator,
-        and a run makes two or three). Hidden, the set-up is instant and the run the same to
-        the last bit."""
+        over a dense pattern, grew as N^2.5 to set up (24 s per integrator at 1024 links, and a
+        run makes two or three; bench/results/study_scaling_setup.md). Hidden, the set-up takes
+        0.04 s there and the run is the same to the last bit."""
         system = self.system
         if not newton:
             x = ca.stop_diff(x, 1)
