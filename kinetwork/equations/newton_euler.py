@@ -9,7 +9,7 @@ sits at ``R @ x + p`` in the parent's. Gravity enters as an upward acceleration 
 Each body's step of a pass is one call of a small SX Function on that body's expressions
 (``_steps``), not a few dozen calls of CasADi's matrix operations from Python: those cost
 ~50 us each whatever their size (the wrapper checks every argument's shape), and were 80 %
-of building a 512-link chain (12 s; 3 s now). Evaluating an SX Function on SX arguments
+of building a 512-link chain (11.6 s; 3.8 s of CPU now, most of it elsewhere). Evaluating an SX Function on SX arguments
 expands it, folding the zeros and ones of the arguments, so the expressions are the same
 operations as before.
 """

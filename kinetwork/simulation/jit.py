@@ -67,10 +67,10 @@ SPLIT_STATEMENTS, PART_STATEMENTS = 20_000, 5_000
 #: Newton setup, not per step, and -O0 compiles it 4x sooner (the eight-four-bar chain's,
 #: 207,000 statements)
 JACOBIAN_O1_STATEMENTS = 20_000
-#: any function of more statements than this is compiled at -O0 too: gcc -O1 spends ~0.15 ms
-#: of CPU per statement (mostly register allocation: 22 s for a 1024-link chain's right-hand
-#: side, 148,000 statements, on a quiet core), -O0 a quarter of that; the code then runs
-#: ~2-3x slower (bench/study_scaling.py), which a model that size pays on every run
+#: any function of more statements than this is compiled at -O0 too: gcc -O1 spent 18.7 s of
+#: CPU on a 256-link chain's right-hand side (37,000 statements, mostly in register
+#: allocation), -O0 3.2 s; the code then runs 2.8x slower (bench/results/study_scaling.md),
+#: which a model that size pays on every run. Chains past ~280 links, 148,000 at 1024
 O1_STATEMENTS = 40_000
 #: the C a key names: bump when the generated or split code changes for the same Function
 _SCHEME = "parts-1"
