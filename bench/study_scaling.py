@@ -15,7 +15,15 @@ Also per N: a cached run (a new System of the same model simulated for 1 s, 101 
 library found in the cache: what a second process pays), and the study process's peak resident
 memory after that N (``ru_maxrss``: sizes go up, so each row's peak is its own N's).
 
-JIT strategies (``--strategies``, and in the full run): the 1024-link right-hand side and the
+The chain of eight four-bar loops in both loop formulations (build, the first run's cold JIT
+from an empty cache, the run again; the default formulation is marked), and what -O0 costs at
+run time: a 256-link chain's right-hand side compiled at -O1 and at -O0 (``jit.O1_STATEMENTS``).
+
+Setting up CVODES (``--setup``, its own run: results/study_scaling_setup.md): the time CasADi
+takes to build the DAE's Jacobian function and a CVODES integrator around a chain's compiled
+right-hand side, which the default method hides its derivatives from (``Compiled.dae``).
+
+JIT strategies (``--strategies``, and in the quick run): the 1024-link right-hand side and the
 eight-four-bar chain's DAE Jacobian compiled one file at -O1 (before), in parts at -O1 side by
 side (``jit.SPLIT_STATEMENTS``), and in parts at -O0; compiler CPU time, wall time, and the
 cost of one evaluation. And the eight-four-bar chain's first run from a cold cache.
@@ -27,6 +35,7 @@ Run: ``.venv/bin/python bench/study_scaling.py [--quick]``; writes results/study
 """
 
 import argparse
+import multiprocessing
 import os
 import resource
 import statistics
@@ -137,6 +146,9 @@ def main(quick=False, only_strategies=False, sizes=None):
                   f"jit cold {r['jit_cold_s']:6.2f} s warm {r['jit_warm_s'] * 1e3:6.1f} ms  "
                   f"C {r['rhs_c_us']:7.2f} us  VM {r['rhs_vm_us']:8.2f} us  "
                   + "  ".join(f"{k} {r[_key(k)]:7.2f} us" for k in tools), flush=True)
+        fourbars = fourbar_rows(2 if quick else 8)
+        write_csv("study_scaling_fourbar", fourbars)
+        cost = o0_cost(16 if quick else 256)
         # the strategies take minutes at full size: their own run (--strategies)
         extra = strategies(quick) if quick else None
     finally:
@@ -148,7 +160,7 @@ def main(quick=False, only_strategies=False, sizes=None):
     fits = exponents(rows, tools)
     charts(rows, tools)
     total = time.perf_counter() - clock
-    report(rows, fits, tools, total, quick, extra)
+    report(rows, fits, tools, total, quick, extra, fourbar_lines(fourbars, cost))
     print(f"study_scaling: {total:.1f} s")
 
 
@@ -172,11 +184,12 @@ def _evaluator(f):
 STRATEGY_TIMEOUT = 150.0
 
 
-def _compile_with(f, jacobian, split, jacobian_o1):
+def _compile_with(f, jacobian, split, jacobian_o1, o1):
     """(compiler CPU s, wall s, us per evaluation or None when stopped) of ``f`` compiled by
     ``jit`` in an empty cache with the given splitting and -O0 thresholds."""
-    saved = (jit.SPLIT_STATEMENTS, jit.JACOBIAN_O1_STATEMENTS, jit.COMPILE_TIMEOUT)
-    jit.SPLIT_STATEMENTS, jit.JACOBIAN_O1_STATEMENTS = split, jacobian_o1
+    saved = (jit.SPLIT_STATEMENTS, jit.JACOBIAN_O1_STATEMENTS, jit.O1_STATEMENTS,
+             jit.COMPILE_TIMEOUT)
+    jit.SPLIT_STATEMENTS, jit.JACOBIAN_O1_STATEMENTS, jit.O1_STATEMENTS = split, jacobian_o1, o1
     jit.COMPILE_TIMEOUT = STRATEGY_TIMEOUT
     try:
         with tempfile.TemporaryDirectory() as folder:
@@ -195,7 +208,8 @@ def _compile_with(f, jacobian, split, jacobian_o1):
             cost = None if g is None else \
                 per_call(_evaluator(g.jacobian() if jacobian else g), batches=5) * 1e6
     finally:
-        jit.SPLIT_STATEMENTS, jit.JACOBIAN_O1_STATEMENTS, jit.COMPILE_TIMEOUT = saved
+        (jit.SPLIT_STATEMENTS, jit.JACOBIAN_O1_STATEMENTS, jit.O1_STATEMENTS,
+         jit.COMPILE_TIMEOUT) = saved
     return cpu, wall, cost
 
 
@@ -205,21 +219,25 @@ def strategies(quick):
     n, m = (128, 2) if quick else (1024, 8)
     never = sys.maxsize
     rhs = scenes.chain(n).compile().f_rhs
-    dae = fourbar_chain(m).compile().f_dae
+    # the partition's DAE and its Jacobian: what IDAS compiles (loops are projected by default)
+    dae = fourbar_chain(m).compile(loops="partition").f_dae
+    now = jit.O1_STATEMENTS
     cases = [(f"chain{n} right-hand side", rhs, False,
-              [("one file, -O1 (before)", never, never),
-               (f"parts of {jit.PART_STATEMENTS}, -O1, side by side (now)",
-                jit.SPLIT_STATEMENTS, never)]),
-             (f"fourbar_chain{m} DAE + exact Jacobian", dae, True,
-              [("one file each, -O1 (before)", never, never),
-               ("parts, -O1, side by side", jit.SPLIT_STATEMENTS, never),
+              [("one file, -O1", never, never, never),
+               (f"parts of {jit.PART_STATEMENTS}, -O1, side by side", jit.SPLIT_STATEMENTS,
+                never, never),
+               (f"parts of {jit.PART_STATEMENTS}, -O0 over {now:,} statements, side by side "
+                "(now)", jit.SPLIT_STATEMENTS, never, now)]),
+             (f"fourbar_chain{m} (partition) DAE + exact Jacobian", dae, True,
+              [("one file each, -O1", never, never, never),
+               ("parts, -O1, side by side", jit.SPLIT_STATEMENTS, never, never),
                ("parts, Jacobian at -O0, side by side (now)", jit.SPLIT_STATEMENTS,
-                jit.JACOBIAN_O1_STATEMENTS)])]
+                jit.JACOBIAN_O1_STATEMENTS, now)])]
     rows = []
     for label, f, jacobian, ways in cases:
         size = (f.jacobian() if jacobian else f).n_instructions()
-        for way, split, o1 in ways:
-            cpu, wall, cost = _compile_with(f, jacobian, split, o1)
+        for way, split, jac_o1, o1 in ways:
+            cpu, wall, cost = _compile_with(f, jacobian, split, jac_o1, o1)
             rows.append({"function": label, "instructions": size, "strategy": way,
                          "compiler_cpu_s": cpu, "wall_s": wall,
                          "eval_us": float("nan") if cost is None else cost})
@@ -231,7 +249,7 @@ def strategies(quick):
     with tempfile.TemporaryDirectory() as folder:
         os.environ["KINETWORK_CACHE"] = folder
         start = time.perf_counter()
-        system = fourbar_chain(m).compile()
+        system = fourbar_chain(m).compile(loops="partition")
         build = time.perf_counter() - start
         start = time.perf_counter()
         res = kn.simulate(system, t_end=2.0, n_points=201, method="idas", rtol=1e-6,
@@ -260,9 +278,149 @@ def strategy_lines(rows, loops):
             "time; one evaluation through the Function's buffer (median over batches).", "",
             table(["function", "instructions", "strategy", "compiler CPU [s]", "wall [s]",
                    "one evaluation [us]"], body), "",
-            f"{loops['model']} as a user meets it, cold cache: build {loops['build_s']:.1f} s, "
+            f"{loops['model']} with the partition, as a user met it before loops were projected "
+            f"by default, cold cache: build {loops['build_s']:.1f} s, "
             f"first run (2 s, idas, rtol 1e-6) {loops['first_run_s']:.1f} s of which JIT "
             f"{loops['jit_s']:.1f} s; the same run again {loops['warm_run_s']:.2f} s."]
+
+
+# -- the eight-four-bar chain, and what -O0 costs at run time -------------------------------------
+def fourbar_rows(m=8):
+    """The chain of ``m`` four-bar loops in each loop formulation, as a user meets it: build,
+    then a first run (2 s, default method, rtol 1e-6) from an empty cache, whose JIT time
+    ``jit_seconds`` is the cold JIT of what that run compiles, then the same run again."""
+    from scenes import fourbar_chain
+    rows = []
+    for loops in ("projected", "partition"):
+        with tempfile.TemporaryDirectory() as folder:
+            os.environ["KINETWORK_CACHE"] = folder
+            cpu, start = time.process_time(), time.perf_counter()
+            system = fourbar_chain(m).compile(loops=loops)
+            build, build_cpu = time.perf_counter() - start, time.process_time() - cpu
+            children, start = _children_cpu(), time.perf_counter()
+            res = kn.simulate(system, t_end=2.0, n_points=201, rtol=1e-6, atol=1e-8)
+            first = time.perf_counter() - start
+            compilers = _children_cpu() - children
+            start = time.perf_counter()
+            kn.simulate(system, t_end=2.0, n_points=201, rtol=1e-6, atol=1e-8)
+            again = time.perf_counter() - start
+            f = system.f_rhs or system.f_dae
+        rows.append({"model": f"fourbar_chain{m}", "loops": loops, "states": system.n_states,
+                     "algebraic": system.n_algebraic, "instructions": f.n_instructions(),
+                     "build_s": build, "build_cpu_s": build_cpu, "first_run_s": first,
+                     "jit_cold_s": res.stats.get("jit_seconds", float("nan")),
+                     "jit_compilers_cpu_s": compilers, "run_again_s": again,
+                     "method": res.stats.get("method", "")})
+        r = rows[-1]
+        print(f"  fourbar_chain{m} loops={loops}: build {build:.2f} s, first run {first:.2f} s "
+              f"(JIT {r['jit_cold_s']:.2f} s, compilers {compilers:.1f} s CPU), again "
+              f"{again:.2f} s", flush=True)
+    return rows
+
+
+def o0_cost(n=256):
+    """One right-hand-side evaluation of an ``n``-link chain compiled at -O1 and at -O0 (us),
+    and each compiler's CPU time (s): what ``jit.O1_STATEMENTS`` trades."""
+    system = scenes.chain(n).compile()
+    p, x = system.param_vector(), np.random.default_rng(0).uniform(-0.5, 0.5, 2 * n)
+    out, saved = {}, jit.O1_STATEMENTS
+    try:
+        for label, limit in (("-O1", sys.maxsize), ("-O0", 0)):
+            jit.O1_STATEMENTS = limit
+            with tempfile.TemporaryDirectory() as folder:
+                os.environ["KINETWORK_CACHE"] = folder
+                children = _children_cpu()
+                f = jit.external(system.f_rhs, False, {}, required=True)
+                cpu = _children_cpu() - children
+                call = numeric(f, p, system.n_states)
+                out[label] = (per_call(lambda: call(0.0, x)) * 1e6, cpu)
+    finally:
+        jit.O1_STATEMENTS = saved
+    print(f"  chain{n}: -O1 {out['-O1'][0]:.1f} us ({out['-O1'][1]:.1f} s CPU to compile), "
+          f"-O0 {out['-O0'][0]:.1f} us ({out['-O0'][1]:.1f} s)", flush=True)
+    return {"N": n, "instructions": system.f_rhs.n_instructions(), **{
+        f"{k}_{what}": v[i] for k, v in out.items() for i, what in enumerate(("us", "cpu_s"))}}
+
+
+def integrator_setup(sizes=(64, 128, 256, 512)):
+    """What CasADi's CVODES costs to set up around a chain's compiled right-hand side with the
+    default method's options (Adams, functional iteration): it builds the DAE's Jacobian
+    function at creation whether or not it will use it, by finite differences of the compiled
+    code over a dense pattern. Before: the equations as they were handed over; now:
+    ``Compiled.dae`` without Newton, its derivatives in x hidden (``stop_diff``)."""
+    from kinetwork.simulation.methods import METHODS
+    opts = {**METHODS["cvodes-adams"].options, "reltol": 1e-7, "abstol": 1e-9}
+    grid = [0.01 * k for k in range(1, 11)]
+    rows = []
+    for n in sizes:
+        system = scenes.chain(n).compile()
+        with tempfile.TemporaryDirectory() as folder:
+            os.environ["KINETWORK_CACHE"] = folder
+            c = compiled_of(system)
+            rhs = c.rhs({"stats": {}})
+            tau, x, pt = ca.MX.sym("tau"), ca.MX.sym("x", system.n_states), ca.MX.sym("p", 1)
+            empty = ca.MX(0, 1)
+            before = ca.Function("dae", [tau, x, ca.MX.sym("z", 0), pt, ca.MX.sym("u", 0)],
+                                 [rhs(tau + pt[0], x, empty), empty, empty, empty],
+                                 ca.dyn_in(), ca.dyn_out())
+            row = {"N": n, "states": system.n_states}
+            for label, dae in (("before", before), ("now", c.dae({"stats": {}}))):
+                start = time.perf_counter()
+                integ = ca.integrator("setup", "cvodes", dae, 0.0, grid, opts)
+                row[f"{label}_s"] = time.perf_counter() - start
+                out = np.asarray(integ(x0=system.x0, p=[0.0])["xf"])
+                row[f"{label}_x"] = out
+        row["same"] = float(np.max(np.abs(row.pop("before_x") - row.pop("now_x"))))
+        rows.append(row)
+        print(f"  chain{n}: a CVODES integrator set up in {row['before_s']:.2f} s before, "
+              f"{row['now_s']:.3f} s now; largest difference of the states "
+              f"{row['same']:.1e}", flush=True)
+    return rows
+
+
+def setup_lines(rows):
+    fit = slope(rows, "before_s") if len(rows) > 1 else float("nan")
+    return ["## Setting up CVODES around a large compiled right-hand side", "",
+            f"{machine()}; {load()}. CasADi builds the DAE's Jacobian function when it "
+            "creates a CVODES integrator, even for Adams with functional iteration (the default "
+            "method), which never evaluates it: by finite differences of the compiled code over "
+            "a dense pattern, a cost that grows faster than N^2 (the slope below). A run creates "
+            "one integrator per "
+            "length of its output-grid chunks (two or three for a plain run). Before: the "
+            "equations handed over as they are; now: their derivatives in x hidden "
+            "(`stop_diff`, `Compiled.dae` for a method without Newton). Both run the same "
+            "0.1 s (the largest difference of the final states is given).", "",
+            table(["N", "states", "set-up before [s]", "set-up now [s]",
+                   "largest state difference"],
+                  [[r["N"], r["states"], f"{r['before_s']:.2f}", f"{r['now_s']:.3f}",
+                    f"{r['same']:.1e}"] for r in rows]), "",
+            f"Log-log slope of the set-up before, from N = {FIT_FROM}: {fit:.2f}."]
+
+
+def fourbar_lines(rows, cost):
+    from kinetwork.graph.model import Model
+    import inspect
+    default = inspect.signature(Model.compile).parameters["loops"].default
+    body = [[r["loops"] + (" (default)" if r["loops"] == default else ""), r["states"],
+             r["algebraic"], r["instructions"], f"{r['build_s']:.2f}", f"{r['jit_cold_s']:.2f}",
+             f"{r['jit_compilers_cpu_s']:.1f}", f"{r['first_run_s']:.2f}",
+             f"{r['run_again_s']:.2f}"] for r in rows]
+    mine = next((r for r in rows if r["loops"] == default), rows[0])
+    return ["", f"### {rows[0]['model']}: a chain of eight four-bar loops", "",
+            "Each formulation built, then run 2 s (default method, rtol 1e-6) from an empty "
+            "cache: JIT cold is what that first run spends in `jit` (code generation and the "
+            "compilers, whose CPU time is given beside it), then the same run again.", "",
+            table(["loops", "states", "algebraic", "instructions (rhs or DAE)", "build [s]",
+                   "JIT cold [s]", "compilers CPU [s]", "first run [s]", "run again [s]"],
+                  body), "",
+            f"The default formulation ({default}): cold JIT {mine['jit_cold_s']:.1f} s "
+            f"(target < 5 s).", "",
+            f"What -O0 costs at run time (functions over {jit.O1_STATEMENTS:,} statements): "
+            f"the {cost['N']}-link chain's right-hand side ({cost['instructions']:,} "
+            f"instructions) evaluates in {cost['-O1_us']:.1f} us at -O1 and "
+            f"{cost['-O0_us']:.1f} us at -O0 ({cost['-O0_us'] / cost['-O1_us']:.1f}x), and "
+            f"compiles in {cost['-O1_cpu_s']:.1f} s and {cost['-O0_cpu_s']:.1f} s of compiler "
+            f"CPU ({cost['-O1_cpu_s'] / max(cost['-O0_cpu_s'], 1e-9):.1f}x)."]
 
 
 def _key(tool):
@@ -272,11 +430,12 @@ def _key(tool):
 def measure(n, tools):
     model_s, model = timed(lambda: scenes.chain(n), budget=0.3, max_repeats=7)
     # validate and assemble afresh each time: model.compile() would hand back its System
-    build_s, system = timed(lambda: kn.System(model, topology=analyze(model)), budget=1.0,
-                            max_repeats=7)
-    cpu = time.process_time()
-    kn.System(model, topology=analyze(model))
-    build_cpu = time.process_time() - cpu
+    cpu, start = time.process_time(), time.perf_counter()
+    system = kn.System(model, topology=analyze(model))
+    build_s, build_cpu = time.perf_counter() - start, time.process_time() - cpu
+    if build_s < 1.0:                   # short: the median of repeats
+        build_s, system = timed(lambda: kn.System(model, topology=analyze(model)),
+                                budget=1.0, max_repeats=7)
     size = system.size()
     with tempfile.TemporaryDirectory() as folder:
         os.environ["KINETWORK_CACHE"] = folder       # jit.cache_dir() reads it on each call
@@ -306,6 +465,7 @@ def measure(n, tools):
                       for i, name in enumerate("txp"))
         empty = numeric(ca.Function("copy", [t_, x_, p_], [x_]), p, system.n_states)
         row = {"N": n, "states": size["states"], "operations": size["operations"],
+               "opt": "-O1" if system.f_rhs.n_instructions() <= jit.O1_STATEMENTS else "-O0",
                "model_s": model_s, "build_s": build_s, "jit_cold_s": cold,
                "jit_cold_compiler_s": gcc, "jit_warm_s": warm, "cached_run_s": cached_run,
                "build_cpu_s": build_cpu, "jit_cold_cpu_s": cold_cpu,
@@ -313,15 +473,34 @@ def measure(n, tools):
                "rhs_c_us": per_call(lambda: c_rhs(0.0, x)) * 1e6,
                "call_overhead_us": per_call(lambda: empty(0.0, x)) * 1e6,
                "rhs_vm_us": per_call(lambda: vm_rhs(0.0, x)) * 1e6}
-    spec = scenes.chain_spec(n)
-    for tool, (build, evaluator) in tools.items():
+    row["peak_rss_mb"] = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024
+    # the peers in a child process, so that their memory is not the study's peak
+    with multiprocessing.get_context("fork").Pool(1) as pool:
+        row.update(pool.apply(_peer_times, (n, list(tools))))
+    return row
+
+
+#: pinocchio's Data holds nv^3 tensors of second-order derivatives (the process grew by 1.2 GB
+#: at 256 links, 8.6 GB at 512: N^3; the study's 24 GB at 1024 before it measured the peers
+#: apart): not above this N
+PEER_MAX_N = {"pinocchio aba": 256}
+
+
+def _peer_times(n, names):
+    """{row key: us per evaluation} of the peers ``names`` on the ``n``-link chain."""
+    tools, spec, out = peers(), scenes.chain_spec(n), {}
+    for tool in names:
+        build, evaluator = tools[tool]
+        if n > PEER_MAX_N.get(tool, n):
+            print(f"  {tool} at N = {n}: not measured (memory, see PEER_MAX_N)", flush=True)
+            out[_key(tool)] = float("nan")
+            continue
         try:
-            row[_key(tool)] = per_call(evaluator(build(spec))) * 1e6
+            out[_key(tool)] = per_call(evaluator(build(spec))) * 1e6
         except ValueError as exc:       # MuJoCo's XML parser nests at most ~500 bodies
             print(f"  {tool} at N = {n}: {str(exc).strip().splitlines()[-1]}", flush=True)
-            row[_key(tool)] = float("nan")
-    row["peak_rss_mb"] = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024
-    return row
+            out[_key(tool)] = float("nan")
+    return out
 
 
 def _children_cpu():
@@ -372,15 +551,18 @@ def charts(rows, tools):
              "JIT compile, cold cache": dict(x=N, y=[r["jit_cold_s"] for r in rows],
                                              style=dict(color="C3")),
              "JIT, cache hit (new System)": dict(x=N, y=[r["jit_warm_s"] for r in rows],
-                                                 style=dict(color="C3", linestyle="--"))}
+                                                 style=dict(color="C3", linestyle="--")),
+             "build + JIT cold (target < 30 s at N = 1024)": dict(
+                 x=N, y=[r["build_s"] + r["jit_cold_s"] for r in rows],
+                 style=dict(color="k", linestyle=":"))}
     chart(RESULTS / "study_scaling_build.png", build, "links N", "wall time [s]",
           "Chain of N rods: build and JIT compilation time\n(build and cache hit: medians "
           "of repeats; cold compile: one run)")
 
 
-def report(rows, fits, tools, total, quick, extra=None):
+def report(rows, fits, tools, total, quick, extra=None, loops=()):
     last = rows[-1]
-    body = [[r["N"], r["states"], r["operations"], f"{r['model_s'] * 1e3:.1f}",
+    body = [[r["N"], r["states"], r["operations"], r["opt"], f"{r['model_s'] * 1e3:.1f}",
              f"{r['build_s'] * 1e3:.1f}", f"{r['jit_cold_s']:.2f}",
              f"{r['jit_warm_s'] * 1e3:.1f}", f"{r['build_s'] + r['jit_cold_s']:.2f}",
              f"{r['build_cpu_s']:.2f} + {r['jit_cold_cpu_s']:.2f} + "
@@ -388,7 +570,7 @@ def report(rows, fits, tools, total, quick, extra=None):
              f"{r['cached_run_s']:.2f}", f"{r['peak_rss_mb']:.0f}",
              f"{r['rhs_c_us']:.2f}", f"{r['rhs_vm_us']:.1f}",
              *(f"{r[_key(t)]:.2f}" for t in tools)] for r in rows]
-    header = ["N", "states", "rhs operations", "model [ms]", "build [ms]", "JIT cold [s]",
+    header = ["N", "states", "rhs operations", "C", "model [ms]", "build [ms]", "JIT cold [s]",
               "JIT hit [ms]", "build + JIT cold [s]",
               "CPU: build + JIT (Python) + compilers [s]", "cached run 1 s [s]", "peak RSS [MB]",
               "rhs C [us]", "rhs VM [us]", *(f"{t} [us]" for t in tools)]
@@ -396,7 +578,8 @@ def report(rows, fits, tools, total, quick, extra=None):
              f"{machine()}; {load()}. Build: median of repeated `model.compile()` "
              f"(validate, assemble, "
              f"CasADi Functions; no C). JIT cold: `compiled(system).rhs(jit)` with an empty "
-             f"cache folder (code generation + gcc -O1, functions over "
+             f"cache folder (code generation + gcc at the level in column C: -O1, -O0 "
+             f"for functions over {jit.O1_STATEMENTS:,} statements; functions over "
              f"{jit.SPLIT_STATEMENTS:,} statements in parts side by side); JIT hit: what the "
              f"same call does for a new System of the same model (hashing the Function's "
              f"serialisation, then loading the cached library), median of repeats. Cached run: "
@@ -413,6 +596,7 @@ def report(rows, fits, tools, total, quick, extra=None):
              *(strategy_lines(*extra) + [""] if extra else
                ["JIT of the largest functions, one file against parts, -O1 against -O0: "
                 "[study_scaling_jit.md](study_scaling_jit.md) (`--strategies`).", ""]),
+             *loops, "",
              f"Log-log slopes from N = {FIT_FROM} to {last['N']}:", "",
              table(["quantity", "exponent"], [[k, f"{v:.2f}"] for k, v in fits.items()]), "",
              "![evaluation cost](study_scaling.png)", "",
@@ -422,10 +606,13 @@ def report(rows, fits, tools, total, quick, extra=None):
              f"{last['call_overhead_us']:.1f} us of the Python call is taken off), "
              f"N^{fits['rhs CasADi VM']:.2f} in CasADi's VM, operations "
              f"N^{fits['operations']:.2f}; target exponent ≤ 1.2. At N = {last['N']}: "
-             f"{last['rhs_c_us']:.1f} us compiled, {last['rhs_vm_us']:.0f} us in the VM"
-             + "".join(f", {last[_key(t)]:.1f} us {t}" for t in tools) + ".",
-             f"- Build at N = {last['N']}: {last['build_s']:.2f} s (target < 1 s), "
-             f"exponent {fits['build']:.2f}; constructing the model itself (adding and "
+             f"{last['rhs_c_us']:.1f} us compiled ({last['opt']}), {last['rhs_vm_us']:.0f} us "
+             f"in the VM" + "".join(f", {last[_key(t)]:.1f} us {t}" for t in tools
+                                    if np.isfinite(last[_key(t)])) + ".",
+             f"- Build at N = {last['N']}: {last['build_s']:.2f} s ({last['build_cpu_s']:.1f} s "
+             f"of CPU)" + "".join(f"; at N = 128: {r['build_s']:.2f} s ({r['build_cpu_s']:.2f} s "
+                                  f"of CPU; target < 1 s)" for r in rows if r["N"] == 128)
+             + f"; exponent {fits['build']:.2f}; constructing the model itself (adding and "
              f"connecting {3 * last['N'] + 1} components): {last['model_s'] * 1e3:.0f} ms, "
              f"exponent {fits['model construction']:.2f}.",
              f"- JIT at N = {last['N']}: {last['jit_cold_s']:.2f} s cold "
@@ -439,7 +626,15 @@ def report(rows, fits, tools, total, quick, extra=None):
              f"{last['build_cpu_s'] + last['jit_cold_cpu_s']:.1f} s in Python and "
              f"{last['jit_cold_compilers_cpu_s']:.1f} s in the compilers, which run "
              f"{jit._cores()} at a time; a cached run of "
-             f"1 s {last['cached_run_s']:.1f} s; peak memory {last['peak_rss_mb']:.0f} MB."]
+             f"1 s {last['cached_run_s']:.1f} s; peak memory {last['peak_rss_mb']:.0f} MB.",
+             "- Memory: the study process's peak is kinetwork's alone since the peers run in a "
+             "child process: pinocchio's Data holds nv^3 tensors of second-order derivatives "
+             "(1.2 GB at 256 links, 8.6 GB at 512), which were the 24 GB at which the 1024-link "
+             "row was killed before; pinocchio is measured up to "
+             f"{PEER_MAX_N['pinocchio aba']} links, MuJoCo's XML up to ~500 nested bodies.",
+             "- The CVODES set-up that a run pays per chunk length (it built the DAE's Jacobian "
+             "function, N^2.5, for Adams that never uses it; 24 s at 1024 links, 0.04 s now): "
+             "[study_scaling_setup.md](study_scaling_setup.md) (`--setup`)."]
     write_markdown("study_scaling", "\n".join(lines))
 
 
@@ -450,5 +645,13 @@ if __name__ == "__main__":
                         help="only the JIT strategies on the largest functions "
                              "(results/study_scaling_jit.md)")
     parser.add_argument("--sizes", type=int, nargs="+", help="these N only")
+    parser.add_argument("--setup", action="store_true",
+                        help="only what CVODES costs to set up around chains of --sizes "
+                             "(results/study_scaling_setup.md)")
     args = parser.parse_args()
-    main(args.quick, args.strategies, args.sizes)
+    if args.setup:
+        found = integrator_setup(args.sizes or (64, 128, 256, 512))
+        write_csv("study_scaling_setup", found)
+        write_markdown("study_scaling_setup", "\n".join(setup_lines(found)))
+    else:
+        main(args.quick, args.strategies, args.sizes)

@@ -1,5 +1,7 @@
 """3-D rotation helpers over CasADi SX (and numbers): shared by components and solver."""
 
+import functools
+
 import casadi as ca
 
 
@@ -22,7 +24,19 @@ def skew(v):
 
 def vee(m):
     """Inverse of skew, from the antisymmetric part of ``m``."""
+    if isinstance(m, ca.SX) and m.shape == (3, 3):
+        return _vee()(m)                   # one call, not ten (see ``rotation``)
+    return _antisymmetric(m)
+
+
+def _antisymmetric(m):
     return ca.vertcat(m[2, 1] - m[1, 2], m[0, 2] - m[2, 0], m[1, 0] - m[0, 1]) / 2
+
+
+@functools.lru_cache(maxsize=1)
+def _vee():
+    m = ca.SX.sym("m", 3, 3)
+    return ca.Function("vee", [m], [_antisymmetric(m)])
 
 
 def unit(v):
@@ -32,9 +46,24 @@ def unit(v):
 
 def rotation(axis, angle):
     """Rotation by ``angle`` about the unit vector ``axis`` (Rodrigues), as SX 3x3."""
+    if isinstance(axis, ca.SX) and isinstance(angle, ca.SX) and axis.shape == (3, 1) \
+            and angle.shape == (1, 1):
+        # one call of the same expression: a dozen calls from Python cost ~1 ms (a 1024-link
+        # chain's build paid a second for them)
+        return _rotation()(axis, angle)
+    return _rodrigues(axis, angle)
+
+
+def _rodrigues(axis, angle):
     n = unit(axis)
     k = skew(n)
     return ca.SX.eye(3) + ca.sin(angle) * k + (1 - ca.cos(angle)) * (k @ k)
+
+
+@functools.lru_cache(maxsize=1)
+def _rotation():
+    axis, angle = ca.SX.sym("axis", 3), ca.SX.sym("angle")
+    return ca.Function("rotation", [axis, angle], [_rodrigues(axis, angle)])
 
 
 # -- quaternions [w, x, y, z] (scalar first) ----------------------------------------------

@@ -90,30 +90,30 @@ class Compiled:
         a chunk: their parameters are the model's then that start t0 (t = t0 + tau), so one
         integrator serves every chunk of the same length. A dict of SX (VM), or an MX
         Function of (tau, x, z, [p; t0], u) around the compiled code (CasADi's integrators
-        compile nothing themselves unless handed a compiled Function)."""
+        compile nothing themselves unless handed a compiled Function).
+
+        ``jacobian``: the method iterates with Newton. Without (Adams' functional iteration)
+        the equations hide their derivatives in x (``_no_newton``)."""
         system = self.system
         eq, a = system.eq, system.asm
-        if not jit:
+        if not jit and (jacobian or not self._no_newton_vm()):
             def build_sx():
                 tau, t0 = ca.SX.sym("tau"), ca.SX.sym("t0")
                 shift = lambda e: ca.substitute(e, a.t, tau + t0)  # noqa: E731
                 return {"x": eq.x, "z": eq.z, "p": ca.vertcat(a.p, t0), "t": tau,
                         "ode": shift(eq.ode), "alg": shift(eq.alg)}
             return self._get("dae_sx", build_sx)
-        jacobian = jacobian and self.jacobian_small()
+        exact = jacobian and bool(jit) and self.jacobian_small()
 
         def build():
             tau, x = ca.MX.sym("tau"), ca.MX.sym("x", system.n_states)
             z = ca.MX.sym("z", system.n_algebraic)
             pt, empty = ca.MX.sym("p", len(system.param_names) + 1), ca.MX(0, 1)
             t, p = tau + pt[-1], pt[:-1]
-            if system.n_algebraic:
-                ode, alg = self._external(system.f_dae, jacobian, jit)(t, x, z, p)
-            else:
-                ode, alg = self.rhs(jit, jacobian)(t, x, p), empty
+            ode, alg = self._equations(jit, exact, jacobian, t, x, z, p)
             return ca.Function("dae", [tau, x, z, pt, ca.MX.sym("u", 0)],
                                [ode, alg, empty, empty], ca.dyn_in(), ca.dyn_out())
-        return self._get(("dae", jacobian), build)
+        return self._get(("dae", bool(jit), exact, jacobian), build)
 
     def dae_scaled(self, jit=None, jacobian=False):
         """The equations over a stretch of any length dt, in s = (t - t0) / dt from 0 to 1
@@ -121,14 +121,14 @@ class Compiled:
         (the events' trial times). As ``dae``: SX, or an MX Function around compiled code."""
         system = self.system
         eq, a = system.eq, system.asm
-        if not jit:
+        if not jit and (jacobian or not self._no_newton_vm()):
             def build_sx():
                 s, t0, dt = ca.SX.sym("s"), ca.SX.sym("t0"), ca.SX.sym("dt")
                 shift = lambda e: ca.substitute(e, a.t, t0 + s * dt)  # noqa: E731
                 return {"x": eq.x, "z": eq.z, "p": ca.vertcat(a.p, t0, dt), "t": s,
                         "ode": dt * shift(eq.ode), "alg": shift(eq.alg)}
             return self._get("dae_scaled_sx", build_sx)
-        jacobian = jacobian and self.jacobian_small()
+        exact = jacobian and bool(jit) and self.jacobian_small()
 
         def build():
             s, x = ca.MX.sym("s"), ca.MX.sym("x", system.n_states)
@@ -136,13 +136,35 @@ class Compiled:
             pt, empty = ca.MX.sym("p", len(system.param_names) + 2), ca.MX(0, 1)
             p, dt = pt[:-2], pt[-1]
             t = pt[-2] + s * dt
-            if system.n_algebraic:
-                ode, alg = self._external(system.f_dae, jacobian, jit)(t, x, z, p)
-            else:
-                ode, alg = self.rhs(jit, jacobian)(t, x, p), empty
+            ode, alg = self._equations(jit, exact, jacobian, t, x, z, p)
             return ca.Function("dae_scaled", [s, x, z, pt, ca.MX.sym("u", 0)],
                                [dt * ode, alg, empty, empty], ca.dyn_in(), ca.dyn_out())
-        return self._get(("dae_scaled", jacobian), build)
+        return self._get(("dae_scaled", bool(jit), exact, jacobian), build)
+
+    def _equations(self, jit, exact, newton, t, x, z, p):
+        """(ode, alg) in MX: the compiled code (or, without ``jit``, the SX Function in
+        CasADi's VM), with its exact Jacobian when ``exact``.
+
+        Without ``newton`` the states enter through ``stop_diff``: a CVODES integrator builds
+        its DAE's Jacobian function when it is created, even for Adams' functional iteration
+        that never evaluates it, and that Jacobian, by finite differences of the compiled code
+        over a dense pattern, grew as N^2.5 to set up (24 s per integrator at 1024 links, and a
+        run makes two or three; bench/results/study_scaling_setup.md). Hidden, the set-up takes
+        0.04 s there and the run is the same to the last bit."""
+        system = self.system
+        if not newton:
+            x = ca.stop_diff(x, 1)
+        if system.n_algebraic:
+            f = self._external(system.f_dae, exact, jit) if jit else system.f_dae
+            return f(t, x, z, p)
+        return (self.rhs(jit, exact) if jit else system.f_rhs)(t, x, p), ca.MX(0, 1)
+
+    def _no_newton_vm(self):
+        """Whether an integrator without Newton runs in the VM around the SX Function, its
+        derivatives hidden, rather than on the SX expressions: when the exact Jacobian is
+        too large, which CasADi would build symbolically at the integrator's creation
+        (a 1024-link chain: 15 GB)."""
+        return self.system.n_algebraic == 0 and not self.jacobian_small()
 
     def integrator(self, key, build):
         """A CasADi integrator built once for ``key`` (its grid and options): the same chunks

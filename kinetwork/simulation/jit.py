@@ -67,6 +67,11 @@ SPLIT_STATEMENTS, PART_STATEMENTS = 20_000, 5_000
 #: Newton setup, not per step, and -O0 compiles it 4x sooner (the eight-four-bar chain's,
 #: 207,000 statements)
 JACOBIAN_O1_STATEMENTS = 20_000
+#: any function of more statements than this is compiled at -O0 too: gcc -O1 spent 18.7 s of
+#: CPU on a 256-link chain's right-hand side (37,000 statements, mostly in register
+#: allocation), -O0 3.2 s; the code then runs 2.8x slower (bench/results/study_scaling.md),
+#: which a model that size pays on every run. Chains past ~280 links, 148,000 at 1024
+O1_STATEMENTS = 40_000
 #: the C a key names: bump when the generated or split code changes for the same Function
 _SCHEME = "parts-1"
 #: a compiler still running after this long (s) is taken to hang (N = 128 builds in 2.5 s)
@@ -279,7 +284,8 @@ def _plan(name, functions, cc, jacobian=False):
     parts = [f.serialize() for f in functions]
     key = hashlib.sha256("\0".join([*parts, str(bool(jacobian)), cc, *CFLAGS, _SCHEME,
                                      str((SPLIT_STATEMENTS, PART_STATEMENTS,
-                                          JACOBIAN_O1_STATEMENTS)), ca.__version__]).encode())
+                                          JACOBIAN_O1_STATEMENTS, O1_STATEMENTS)),
+                                     ca.__version__]).encode())
 
     def generate():
         sources = {}
@@ -297,6 +303,7 @@ def _sources(name, f, optimise):
     """{file name: (C, compiler flags)} of ``f``, in parts when it is long (``_split``)."""
     gen = ca.CodeGenerator(f"{name}.c", {"with_header": False})
     gen.add(f)
+    optimise = optimise and f.n_instructions() <= O1_STATEMENTS
     flags = [*(("-O1",) if optimise else ("-O0",)), *(c for c in CFLAGS if c != "-O1")]
     size = PART_STATEMENTS if f.n_instructions() > SPLIT_STATEMENTS else None
     files = _split(gen.dump(), size) if size else {"main.c": gen.dump()}
