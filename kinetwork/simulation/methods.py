@@ -158,12 +158,12 @@ class _CasadiRun:
         if not exact and \
                 abs(times[-1] - self.t - n * run.spacing) <= 1e-9 * max(1.0, abs(times[-1])):
             grid = ("uniform", n, run.spacing)          # equal intervals: j * spacing
-            taus = (np.arange(1, n + 1) * run.spacing).tolist()
+            taus = lambda: (np.arange(1, n + 1) * run.spacing).tolist()  # noqa: E731
         else:
-            taus = (np.asarray(times, dtype=float) - self.t).tolist()
-            grid = tuple(taus)
+            grid = tuple((np.asarray(times, dtype=float) - self.t).tolist())
+            taus = lambda: list(grid)  # noqa: E731
         key = ("integrator", m.plugin, grid, tuple(sorted(opts.items())), bool(run.jit))
-        build = lambda: ca.integrator("simulate", m.plugin, dae, 0.0, taus, opts)  # noqa: E731
+        build = lambda: ca.integrator("simulate", m.plugin, dae, 0.0, taus(), opts)  # noqa: E731
         if m.plugin == "idas":          # its options hold the state's rate: not reusable
             return build()
         return run.compiled.integrator(key, build)
