@@ -24,6 +24,7 @@ level of the tolerance (their restarts differ); each gives the same numbers ever
 
 from __future__ import annotations
 
+import atexit
 import contextlib
 import math
 import os
@@ -78,9 +79,17 @@ _SINK = {}
 def _sink():
     """The file that catches what the solvers print: one per process, used under SOLVER_LOCK
     (a temporary file per run cost 0.3 ms, a tenth of a small model's run)."""
-    if _SINK.get("pid") != os.getpid():        # a forked child makes its own
-        _SINK.update(pid=os.getpid(), file=tempfile.TemporaryFile())
+    if _SINK.get("pid") != os.getpid():
+        if "file" in _SINK:                    # a forked child's copy of its parent's
+            _SINK["file"].close()
+        _SINK.update(pid=os.getpid(), file=tempfile.TemporaryFile())  # noqa: SIM115
     return _SINK["file"]
+
+
+@atexit.register
+def _close_sink():
+    if _SINK.get("pid") == os.getpid():
+        _SINK.pop("file").close()
 
 
 class Run:
