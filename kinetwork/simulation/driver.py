@@ -24,6 +24,7 @@ level of the tolerance (their restarts differ); each gives the same numbers ever
 
 from __future__ import annotations
 
+import _signal
 import atexit
 import contextlib
 import math
@@ -610,13 +611,15 @@ def _running(run):
             run.abortable = False
             raise Interrupted
     saved = {}
+    # through the C module under ``signal``: its Python wrapper turns each handler into an
+    # enum at 60 us a call (0.25 ms of a run that takes 3 ms)
     for sig in (signal.SIGINT, signal.SIGTERM):
         try:
-            saved[sig] = signal.signal(sig, stop)
+            saved[sig] = _signal.signal(sig, stop)
         except (ValueError, OSError):     # not settable here (an embedded interpreter)
             pass
     try:
         yield
     finally:
         for sig, handler in saved.items():
-            signal.signal(sig, handler)
+            _signal.signal(sig, handler)
