@@ -214,3 +214,68 @@ def test_a_run_in_a_thread_cannot_install_signal_handlers_but_still_runs():
     th.join(60)
     assert len(out["r"].t) == 1001
     assert driver.signal.getsignal(driver.signal.SIGINT) is not None
+
+
+def test_a_quiet_run_is_one_call_of_its_integrator_and_a_watched_one_goes_in_chunks(monkeypatch):
+    """Each chunk restarts a multistep method (order and step size from scratch): a run that
+    nothing watches (no progress, cancel, time limit, loops or events) goes in one CVODES call
+    over the whole grid, and its states and evaluations are those of one CVODES Adams call
+    built here by hand from the System's right-hand side at the solver's tolerances."""
+    import casadi as ca
+    from scenes.chains import chain
+
+    from kinetwork.simulation.tolerance import solver_tolerances
+    system = chain(8).compile()
+    calls = []
+    advance = methods._CasadiRun.advance
+    monkeypatch.setattr(methods._CasadiRun, "advance",
+                        lambda self, times, exact=False: calls.append(len(times))
+                        or advance(self, times, exact))
+    quiet = kn.simulate(system, t_end=10.0, n_points=1001, method="cvodes-adams", jit=False)
+    assert calls == [1000]
+    rtol, atol, steps = solver_tolerances(METHODS["cvodes-adams"], system, 1e-6, 1e-8)
+    p0 = system.param_vector()
+    t, x, p = ca.SX.sym("t"), ca.SX.sym("x", system.n_states), ca.SX.sym("p", len(p0))
+    one = ca.integrator("one", "cvodes", {"t": t, "x": x, "p": p, "ode": system.f_rhs(t, x, p)},
+                        0.0, quiet.t[1:].tolist(),
+                        {"linear_multistep_method": "adams", "reltol": rtol, "abstol": atol,
+                         "nonlinear_solver_iteration": "functional", "max_num_steps": steps})
+    by_hand = np.asarray(one(x0=system.x0, p=p0)["xf"]).T
+    np.testing.assert_allclose(quiet.states[1:], by_hand, rtol=0, atol=1e-12)
+    assert quiet.stats["rhs_evaluations"] == one.stats()["nfevals"]
+
+    calls.clear()
+    watched = kn.simulate(system, t_end=10.0, n_points=1001, method="cvodes-adams", jit=False,
+                          progress=lambda t: None)
+    assert len(calls) >= 2 and sum(calls) == 1000
+    assert watched.stats["rhs_evaluations"] > quiet.stats["rhs_evaluations"]
+    np.testing.assert_allclose(watched.states, quiet.states, rtol=0, atol=1e-5)
+
+
+def test_a_signal_stops_a_quiet_run_within_its_one_call_and_keeps_the_rows_it_reached():
+    """CasADi checks Python's signals at every evaluation of the equations: the driver's
+    handler aborts the call there, and the rows CasADi had written stay (they are the
+    seed's motion: the closed form agrees)."""
+    import signal
+    import time
+    system = double_pendulum(q0=(1.0, -0.5)).compile()
+    kn.simulate(system, t_end=0.1, jit=False)                 # built: the run starts at once
+    timer = threading.Timer(0.5, os.kill, (os.getpid(), signal.SIGINT))
+    start = time.perf_counter()
+    timer.start()
+    try:
+        with pytest.raises(kn.SimulationError) as info:
+            kn.simulate(system, t_end=1e4, n_points=10**5 + 1, rtol=1e-10, atol=1e-12,
+                        jit=False)
+    finally:
+        timer.cancel()
+    took = time.perf_counter() - start
+    err = info.value
+    assert err.reason == "interrupted by SIGINT" and err.signal == signal.SIGINT
+    assert took < 2.0 and 0 < err.t_reached < 1e4
+    res = err.results
+    assert len(res.t) == round(err.t_reached / 0.1) + 1 > 101 and res.t[-1] == err.t_reached
+    assert "solver_output" not in res.stats          # no solver failure to speak of
+    assert np.all(np.isfinite(res.states)) and np.all(np.isfinite(res["probe1.angle"]))
+    ref = seed_reference(res.t[:101], x0=(1.0, -0.5, 0, 0))      # the first 10 s
+    assert np.max(np.abs(res.states[:101] - ref)) < 1e-6
