@@ -462,8 +462,13 @@ def choose(run):
         return ["idas"], {"loops": system.formulation_note}
     why = {"stiff": False, "damped": system.damped}
     if system.damped:
-        rhs = numeric(run.compiled.rhs(run.jit), run.p, system.n_states)
-        stiff, sigma, omega = stiffness(rhs, run.t_start, run.t_end, run.x0)
+        def test():
+            rhs = numeric(run.compiled.rhs(run.jit), run.p, system.n_states)
+            return stiffness(rhs, run.t_start, run.t_end, run.x0)
+        # once per start, horizon and parameter values: a model run again asks the same
+        key = ("stiffness", float(run.t_start), float(run.t_end),
+               np.asarray(run.x0, float).tobytes(), np.asarray(run.p, float).tobytes())
+        stiff, sigma, omega = run.compiled.memo(key, test)
         why.update(stiff=bool(stiff), decay_rate=sigma, motion_rate=omega)
     return (["cvodes"] if why["stiff"] else ["cvodes-adams", "cvodes"]), why
 
