@@ -381,7 +381,8 @@ class Canvas:
         """A polyline ``width_pt`` points wide, round where it turns (Pillow's own round
         joints cost a Python call per point: here only where a turn would show a notch)."""
         ox, oy = self._origin
-        xy = (np.asarray(points, dtype=float) - (ox, oy)) * SCALE
+        # Pillow's pixel k is centred on k: the file's coordinate x is at x * SCALE - 0.5
+        xy = (np.asarray(points, dtype=float) - (ox, oy)) * SCALE - 0.5
         width = max(1, round(width_pt * PX * SCALE))
         self._draw.line(xy.ravel().tolist(), fill=fill, width=width)
         if len(xy) > 2 and width > 2:
@@ -401,7 +402,7 @@ class Canvas:
             y += on + off
 
     def rectangle(self, box, width_pt):
-        x0, y0, x1, y1 = (v * SCALE for v in box)
+        x0, y0, x1, y1 = (v * SCALE - 0.5 for v in box)
         w = max(1, round(width_pt * PX * SCALE))
         half = w / 2
         self._draw.rectangle((x0 - half, y0 - half, x1 + half, y1 + half), outline="black",
