@@ -193,6 +193,9 @@ def main():
         split = phases(envs["this tree"], out, repeats)
         # the interpreter's start: the CPU of ``import kinetwork``, the first command
         start = statistics.median(c for _, c in timed[commands(out)[0][0]]["this tree"])
+        subprocess.run([sys.executable, "-c", PICTURES, str(REPO / MODELS["seed"]),
+                        str(HERE / "results" / "first_answer_plot")], env=envs["this tree"],
+                       cwd=out, check=True)
     estimate = start + command_path(split)
     seed_plot = next(label for label in timed if "double_pendulum" in label and "plot" in label)
     baseline_note = "" if len(trees) == 1 else (
@@ -200,9 +203,6 @@ def main():
         f"runs: its CPU time, {statistics.median(c for _, c in timed[seed_plot]['baseline']):.2f} s, "
         f"is more than its wall time on an idle machine, which the study of that commit put at "
         f"about 1.6 s (the drawing process's path).")
-        subprocess.run([sys.executable, "-c", PICTURES, str(REPO / MODELS["seed"]),
-                        str(HERE / "results" / "first_answer_plot")], env=envs["this tree"],
-                       cwd=out, check=True)
     write_csv("study_first_answer", rows)
     names = list(trees)
     header = ["command"] + [f"{n}: wall (s)" for n in names] + \

@@ -131,9 +131,10 @@ def test_curves_lie_where_matplotlib_s_axis_limits_map_the_data_and_nan_leaves_g
             assert column.size, x
             errors.append(column.mean() - expected)
             checked += 1
-        # a 3 px wide line, antialiased, on slopes up to 2 px per px: its centre within 1.5 px
+        # a 3 px wide line, antialiased, on slopes up to 2 px per px: its centre within 1.5 px;
+        # on average within the half pixel to which the frame is found
         assert checked > 0.8 * (right - left)
-        assert np.max(np.abs(errors)) < 1.5 and abs(np.mean(errors)) < 0.3, errors
+        assert np.max(np.abs(errors)) < 1.5 and abs(np.mean(errors)) < 0.5, errors
     left, top, right, bottom = frame(image, boxes[0][:4])
     gap = [x for x in range(left, right) if 1.23 < (x - left) / (right - left) * 2.0 < 1.47]
     assert len(gap) > 20 and not blue[top + 2:bottom - 1, gap].any()
