@@ -64,14 +64,17 @@ def environment(tree, pycache, jit_cache):
     return env
 
 
-#: phases of the matplotlib route, timed after the command's own
+#: the names of the phases of the PNG and of matplotlib's route (prefix)
+PILLOW = "import Pillow (kinetwork.quickplot)"
+DRAW = "plot: draw (Pillow: lines at 2x, reduced; texts)"
+PNG = "plot: PNG (rows unfiltered, zlib level 1)"
 MPL = "matplotlib route: "
 
 #: the phases of ``kinetwork run --plot`` on the seed, each timed (CPU) in a fresh process, one
 #: after the other as the command runs them: load, build, run, CSV, then the PNG drawn with
 #: Pillow; then matplotlib's route to the same file (what the command used before, and still
 #: uses for other formats), for comparison
-PHASES = """
+PHASES = f"PILLOW, DRAW, PNG, MPL = {(PILLOW, DRAW, PNG, MPL)!r}\n" + """
 import json, sys, time
 done, clock = {}, time.process_time()
 def lap(name):
@@ -87,14 +90,14 @@ model = _load(sys.argv[1]); lap("import kinetwork's layers + load the model")
 system = model.compile(); lap("build the System")
 res = kn.simulate(system); lap("simulate (cached JIT library)")
 res.to_csv("phases.csv"); lap("write the CSV")
-from kinetwork import quickplot; lap("import Pillow (kinetwork.quickplot)")
-image = quickplot.render(res, title=model.name); lap("plot: draw (Pillow, 2x, reduced)")
-image.save("phases.png", format="png", compress_level=1); lap("plot: PNG (zlib level 1)")
+from kinetwork import quickplot; lap(PILLOW)
+image = quickplot.render(res, title=model.name); lap(DRAW)
+open("phases.png", "wb").write(quickplot.png_bytes(image)); lap(PNG)
 import matplotlib.figure, matplotlib.backends.backend_agg; lap(MPL + "import matplotlib")
 from kinetwork.plot import save_plot
 save_plot(res, "phases_mpl.png", title=model.name); lap(MPL + "figure, draw, PNG")
 print(json.dumps(done))
-""".replace("MPL + ", repr(MPL) + " + ")
+"""
 
 
 def phases(env, cwd, repeats):
@@ -197,6 +200,7 @@ def main():
                         str(HERE / "results" / "first_answer_plot")], env=envs["this tree"],
                        cwd=out, check=True)
     estimate = start + command_path(split)
+    light = split[PILLOW] + split[DRAW] + split[PNG]
     seed_plot = next(label for label in timed if "double_pendulum" in label and "plot" in label)
     baseline_note = "" if len(trees) == 1 else (
         f" The baseline forks a drawing process that imports matplotlib while the model "
@@ -235,9 +239,9 @@ for other formats, in a drawing process forked at its start).
 
 {table(["phase", "CPU (s)"], [[k, f"{v:.3f}"] for k, v in split.items()])}
 
-The PNG costs {split["import Pillow (kinetwork.quickplot)"] + split["plot: draw (Pillow, 2x, reduced)"] + split["plot: PNG (zlib level 1)"]:.2f} s of CPU with Pillow (import, drawing, file) against
+The PNG costs {light:.2f} s of CPU with Pillow (import, drawing, file) against
 {matplotlib_path(split):.2f} s with matplotlib (import, figure, drawing, file): ratio
-{matplotlib_path(split) / (split["import Pillow (kinetwork.quickplot)"] + split["plot: draw (Pillow, 2x, reduced)"] + split["plot: PNG (zlib level 1)"]):.1f}.
+{matplotlib_path(split) / light:.1f}.
 On an idle machine the seed's `run --plot` would take about {estimate:.2f} s: the
 interpreter's start ({start:.3f} s, `import kinetwork`'s CPU) and the command's path
 ({command_path(split):.2f} s, one process). An estimate from CPU times, which the load does

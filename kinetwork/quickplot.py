@@ -3,8 +3,9 @@
 matplotlib takes a second to import and more than half a second to draw the seed's eight
 panels; the run itself takes milliseconds. This module draws the same figure (plot.py's panel
 packing, titles, units, 1-2-2.5-5 ticks labelled like matplotlib's ScalarFormatter, tab10
-colours, DejaVu Sans, 150 dpi, the same pixel size) in a tenth of a second, at three
-times the size and reduced with a box filter, so lines and text are antialiased.
+colours, DejaVu Sans, 150 dpi, the same pixel size) in a tenth of a second: lines at twice
+the size, reduced with a box filter, so they are antialiased; texts by FreeType at the
+file's size, antialiased too.
 
 It draws what the command line's plots hold: one run, scalars and x/y/z vectors, events, nan
 gaps, the hide-flat note. :func:`drawable` says when a file needs matplotlib instead (another
@@ -12,11 +13,13 @@ format, an orientation's nine dashed curves, several runs, a time axis matplotli
 with an offset); ``kinetwork.plot.save_plot`` stays the way for everything else.
 """
 
-import contextlib
 import functools
 import importlib.util
 import math
 import os
+import pathlib
+import struct
+import zlib
 
 import numpy as np
 from PIL import Image, ImageDraw, ImageFont
@@ -25,7 +28,7 @@ from .errors import ModelError
 from .plot import _flat, _names, _Panel, _rows
 from .util import atomic_write
 
-DPI, SCALE = 150, 3                     # the file's resolution; drawn this much larger
+DPI, SCALE = 150, 2                     # the file's resolution; lines drawn this much larger
 PX = DPI / 72.0                         # points -> pixels of the file
 #: matplotlib's default style (rcParams), in points
 FONT, SUPTITLE, SMALL = 10.0, 12.0, 6.94
@@ -60,7 +63,28 @@ def save_png(results, path, *names, title=None, hide_flat=False):
     :func:`drawable` accepts. Raises ModelError as save_plot does (nothing to plot, an
     unknown name, only constant signals with hide_flat)."""
     image = render(results, *names, title=title, hide_flat=hide_flat)
-    atomic_write(path, lambda tmp: image.save(tmp, format="png", compress_level=1))
+    data = png_bytes(image)
+    atomic_write(path, lambda tmp: pathlib.Path(tmp).write_bytes(data))
+
+
+def png_bytes(image):
+    """An RGB image as a PNG file's bytes: rows unfiltered, zlib level 1. Pillow's encoder
+    tries five filters on every row, which takes twice as long for a larger file here."""
+    height, width = image.height, image.width
+    rows = np.zeros((height, 1 + 3 * width), dtype=np.uint8)        # filter byte 0: none
+    rows[:, 1:] = np.asarray(image, dtype=np.uint8).reshape(height, 3 * width)
+
+    def chunk(kind, body):
+        return struct.pack(">I", len(body)) + kind + body + \
+            struct.pack(">I", zlib.crc32(kind + body))
+
+    per_metre = round(DPI / 0.0254)
+    return b"".join([b"\x89PNG\r\n\x1a\n",
+                     chunk(b"IHDR", struct.pack(">IIBBBBB", width, height, 8, 2, 0, 0, 0)),
+                     chunk(b"pHYs", struct.pack(">IIB", per_metre, per_metre, 1)),
+                     chunk(b"tEXt", b"Software\x00kinetwork"),
+                     chunk(b"IDAT", zlib.compress(rows.tobytes(), 1)),
+                     chunk(b"IEND", b"")])
 
 
 def render(results, *names, title=None, hide_flat=False):
@@ -79,10 +103,15 @@ def render(results, *names, title=None, hide_flat=False):
     panels = [[_PanelView(results, name) for name in row] for row in rows]
     xlim = _time_limits(results.t)
     boxes = _layout(canvas, panels, n_cols, xlim, title, note)
+    placed = [(panel, boxes[i][j]) for i, row in enumerate(panels)
+              for j, panel in enumerate(row)]
+    for panel, box in placed:
+        panel.draw_inside(canvas, box, results, xlim)
+    canvas.clear_outside([box for _, box in placed])    # matplotlib clips lines to the axes
     bottom = {j: i for i, row in enumerate(panels) for j in range(len(row))}
     for i, row in enumerate(panels):
         for j, panel in enumerate(row):
-            panel.draw(canvas, boxes[i][j], results, xlim, last=bottom[j] == i)
+            panel.draw_around(canvas, boxes[i][j], xlim, last=bottom[j] == i)
     if title:
         canvas.text((width / 2, EDGE * PX), title, SUPTITLE, valign="top")
     if note:
@@ -213,23 +242,34 @@ class _PanelView:
         x0, y0, x1, y1 = box
         return (_Axis(*xlim, (x1 - x0) / PX, 3), _Axis(*self.ylim, (y1 - y0) / PX, 2))
 
-    def draw(self, canvas, box, results, xlim, last):
-        """Grid, events and curves clipped to ``box`` (pixels of the file), then the frame,
-        ticks and texts around it; tick labels and "time [s]" under the last of a column."""
+    def mapping(self, box, xlim):
+        """(x axis, y axis, time -> pixel column, value -> pixel row) of the panel in ``box``
+        (x0, y0, x1, y1: pixels of the file, y down)."""
         x0, y0, x1, y1 = box
         xaxis, yaxis = self.axes(box, xlim)
         to_x = lambda v: x0 + (np.asarray(v) - xaxis.low) / (xaxis.high - xaxis.low) * (x1 - x0)
         to_y = lambda v: y1 - (np.asarray(v) - yaxis.low) / (yaxis.high - yaxis.low) * (y1 - y0)
-        with canvas.clipped(box) as inside:
-            for x in to_x(xaxis.ticks):
-                inside.line([(x, y0), (x, y1)], GRID, SPINE)
-            for y in to_y(yaxis.ticks):
-                inside.line([(x0, y), (x1, y)], GRID, SPINE)
-            for x in to_x(self.events):
-                inside.dotted(x, y0, y1, EVENT, 0.6)
-            for k, values in enumerate(self.curves):
-                for piece in _finite_pieces(to_x(results.t), to_y(values)):
-                    inside.line(piece, TAB10[k % 10], LINE)
+        return xaxis, yaxis, to_x, to_y
+
+    def draw_inside(self, canvas, box, results, xlim):
+        """Grid, events and curves (what spills over is cleared afterwards)."""
+        x0, y0, x1, y1 = box
+        xaxis, yaxis, to_x, to_y = self.mapping(box, xlim)
+        for x in to_x(xaxis.ticks):
+            canvas.line([(x, y0), (x, y1)], GRID, SPINE)
+        for y in to_y(yaxis.ticks):
+            canvas.line([(x0, y), (x1, y)], GRID, SPINE)
+        for x in to_x(self.events):
+            canvas.dotted(x, y0, y1, EVENT, 0.6)
+        for k, values in enumerate(self.curves):
+            for piece in _finite_pieces(to_x(results.t), to_y(values)):
+                canvas.line(piece, TAB10[k % 10], LINE)
+
+    def draw_around(self, canvas, box, xlim, last):
+        """The frame, ticks and texts around the panel; tick labels and "time [s]" under the
+        last panel of a column."""
+        x0, y0, x1, y1 = box
+        xaxis, yaxis, to_x, to_y = self.mapping(box, xlim)
         canvas.rectangle(box, SPINE)
         tick = TICK * PX
         for x in to_x(xaxis.ticks):
@@ -346,36 +386,35 @@ def _font_file():
 class Canvas:
     """An RGB image SCALE times the file's size, drawn in the file's pixel coordinates."""
 
-    def __init__(self, width, height, image=None, origin=(0.0, 0.0), fonts=None):
+    def __init__(self, width, height):
         self.width, self.height = width, height
-        self._image = image or Image.new("RGB", (width * SCALE, height * SCALE), "white")
+        self._image = Image.new("RGB", (width * SCALE, height * SCALE), "white")
         self._draw = ImageDraw.Draw(self._image)
-        self._origin = origin           # the file's pixel at this image's corner
-        self._fonts = {} if fonts is None else fonts
+        self._fonts = {}
+        self._texts = []                # drawn on the reduced image: FreeType antialiases
 
     def font(self, points):
+        """DejaVu Sans of ``points`` at the file's resolution (texts are drawn there)."""
         if points not in self._fonts:
-            size = points * PX * SCALE
             path = _font_file()
-            self._fonts[points] = ImageFont.truetype(path, size) if path else \
-                ImageFont.load_default(size)
+            self._fonts[points] = ImageFont.truetype(path, points * PX) if path else \
+                ImageFont.load_default(points * PX)
         return self._fonts[points]
 
     def width_of(self, text, points):
-        return self.font(points).getlength(text) / SCALE
+        return self.font(points).getlength(text)
 
     def height_of(self, points):
         """The height of a line of text as matplotlib measures it (the ink of "lp")."""
         _, top, _, bottom = self.font(points).getbbox("lp", anchor="ls")
-        return (bottom - top) / SCALE
+        return bottom - top
 
     def line(self, points, fill, width_pt):
         """A polyline ``width_pt`` points wide, round where it turns (Pillow's own round
         joints cost a Python call per point: here only where a turn would show a notch)."""
-        ox, oy = self._origin
-        # a wide line of odd width (9 px here) is centred on the pixel its ends truncate to:
-        # on average where it belongs
-        xy = (np.asarray(points, dtype=float) - (ox, oy)) * SCALE
+        # Pillow truncates a wide line's ends to whole pixels: unshifted, the curves lie on
+        # average within a tenth of a pixel of where they belong (tests/test_quickplot.py)
+        xy = np.asarray(points, dtype=float) * SCALE
         width = max(1, round(width_pt * PX * SCALE))
         self._draw.line(xy.ravel().tolist(), fill=fill, width=width)
         if len(xy) > 2 and width > 2:
@@ -409,8 +448,8 @@ class Canvas:
         _, ascent, _, descent = font.getbbox("lp", anchor="ls")      # ascent < 0 < descent
         baseline = {"top": -ascent, "center": -ascent / 2, "baseline": 0.0,
                     "bottom": -descent}[valign]
-        self._draw.text((xy[0] * SCALE, xy[1] * SCALE + baseline), text, font=font,
-                        fill=fill, anchor=align + "s")
+        self._texts.append(lambda image, draw: draw.text(
+            (xy[0], xy[1] + baseline), text, font=font, fill=fill, anchor=align + "s"))
 
     def vertical_text(self, xy, text, points, fill="black"):
         """Text turned a quarter left, its descent side (right) at ``x``, centred on ``y``."""
@@ -420,19 +459,37 @@ class Canvas:
         strip = Image.new("L", (length, math.ceil(descent - ascent) + 2), 0)
         ImageDraw.Draw(strip).text((1, 1 - ascent), text, font=font, fill=255, anchor="ls")
         turned = strip.rotate(90, expand=True)
-        x = round(xy[0] * SCALE) - turned.width
-        y = round(xy[1] * SCALE - turned.height / 2)
-        self._image.paste(fill, (x, y, x + turned.width, y + turned.height), turned)
+        x, y = round(xy[0]) - turned.width, round(xy[1] - turned.height / 2)
+        self._texts.append(lambda image, draw: image.paste(
+            fill, (x, y, x + turned.width, y + turned.height), turned))
 
-    @contextlib.contextmanager
-    def clipped(self, box):
-        """A canvas drawing inside ``box`` only (matplotlib clips lines to the axes): a crop
-        of this one, in the same coordinates, pasted back at the end."""
-        corner = [round(v * SCALE) for v in box]
-        inside = Canvas(0, 0, self._image.crop(corner), (corner[0] / SCALE, corner[1] / SCALE),
-                        self._fonts)
-        yield inside
-        self._image.paste(inside._image, corner[:2])
+    def clear_outside(self, boxes):
+        """Paint white what lies outside ``boxes``: panels on a grid, one row's boxes
+        sharing their top and bottom, each box's edges on the frame drawn next."""
+        width, height = self._image.size
+        rows = {}
+        for x0, y0, x1, y1 in boxes:
+            rows.setdefault((round(y0 * SCALE), round(y1 * SCALE)), []).append(
+                (round(x0 * SCALE), round(x1 * SCALE)))
+        white = []
+        above = 0
+        for (top, bottom), spans in sorted(rows.items()):
+            white.append((0, above, width, top))
+            left = 0
+            for x0, x1 in sorted(spans):
+                white.append((left, top, x0, bottom))
+                left = x1 + 1
+            white.append((left, top, width, bottom))
+            above = bottom + 1
+        white.append((0, above, width, height))
+        for x0, y0, x1, y1 in white:
+            if x1 > x0 and y1 > y0:
+                self._draw.rectangle((x0, y0, x1 - 1, y1 - 1), fill="white")
 
     def image(self):
-        return self._image.reduce(SCALE)
+        """The file's pixels: the drawing reduced SCALE times (a box filter), texts on top."""
+        image = self._image.reduce(SCALE)
+        draw = ImageDraw.Draw(image)
+        for text in self._texts:
+            text(image, draw)
+        return image
