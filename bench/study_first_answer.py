@@ -202,11 +202,12 @@ def main():
     estimate = start + command_path(split)
     light = split[PILLOW] + split[DRAW] + split[PNG]
     seed_plot = next(label for label in timed if "double_pendulum" in label and "plot" in label)
+    baseline_cpu = statistics.median(c for _, c in timed[seed_plot].get("baseline", [(0, 0)]))
     baseline_note = "" if len(trees) == 1 else (
         f" The baseline forks a drawing process that imports matplotlib while the model "
-        f"runs: its CPU time, {statistics.median(c for _, c in timed[seed_plot]['baseline']):.2f} s, "
-        f"is more than its wall time on an idle machine, which the study of that commit put at "
-        f"about 1.6 s (the drawing process's path).")
+        f"runs: its CPU time, {baseline_cpu:.2f} s, is more than its wall time on an idle "
+        f"machine, which the study of that commit put at about 1.6 s (the drawing process's "
+        f"path).")
     write_csv("study_first_answer", rows)
     names = list(trees)
     header = ["command"] + [f"{n}: wall (s)" for n in names] + \

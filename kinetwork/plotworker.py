@@ -12,6 +12,7 @@ parent). If the child cannot be started, or dies, the parent draws the plots its
 Standard library only at import: this module runs before numpy is loaded.
 """
 
+import itertools
 import os
 import pickle
 import select
@@ -41,7 +42,7 @@ def wanted(argv):
     are drawn later."""
     if not argv or argv[0] != "run":
         return False
-    files = [b for a, b in zip(argv[1:], argv[2:]) if a == "--plot"] + \
+    files = [b for a, b in itertools.pairwise(argv[1:]) if a == "--plot"] + \
         [a.partition("=")[2] for a in argv[1:] if a.startswith("--plot=")]
     return any(not f.lower().endswith(".png") for f in files)
 

@@ -372,7 +372,7 @@ def _layout(canvas, panels, n_cols, xlim, title, note):
 
 # -- drawing: Pillow at SCALE times the size, in the file's pixel coordinates ----------------
 
-@functools.lru_cache(maxsize=None)
+@functools.cache
 def _font_file():
     """matplotlib's DejaVu Sans, found without importing matplotlib; None if absent."""
     spec = importlib.util.find_spec("matplotlib")
