@@ -193,21 +193,30 @@ ENV = dict(os.environ, KINETWORK_JIT="0")
 
 
 def test_the_command_line_draws_a_png_without_matplotlib_scipy_or_a_second_process(tmp_path):
+    """... and hands a PNG the light renderer does not draw (an orientation) to matplotlib."""
     double_pendulum().save(tmp_path / "seed.json")
+    tip = double_pendulum()
+    tip.add(kn.Probe("tip", quantities=["orientation"]))
+    tip.connect("tip.port", "elbow.frame_b")
+    tip.save(tmp_path / "tip.json")
     code = textwrap.dedent("""
         import json, os, sys
         def no_fork():
             raise AssertionError("forked")
         os.fork = no_fork
         from kinetwork import cli
-        sys.argv = ["kinetwork", "run", "seed.json", "--t-end", "1", "--plot", "s.png",
-                    "--quiet"]
-        code = cli.main()
-        print(json.dumps([code, sorted(m for m in ("matplotlib", "scipy") if m in sys.modules)]))
+        def run(model, png):
+            sys.argv = ["kinetwork", "run", model, "--t-end", "1", "--plot", png, "--quiet"]
+            return cli.main()
+        code = run("seed.json", "s.png")
+        loaded = sorted(m for m in ("matplotlib", "scipy") if m in sys.modules)
+        print(json.dumps([code, loaded, run("tip.json", "t.png")]))
     """)
     done = subprocess.run([sys.executable, "-c", code], cwd=tmp_path, env=ENV, check=False,
                           capture_output=True, text=True, timeout=300)
     assert done.returncode == 0, done.stderr
-    assert json.loads(done.stdout.splitlines()[-1]) == [0, []]
+    assert json.loads(done.stdout.splitlines()[-1]) == [0, [], 0]
     with Image.open(tmp_path / "s.png") as image:
-        assert image.size == (2160, 825)
+        assert image.size == (2160, 825) and image.info["Software"] == "kinetwork"
+    with Image.open(tmp_path / "t.png") as image:
+        assert image.info["Software"].startswith("Matplotlib")
