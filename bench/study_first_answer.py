@@ -15,14 +15,15 @@ x.csv`` with and without ``--plot x.png`` (the seed: 8 panels, 2160 x 825 px); t
 is put first on ``PYTHONPATH``) side by side: the two trees alternate run by run, so both meet
 the same load on this shared machine; their ratio is the figure to read, more than either time.
 CPU time (user + system, the process and its children) is reported beside wall time: the
-wall time of a run that draws in a second process is less than its CPU time.
+wall time of a run that draws in a second process (the baseline's) is less than its CPU time.
 
 Bytecode: an environment with PYTHONDONTWRITEBYTECODE recompiles every module of kinetwork in
 every process (0.3-0.6 s here); a user's install has its bytecode written. The study writes
 it to a temporary folder (PYTHONPYCACHEPREFIX) for both trees.
 
 Run: ``.venv/bin/python bench/study_first_answer.py [--quick] [--baseline DIR]``; writes
-results/study_first_answer.csv and .md.
+results/study_first_answer.csv and .md, and the seed's plot file as the command draws it
+(Pillow) and as matplotlib does: results/first_answer_plot_light.png and _matplotlib.png.
 """
 
 import argparse
@@ -63,9 +64,17 @@ def environment(tree, pycache, jit_cache):
     return env
 
 
-#: the phases of ``kinetwork run --plot`` on the seed, each timed (CPU) in a fresh process: the
-#: parent's (load, build, run, CSV) and the drawing process's (matplotlib, the figure, the PNG)
-PHASES = """
+#: the names of the phases of the PNG and of matplotlib's route (prefix)
+PILLOW = "import Pillow (kinetwork.quickplot)"
+DRAW = "plot: draw (Pillow: lines at 2x, reduced; texts)"
+PNG = "plot: PNG (rows unfiltered, zlib level 1)"
+MPL = "matplotlib route: "
+
+#: the phases of ``kinetwork run --plot`` on the seed, each timed (CPU) in a fresh process, one
+#: after the other as the command runs them: load, build, run, CSV, then the PNG drawn with
+#: Pillow; then matplotlib's route to the same file (what the command used before, and still
+#: uses for other formats), for comparison
+PHASES = f"PILLOW, DRAW, PNG, MPL = {(PILLOW, DRAW, PNG, MPL)!r}\n" + """
 import json, sys, time
 done, clock = {}, time.process_time()
 def lap(name):
@@ -81,16 +90,12 @@ model = _load(sys.argv[1]); lap("import kinetwork's layers + load the model")
 system = model.compile(); lap("build the System")
 res = kn.simulate(system); lap("simulate (cached JIT library)")
 res.to_csv("phases.csv"); lap("write the CSV")
-import matplotlib.figure, matplotlib.backends.backend_agg; lap("import matplotlib (Figure, Agg)")
-from kinetwork.plot import plot_results
-fig = plot_results(res, title=model.name, _detached=True); lap("plot: figure, lines, margins")
-from matplotlib.backends.backend_agg import FigureCanvasAgg
-canvas = FigureCanvasAgg(fig); fig.set_dpi(150); canvas.draw(); lap("plot: draw (Agg, 150 dpi)")
-import io
-from PIL import Image
-Image.frombuffer("RGBA", canvas.get_width_height(), canvas.buffer_rgba(), "raw", "RGBA", 0,
-                 1).save(io.BytesIO(), format="png", compress_level=1)
-lap("plot: PNG (zlib level 1)")
+from kinetwork import quickplot; lap(PILLOW)
+image = quickplot.render(res, title=model.name); lap(DRAW)
+open("phases.png", "wb").write(quickplot.png_bytes(image)); lap(PNG)
+import matplotlib.figure, matplotlib.backends.backend_agg; lap(MPL + "import matplotlib")
+from kinetwork.plot import save_plot
+save_plot(res, "phases_mpl.png", title=model.name); lap(MPL + "figure, draw, PNG")
 print(json.dumps(done))
 """
 
@@ -107,17 +112,28 @@ def phases(env, cwd, repeats):
     return {k: statistics.median(r[k] for r in runs) for k in runs[0]}
 
 
-def parent_path(split):
-    """CPU seconds of the parent's phases: imports, load, build, run, CSV."""
-    keys = list(split)
-    return sum(split[k] for k in keys[:keys.index("write the CSV") + 1])
+def command_path(split):
+    """CPU seconds of the command's own phases: imports, load, build, run, CSV, PNG."""
+    return sum(v for k, v in split.items() if not k.startswith(MPL))
 
 
-def drawing_path(split):
-    """CPU seconds of the drawing process: numpy, matplotlib, the figure, drawing, PNG."""
-    keys = list(split)
-    return split["import numpy"] + sum(split[k] for k in
-                                       keys[keys.index("write the CSV") + 1:])
+def matplotlib_path(split):
+    """CPU seconds of matplotlib's route from the run to the same PNG (import included)."""
+    return sum(v for k, v in split.items() if k.startswith(MPL))
+
+
+#: the seed's plot file both ways, side by side in results/ for the reader to compare
+PICTURES = """
+import sys
+import kinetwork as kn
+from kinetwork import quickplot
+from kinetwork.cli import _load
+from kinetwork.plot import save_plot
+model = _load(sys.argv[1])
+res = kn.simulate(model)
+quickplot.save_png(res, sys.argv[2] + "_light.png", title=model.name)
+save_plot(res, sys.argv[2] + "_matplotlib.png", title=model.name)
+"""
 
 
 def run_once(argv, env, cwd):
@@ -180,12 +196,18 @@ def main():
         split = phases(envs["this tree"], out, repeats)
         # the interpreter's start: the CPU of ``import kinetwork``, the first command
         start = statistics.median(c for _, c in timed[commands(out)[0][0]]["this tree"])
-    estimate = start + max(parent_path(split), drawing_path(split))
+        subprocess.run([sys.executable, "-c", PICTURES, str(REPO / MODELS["seed"]),
+                        str(HERE / "results" / "first_answer_plot")], env=envs["this tree"],
+                       cwd=out, check=True)
+    estimate = start + command_path(split)
+    light = split[PILLOW] + split[DRAW] + split[PNG]
     seed_plot = next(label for label in timed if "double_pendulum" in label and "plot" in label)
+    baseline_cpu = statistics.median(c for _, c in timed[seed_plot].get("baseline", [(0, 0)]))
     baseline_note = "" if len(trees) == 1 else (
-        f" The baseline draws in the one process: its CPU time, "
-        f"{statistics.median(c for _, c in timed[seed_plot]['baseline']):.2f} s, is about its "
-        f"wall time on an idle machine.")
+        f" The baseline forks a drawing process that imports matplotlib while the model "
+        f"runs: its CPU time, {baseline_cpu:.2f} s, is more than its wall time on an idle "
+        f"machine, which the study of that commit put at about 1.6 s (the drawing process's "
+        f"path).")
     write_csv("study_first_answer", rows)
     names = list(trees)
     header = ["command"] + [f"{n}: wall (s)" for n in names] + \
@@ -211,18 +233,25 @@ cache folder.{f" Baseline: `{trees['baseline']}`." if args.baseline else ""}
 {table(header, lines)}
 
 Where the time of the seed's `run --plot` goes (this tree; CPU seconds per phase, each phase
-after the one before in one fresh process, median of {repeats}): the command forks its drawing
-process at its start, so the parent's phases (down to the CSV) and the drawing process's
-(from matplotlib on) run side by side; the wall time on an idle machine is about the longer
-of the two, and the drawing process's is the longer.
+after the one before in one fresh process, median of {repeats}): the command draws the PNG
+itself, with Pillow, after the run (kinetwork/quickplot.py); matplotlib's route to the same
+file, timed after it in the same process, is what the command took before (and still takes
+for other formats, in a drawing process forked at its start).
 
 {table(["phase", "CPU (s)"], [[k, f"{v:.3f}"] for k, v in split.items()])}
 
+The PNG costs {light:.2f} s of CPU with Pillow (import, drawing, file) against
+{matplotlib_path(split):.2f} s with matplotlib (import, figure, drawing, file): ratio
+{matplotlib_path(split) / light:.1f}.
 On an idle machine the seed's `run --plot` would take about {estimate:.2f} s: the
-interpreter's start ({start:.3f} s, `import kinetwork`'s CPU) and the longer of the parent's
-path ({parent_path(split):.2f} s) and the drawing process's ({drawing_path(split):.2f} s, which also
-imports numpy). An estimate from CPU times, which the load does not inflate as it does wall
-times; measured wall times above are what this machine gave under its load.{baseline_note}
+interpreter's start ({start:.3f} s, `import kinetwork`'s CPU) and the command's path
+({command_path(split):.2f} s, one process). An estimate from CPU times, which the load does
+not inflate as it does wall times; measured wall times above are what this machine gave under
+its load.{baseline_note}
+
+Bytecode: measured with kinetwork's bytecode written (PYTHONPYCACHEPREFIX, for both trees), as
+an installed package has it; a source tree run with PYTHONDONTWRITEBYTECODE recompiles every
+module of kinetwork in every process (`python -m compileall kinetwork` once avoids that).
 
 Targets (issue 18, item 4): `kinetwork run` of the seed with `--plot` under 1.0 s wall, and
 `import kinetwork` under 0.25 s, as whole processes.

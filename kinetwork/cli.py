@@ -266,8 +266,9 @@ def build_parser():
 
 def main(argv=None):
     """Run the ``kinetwork`` command; returns the exit code."""
-    # the command line's own process (not a call from Python): draw its plots in a second
-    # process, importing matplotlib while this one loads and runs the model
+    # the command line's own process (not a call from Python), plotting into a file that is
+    # not a PNG: draw it in a second process, importing matplotlib while this one loads and
+    # runs the model (PNGs are drawn here, with Pillow, after the run)
     worker = plotworker.PlotWorker.start() if argv is None and \
         plotworker.wanted(sys.argv[1:]) else None
     try:
@@ -362,11 +363,22 @@ def _outputs(args, results, title):
         _write(args.out, results.to_csv,
                f"{len(results.t)} points x {len(results.columns()[0])} columns to", quiet)
     if args.plot:
-        from .plot import save_plot
-        worker = getattr(args, "plot_worker", None)
-        draw = save_plot if worker is None else worker.save     # the same call, elsewhere
-        _write(args.plot, lambda path: draw(results, path, *args.plot_signals, title=title,
-                                            hide_flat=args.hide_flat), "probe plots to", quiet)
+        _write(args.plot, lambda path: _save_plot(args, results, path, title),
+               "probe plots to", quiet)
+
+
+def _save_plot(args, results, path, title):
+    """The probe plots into ``path``: a PNG drawn here with Pillow when the light renderer
+    draws what it holds (no matplotlib to import: the quick first answer), else matplotlib's
+    ``save_plot``, in the drawing process forked for other formats when there is one."""
+    from . import quickplot
+    names, hide_flat = args.plot_signals, args.hide_flat
+    if quickplot.drawable(path, results, names):
+        return quickplot.save_png(results, path, *names, title=title, hide_flat=hide_flat)
+    from .plot import save_plot
+    worker = getattr(args, "plot_worker", None)
+    draw = save_plot if worker is None else worker.save     # the same call, elsewhere
+    return draw(results, path, *names, title=title, hide_flat=hide_flat)
 
 
 @contextlib.contextmanager

@@ -1,5 +1,5 @@
-"""The probe plots of ``kinetwork run --plot``, drawn by a second process started with the
-command.
+"""The probe plots of ``kinetwork run --plot`` in formats other than PNG (pdf, svg, ...),
+drawn by a second process started with the command (a PNG is drawn by ``quickplot``).
 
 matplotlib takes longer to import than kinetwork takes to load, build and run the seed, and
 drawing takes as long again. So the command forks at its start, before it imports anything
@@ -12,6 +12,7 @@ parent). If the child cannot be started, or dies, the parent draws the plots its
 Standard library only at import: this module runs before numpy is loaded.
 """
 
+import itertools
 import os
 import pickle
 import select
@@ -36,9 +37,14 @@ class PlotSignal:
 
 def wanted(argv):
     """Whether the command line ``argv`` (without the program name) runs a model with
-    ``--plot``: worth a drawing process. A miss only means the plots are drawn later."""
-    return bool(argv) and argv[0] == "run" and any(
-        a == "--plot" or a.startswith("--plot=") for a in argv[1:])
+    ``--plot`` into a file other than a PNG (PNGs are drawn by ``quickplot``, in the command's
+    own process, without matplotlib): worth a drawing process. A miss only means the plots
+    are drawn later."""
+    if not argv or argv[0] != "run":
+        return False
+    files = [b for a, b in itertools.pairwise(argv[1:]) if a == "--plot"] + \
+        [a.partition("=")[2] for a in argv[1:] if a.startswith("--plot=")]
+    return any(not f.lower().endswith(".png") for f in files)
 
 
 class PlotWorker:

@@ -61,9 +61,10 @@ def test_the_command_line_imports_what_a_run_needs_and_nothing_else(seed_file, t
 
 
 def test_run_with_plot_draws_in_its_own_process(seed_file, tmp_path):
-    """The command line's --plot is drawn by the forked process (matplotlib never enters the
-    parent), also for a partial run; its refusals reach the user as before; a drawing process
-    that died leaves the drawing to the parent."""
+    """The command line's --plot never imports matplotlib in the command's process: a PNG is
+    drawn there with Pillow, another format by the forked process; also for a partial run; the
+    refusals reach the user as before; a drawing process that died leaves the drawing to the
+    parent."""
     blowup = double_pendulum()
     blowup.add(kn.rotational.Torque("blowup", tau="1/(1-t)**3"))
     blowup.connect("blowup.flange", "shoulder.axis")
@@ -79,7 +80,8 @@ def test_run_with_plot_draws_in_its_own_process(seed_file, tmp_path):
         codes = [run({str(seed_file)!r}, "--out", "a.csv", "--plot", "a.png", "--t-end", "1"),
                  run("blowup.json", "--out", "b.csv", "--plot", "b.png"),
                  run({str(seed_file)!r}, "--plot", "c.png", "--plot-signals", "probe9"),
-                 run({str(seed_file)!r}, "--out", "a.csv", "--plot", "a.csv/d.png")]
+                 run({str(seed_file)!r}, "--out", "a.csv", "--plot", "a.csv/d.png"),
+                 run({str(seed_file)!r}, "--plot", "f.svg", "--t-end", "0.5")]
         in_parent = "matplotlib" in sys.modules
         worker = plotworker.PlotWorker.start()
         os.kill(worker.pid, signal.SIGKILL)
@@ -89,7 +91,7 @@ def test_run_with_plot_draws_in_its_own_process(seed_file, tmp_path):
         print(json.dumps([codes, in_parent]))
     """, tmp_path)
     codes, in_parent = json.loads(out.splitlines()[-1])
-    assert codes == [0, 3, 1, 1], err
+    assert codes == [0, 3, 1, 1, 0], err
     assert not in_parent
     assert out.count("wrote probe plots to a.png") == 1 and "b.png" in out
     assert "no probe or signal 'probe9'" in err and "cannot write a.csv/d.png" in err
@@ -99,11 +101,15 @@ def test_run_with_plot_draws_in_its_own_process(seed_file, tmp_path):
         image = mpimg.imread(tmp_path / name)
         assert image.shape[1] == width and image.std() > 0.05, name
     assert not (tmp_path / "c.png").exists()
+    assert (tmp_path / "f.svg").read_text().lstrip().startswith("<?xml")
 
 
 def test_the_drawing_process_is_asked_for_by_run_with_plot_only():
-    assert plotworker.wanted(["run", "m.json", "--plot", "p.png"])
-    assert plotworker.wanted(["run", "m.json", "--plot=p.png"])
+    """... and only for formats other than PNG, which the command draws itself (quickplot)."""
+    assert plotworker.wanted(["run", "m.json", "--plot", "p.svg"])
+    assert plotworker.wanted(["run", "m.json", "--plot=p.pdf"])
+    assert not plotworker.wanted(["run", "m.json", "--plot", "p.png"])
+    assert not plotworker.wanted(["run", "m.json", "--plot=P.PNG"])
     assert not plotworker.wanted(["run", "m.json", "--plot-signals", "probe1"])
     assert not plotworker.wanted(["validate", "m.json", "--plot", "p.png"])
     assert not plotworker.wanted([])

@@ -21,7 +21,7 @@ import kinetwork
 PACKAGE = pathlib.Path(kinetwork.__file__).resolve().parent
 LAYERS = [("errors", "util", "expr", "units", "spatial"), ("components",), ("graph",),
           ("equations",), ("simulation",),
-          ("plot", "plotworker", "schema", "symbolic", "animation", "diagram", "urdf",
+          ("plot", "plotworker", "quickplot", "schema", "symbolic", "animation", "diagram", "urdf",
            "examples", "studio", "analysis", "cli", "__main__", "")]
 RANK = {name: rank for rank, names in enumerate(LAYERS) for name in names}
 
