@@ -6,7 +6,8 @@ goes to ``results/<study>.log``; its markdown (``results/<study>.md``, with or w
 A study that runs past ``--timeout`` is stopped with its child processes. The exit code is
 nonzero if any study failed or was stopped.
 
-Run: ``python bench/run.py [--quick] [--timeout S] [study ...]``.
+Run: ``python bench/run.py [--quick] [--timeout S] [study ...]``; ``--gather`` runs nothing and
+writes the summary from every study's latest results (each says its own machine and date).
 """
 
 import argparse
@@ -77,14 +78,40 @@ def under_title(text):
                   flags=re.MULTILINE)
 
 
+def gather():
+    """results/summary.md from the results already there: every study's markdown files (its
+    own, then the extra ones it writes, ``<stem>_*.md``), in the order ``run.py`` runs them."""
+    lines = ["# kinetwork benchmarks", "",
+             f"Gathered from each study's latest results on {machine()} (`bench/run.py "
+             f"--gather`); every study says when and under which load it ran.", "",
+             "| study | results |", "| --- | --- |"]
+    sections = []
+    for path in studies():
+        stem = path.stem.removeprefix("study_")
+        mds = sorted({*RESULTS.glob(f"{path.stem}*.md"), *RESULTS.glob(f"{stem}*.md")} -
+                     {RESULTS / "summary.md"})
+        if not mds:
+            continue
+        lines.append(f"| {path.name} | {', '.join(f'`{md.name}`' for md in mds)} |")
+        sections += ["", *(under_title(md.read_text()).rstrip() for md in mds)]
+    (RESULTS / "summary.md").write_text("\n".join(lines + sections) + "\n")
+    print(f"summary of {len(lines) - 6} studies in {RESULTS / 'summary.md'}", flush=True)
+
+
 def main():
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--quick", action="store_true",
                         help="each study's smoke-test mode (under a minute in all)")
     parser.add_argument("--timeout", type=float, default=None,
                         help="seconds before a study is stopped (default 600, quick 120)")
+    parser.add_argument("--gather", action="store_true",
+                        help="run nothing: gather every study's latest results into the "
+                             "summary (studies run at different times, each dated)")
     parser.add_argument("only", nargs="*", help="run only these studies (by file stem)")
     args = parser.parse_args()
+    if args.gather:
+        gather()
+        return
     timeout = args.timeout or (120.0 if args.quick else 600.0)
     RESULTS.mkdir(exist_ok=True)
     todo = studies(args.only)

@@ -53,6 +53,8 @@ def _bench_summary():
         name = match.group(2)
         return f"![{match.group(1)}](bench/{name})" if (BENCH / name).is_file() else ""
     text = re.sub(r"!\[([^\]]*)\]\(([^)/]+\.png)\)", image, text)
+    # a study's link to another results file: that file's section is on this page too
+    text = re.sub(r"(?<!!)\[([^\]]*)\]\(([^)/]+\.md)\)", r"`\2`", text)
     return re.sub(r"^(#+) ", lambda m: "#" + m.group(1) + " ", text, flags=re.M)
 
 
