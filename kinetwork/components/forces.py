@@ -258,14 +258,14 @@ class Force(PartialResolved, library=MB):
 
 class Torque(PartialResolved, library=MB):
     """A torque on frame_b and its reaction on frame_a, resolved in ``resolve_in`` (MSL's
-    Forces.Torque); entries given by ``t`` (expressions in time allowed) or by the signals
-    t1, t2, t3.
+    Forces.Torque); entries given by ``t`` (expressions in time and in signal outputs
+    allowed) or by the signals t1, t2, t3.
 
     Parameters
     ----------
     t : N*m, 3 values, default [0, 0, 0]
-        Torque, resolved in ``resolve_in``; expressions in time allowed; a wired t1, t2, t3
-        replaces its entry.
+        Torque, resolved in ``resolve_in``; expressions in time and in signal outputs by
+        dotted name ("pos.y") allowed; a wired t1, t2, t3 replaces its entry.
     resolve_in : "world", "frame_a", "frame_b" or "frame_resolve", default "frame_b"
         Frame the torque is resolved in.
     """
@@ -286,11 +286,11 @@ class ForceAndTorque(PartialResolved, library=MB):
     Parameters
     ----------
     f : N, 3 values, default [0, 0, 0]
-        Force, resolved in ``resolve_in``; expressions in t allowed; a wired f1, f2, f3
-        replaces its entry.
+        Force, resolved in ``resolve_in``; expressions in t and in signal outputs by dotted
+        name ("pos.y") allowed; a wired f1, f2, f3 replaces its entry.
     t : N*m, 3 values, default [0, 0, 0]
-        Torque, resolved in ``resolve_in``; expressions in time allowed; a wired t1, t2, t3
-        replaces its entry.
+        Torque, resolved in ``resolve_in``; expressions in time and in signal outputs by
+        dotted name ("pos.y") allowed; a wired t1, t2, t3 replaces its entry.
     resolve_in : "world", "frame_a", "frame_b" or "frame_resolve", default "frame_b"
         Frame both vectors are resolved in.
     """
