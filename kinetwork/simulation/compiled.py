@@ -94,52 +94,47 @@ class Compiled:
 
         ``jacobian``: the method iterates with Newton. Without (Adams' functional iteration)
         the equations hide their derivatives in x (``_no_newton``)."""
-        system = self.system
-        eq, a = system.eq, system.asm
-        if not jit and (jacobian or not self._no_newton_vm()):
-            def build_sx():
-                tau, t0 = ca.SX.sym("tau"), ca.SX.sym("t0")
-                shift = lambda e: ca.substitute(e, a.t, tau + t0)  # noqa: E731
-                return {"x": eq.x, "z": eq.z, "p": ca.vertcat(a.p, t0), "t": tau,
-                        "ode": shift(eq.ode), "alg": shift(eq.alg)}
-            return self._get("dae_sx", build_sx)
-        exact = jacobian and bool(jit) and self.jacobian_small()
-
-        def build():
-            tau, x = ca.MX.sym("tau"), ca.MX.sym("x", system.n_states)
-            z = ca.MX.sym("z", system.n_algebraic)
-            pt, empty = ca.MX.sym("p", len(system.param_names) + 1), ca.MX(0, 1)
-            t, p = tau + pt[-1], pt[:-1]
-            ode, alg = self._equations(jit, exact, jacobian, t, x, z, p)
-            return ca.Function("dae", [tau, x, z, pt, ca.MX.sym("u", 0)],
-                               [ode, alg, empty, empty], ca.dyn_in(), ca.dyn_out())
-        return self._get(("dae", bool(jit), exact, jacobian), build)
+        return self._dae("dae", False, jit, jacobian)
 
     def dae_scaled(self, jit=None, jacobian=False):
         """The equations over a stretch of any length dt, in s = (t - t0) / dt from 0 to 1
         (d/ds = dt d/dt): parameters [p; t0; dt], so one integrator to s = 1 reaches any time
         (the events' trial times). As ``dae``: SX, or an MX Function around compiled code."""
+        return self._dae("dae_scaled", True, jit, jacobian)
+
+    def _dae(self, name, scaled, jit, jacobian):
+        """``dae`` (t = t0 + tau) or, ``scaled``, ``dae_scaled`` (t = t0 + s dt, the rates
+        times dt), each built once per kind."""
         system = self.system
         eq, a = system.eq, system.asm
+        n_extra = 2 if scaled else 1            # t0, and dt when scaled
+
+        def clock(tau, extra):
+            """t, and dt/dtau when it is not 1 (the rates are multiplied by it)."""
+            return (extra[0] + tau * extra[1], extra[1]) if scaled else (extra[0] + tau, None)
+
+        def rates(ode, factor):
+            return ode if factor is None else factor * ode
         if not jit and (jacobian or not self._no_newton_vm()):
             def build_sx():
-                s, t0, dt = ca.SX.sym("s"), ca.SX.sym("t0"), ca.SX.sym("dt")
-                shift = lambda e: ca.substitute(e, a.t, t0 + s * dt)  # noqa: E731
-                return {"x": eq.x, "z": eq.z, "p": ca.vertcat(a.p, t0, dt), "t": s,
-                        "ode": dt * shift(eq.ode), "alg": shift(eq.alg)}
-            return self._get("dae_scaled_sx", build_sx)
+                tau, extra = ca.SX.sym("tau"), ca.SX.sym("extra", n_extra)
+                t, factor = clock(tau, extra)
+                return {"x": eq.x, "z": eq.z, "p": ca.vertcat(a.p, extra), "t": tau,
+                        "ode": rates(ca.substitute(eq.ode, a.t, t), factor),
+                        "alg": ca.substitute(eq.alg, a.t, t)}
+            return self._get(f"{name}_sx", build_sx)
         exact = jacobian and bool(jit) and self.jacobian_small()
 
         def build():
-            s, x = ca.MX.sym("s"), ca.MX.sym("x", system.n_states)
+            tau, x = ca.MX.sym("tau"), ca.MX.sym("x", system.n_states)
             z = ca.MX.sym("z", system.n_algebraic)
-            pt, empty = ca.MX.sym("p", len(system.param_names) + 2), ca.MX(0, 1)
-            p, dt = pt[:-2], pt[-1]
-            t = pt[-2] + s * dt
-            ode, alg = self._equations(jit, exact, jacobian, t, x, z, p)
-            return ca.Function("dae_scaled", [s, x, z, pt, ca.MX.sym("u", 0)],
-                               [dt * ode, alg, empty, empty], ca.dyn_in(), ca.dyn_out())
-        return self._get(("dae_scaled", bool(jit), exact, jacobian), build)
+            pt, empty = ca.MX.sym("p", len(system.param_names) + n_extra), ca.MX(0, 1)
+            t, factor = clock(tau, pt[-n_extra:])
+            ode, alg = self._equations(jit, exact, jacobian, t, x, z, pt[:-n_extra])
+            return ca.Function(name, [tau, x, z, pt, ca.MX.sym("u", 0)],
+                               [rates(ode, factor), alg, empty, empty], ca.dyn_in(),
+                               ca.dyn_out())
+        return self._get((name, bool(jit), exact, jacobian), build)
 
     def _equations(self, jit, exact, newton, t, x, z, p):
         """(ode, alg) in MX: the compiled code (or, without ``jit``, the SX Function in
