@@ -55,7 +55,7 @@ from common import RESULTS, load, machine, table, timed, write_csv, write_markdo
 import kinetwork as kn
 from scenes import loops as ls
 from scenes import reference_loops as rl
-from kinetwork.simulation.compiled import JACOBIAN_JIT_LIMIT, compiled
+from kinetwork.solver.compiled import JACOBIAN_JIT_LIMIT, compiled
 
 THETA0 = 1.0
 SPACING = 0.05
@@ -894,7 +894,7 @@ def report_pareto(rows, wall):
              f"{T_PRECISION:g} s, output every {SPACING:g} s, no probes, JIT on. For every "
              f"formulation + method: the first run of the sweep (rtol 1e-3 .. 1e-11, atol = "
              f"rtol / 100, as a user asks them: `simulate` tightens them for CVODES and IDAS, "
-             f"`kinetwork/simulation/tolerance.py`; collocation: step 0.05 s halved) whose "
+             f"`kinetwork/solver/tolerance.py`; collocation: step 0.05 s halved) whose "
              f"max crank-angle error is within {PARETO_TARGET:g} rad of the reference "
              f"(`reference_loops` for the planar two; for the spatial four-bar, which has "
              f"none, kinetwork's Baumgarte ODE under DOP853 at 1e-13), its wall time (median "

@@ -7,7 +7,7 @@ right-hand side cold (an empty cache folder) and warm (a new System of the same 
 library found in the cache): the cold one timed once around ``compiled(system).rhs(jit)``, the
 warm one as the median of repeated ``jit.external`` calls (what that call does on a hit); and
 the cost of one right-hand-side evaluation from Python: kinetwork compiled C and CasADi's
-virtual machine, both through ``kinetwork.simulation.compiled.numeric`` (~0.5 us of call overhead included),
+virtual machine, both through ``kinetwork.solver.compiled.numeric`` (~0.5 us of call overhead included),
 pinocchio's ``aba`` and MuJoCo's ``mj_forward`` on the peers' models of the same chain. Each
 per-evaluation time is the median over batches of repeated calls on one state.
 
@@ -51,8 +51,8 @@ from common import RESULTS, STYLE, chart, load, machine, table, timed, write_csv
 from scenes import chains as scenes
 import kinetwork as kn
 from kinetwork.graph.topology import analyze
-from kinetwork.simulation import jit
-from kinetwork.simulation.compiled import compiled as compiled_of, numeric
+from kinetwork.solver import jit
+from kinetwork.solver.compiled import compiled as compiled_of, numeric
 
 SIZES = (2, 4, 8, 16, 32, 64, 128, 256, 512, 1024)
 FIT_FROM = 8
@@ -348,7 +348,7 @@ def integrator_setup(sizes=(64, 128, 256, 512)):
     function at creation whether or not it will use it, by finite differences of the compiled
     code over a dense pattern. Before: the equations as they were handed over; now:
     ``Compiled.dae`` without Newton, its derivatives in x hidden (``stop_diff``)."""
-    from kinetwork.simulation.methods import METHODS
+    from kinetwork.solver.methods import METHODS
     opts = {**METHODS["cvodes-adams"].options, "reltol": 1e-7, "abstol": 1e-9}
     grid = [0.01 * k for k in range(1, 11)]
     rows = []

@@ -45,7 +45,7 @@ from scenes import reference_loops as rl
 from scenes.reference import seed_reference
 
 import kinetwork as kn
-from kinetwork.simulation import tolerance
+from kinetwork.solver import tolerance
 
 sys.path.insert(0, str(common.HERE / "peers"))
 import pinocchio_peer

@@ -534,7 +534,7 @@ def counts_table(scene, system, built, horizon, rtols):
     kinetwork hands CVODES for it (``tolerance.solver_tolerances``: the same method at the
     same tolerances): wall time (least of 3), steps and right-hand-side evaluations, so that
     a difference in time reads as a difference in count or in cost per evaluation."""
-    from kinetwork.simulation.tolerance import solver_tolerances
+    from kinetwork.solver.tolerance import solver_tolerances
     t = built["t"]
     rows = []
     for r in rtols:
@@ -643,7 +643,7 @@ def casadi_study(quick):
     lines += against_hand_written(curves_of)
     lines += ["## Where the time goes", "",
               "Per rtol asked of kinetwork, and in brackets the solver's rtol it maps it to "
-              "(``kinetwork/simulation/tolerance.py``), at which the hand-written route runs "
+              "(``kinetwork/solver/tolerance.py``), at which the hand-written route runs "
               "here too (the same method at the same tolerances): the least wall time of 3 "
               "runs, steps and right-hand-side evaluations (kinetwork's counted by CVODES), "
               "and wall time per evaluation (the whole run divided by the evaluations: "
@@ -675,9 +675,9 @@ def overheads(rtols=(1e-4, 1e-7)):
     kinetwork functions are wrapped to be timed: a diagnostic, not a benchmark."""
     import casadi as ca
     from kinetwork.equations import system as system_module
-    from kinetwork.simulation import methods
-    from kinetwork.simulation.compiled import compiled
-    from kinetwork.simulation.tolerance import solver_tolerances
+    from kinetwork.solver import methods
+    from kinetwork.solver.compiled import compiled
+    from kinetwork.solver.tolerance import solver_tolerances
     clocks = {}
 
     def wrap(owner, name):
@@ -742,7 +742,7 @@ def overheads(rtols=(1e-4, 1e-7)):
              "kinetwork, in brackets; both routes at that one): one `simulate` with "
              "cvodes-adams (what `auto` runs on these undamped chains; least of 3), its "
              "integrator calls (the driver's chunks: number and time; one for a run that "
-             "nothing watches, see ``kinetwork/simulation/driver.py``), CVODES' "
+             "nothing watches, see ``kinetwork/solver/driver.py``), CVODES' "
              "right-hand-side evaluations over them, the probes' evaluation on the output "
              "grid (`System.outputs_p`; these chains have no probe), the rest; then "
              "kinetwork's own compiled DAE in one integrator call over the whole grid, and the "

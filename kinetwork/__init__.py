@@ -34,9 +34,9 @@ _LAZY = {
     "electrical": ("components.electrical", None),
     "signals": ("components.signals", None),
     "System": ("equations.system", "System"),
-    "simulate": ("simulation.driver", "simulate"),
-    "METHODS": ("simulation.methods", "METHODS"),
-    "Results": ("simulation.results", "Results"),
+    "simulate": ("solver.driver", "simulate"),
+    "METHODS": ("solver.methods", "METHODS"),
+    "Results": ("solver.results", "Results"),
     "schema": ("schema", None),       # the module, callable: kn.schema()
     "from_urdf": ("urdf", "from_urdf"),
     "examples": ("examples", None),
@@ -68,7 +68,7 @@ def _install():
     graph = importlib.import_module(f"{__name__}.graph.model")
     if "_repr_svg_" not in vars(graph.Model):
         graph.Model._repr_svg_ = _repr_svg_
-    results = importlib.import_module(f"{__name__}.simulation.results")
+    results = importlib.import_module(f"{__name__}.solver.results")
     if results._animator is None:
         results.install_animator(_animate)
 

@@ -90,7 +90,7 @@ def build_parser():
     """The argument parser of the ``kinetwork`` command."""
     from .analysis import commands as analysis_commands
     from .analysis.sweep import add_command as add_sweep
-    from .simulation.methods import METHODS
+    from .solver.methods import METHODS
 
     parser = argparse.ArgumentParser(
         prog="kinetwork",
@@ -414,7 +414,7 @@ def _run(args):
     # a subsystem's value by path ("cyl1.phi0") is a constant of its instance: set on the
     # model before it is compiled; model parameters go to the integrator
     from .graph.settings import check_output, check_settings
-    from .simulation.driver import DEFAULTS
+    from .solver.driver import DEFAULTS
 
     params = {}
     for name, value in args.param:
@@ -471,7 +471,7 @@ def _run(args):
           f"({code}{'; ' + work if work else ''}) in {done - compiled:.3g} s wall time "
           f"(build {compiled - start:.3g} s)")
     if "error_estimate" in stats:
-        from .simulation.estimate import summary
+        from .solver.estimate import summary
         print("\n".join(summary(stats["error_estimate"], results.signal_names)))
     _outputs(args, results, model.name)
     return 0
@@ -676,7 +676,7 @@ def _schema(args):
 
 
 def _cache(args):
-    from .simulation import jit
+    from .solver import jit
     if args.clear:
         removed = jit.clear_cache()
         print(f"removed {removed} file{'s' * (removed != 1)} from {jit.cache_dir()}")
@@ -693,7 +693,7 @@ def _cache(args):
 
 
 def _methods(args):
-    from .simulation.driver import DEFAULTS, METHODS
+    from .solver.driver import DEFAULTS, METHODS
     width = max(map(len, METHODS))
     print(f"default: {DEFAULTS['method']}, rtol {DEFAULTS['rtol']:g}, atol {DEFAULTS['atol']:g}")
     for name, method in METHODS.items():

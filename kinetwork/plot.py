@@ -13,7 +13,7 @@ import numpy as np
 
 from .util import atomic_write, callable_module, suggest
 from .errors import ModelError
-from .simulation.results import install_plotter
+from .solver.results import install_plotter
 
 #: a probe with more quantities than this wraps onto further rows (a frame probe has eight)
 MAX_COLUMNS = 4

@@ -13,7 +13,7 @@ from .components.base import COLOR, REGISTRY
 from .components.reference import param_line, reference
 from .graph.io import DEFINITION_KEYS, FORMAT, KEYS, KEYS_V2, VERSION
 from .graph.settings import SIMULATION_KEYS
-from .simulation.methods import METHODS
+from .solver.methods import METHODS
 from .util import callable_module
 
 IDENT = "^[A-Za-z_][A-Za-z0-9_]*$"

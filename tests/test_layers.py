@@ -3,7 +3,7 @@
 Every module is read with ``ast`` (nothing is imported): each import, at any depth (inside
 functions too), relative or absolute, is resolved to the kinetwork module it names. Layers,
 lowest first (the package docstring's list): the helpers ``errors``, ``util``, ``expr``,
-``units``, ``spatial``; ``components``; ``graph``; ``equations``; ``simulation``; the faces
+``units``, ``spatial``; ``components``; ``graph``; ``equations``; ``solver``; the faces
 ``plot``, ``schema``, ``symbolic``, ``cli`` (and ``kinetwork/__init__.py``, which gathers
 them all). A module of a sub-package is in its package's layer. A module may import from its
 own layer and those below it; the imports must not form a cycle, within a layer either.
@@ -20,7 +20,7 @@ import kinetwork
 
 PACKAGE = pathlib.Path(kinetwork.__file__).resolve().parent
 LAYERS = [("errors", "util", "expr", "units", "spatial"), ("components",), ("graph",),
-          ("equations",), ("simulation",),
+          ("equations",), ("solver", "simulation"),
           ("plot", "plotworker", "quickplot", "schema", "symbolic", "animation", "diagram", "urdf",
            "examples", "studio", "analysis", "cli", "__main__", "")]
 RANK = {name: rank for rank, names in enumerate(LAYERS) for name in names}
@@ -109,7 +109,7 @@ def test_no_import_cycles():
      "kinetwork.components.base"),
     ("def f():\n    from .topology import analyze", "kinetwork.graph.model",
      "kinetwork.graph.topology"),
-    ("import kinetwork.simulation.jit", "kinetwork.cli", "kinetwork.simulation.jit"),
+    ("import kinetwork.solver.jit", "kinetwork.cli", "kinetwork.solver.jit"),
     ("from kinetwork.components import multibody", "kinetwork.cli",
      "kinetwork.components.multibody"),
     ("from kinetwork import Model", "kinetwork.cli", "kinetwork"),

@@ -17,7 +17,7 @@ import kinetwork as kn
 from kinetwork import quickplot
 from kinetwork.plot import plot_results
 from kinetwork.plotworker import PlotSignal
-from kinetwork.simulation.results import Results
+from kinetwork.solver.results import Results
 from scenes import double_pendulum
 
 matplotlib.use("Agg")

@@ -39,12 +39,12 @@ from ..equations.system import OVERFLOW, System, overflow_message
 from ..errors import ModelError, SimulationError
 from ..expr import parse
 from ..graph.model import evaluate
-from ..simulation import jit as _jit
-from ..simulation.capture import SOLVER_LOCK, solver_output
-from ..simulation.compiled import compiled
-from ..simulation.driver import DEFAULTS, simulate
-from ..simulation.driver import _check as check_settings
-from ..simulation.methods import (
+from ..solver import jit as _jit
+from ..solver.capture import SOLVER_LOCK, solver_output
+from ..solver.compiled import compiled
+from ..solver.driver import DEFAULTS, simulate
+from ..solver.driver import _check as check_settings
+from ..solver.methods import (
     METHODS,
     STIFF_HORIZON_STEPS,
     STIFF_RATIO,

@@ -2,7 +2,7 @@
 
 Each element acts between a flange ``b`` and a flange ``a`` (its support: unwired, the
 world) and is in one of a few modes, which the integration driver changes at events
-(``kinetwork.simulation.events``). A mode is a state of the model (``brake.mode``, its rate
+(``kinetwork.solver.events``). A mode is a state of the model (``brake.mode``, its rate
 zero), so one compiled system serves every mode. The force into flange b is
 
     f = (1 - held(mode)) * law(rel, w_rel, mode) + F
@@ -80,7 +80,7 @@ class PartialFriction(PartialHybrid):
     modes = {-1: "sliding backward", 0: "stuck", 1: "sliding forward"}
     hold_mode = 0
     #: the modes an element at rest may take, decided together with the others at rest at
-    #: the same instant (``simulation/events.py``): stuck, or sliding the way it accelerates
+    #: the same instant (``solver/events.py``): stuck, or sliding the way it accelerates
     at_rest_modes = (0, 1, -1)
 
     def kinetic(self, u):

@@ -9,7 +9,7 @@ relative acceleration of each element is affine in the forces F, so the conditio
 
 (a held element keeps its flanges together, any other holds with nothing) are one small
 linear system in F, solved symbolically: one compiled system serves every combination of
-modes, and a stuck friction is exactly stuck. The driver (``simulation/events.py``) reads
+modes, and a stuck friction is exactly stuck. The driver (``solver/events.py``) reads
 the indicators and numbers of ``f_values`` and applies impulses with ``f_response``.
 """
 
@@ -22,9 +22,9 @@ from ..errors import ModelError
 
 #: columns of ``Modes.f_values``: the indicator, the relative position and speed, the holding
 #: force, the element's two numbers (a static limit, a restitution), and the relative
-#: acceleration (which way an element at rest starts to slide: ``simulation/events.py``),
+#: acceleration (which way an element at rest starts to slide: ``solver/events.py``),
 #: and the indicator's rate along the motion (an indicator that dips to zero and back between
-#: two sampled points has a minimum there: ``simulation/events.py`` looks for it)
+#: two sampled points has a minimum there: ``solver/events.py`` looks for it)
 COLUMNS = ("indicator", "rel", "w_rel", "force", "value0", "value1", "a_rel", "rate")
 
 

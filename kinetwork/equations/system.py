@@ -2,7 +2,7 @@
 
 A System is built once per model content (``Model.compile`` keeps it) and is not changed by
 running it: whatever a run compiles or caches (C code, integrators) lives in
-``kinetwork.simulation``. Model parameters stay symbols, so one System serves every
+``kinetwork.solver``. Model parameters stay symbols, so one System serves every
 parameter value.
 """
 
@@ -356,7 +356,7 @@ class System:
     @functools.cached_property
     def damped(self):
         """Whether a generalized force depends on the speeds (dampers): only then can the
-        model be stiff in the sense of ``kinetwork.simulation.driver.stiffness``."""
+        model be stiff in the sense of ``kinetwork.solver.driver.stiffness``."""
         return bool(ca.depends_on(self.asm.Q, self.asm.u)) if self.n_states else False
 
     # -- size -----------------------------------------------------------------------------

@@ -16,7 +16,7 @@ import threading
 import numpy as np
 
 from ..errors import ModelError, SimulationError
-from ..simulation.driver import DEFAULTS, simulate
+from ..solver.driver import DEFAULTS, simulate
 from .checks import build, plain, problems_of
 from .files import StudioError
 

@@ -1,5 +1,5 @@
 """Several frictions changing mode at one instant: their modes decided together
-(``simulation/events.py``, ``Events._together``), against closed forms."""
+(``solver/events.py``, ``Events._together``), against closed forms."""
 
 import numpy as np
 import pytest

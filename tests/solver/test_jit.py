@@ -5,8 +5,8 @@ import numpy as np
 import pytest
 
 import kinetwork as kn
-from kinetwork.simulation import compiled as compiled_module, jit
-from kinetwork.simulation.compiled import compiled, numeric
+from kinetwork.solver import compiled as compiled_module, jit
+from kinetwork.solver.compiled import compiled, numeric
 from scenes import build_kinetwork, double_pendulum, random_mechanism
 from scenes.reference import seed_reference
 

@@ -1,4 +1,4 @@
-"""Events in the driver (``simulation/events.py``): located to the integrator's tolerance by
+"""Events in the driver (``solver/events.py``): located to the integrator's tolerance by
 every method that takes them, against closed forms."""
 
 import matplotlib
@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 import kinetwork as kn
-from kinetwork.simulation.methods import METHODS
+from kinetwork.solver.methods import METHODS
 
 matplotlib.use("Agg")
 

@@ -13,8 +13,8 @@ from scenes import reference_loops as rl
 from scenes.reference import seed_reference
 
 import kinetwork as kn
-from kinetwork.simulation import tolerance
-from kinetwork.simulation.methods import METHODS
+from kinetwork.solver import tolerance
+from kinetwork.solver.methods import METHODS
 
 T_END = 3.0
 N_POINTS = 151

@@ -8,9 +8,9 @@ import pytest
 
 import kinetwork as kn
 from kinetwork.equations import newton_euler
-from kinetwork.simulation import compiled as compiled_module, jit
-from kinetwork.simulation.compiled import compiled, numeric
-from kinetwork.simulation.methods import METHODS
+from kinetwork.solver import compiled as compiled_module, jit
+from kinetwork.solver.compiled import compiled, numeric
+from kinetwork.solver.methods import METHODS
 from scenes import chains
 from scenes.reference import seed_reference
 

@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 from scenes import build_kinetwork, random_mechanism
 
-from kinetwork.simulation import jit
+from kinetwork.solver import jit
 
 pytestmark = pytest.mark.skipif(jit.compiler() is None, reason="no C compiler")
 

@@ -12,8 +12,8 @@ from scenes.reference import seed_reference
 
 import kinetwork as kn
 from kinetwork.graph.model import install_compiler
-from kinetwork.simulation import driver, methods
-from kinetwork.simulation.methods import METHODS, Failure
+from kinetwork.solver import driver, methods
+from kinetwork.solver.methods import METHODS, Failure
 
 
 def five_bar():
@@ -224,7 +224,7 @@ def test_a_quiet_run_is_one_call_of_its_integrator_and_a_watched_one_goes_in_chu
     import casadi as ca
     from scenes.chains import chain
 
-    from kinetwork.simulation.tolerance import solver_tolerances
+    from kinetwork.solver.tolerance import solver_tolerances
     system = chain(8).compile()
     calls = []
     advance = methods._CasadiRun.advance

@@ -8,8 +8,8 @@ import numpy as np
 import pytest
 
 import kinetwork as kn
-from kinetwork.simulation import methods
-from kinetwork.simulation.methods import stiffness
+from kinetwork.solver import methods
+from kinetwork.solver.methods import stiffness
 from scenes import chain, double_pendulum   # chain: n uniform rods on revolute z joints
 from scenes.reference import PAPER, seed_energy, seed_mvg, seed_reference
 

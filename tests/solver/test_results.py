@@ -1,4 +1,4 @@
-"""Results (kinetwork/simulation/results.py), built by hand from Signal descriptors: shapes,
+"""Results (kinetwork/solver/results.py), built by hand from Signal descriptors: shapes,
 keys, CSV columns, the partial-run line and the atomic write."""
 
 import csv
@@ -9,7 +9,7 @@ import pytest
 
 import kinetwork as kn
 from kinetwork.equations.signals import Signal
-from kinetwork.simulation.results import Results
+from kinetwork.solver.results import Results
 
 SIGNALS = [Signal("p.angle", "rad", (), "p", "angle", "j.axis"),
            Signal("f.position", "m", (3,), "f", "position", "b.frame_a"),

@@ -14,8 +14,8 @@ import numpy as np
 import pytest
 
 from kinetwork.errors import ModelError
-from kinetwork.simulation import jit
-from kinetwork.simulation.jit import JitFallbackWarning
+from kinetwork.solver import jit
+from kinetwork.solver.jit import JitFallbackWarning
 
 X = np.array([0.3, -1.2])
 PLANT = r"""

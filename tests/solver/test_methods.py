@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 import kinetwork as kn
-from kinetwork.simulation.compiled import numeric
+from kinetwork.solver.compiled import numeric
 from scenes import double_pendulum
 from scenes.reference import seed_reference
 

@@ -198,7 +198,7 @@ def simulate(model: Model | System, t_end: float | None = None, n_points: int | 
         Model parameter values for this run, numbers (SI) or numbers with a unit
         (``{"c": "2 N*m/rad"}``, see ``Model.parameter_values``); no recompilation.
     jit : bool, optional
-        Compile the equations to C (cached on disk, see ``kinetwork.simulation.jit``). True
+        Compile the equations to C (cached on disk, see ``kinetwork.solver.jit``). True
         insists (a ModelError when it cannot be done); None (default) compiles when a C
         compiler is found and ``KINETWORK_JIT`` is not 0, and falls back to CasADi's virtual
         machine, with a warning, when compilation fails.
@@ -221,7 +221,7 @@ def simulate(model: Model | System, t_end: float | None = None, n_points: int | 
         With kinematic loops: where the partition of the speeds into independent and
         dependent ones nears a singular configuration (a dead point of the independent
         coordinates, or a change point of the mechanism), choose another partition there and
-        go on (``kinetwork.simulation.loopwatch``); ``stats["repartitions"]`` counts them,
+        go on (``kinetwork.solver.loopwatch``); ``stats["repartitions"]`` counts them,
         ``stats["repartition_times"]`` says when. False: stop there with a SimulationError.
     error_estimate : bool, optional
         Run again at tighter tolerances on the same compiled System and put an estimate of

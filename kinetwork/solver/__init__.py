@@ -1,0 +1,1 @@
+"""Running a System: the one integrator driver, the method table, the JIT cache, Results."""
