@@ -25,6 +25,9 @@ class PartialTwoPin(Component):
     n_states = 0
     state_labels = ()
     state_units = ()
+    #: the parameters giving the states' starts: one given makes its state preferred where
+    #: a constraint leaves a choice (index reduction)
+    start_params = ()
 
     def laws(self, e):
         """The two residuals: the current through (i_p + i_n = 0) and the component's law."""
@@ -55,6 +58,7 @@ class Inductor(PartialTwoPin, library=LIB):
     n_states = 1
     state_labels = ("i",)
     state_units = ("A",)
+    start_params = ("i0",)
 
     def law(self, v, i, e):
         return i - e.x[0]
@@ -73,6 +77,7 @@ class Capacitor(PartialTwoPin, library=LIB):
     n_states = 1
     state_labels = ("v",)
     state_units = ("V",)
+    start_params = ("v0",)
 
     def law(self, v, i, e):
         return v - e.x[0]

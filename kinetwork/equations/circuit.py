@@ -1,28 +1,41 @@
 """Electrical circuits (``kinetwork.components.electrical``), solved by structural analysis.
 
 The unknowns are one potential per connection set of pins (the connection sets are the
-alias elimination: every pin wired together shares one symbol) and one current per pin.
-The equations are Kirchhoff's current law at every set and each component's laws, one per
-pin, linear in the unknowns, with the components' states (inductor currents, capacitor
-voltages), the speeds of EMF flanges, time and signal inputs as knowns. Matching equations to
-unknowns (networkx's Hopcroft-Karp) finds a circuit that is structurally singular (no
-ground, two voltage sources in parallel) or of higher index (a capacitor across a voltage
-source, an inductor in series with a current source), refused with its components named;
-the strongly connected components of the matched dependency graph (Tarjan), in topological
-order, are the block-lower-triangular form: each block is solved symbolically in turn, a
-scalar block by one division, a loop of resistors as one small linear system.
+alias elimination: every pin wired together shares one symbol), one current per pin and
+the derivatives of the components' states (inductor currents, capacitor voltages). The
+equations are Kirchhoff's current law at every set, each component's laws (one per pin)
+and its states' rate equations (C v' = i, L i' = v); the speeds of EMF flanges, time and
+the signals at the sources' u inputs are knowns.
 
-Every current and potential so becomes an expression of the states, the mechanism's speeds,
-t and placeholders for the signals at the sources' u inputs (their values are substituted
-when the network has them all: ``Circuit.inputs``).
+A circuit whose laws fix a relation among its states (a capacitor across a voltage source,
+a loop of capacitors, inductors in series, an inductor in series with a current source) is
+of higher index: ``structure.reduce_index`` finds the equations to differentiate
+(Pantelides), CasADi differentiates them, and the dummy derivatives pick the states those
+constraints fix, which become algebraic (solved from the other states and the sources), as
+a Modelica tool does. Where the choice is free, a state whose start the user gave (``v0``,
+``i0``) stays a state, then the one placed first. A structurally singular circuit (no
+ground, two voltage sources in parallel, an open current source) is refused naming the
+components whose laws over-determine it, sorted.
+
+The index-1 system left is solved block by block (``structure.solve_blocks``): a linear
+block symbolically, a nonlinear one (a diode and its resistor) torn, its tearing unknowns
+left to IDAS as algebraic variables. Every current and potential so becomes an expression
+of the states, the mechanism's speeds, t and placeholders for the signals at the sources'
+u inputs (and their time derivatives, where a constraint was differentiated): the network
+substitutes those once it has them (``Circuit.inputs``, ``Circuit.input_rates``).
 """
 
 import casadi as ca
 import networkx as nx
+import numpy as np
 
 from ..errors import ModelError
+from .structure import Singular, reduce_index, solve_blocks
 
 DOMAIN = "electrical"
+#: a given start further than this (relative to 1 + |value|) from the value a constraint
+#: fixes is refused
+START_TOL = 1e-9
 
 
 class _Pins:
@@ -31,6 +44,7 @@ class _Pins:
     def __init__(self, circuit, comp, x, u, w):
         self._c, self._comp, self.x, self.u, self.w = circuit, comp, x, u, w
         self.t = circuit.b.t
+        self.parameters = circuit.parameters
 
     def v(self, pin):
         return self._c.potential[self._c.topo.set_of[self._comp.port_ref(pin)]]
@@ -48,9 +62,16 @@ class Circuit:
                       if any(port.domain == DOMAIN for port in c.ports.values())]
         self.potential, self.current = {}, {}      # set -> SX, PortRef -> SX
         self.inputs = {}                           # placeholder -> signal set of its u
+        self.input_rates = {}                      # placeholder of du/dt -> signal set
         self.sources = {}                          # component name -> its placeholder
+        self.source_rates = {}                     # component name -> placeholder of du/dt
+        self.speeds = {}                           # EMF name -> (symbol of w, of dw/dt)
         self.views = {}
+        self.parameters = ({name: b.p[i] for i, name in enumerate(self.model.parameters)}
+                           if b.p is not None else {})
         self.summary = ""
+        #: state name -> why it is no state (its value fixed by a differentiated constraint)
+        self.demoted = {}
 
     # -- building ---------------------------------------------------------------------------
     def build(self):
@@ -76,37 +97,56 @@ class Circuit:
         for s in sets:                            # Kirchhoff's current law
             equations.append(sum((self.current[r] for r in self.topo.sets[s]
                                   if r in self.current), ca.SX(0)))
-            owners.append(f"the currents at {{{self._where(s)}}}")
+            owners.append(None)
+        knowns = []
         for c in self.comps:
-            view = self._view(c)
+            view = self._view(c, knowns)
             for eq in self.b.bound[c.name].laws(view):
                 equations.append(ca.SX(eq))
-                owners.append(self.model.place(c))
-        solved = self._solve(equations, owners, unknowns, names)
-        values = ca.vertcat(*[solved[k] for k in range(len(unknowns))])
-        z = ca.vertcat(*unknowns)
-
-        def sub(e):
-            return ca.substitute(ca.SX(e), z, values)
-        for s in sets:
-            self.potential[s] = sub(self.potential[s])
-        for ref in self.current:
-            self.current[ref] = sub(self.current[ref])
+                owners.append(c)
+        states, rates, labels, priority = [], [], [], []
         for c in self.comps:
             view = self.views[c.name]
-            for x, rate in zip(view.x, self.b.bound[c.name].rates(view)):
-                self.b.net.rate[self.b._at(x)] = sub(rate)
+            for k, (x, rate) in enumerate(zip(view.x, self.b.bound[c.name].rates(view))):
+                dx = ca.SX.sym(f"der_{x.name()}")
+                states.append(x)
+                rates.append(dx)
+                equations.append(dx - rate)
+                owners.append(c)
+                labels.append((c, k))
+                priority.append((_start_key(c, k) in c.given, -len(priority)))
+        self._names = names + [self.b.net.names[self.b._at(x)] for x in states]
+        self._owners = owners
+        try:
+            reduced = reduce_index(equations, unknowns, states, rates, knowns, self.b.t,
+                                   priority, self._sample,
+                                   self.b.p if self.b.p is not None else ca.SX(0, 1))
+        except Singular as exc:
+            raise self._refusal(exc, len(unknowns)) from None
+        try:
+            solved = solve_blocks(reduced.equations, reduced.unknowns, self._regular)
+        except Singular as exc:
+            raise self._refusal(exc, len(unknowns), reduced) from None
+        self._apply(reduced, solved, unknowns, states, rates, labels, sets)
         return self
 
-    def _view(self, comp):
+    def _view(self, comp, knowns):
         b = self.b
         bound = b.bound[comp.name]
         x = [b._state(f"{comp.name}.{label}", unit, start, 0) for label, unit, start in
              zip(bound.state_labels, bound.state_units, bound.initial())]
         u = self.sources.get(comp.name)
+        if u is not None:
+            du = self.source_rates[comp.name] = ca.SX.sym(f"du_{comp.name}")
+            self.input_rates[du] = self.inputs[u]
+            knowns.append((u, du))
         w = None
         if getattr(type(comp), "converter", False):
-            w = (b.net.vel[comp.port_ref("flange")] - b.net.vel[comp.port_ref("support")])
+            # a symbol for the speed, its derivative the flange's relative acceleration:
+            # both put in once the circuit is solved (``_apply``)
+            w, dw = self.speeds[comp.name] = (ca.SX.sym(f"w_{comp.name}"),
+                                               ca.SX.sym(f"dw_{comp.name}"))
+            knowns.append((w, dw))
         view = _Pins(self, comp, x, u, w)
         self.views[comp.name] = view
         return view
@@ -145,7 +185,7 @@ class Circuit:
         grounded = {self.topo.set_of[c.port_ref("p")] for c in self.comps
                     if c.type_name == "electrical.Ground"}
         problems = []
-        for part in nx.connected_components(g):
+        for part in sorted(nx.connected_components(g), key=min):
             if not part & grounded:
                 names = sorted({r.component.name for s in part for r in self.topo.sets[s]
                                 if r.component.role != "probe"})
@@ -158,86 +198,211 @@ class Circuit:
     def _where(self, s):
         return ", ".join(r.path for r in self.topo.sets[s] if r.component.role != "probe")
 
-    # -- structural analysis ----------------------------------------------------------------
-    def _solve(self, equations, owners, unknowns, names):
-        """Index of unknown -> its expression in the knowns: matching, then the blocks of
-        the block-lower-triangular form, in order."""
-        z = ca.vertcat(*unknowns)
-        r = ca.vertcat(*equations)
-        jac = ca.jacobian(r, z)
-        if ca.depends_on(jac, z):
-            bad = sorted({owners[k] for k in range(len(equations))
-                          if ca.depends_on(ca.jacobian(r[k], z), z)})
-            raise ModelError([f"{o}: its law is not linear in the currents and potentials"
-                              for o in bad])
-        sparsity = jac.sparsity()
-        rows, cols = sparsity.get_triplet()
-        g = nx.Graph()
-        eqs = [("e", k) for k in range(len(equations))]
-        g.add_nodes_from(eqs, bipartite=0)
-        g.add_nodes_from((("z", j) for j in range(len(unknowns))), bipartite=1)
-        g.add_edges_from((("e", i), ("z", j)) for i, j in zip(rows, cols))
-        matching = nx.bipartite.hopcroft_karp_matching(g, top_nodes=eqs)
-        unmatched = [k for k in range(len(equations)) if ("e", k) not in matching]
-        if unmatched or len(equations) != len(unknowns):
-            lost = [names[j] for j in range(len(unknowns)) if ("z", j) not in matching]
-            over = sorted({owners[k] for k in unmatched})
-            raise ModelError(
-                f"circuit: the equations of {', '.join(over) or 'the circuit'} leave "
-                f"{', '.join(lost) or 'nothing'} undetermined and constrain the rest twice: "
-                f"the circuit is structurally singular (two voltage sources in parallel, a "
-                f"current source in series with another, an open current source) or of "
-                f"higher index (a capacitor directly across a voltage source or another "
-                f"capacitor loop, an inductor in series with a current source), which "
-                f"kinetwork does not solve; add a resistor to the loop or the cut set")
-        assigned = {k: matching[("e", k)][1] for k in range(len(equations))}
-        dep = nx.DiGraph()
-        dep.add_nodes_from(range(len(equations)))
-        owner_of = {j: k for k, j in assigned.items()}
-        for i, j in zip(rows, cols):
-            if assigned[i] != j:
-                dep.add_edge(owner_of[j], i)      # equation i needs what owner_of[j] gives
-        dag = nx.condensation(dep)
-        sizes = sorted((len(dag.nodes[c]["members"]) for c in dag), reverse=True)
-        loops = [n for n in sizes if n > 1]
-        states = sum(len(v.x) for v in self.views.values())
-        self.summary = (f"circuits: {len(unknowns) - len(self.current)} node potentials and "
-                        f"{len(self.current)} pin currents in {len(sizes)} blocks solved "
-                        f"symbolically" + (f" (linear loops of {', '.join(map(str, loops))})"
-                                           if loops else "") + f", {states} states")
-        solved = {}
-        known_z, known_v = [], []
-        for c in nx.topological_sort(dag):
-            block = sorted(dag.nodes[c]["members"])
-            zs = [assigned[k] for k in block]
-            res = ca.vertcat(*[r[k] for k in block])
-            if known_z:
-                res = ca.substitute(res, ca.vertcat(*known_z), ca.vertcat(*known_v))
-            zb = ca.vertcat(*[unknowns[j] for j in zs])
-            a = ca.jacobian(res, zb)
-            rest = ca.substitute(res, zb, ca.SX.zeros(len(zs)))
-            self._regular(a, [owners[k] for k in block])
-            values = -rest / a if len(zs) == 1 else -ca.solve(a, rest)
-            for n, j in enumerate(zs):
-                solved[j] = values[n]
-                known_z.append(unknowns[j])
-                known_v.append(values[n])
-        return solved
-
-    def _regular(self, a, owners):
-        """Refuse a block whose matrix is singular at the parameters' values (a loop of
-        zero resistances)."""
+    # -- numbers at the parameters' values --------------------------------------------------
+    def _at_values(self, expr):
         b = self.b
-        det = ca.det(a)
         if b.p is not None and b.p.numel():
-            det = ca.substitute(det, b.p, ca.DM(b.p_values))
+            expr = ca.substitute(expr, b.p, ca.DM(b.p_values))
+        return expr
+
+    def _sample(self, expr):
+        """A Jacobian at the parameters' values and generic values of every other symbol
+        (the same in every run): where the dummy derivatives' ranks are taken."""
+        expr = self._at_values(ca.SX(expr))
+        syms = ca.symvar(expr)
+        if syms:
+            rng = np.random.default_rng(20260527)
+            expr = ca.substitute(expr, ca.vertcat(*syms),
+                                 ca.DM(rng.uniform(0.5, 1.5, len(syms))))
+        return np.array(ca.evalf(expr), dtype=float).reshape(expr.shape)
+
+    def _regular(self, a):
+        """Whether a block's matrix is regular at the parameters' values (a loop of zero
+        resistances is not); one whose entries vary in time is taken as regular (IDAS or
+        CVODES will say where it is not)."""
+        det = self._at_values(ca.det(a))
         if not det.is_constant():
-            return                  # a coefficient varies in time: CVODES will say
+            return True
         det = float(det)
-        if abs(det) < 1e-300 or det != det:
-            raise ModelError(f"circuit: the equations of {', '.join(sorted(set(owners)))} "
-                             f"are singular at the parameters' values (det = {det:g}): a "
-                             f"loop of zero resistances or of sources")
+        return abs(det) >= 1e-300 and det == det
+
+    # -- the solution -----------------------------------------------------------------------
+    def _apply(self, reduced, solved, unknowns, states, rates, labels, sets):
+        """Put the solution in place: potentials, currents, the kept states' rates, the
+        demoted states' values (and their states dropped), the algebraic variables."""
+        value = dict(zip((z.element_hash() for z in reduced.unknowns), solved.values))
+        z = ca.vertcat(*[u for u in unknowns])
+        vz = ca.vertcat(*[value[u.element_hash()] for u in unknowns])
+        demoted = [states[i] for i in reduced.demoted]
+        vd = [value[x.element_hash()] for x in demoted]
+        known = self._knowns()
+
+        def sub(e):
+            e = ca.substitute(ca.SX(e), z, vz)
+            if demoted:
+                e = ca.substitute(e, ca.vertcat(*demoted), ca.vertcat(*vd))
+            return known(e)
+        for s in sets:
+            self.potential[s] = sub(self.potential[s])
+        for ref in self.current:
+            self.current[ref] = sub(self.current[ref])
+        for i in reduced.states:
+            self.b.net.rate[self.b._at(states[i])] = sub(value[rates[i].element_hash()])
+        self._check_starts(reduced, states, labels, [sub(v) for v in vd])
+        for i in reduced.demoted:
+            self._drop(states[i])
+        if solved.kept:
+            net = self.b.net
+            owners = sorted({o.name for o in self._owners if o is not None and any(
+                ca.depends_on(r, k) for r in solved.residuals for k in solved.kept)})
+            net.alg_z += solved.kept
+            net.alg_res += [sub(r) for r in solved.residuals]
+            net.alg_names += [self._label(k, unknowns) for k in solved.kept]
+            net.alg_units += ["V" if k.name().startswith("v") else "A"
+                              for k in solved.kept]
+            net.loops_kept.append(owners)
+        # the rates of the sources' signals are needed only where a constraint was
+        # differentiated through a source (the network finds them: ``_input_rates``)
+        used = ca.vertcat(*self.potential.values(), *self.current.values(),
+                          *self.b.net.rate, *self.b.net.alg_res)
+        self.input_rates = {du: s for du, s in self.input_rates.items()
+                            if ca.depends_on(used, du)}
+        self.summary = self._summary(reduced, solved, unknowns, states)
+
+    def _knowns(self):
+        """The function putting the EMF speeds in, and their derivatives where a
+        differentiated constraint reads them: zero on a flange that cannot turn; on one that
+        moves, the circuit constrains the mechanism, which is refused."""
+        net = self.b.net
+
+        def known(e):
+            for name, (w, dw) in self.speeds.items():
+                c = self.model.components[name]
+                f, s = c.port_ref("flange"), c.port_ref("support")
+                if ca.depends_on(e, dw):
+                    acc = ca.SX(net.acc[f] - net.acc[s])
+                    if not acc.is_zero():
+                        raise ModelError(
+                            f"{self.model.place(c)}: the circuit fixes the voltage across "
+                            f"{name} (it is wired across a voltage source or a capacitor "
+                            f"with no resistance or inductance in between), so it "
+                            f"constrains the speed of the mechanism at {name}.flange, "
+                            f"which kinetwork does not reduce; add the armature's resistance "
+                            f"or inductance")
+                    e = ca.substitute(e, dw, acc)
+                if ca.depends_on(e, w):
+                    e = ca.substitute(e, w, ca.SX(net.vel[f] - net.vel[s]))
+            return e
+        return known
+
+    def _check_starts(self, reduced, states, labels, values):
+        """Record why each demoted state is no state, and check a start the user gave it
+        against the constraint (at t = 0 and the parameters' values): one that disagrees,
+        or that depends on signals the network has not built yet, is refused."""
+        net, problems = self.b.net, []
+        kept = [states[i] for i in reduced.states]
+        starts = [self._at_values(ca.SX(net.start[self.b._at(x)])) for x in kept]
+        for i, v in zip(reduced.demoted, values):
+            comp, k = labels[i]
+            key = _start_key(comp, k)
+            name = net.names[self.b._at(states[i])]
+            self.demoted[name] = self._why(reduced, comp, v, kept, states, labels)
+            if key not in comp.given:
+                continue
+            at0 = self._at_values(ca.substitute(v, self.b.t, ca.SX(0)))
+            if kept:
+                at0 = ca.substitute(at0, ca.vertcat(*kept), ca.vertcat(*starts))
+            given = float(self._at_values(ca.SX(self.b.bound[comp.name].initial()[k])))
+            where = self.model.place(comp, key)
+            if not at0.is_constant():
+                problems.append(f"{where}: {name} is no state ({self.demoted[name]}); its "
+                                f"start follows from signals, so it cannot be given: remove "
+                                f"{key}")
+                continue
+            fixed = float(at0)
+            if abs(fixed - given) > START_TOL * (1 + abs(fixed)):
+                problems.append(f"{where} = {given:g}: {name} is no state "
+                                f"({self.demoted[name]}), and the constraint gives {fixed:g} "
+                                f"at the start: remove {key} or make it agree")
+        if problems:
+            raise ModelError(problems)
+
+    def _why(self, reduced, comp, value, kept, states, labels):
+        """What fixes ``comp``'s state: the kept states and the sources its value follows
+        from, and the components of the constraint (the laws differentiated in the step
+        that found it, with the components of those states), grounds left out."""
+        reads = [i for i, x in zip(reduced.states, kept) if ca.depends_on(value, x)]
+        group = {labels[i][0].name for i in reads} | {comp.name}
+        for eqs in reduced.constraints:
+            if any(self._owners[e] is comp for e in eqs):
+                group |= {self._owners[e].name for e in eqs if self._owners[e] is not None}
+        group = [c.name for c in self.comps if c.name in group
+                 and c.type_name != "electrical.Ground"]
+        names = [self.b.net.names[self.b._at(states[i])] for i in reads]
+        driven = [c for c in group if getattr(type(self.model.components[c]),
+                                              "reference_key", None)]
+        follows = ", ".join(names + [f"the source {c}" for c in driven]) or "the sources"
+        return f"follows from {follows} through the constraint of {', '.join(group)}"
+
+    def _drop(self, x):
+        """Take the state ``x`` out of the network: a constraint gives its value."""
+        net = self.b.net
+        at = self.b._at(x)
+        for seq in (net.x, net.rate, net.start, net.names, net.units):
+            del seq[at]
+
+    def _label(self, z, unknowns):
+        """A short name of an unknown kept as an algebraic variable: ``D1.p.v`` for the
+        potential at a set holding pin D1.p, ``D1.p.i`` for a pin's current."""
+        for s, v in zip(sorted(self.potential), unknowns):
+            if v.element_hash() == z.element_hash():
+                first = next(r for r in self.topo.sets[s] if r.component.role != "probe")
+                return f"{first.path}.v"
+        for ref, v in zip(self.current, unknowns[len(self.potential):]):
+            if v.element_hash() == z.element_hash():
+                return f"{ref.path}.i"
+        return z.name()
+
+    def _summary(self, reduced, solved, unknowns, states):
+        n_pot = len(self.potential)
+        loops = [n for n in solved.sizes if n > 1]
+        out = (f"circuits: {n_pot} node potentials and {len(self.current)} pin currents in "
+               f"{len(solved.sizes)} blocks solved symbolically"
+               + (f" (linear loops of {', '.join(map(str, loops))})" if loops else "")
+               + f", {len(reduced.states)} states")
+        if reduced.demoted:
+            out += (f"; index reduced (Pantelides, dummy derivatives): "
+                    f"{len(reduced.constraints)} constraints differentiated, states demoted "
+                    f"to algebraic: " + "; ".join(f"{name} ({why})" for name, why in
+                                                  self.demoted.items()))
+        if solved.kept:
+            out += (f"; {solved.nonlinear} nonlinear blocks, {len(solved.kept)} algebraic "
+                    f"variables")
+        return out
+
+    def _refusal(self, exc, n_unknowns, reduced=None):
+        """The ModelError of a circuit that cannot be solved: the components whose laws
+        over-determine it and the unknowns left undetermined, each sorted."""
+        eqs = exc.equations if reduced is None else sorted({reduced.origin[e]
+                                                            for e in exc.equations})
+        comps = sorted({self._owners[e].name for e in eqs if self._owners[e] is not None})
+        kcl = any(self._owners[e] is None for e in eqs)
+        if reduced is None:
+            lost = [self._names[v] for v in exc.unknowns]
+        else:
+            lost = [self._names[reduced.base[v][0]] for v in exc.unknowns]
+        what = (", ".join(comps) or "the circuit") + (
+            " and Kirchhoff's current law" if kcl and comps else "")
+        if exc.reason:
+            return ModelError(f"circuit: the equations of {what} cannot be solved: "
+                              f"{exc.reason}" + (f"; undetermined: {', '.join(lost)}"
+                                                 if lost else ""))
+        return ModelError(
+            f"circuit: the equations of {what} constrain their unknowns twice and leave "
+            f"{', '.join(lost) or 'nothing'} undetermined: the circuit is structurally "
+            f"singular (two voltage sources in parallel, a loop of voltage sources, a current "
+            f"source in series with another, an open current source, an ideal op-amp with "
+            f"no feedback)")
 
     # -- what the network reads -------------------------------------------------------------
     def output(self, comp):
@@ -256,8 +421,10 @@ class Circuit:
         return self.current[comp.port_ref("p")]
 
     def placeholders_in(self, expr):
-        """Names of the sources whose signal input ``expr`` depends on."""
-        return [name for name, ph in self.sources.items() if ca.depends_on(ca.SX(expr), ph)]
+        """Names of the sources whose signal input (or its rate) ``expr`` depends on."""
+        expr = ca.SX(expr)
+        return [name for name, ph in self.sources.items()
+                if ca.depends_on(expr, ph) or ca.depends_on(expr, self.source_rates[name])]
 
     def fill(self, net):
         """Pins' potentials and currents into the network's ``pos`` and ``flow`` (what
@@ -265,3 +432,9 @@ class Circuit:
         for ref, i in self.current.items():
             net.pos[ref] = self.potential[self.topo.set_of[ref]]
             net.flow[ref] = i
+
+
+def _start_key(comp, k):
+    """The parameter giving the start of ``comp``'s state k (``v0``, ``i0``), or None."""
+    keys = getattr(type(comp), "start_params", ())
+    return keys[k] if k < len(keys) else None

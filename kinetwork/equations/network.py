@@ -63,6 +63,7 @@ class Network:
     alg_z: list = field(default_factory=list)          # their outputs, unknowns ...
     alg_res: list = field(default_factory=list)        # ... and their equations z - f(z)
     alg_names: list = field(default_factory=list)
+    alg_units: list = field(default_factory=list)
     block_states: int = 0
     no_acceleration: set = field(default_factory=set)  # sets of massless groups
     #: speed index -> Prescribed, for joints whose coordinate a motion source gives
@@ -71,6 +72,8 @@ class Network:
     hybrid: list = field(default_factory=list)
     #: what structural analysis made of the circuits (``circuit.Circuit.summary``)
     circuit: str = ""
+    #: state name -> why it is no state: index reduction found a constraint that fixes it
+    demoted: dict = field(default_factory=dict)
 
     def summary(self, topo):
         """A line on what structural analysis made of the 1-D network and the blocks."""
@@ -190,6 +193,7 @@ class _Builder:
         self.circuit = Circuit(self).build()
         self.circuit.fill(self.net)
         self.net.circuit = self.circuit.summary
+        self.net.demoted.update(self.circuit.demoted)
         self._flows("compliant")               # springs and dampers need no signal
         self._passive = ca.SX.zeros(self.u.shape[0])
         for group in self.topo.oned:
@@ -375,6 +379,7 @@ class _Builder:
                 self.net.alg_z.append(z[i])
                 self.net.alg_res.append(residual[i])
                 self.net.alg_names.append(f"{c.name}.y")
+                self.net.alg_units.append("")
                 self.net.signal[s] = z[i]
             self.net.loops_kept.append(names)
             return
@@ -620,6 +625,7 @@ class _Builder:
             if self.model.components[name].role == "source":
                 for placeholder, s in read.values():
                     self.pending[placeholder] = net.signal[s]
+        self._input_rates()
         for joint_ports in self._axis_ports():
             ref, u = joint_ports
             net.axis_flow[u] += net.flow.get(ref, 0)
@@ -636,6 +642,29 @@ class _Builder:
         net.alg_res = [sub(r) for r in net.alg_res]
         for rec in net.prescribed.values():
             rec.pos, rec.vel, rec.acc = sub(rec.pos), sub(rec.vel), sub(rec.acc)
+
+    def _input_rates(self):
+        """The time derivative of each signal whose circuit constraint was differentiated (a
+        voltage source's u across a capacitor): through t and the rates of the states it
+        reads (signal blocks); one that follows the mechanism's motion is refused."""
+        if not self.circuit.input_rates:
+            return
+        sub = self._substitution()
+        moving = ca.vertcat(self.q, self.u, self.udot)
+        for du, s in self.circuit.input_rates.items():
+            e = sub(self.net.signal[s])
+            if ca.depends_on(e, moving):
+                names = ", ".join(self.circuit.placeholders_in(du))
+                raise ModelError(f"{names}: a constraint of the circuit differentiates its "
+                                 f"input u, whose signal follows the motion of the mechanism; "
+                                 f"put a resistor or an inductor where the source meets the "
+                                 f"capacitors (or the inductors)")
+            states = [x for x in self.net.x if ca.depends_on(e, x)]
+            rate = ca.jacobian(e, self.t)
+            if states:
+                rate += ca.jtimes(e, ca.vertcat(*states),
+                                  sub(ca.vertcat(*[self.net.rate[self._at(x)] for x in states])))
+            self.pending[du] = rate
 
     def _substitution(self):
         """The function putting every placeholder's expression in its place."""

@@ -1,0 +1,453 @@
+"""Structural analysis of a system of equations in CasADi SX: the matching of equations to
+unknowns, the Dulmage-Mendelsohn parts that name a singular system, Pantelides' index
+reduction with Mattsson and Söderlind's dummy derivatives, and the block-lower-triangular
+solve of what is left.
+
+A differential-algebraic system is written as residuals in algebraic unknowns y, state
+candidates x and their derivatives x' (each x' an unknown of its own, the state's rate
+equation one of the residuals), and knowns: time, parameters and symbols whose time
+derivatives the caller gives. It is of index 1 when the residuals can be solved for y and
+x' with x known. When they cannot, a constraint among the states is hidden in them (a
+capacitor across a voltage source: v_C = V(t)); Pantelides' algorithm (1988) finds, by
+augmenting paths in the bipartite graph of equations and highest derivatives, the smallest
+sets of equations to differentiate, CasADi's AD differentiates them, and the dummy
+derivatives (Mattsson and Söderlind 1993) pick which states the differentiated equations
+fix: their derivatives become algebraic unknowns ("dummies") and the states themselves are
+solved from the original equations, so the system stays square, of index 1, on the
+constraint manifold, and no equation is dropped. Among the states a choice is possible
+for (the capacitors of a loop), ``priority`` says which to keep.
+
+Every choice is made in index order, so the same system gives the same reduction, the same
+states and the same messages in every run.
+"""
+
+from dataclasses import dataclass, field
+
+import casadi as ca
+import networkx as nx
+import numpy as np
+
+#: differentiations of one equation beyond which a system is refused (circuits need one,
+#: a circuit that constrains a mechanism two)
+MAX_DIFFERENTIATIONS = 3
+#: a singular value below this fraction of the largest counts as zero (dummy selection)
+RANK_TOL = 1e-9
+
+
+class Singular(Exception):
+    """A structurally singular system: ``equations`` (indices) over-determine the unknowns
+    they read and ``unknowns`` (indices) are left undetermined (the Dulmage-Mendelsohn
+    parts, the same for every maximum matching)."""
+
+    def __init__(self, equations, unknowns, reason=""):
+        super().__init__(reason)
+        self.equations, self.unknowns, self.reason = equations, unknowns, reason
+
+
+def incidence(expressions, symbols):
+    """For each expression, the sorted indices of the ``symbols`` it depends on (the
+    sparsity of its Jacobian: a term that cancels is no dependence)."""
+    if not expressions:
+        return []
+    out = [[] for _ in expressions]
+    if not symbols:
+        return out
+    jac = ca.jacobian(ca.vertcat(*expressions), ca.vertcat(*symbols))
+    for i, j in zip(*jac.sparsity().get_triplet()):
+        out[i].append(j)
+    return [sorted(c) for c in out]
+
+
+def augment(root, candidates, owner, colored_eqs, colored_vars):
+    """An augmenting path from equation ``root`` (iterative depth-first search, unknowns in
+    index order): True and ``owner`` (unknown -> equation) updated, or False with what the
+    search visited coloured (Pantelides' colouring)."""
+    def free(e):
+        return next((v for v in candidates(e) if v not in owner), None)
+    colored_eqs.add(root)
+    f = free(root)
+    if f is not None:
+        owner[f] = root
+        return True
+    stack, via = [(root, iter(candidates(root)))], []
+    while stack:
+        _, it = stack[-1]
+        for v in it:
+            if v in colored_vars:
+                continue
+            colored_vars.add(v)
+            nxt = owner[v]
+            colored_eqs.add(nxt)
+            via.append(v)
+            f = free(nxt)
+            if f is not None:
+                owner[f] = nxt
+                for (e, _), var in zip(stack, via):
+                    owner[var] = e
+                return True
+            stack.append((nxt, iter(candidates(nxt))))
+            break
+        else:
+            stack.pop()
+            if via:
+                via.pop()
+    return False
+
+
+def match(inc, allowed=None):
+    """A maximum matching of equations (rows of ``inc``) to unknowns: unknown -> equation."""
+    owner = {}
+    for k, row in enumerate(inc):
+        augment(k, lambda e: [v for v in inc[e] if allowed is None or allowed(v)], owner,
+                set(), set())
+    return owner
+
+
+def singular_parts(inc, n_unknowns, owner):
+    """The over-determined equations and the under-determined unknowns of a maximum
+    matching ``owner`` (Dulmage-Mendelsohn: what alternating paths reach from an unmatched
+    equation, and from an unmatched unknown), both sorted."""
+    matched_eq = {e: v for v, e in owner.items()}
+    readers = [[] for _ in range(n_unknowns)]
+    for e, row in enumerate(inc):
+        for v in row:
+            readers[v].append(e)
+    over, seen = set(), set()
+    todo = [e for e in range(len(inc)) if e not in matched_eq]
+    while todo:
+        e = todo.pop()
+        if e in over:
+            continue
+        over.add(e)
+        for v in inc[e]:
+            if v not in seen and v in owner:
+                seen.add(v)
+                todo.append(owner[v])
+    under, seen_eq = set(), set()
+    todo = [v for v in range(n_unknowns) if v not in owner]
+    while todo:
+        v = todo.pop()
+        if v in under:
+            continue
+        under.add(v)
+        for e in readers[v]:
+            if e not in seen_eq and e in matched_eq:
+                seen_eq.add(e)
+                todo.append(matched_eq[e])
+    return sorted(over), sorted(under)
+
+
+@dataclass
+class Reduced:
+    """An index-1 system from ``reduce_index``: ``equations`` in ``unknowns`` (square),
+    with ``states`` (indices of the candidates kept) known; ``demoted`` are the candidates
+    whose values the differentiated constraints fix (now among the unknowns, their
+    derivatives too); ``differentiated[k]`` how often original equation k was."""
+    equations: list
+    unknowns: list
+    states: list
+    demoted: list
+    differentiated: dict = field(default_factory=dict)
+    #: for each equation of ``equations``, the original equation it is (a derivative of)
+    origin: list = field(default_factory=list)
+    #: for each unknown of ``unknowns``, (index of y or x it is, times differentiated)
+    base: list = field(default_factory=list)
+    #: the original equations of each constraint found (one per failed augmenting path)
+    constraints: list = field(default_factory=list)
+
+
+def reduce_index(equations, algebraic, states, rates, knowns, t, priority, sample,
+                 constants=()):
+    """Pantelides and dummy derivatives on F(x', x, y, knowns, t) = 0.
+
+    Parameters
+    ----------
+    equations : list of SX
+        The residuals, as many as ``algebraic`` and ``states`` together (the rate
+        equations x' - f = 0 among them).
+    algebraic, states, rates : list of SX
+        The unknowns y, the state candidates x and their derivatives x' (symbols).
+    knowns : list of (SX, SX or None)
+        Symbols the residuals read besides t and their time derivatives (symbols the caller
+        resolves; None: not differentiable, a ``Singular`` when a constraint needs it).
+    t : SX
+        Time.
+    constants : SX
+        Symbols constant in time (the parameters).
+    priority : list
+        A sortable key per state candidate: where the constraints leave a choice, the
+        candidates of larger key stay states.
+    sample : callable
+        ``sample(expr)``: a numeric value of a Jacobian at generic values of its symbols
+        (the parameters at their values); the ranks that pick the dummies are taken there.
+
+    Returns
+    -------
+    Reduced
+    """
+    n_y, n_x = len(algebraic), len(states)
+    var = list(algebraic) + list(states) + list(rates)
+    der = [None] * len(var)                 # index of the derivative variable
+    integ = [None] * len(var)               # index of the variable this derives
+    for i in range(n_x):
+        der[n_y + i], integ[n_y + n_x + i] = n_y + n_x + i, n_y + i
+    eqs = list(equations)
+    eq_der, eq_integ = [None] * len(eqs), [None] * len(eqs)
+    inc = incidence(eqs, var)
+    _check_regular(inc, n_y, n_x, len(eqs))
+
+    timeless = {s.element_hash() for s in ca.symvar(ca.vertcat(
+        t, *var, *[k for k, _ in knowns], ca.SX(constants)))}
+
+    def base(v):
+        return _last(integ, v)
+
+    def differentiate(e):
+        expr = eqs[e]
+        vs = inc[e]
+        stray = [s.name() for s in ca.symvar(expr) if s.element_hash() not in timeless]
+        if stray:
+            raise Singular([_last(eq_integ, e)], [], f"it reads {', '.join(stray)}, whose time "
+                           f"derivative is not known")
+        d = ca.jacobian(expr, t)
+        if vs:
+            d += ca.jtimes(expr, ca.vertcat(*[var[v] for v in vs]),
+                           ca.vertcat(*[var[der[v]] for v in vs]))
+        for (sym, dsym) in knowns:
+            if ca.depends_on(expr, sym):
+                if dsym is None:
+                    raise Singular([_last(eq_integ, e)], [],
+                                   f"it needs the time derivative of {sym.name()}")
+                d += ca.jacobian(expr, sym) * dsym
+        eqs.append(ca.simplify(d))
+        eq_der.append(None)
+        eq_integ.append(e)
+        eq_der[e] = len(eqs) - 1
+        inc.append(incidence([eqs[-1]], var)[0])
+        return len(eqs) - 1
+
+    def new_derivative(v):
+        var.append(ca.SX.sym(f"der_{var[v].name()}"))
+        timeless.add(var[-1].element_hash())
+        der.append(None)
+        integ.append(v)
+        der[v] = len(var) - 1
+        return der[v]
+
+    def level(e):
+        n = 0
+        while eq_integ[e] is not None:
+            e, n = eq_integ[e], n + 1
+        return n
+
+    owner, constraints = {}, []
+    for k in range(len(equations)):
+        e = k
+        while True:
+            ceq, cvar = set(), set()
+            if augment(e, lambda q: [v for v in inc[q] if der[v] is None], owner, ceq, cvar):
+                break
+            if level(e) >= MAX_DIFFERENTIATIONS:
+                raise Singular(sorted({_last(eq_integ, q) for q in ceq}),
+                               sorted({base(v) for v in cvar}),
+                               f"differentiated {MAX_DIFFERENTIATIONS} times without "
+                               f"finding its unknowns")
+            constraints.append(sorted({_last(eq_integ, q) for q in ceq}))
+            for v in sorted(cvar):
+                new_derivative(v)
+            for q in sorted(ceq):
+                differentiate(q)
+            for v in sorted(cvar):
+                owner[der[v]] = eq_der[owner[v]]
+            e = eq_der[e]
+    try:
+        dummies = _dummies(eqs, var, eq_der, eq_integ, der, integ, n_y, priority, sample)
+    except Singular as exc:
+        raise Singular(sorted({_last(eq_integ, q) for q in exc.equations}), [],
+                       exc.reason) from None
+    kept = [v for v in range(len(var)) if der[v] is not None and der[v] not in dummies]
+    extra = [v for v in kept if not n_y <= v < n_y + n_x]
+    if extra:
+        raise Singular([], sorted({base(v) for v in extra}),
+                       "its constraints leave a choice only among unknowns that are no "
+                       "states (a potential or a current), which kinetwork does not take as "
+                       "states")
+    unknowns = [v for v in range(len(var)) if v not in kept]
+    if len(unknowns) != len(eqs):
+        raise Singular(sorted(set(range(len(equations)))), [],
+                       "the reduced system is not square")
+
+    def order(v):
+        n = 0
+        while integ[v] is not None:
+            v, n = integ[v], n + 1
+        return v, n
+    return Reduced(eqs, [var[v] for v in unknowns], [v - n_y for v in kept],
+                   [i for i in range(n_x) if der[n_y + i] in dummies],
+                   {k: level(_last(eq_der, k)) for k in range(len(equations))
+                    if eq_der[k] is not None},
+                   [_last(eq_integ, e) for e in range(len(eqs))],
+                   [order(v) for v in unknowns], constraints)
+
+
+def _last(links, k):
+    """Follow ``links`` (derivative or antiderivative indices) from ``k`` to its end."""
+    while links[k] is not None:
+        k = links[k]
+    return k
+
+
+def _check_regular(inc, n_y, n_x, n_eqs):
+    """The system is structurally regular when its equations match its unknown functions
+    (y and x, a state and its derivative being one function): otherwise no differentiation
+    helps (two voltage sources in parallel) and Pantelides' algorithm would not end."""
+    def function(v):
+        return v if v < n_y + n_x else v - n_x
+    rows = [sorted({function(v) for v in row}) for row in inc]
+    owner = match(rows)
+    if len(owner) < n_eqs or n_eqs != n_y + n_x:
+        over, under = singular_parts(rows, n_y + n_x, owner)
+        raise Singular(over, under)
+
+
+def _dummies(eqs, var, eq_der, eq_integ, der, integ, n_y, priority, sample):
+    """Mattsson-Söderlind: level by level from the highest derivatives, as many dummy
+    derivatives as differentiated equations, chosen among the derivatives of the variables
+    those equations fix so that their Jacobian is regular; derivatives of algebraic
+    unknowns first, then of states of the lowest ``priority``."""
+    rows = [e for e in range(len(eqs)) if eq_der[e] is None and eq_integ[e] is not None]
+    cols = [v for v in range(len(var)) if der[v] is None and integ[v] is not None]
+    chosen_all = set()
+    while rows:
+        cols = [v for v in cols if any(ca.depends_on(eqs[e], var[v]) for e in rows)]
+        cols.sort(key=lambda v: _rank_key(v, integ, n_y, priority))
+        jac = sample(ca.jacobian(ca.vertcat(*[eqs[e] for e in rows]),
+                                 ca.vertcat(*[var[v] for v in cols])) if cols else None)
+        chosen, picked = [], np.zeros((len(rows), 0))
+        for c, v in enumerate(cols):
+            trial = np.column_stack([picked, jac[:, c]])
+            if _rank(trial) > picked.shape[1]:
+                picked = trial
+                chosen.append(v)
+                if len(chosen) == len(rows):
+                    break
+        if len(chosen) < len(rows):
+            raise Singular(sorted(rows), [], "its differentiated equations are singular")
+        chosen_all.update(chosen)
+        rows = [eq_integ[e] for e in rows if eq_integ[eq_integ[e]] is not None]
+        cols = [integ[v] for v in chosen if integ[integ[v]] is not None]
+    return chosen_all
+
+
+def _rank_key(v, integ, n_y, priority):
+    """Order in which derivatives are taken as dummies: of algebraic unknowns (and of their
+    derivatives) first, then of state candidates by ``priority``, lowest first."""
+    base = v
+    while integ[base] is not None:
+        base = integ[base]
+    if base < n_y:
+        return (0, 0, base)
+    return (1, priority[base - n_y], -base)
+
+
+def _rank(a):
+    if a.size == 0:
+        return 0
+    s = np.linalg.svd(a, compute_uv=False)
+    return int(np.sum(s > RANK_TOL * max(1.0, s[0])))
+
+
+@dataclass
+class Solved:
+    """The block-lower-triangular solve of a square system: ``values[j]``, unknown j in the
+    knowns (and in ``kept``); ``kept`` and ``residuals``, the unknowns and equations of
+    nonlinear blocks left to the integrator as algebraic variables (what tearing leaves of
+    each block); ``sizes`` the blocks' sizes, largest first."""
+    values: list
+    kept: list
+    residuals: list
+    sizes: list
+    nonlinear: int = 0
+
+
+def solve_blocks(equations, unknowns, regular):
+    """Solve ``equations`` for ``unknowns`` block by block (Tarjan's strongly connected
+    components of the matched dependency graph, in topological order): a linear block
+    symbolically, a nonlinear block torn (the unknowns it reads nonlinearly stay unknowns,
+    the rest are solved from them).
+
+    ``regular(matrix)`` says whether a block's matrix is regular at the parameters' values;
+    a block where it is not, or a system that is not structurally regular, raises
+    ``Singular`` naming the equations.
+    """
+    n = len(unknowns)
+    inc = incidence(equations, unknowns)
+    owner = match(inc)
+    if len(owner) < n or len(equations) != n:
+        raise Singular(*singular_parts(inc, n, owner))
+    assigned = {e: v for v, e in owner.items()}
+    dep = nx.DiGraph()
+    dep.add_nodes_from(range(n))
+    for e, row in enumerate(inc):
+        for v in row:
+            if assigned[e] != v:
+                dep.add_edge(owner[v], e)        # equation e needs what owner[v] gives
+    dag = nx.condensation(dep)
+    out = Solved([None] * n, [], [], sorted((len(dag.nodes[c]["members"]) for c in dag),
+                                            reverse=True))
+    known_z, known_v = [], []
+    for c in nx.lexicographical_topological_sort(dag, key=lambda c: min(
+            dag.nodes[c]["members"])):
+        block = sorted(dag.nodes[c]["members"])
+        zs = [assigned[e] for e in block]
+        res = ca.vertcat(*[equations[e] for e in block])
+        if known_z:
+            res = ca.substitute(res, ca.vertcat(*known_z), ca.vertcat(*known_v))
+        zb = ca.vertcat(*[unknowns[j] for j in zs])
+        a = ca.jacobian(res, zb)
+        if not ca.depends_on(a, zb):
+            if not regular(a):
+                raise Singular(block, [], "singular at the parameters' values")
+            solved = _linear(a, res, zb)
+        else:
+            out.nonlinear += 1
+            solved = _tear(res, zb, a, regular, out)
+        for k, j in enumerate(zs):
+            out.values[j] = solved[k]
+            known_z.append(unknowns[j])
+            known_v.append(solved[k])
+    return out
+
+
+def _linear(a, res, z):
+    """z from res(z) = a z + res(0) = 0."""
+    rest = ca.substitute(res, z, ca.SX.zeros(z.shape[0]))
+    return -rest / a if z.shape[0] == 1 else -ca.solve(a, rest)
+
+
+def _tear(res, zb, a, regular, out):
+    """A nonlinear block: the unknowns whose Jacobian columns depend on the block's unknowns
+    (read nonlinearly) tear it; the others, whose columns are constant, are solved from as
+    many of its equations (a matching, regular at the parameters' values), and the
+    equations left are the residuals in the tearing unknowns, which stay unknowns. Where no
+    such split exists the whole block stays."""
+    m = zb.shape[0]
+    tear = [j for j in range(m) if ca.depends_on(a[:, j], zb)]
+    rest = [j for j in range(m) if j not in tear]
+    if rest:
+        rows = [[c for c, j in enumerate(rest) if ca.depends_on(res[i], zb[j])]
+                for i in range(m)]
+        owner = match(rows)
+        solving = [owner.get(c) for c in range(len(rest))]
+        if None not in solving and regular(a[solving, rest]):
+            zn = zb[rest]
+            xn = _linear(a[solving, rest], res[solving], zn)
+            values = ca.SX(zb)
+            values[rest] = xn
+            out.kept += [zb[j] for j in tear]
+            out.residuals += [ca.substitute(res[i], zn, xn) for i in range(m)
+                              if i not in solving]
+            return values
+    out.kept += [zb[j] for j in range(m)]
+    out.residuals += [res[i] for i in range(m)]
+    return zb
