@@ -7,12 +7,19 @@ rates from ``rates``. ``kinetwork.equations.circuit`` gathers them with Kirchhof
 at every connection set, and solves the circuit by structural analysis (the connection sets
 are the alias elimination of the potentials; a block-lower-triangular sort of the rest).
 What a component is handed, ``e``, reads ``e.v("p")``, ``e.i("p")``, ``e.x`` (its states),
-``e.t``, ``e.u`` (the signal at u, or None when unwired) and, for an EMF, ``e.w`` (the speed of
-its flange relative to its support).
+``e.t``, ``e.u`` (the signal at u, or None when unwired), ``e.parameters`` (the model's
+parameters as symbols), ``e.place(key)`` (where a parameter is, for messages) and, for an EMF,
+``e.w`` (the speed of its flange relative to its support). A law may be nonlinear (a diode):
+the circuit's solver then leaves the unknowns it reads nonlinearly to IDAS.
 """
 
+import casadi as ca
+
+from ..errors import ModelError
+from ..expr import casadi_functions, parse
 from .base import Component, Param, Port, PortRef
 from .loopjoints import Expansion
+from .signals import ExpressionParam
 
 LIB = "electrical"
 
@@ -44,11 +51,57 @@ class PartialTwoPin(Component):
 
 
 class Resistor(PartialTwoPin, library=LIB):
-    """Ideal linear resistor: v = R i."""
-    R = Param(unit="Ohm", min=0.0, doc="Resistance")
+    """Ideal linear resistor: v = R i (R positive, zero or negative, as MSL's)."""
+    R = Param(unit="Ohm", doc="Resistance")
 
     def law(self, v, i, e):
         return v - self.R * i
+
+
+class Conductor(PartialTwoPin, library=LIB):
+    """Ideal linear conductor: i = G v (G positive, zero or negative), MSL's
+    Analog.Basic.Conductor."""
+    G = Param(unit="S", doc="Conductance")
+
+    def law(self, v, i, e):
+        return i - self.G * v
+
+
+class NonlinearResistor(PartialTwoPin, library=LIB):
+    """A resistor whose current from p to n is an expression of its voltage v = v_p - v_n
+    (and of t and the model's parameters): MSL's Chua resistor is
+    ``i="if_else(v < -Ve, Gb*(v + Ve) - Ga*Ve, if_else(v > Ve, Gb*(v - Ve) + Ga*Ve, Ga*v))"``.
+    A nonlinear law makes the circuit a DAE that IDAS solves."""
+    i = ExpressionParam(doc="Current from p to n, in the voltage v, t and the model's "
+                            "parameters", unit="A")
+
+    def law(self, v, i, e):
+        if not isinstance(self.i, str):
+            return i - self.i
+        expr = parse(self.i)
+        env = {**e.parameters, "t": e.t, "v": v}
+        unknown = sorted(expr.names - set(env))
+        if unknown:
+            raise ModelError(f"{e.place('i')}: unknown name {unknown[0]!r} in {self.i!r}; "
+                             f"names are v (the voltage), t and the model's parameters "
+                             f"{', '.join(e.parameters) or '(none)'}")
+        return i - ca.SX(expr.evaluate(env, casadi_functions()))
+
+
+class Diode(PartialTwoPin, library=LIB):
+    """Simple diode with a parallel ohmic resistance, MSL's Analog.Semiconductors.Diode
+    (without its heat port): i = Ids (exlin(v/Vt, Maxexp) - 1) + v/R, the exponential
+    continued linearly beyond the exponent Maxexp so that it cannot overflow."""
+    Ids = Param(1e-6, unit="A", min=0.0, doc="Saturation current")
+    Vt = Param(0.04, unit="V", positive=True, doc="Voltage equivalent of temperature (kT/qn)")
+    Maxexp = Param(15.0, unit="1", positive=True,
+                   doc="Max. exponent for linear continuation")
+    R = Param(1e8, unit="Ohm", positive=True, doc="Parallel ohmic resistance")
+
+    def law(self, v, i, e):
+        x = v / self.Vt
+        exlin = ca.exp(ca.fmin(x, self.Maxexp)) * (1 + ca.fmax(x - self.Maxexp, 0))
+        return i - (self.Ids * (exlin - 1) + v / self.R)
 
 
 class Inductor(PartialTwoPin, library=LIB):

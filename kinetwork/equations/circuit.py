@@ -52,6 +52,9 @@ class _Pins:
     def i(self, pin):
         return self._c.current[self._comp.port_ref(pin)]
 
+    def place(self, key):
+        return self._c.model.place(self._comp, key)
+
 
 class Circuit:
     """The electrical part of a model, built into the 1-D network's builder ``b``."""
@@ -367,14 +370,13 @@ class Circuit:
         n_pot = len(self.potential)
         loops = [n for n in solved.sizes if n > 1]
         out = (f"circuits: {n_pot} node potentials and {len(self.current)} pin currents in "
-               f"{len(solved.sizes)} blocks solved symbolically"
+               f"{len(solved.sizes)} blocks" + ("" if solved.kept else " solved symbolically")
                + (f" (linear loops of {', '.join(map(str, loops))})" if loops else "")
                + f", {len(reduced.states)} states")
         if reduced.demoted:
-            out += (f"; index reduced (Pantelides, dummy derivatives): "
-                    f"{len(reduced.constraints)} constraints differentiated, states demoted "
-                    f"to algebraic: " + "; ".join(f"{name} ({why})" for name, why in
-                                                  self.demoted.items()))
+            out += (f"; index reduction (Pantelides, dummy derivatives): "
+                    f"{len(reduced.constraints)} constraints differentiated, "
+                    f"{', '.join(self.demoted)} demoted to algebraic")
         if solved.kept:
             out += (f"; {solved.nonlinear} nonlinear blocks, {len(solved.kept)} algebraic "
                     f"variables")

@@ -340,12 +340,14 @@ def _dummies(eqs, var, eq_der, eq_integ, der, integ, n_y, priority, sample):
 
 
 def _rank_key(v, integ, n_y, priority):
-    """Order in which derivatives are taken as dummies: of algebraic unknowns (and of their
-    derivatives) first, then of state candidates by ``priority``, lowest first."""
-    base = v
+    """Order in which derivatives are taken as dummies: those of algebraic unknowns and the
+    second and higher derivatives first (a state is the variable itself, not its derivative
+    introduced by a rate equation x' = u), then first derivatives of state candidates by
+    ``priority``, lowest first."""
+    base, order = v, 0
     while integ[base] is not None:
-        base = integ[base]
-    if base < n_y:
+        base, order = integ[base], order + 1
+    if base < n_y or order > 1:
         return (0, 0, base)
     return (1, priority[base - n_y], -base)
 
