@@ -155,6 +155,7 @@ class _Motion:
     coord: tuple                     # placeholders (or the joint's q, u, udot)
     reference: ca.SX = None
     drive: ca.SX = None              # on a joint: the symbol of the generalized force
+    offset: ca.SX = 0                # the source's flange is at k theta + offset
 
 
 class _Builder:
@@ -167,6 +168,7 @@ class _Builder:
         n = u.shape[0]
         self.net = Network({}, {}, {}, {}, ca.SX.zeros(n), ca.SX.zeros(n), ca.SX.zeros(n))
         self.k = {}                  # connection set -> ratio to its group's coordinate
+        self.c = {}                  # ... and offset: position = k theta + c (a Mass's L)
         self.kt = {}                 # ... and of its torques (differs through gear losses)
         self.losses = {}             # gear with a loss -> eta^mode
         self.group_of = {}           # connection set -> group
@@ -186,7 +188,8 @@ class _Builder:
             theta, w, a = self.coord[group.index]
             k = self.k[s]
             for ref in self.topo.sets[s]:
-                self.net.pos[ref], self.net.vel[ref], self.net.acc[ref] = k * theta, k * w, k * a
+                self.net.pos[ref] = k * theta + self.c[s]
+                self.net.vel[ref], self.net.acc[ref] = k * w, k * a
         self._block_states()
         # circuits next: their currents are expressions of states and speeds, so EMF
         # torques are known before any balance (``circuit.py``)
@@ -214,11 +217,15 @@ class _Builder:
             self.group_of[s] = group
             if parent is None:
                 self.k[s] = self.kt[s] = ca.SX(1)
+                self.c[s] = ca.SX(0)
                 continue
             r = self.bound[element.name].ratio()
+            length = self.bound[element.name].length()
             a_here = self.topo.set_of[element.port_ref("flange_a")] == s
-            # position(flange_a) = r * position(flange_b)
+            # position(flange_a) = r * (position(flange_b) - length)
             self.k[s] = self.k[parent] * r if a_here else self.k[parent] / r
+            self.c[s] = r * (self.c[parent] - length) if a_here else \
+                self.c[parent] / r + length
             # torques pass a gear with efficiency eta as torque_b = -r eta^m torque_a, m = +1
             # while flange_a drives (power from a to b), -1 while flange_b does
             loss = self._loss(element, group)
@@ -282,14 +289,21 @@ class _Builder:
         units = _units(group)
         labels = list(zip((_pos(group), _vel(group)), units))[:comp.n_states]
         x = [self._state(f"{comp.name}.{label}", unit, 0, 0) for label, unit in labels]
-        self.motions.append(_Motion(comp, flange.component, group,
-                                    self.k[self.topo.set_of[flange]], x, coord))
+        at = self.topo.set_of[flange]
+        self.motions.append(_Motion(comp, flange.component, group, self.k[at], x, coord,
+                                    offset=self.c[at]))
 
     def _free(self, group):
         inertias = [e for e in group.rigid if e.has_inertia]
         first = self.bound[inertias[0].name]
         pos_unit, vel_unit = _units(group)
-        k = self.k[self.topo.set_of[inertias[0].port_ref("flange_a")]]
+        at = self.topo.set_of[inertias[0].port_ref("flange_a")]
+        k = self.k[at]
+        # the coordinate is the first inertia's centre (MSL's Mass.s, between its flanges
+        # L apart), in the units of its flanges divided by their ratio
+        centre = self.c[at] + first.length() / 2
+        for s, _, _ in group.sets:
+            self.c[s] = self.c[s] - self.k[s] * centre / k
         p0 = 0 if first.position0 is None else first.position0 / k
         w0 = 0 if first.speed0 is None else first.speed0 / k
         a = ca.SX.sym(f"g{group.index}_acc")
@@ -724,8 +738,8 @@ class _Builder:
                 joint = m.group.definer.component
                 j = joint.coordinate_ports[m.group.definer.name]
                 self.net.prescribed[self.uindex[joint.name][j]] = Prescribed(
-                    self.qindex[joint.name][j], pos / m.k, vel / m.k, acc / m.k, m.drive,
-                    m.comp.name, joint.name)
+                    self.qindex[joint.name][j], (pos - m.offset) / m.k, vel / m.k, acc / m.k,
+                    m.drive, m.comp.name, joint.name)
             else:
                 self.pending.update(zip(m.coord, (pos, vel, acc)))
 
