@@ -30,6 +30,7 @@ import networkx as nx
 import numpy as np
 
 from ..errors import ModelError
+from .circuit_dae import Candidate, Dae, couple
 from .structure import Singular, reduce_index, solve_blocks
 
 DOMAIN = "electrical"
@@ -69,6 +70,8 @@ class Circuit:
         self.sources = {}                          # component name -> its placeholder
         self.source_rates = {}                     # component name -> placeholder of du/dt
         self.speeds = {}                           # EMF name -> (symbol of w, of dw/dt)
+        #: free group index -> ``circuit_dae.Coupled``: rotors a constraint couples in
+        self.coupled = {}
         self.views = {}
         self.parameters = ({name: b.p[i] for i, name in enumerate(self.model.parameters)}
                            if b.p is not None else {})
@@ -84,54 +87,86 @@ class Circuit:
         sets = sorted({self.topo.set_of[c.port_ref(pn)] for c in self.comps
                        for pn, port in c.ports.items() if port.domain == DOMAIN})
         self._check_grounds(sets)
-        unknowns, names = [], []
+        dae = self._equations(sets)
+        try:
+            reduced = self._reduce(dae)
+            moving = self._moving(reduced.equations, derivative=True)
+        except Singular as exc:
+            # with the speeds as knowns, EMFs tied to each other look like voltage sources
+            # in parallel: with the rotors' balances they may not be
+            moving = self._moving([dae.equations[e] for e in exc.equations])
+            if not moving:
+                raise self._refusal(exc, dae) from None
+        if moving:
+            # a constraint reaches the speed of rotors (or masses) the EMFs turn: their
+            # balances join the system, their speeds among its candidate states
+            dae = couple(self, dae, moving)
+            try:
+                reduced = self._reduce(dae)
+            except Singular as exc:
+                raise self._refusal(exc, dae) from None
+        try:
+            solved = solve_blocks(reduced.equations, reduced.unknowns, self._regular)
+        except Singular as exc:
+            raise self._refusal(exc, dae, reduced) from None
+        self._apply(dae, reduced, solved, sets)
+        return self
+
+    def _equations(self, sets):
+        """The circuit's DAE: Kirchhoff's current law at every set, the components' laws
+        and their states' rate equations, in the unknown potentials and pin currents."""
+        dae = Dae()
         for s in sets:
             self.potential[s] = ca.SX.sym(f"v{s}")
-            unknowns.append(self.potential[s])
-            names.append(f"the potential at {{{self._where(s)}}}")
+            dae.unknowns.append(self.potential[s])
+            dae.names.append(f"the potential at {{{self._where(s)}}}")
         for c in self.comps:
             for pn, port in c.ports.items():
                 if port.domain == DOMAIN:
                     ref = c.port_ref(pn)
                     self.current[ref] = ca.SX.sym(f"i_{c.name}_{pn}")
-                    unknowns.append(self.current[ref])
-                    names.append(f"the current into {ref.path}")
-        equations, owners = [], []
-        for s in sets:                            # Kirchhoff's current law
-            equations.append(sum((self.current[r] for r in self.topo.sets[s]
-                                  if r in self.current), ca.SX(0)))
-            owners.append(None)
-        knowns = []
+                    dae.unknowns.append(self.current[ref])
+                    dae.names.append(f"the current into {ref.path}")
+        for s in sets:
+            dae.add(sum((self.current[r] for r in self.topo.sets[s] if r in self.current),
+                        ca.SX(0)), None)
         for c in self.comps:
-            view = self._view(c, knowns)
+            view = self._view(c, dae.knowns)
             for eq in self.b.bound[c.name].laws(view):
-                equations.append(ca.SX(eq))
-                owners.append(c)
-        states, rates, labels, priority = [], [], [], []
+                dae.add(ca.SX(eq), c)
         for c in self.comps:
             view = self.views[c.name]
-            for k, (x, rate) in enumerate(zip(view.x, self.b.bound[c.name].rates(view))):
-                dx = ca.SX.sym(f"der_{x.name()}")
-                states.append(x)
-                rates.append(dx)
-                equations.append(dx - rate)
-                owners.append(c)
-                labels.append((c, k))
-                priority.append((_start_key(c, k) in c.given, -len(priority)))
-        self._names = names + [self.b.net.names[self.b._at(x)] for x in states]
-        self._owners = owners
-        try:
-            reduced = reduce_index(equations, unknowns, states, rates, knowns, self.b.t,
-                                   priority, self._sample,
-                                   self.b.p if self.b.p is not None else ca.SX(0, 1))
-        except Singular as exc:
-            raise self._refusal(exc, len(unknowns)) from None
-        try:
-            solved = solve_blocks(reduced.equations, reduced.unknowns, self._regular)
-        except Singular as exc:
-            raise self._refusal(exc, len(unknowns), reduced) from None
-        self._apply(reduced, solved, unknowns, states, rates, labels, sets)
-        return self
+            bound = self.b.bound[c.name]
+            for k, (x, rate) in enumerate(zip(view.x, bound.rates(view))):
+                key = _start_key(c, k)
+                dae.candidate(Candidate(x, self.b.net.names[self.b._at(x)], c, key,
+                                        bound.initial()[k]), rate, c)
+        return dae
+
+    def _reduce(self, dae):
+        return reduce_index(dae.equations, dae.unknowns, [c.x for c in dae.candidates],
+                            [c.dx for c in dae.candidates], dae.knowns, self.b.t,
+                            # a start given keeps a state, then a rotor's speed (the
+                            # mechanism's), then the first placed
+                            [(c.key in c.comp.given, c.group is not None, -k)
+                             for k, c in enumerate(dae.candidates)],
+                            self._sample, self.b.p if self.b.p is not None else ca.SX(0, 1))
+
+    def _moving(self, equations, derivative=False):
+        """EMFs whose speed (with ``derivative``, the speed's derivative) ``equations``
+        read, where their flange or support moves: the circuit may constrain the
+        mechanism."""
+        if not self.speeds or not equations:
+            return []
+        eqs = ca.vertcat(*equations)
+        net = self.b.net
+        out = []
+        for name, (w, dw) in self.speeds.items():
+            c = self.model.components[name]
+            vel = ca.SX(net.vel[c.port_ref("flange")] - net.vel[c.port_ref("support")])
+            if ca.depends_on(eqs, dw if derivative else w) and not vel.is_zero():
+                out.append(c)
+        return out
 
     def _view(self, comp, knowns):
         b = self.b
@@ -230,52 +265,63 @@ class Circuit:
         return abs(det) >= 1e-300 and det == det
 
     # -- the solution -----------------------------------------------------------------------
-    def _apply(self, reduced, solved, unknowns, states, rates, labels, sets):
-        """Put the solution in place: potentials, currents, the kept states' rates, the
-        demoted states' values (and their states dropped), the algebraic variables."""
+    def _apply(self, dae, reduced, solved, sets):
+        """Put the solution in place: potentials, currents, the kept states' rates (a
+        coupled rotor's acceleration), the demoted states' values (their states dropped),
+        the algebraic variables."""
+        b = self.b
         value = dict(zip((z.element_hash() for z in reduced.unknowns), solved.values))
-        z = ca.vertcat(*[u for u in unknowns])
-        vz = ca.vertcat(*[value[u.element_hash()] for u in unknowns])
-        demoted = [states[i] for i in reduced.demoted]
-        vd = [value[x.element_hash()] for x in demoted]
+        z = ca.vertcat(*dae.unknowns)
+        vz = ca.vertcat(*[value[u.element_hash()] for u in dae.unknowns])
+        demoted = [dae.candidates[i] for i in reduced.demoted]
+        dx = ca.vertcat(*[d.x for d in demoted])
+        vd = ca.vertcat(*[value[d.x.element_hash()] for d in demoted])
         known = self._knowns()
 
         def sub(e):
             e = ca.substitute(ca.SX(e), z, vz)
             if demoted:
-                e = ca.substitute(e, ca.vertcat(*demoted), ca.vertcat(*vd))
+                e = ca.substitute(e, dx, vd)
             return known(e)
         for s in sets:
             self.potential[s] = sub(self.potential[s])
         for ref in self.current:
             self.current[ref] = sub(self.current[ref])
-        for i in reduced.states:
-            self.b.net.rate[self.b._at(states[i])] = sub(value[rates[i].element_hash()])
-        self._check_starts(reduced, states, labels, [sub(v) for v in vd])
-        for i in reduced.demoted:
-            self._drop(states[i])
+        for cand in dae.candidates:
+            rate = sub(value[cand.dx.element_hash()])
+            if cand.group is not None:
+                self.coupled[cand.group.index].acc = rate
+            elif cand not in demoted:
+                b.net.rate[b._at(cand.x)] = rate
+        kept = [dae.candidates[i] for i in reduced.states]
+        self._check_starts(dae, reduced, kept, demoted, [sub(v) for v in ca.vertsplit(vd)])
+        for cand, v in zip(demoted, ca.vertsplit(vd)):
+            if cand.group is not None:       # a rotor's speed: the network substitutes it
+                b.pending[cand.x] = sub(v)
+            self._drop(cand.x)
         if solved.kept:
-            net = self.b.net
-            owners = sorted({o.name for o in self._owners if o is not None and any(
+            net = b.net
+            owners = sorted({o.name for o in dae.owners if o is not None and any(
                 ca.depends_on(r, k) for r in solved.residuals for k in solved.kept)})
             net.alg_z += solved.kept
             net.alg_res += [sub(r) for r in solved.residuals]
-            net.alg_names += [self._label(k, unknowns) for k in solved.kept]
+            net.alg_names += [self._label(k, dae.unknowns) for k in solved.kept]
             net.alg_units += ["V" if k.name().startswith("v") else "A"
                               for k in solved.kept]
             net.loops_kept.append(owners)
         # the rates of the sources' signals are needed only where a constraint was
         # differentiated through a source (the network finds them: ``_input_rates``)
         used = ca.vertcat(*self.potential.values(), *self.current.values(),
-                          *self.b.net.rate, *self.b.net.alg_res)
+                          *b.net.rate, *b.net.alg_res,
+                          *[c.acc for c in self.coupled.values()])
         self.input_rates = {du: s for du, s in self.input_rates.items()
                             if ca.depends_on(used, du)}
-        self.summary = self._summary(reduced, solved, unknowns, states)
+        self.summary = self._summary(dae, reduced, solved)
 
     def _knowns(self):
         """The function putting the EMF speeds in, and their derivatives where a
-        differentiated constraint reads them: zero on a flange that cannot turn; on one that
-        moves, the circuit constrains the mechanism, which is refused."""
+        differentiated constraint reads them: zero on a flange that cannot turn (on one that
+        turns freely, the rotor was coupled into the system: ``circuit_dae.couple``)."""
         net = self.b.net
 
         def known(e):
@@ -283,69 +329,57 @@ class Circuit:
                 c = self.model.components[name]
                 f, s = c.port_ref("flange"), c.port_ref("support")
                 if ca.depends_on(e, dw):
-                    acc = ca.SX(net.acc[f] - net.acc[s])
-                    if not acc.is_zero():
-                        raise ModelError(
-                            f"{self.model.place(c)}: the circuit fixes the voltage across "
-                            f"{name} (it is wired across a voltage source or a capacitor "
-                            f"with no resistance or inductance in between), so it "
-                            f"constrains the speed of the mechanism at {name}.flange, "
-                            f"which kinetwork does not reduce; add the armature's resistance "
-                            f"or inductance")
-                    e = ca.substitute(e, dw, acc)
+                    e = ca.substitute(e, dw, ca.SX(net.acc[f] - net.acc[s]))
                 if ca.depends_on(e, w):
                     e = ca.substitute(e, w, ca.SX(net.vel[f] - net.vel[s]))
             return e
         return known
 
-    def _check_starts(self, reduced, states, labels, values):
+    def _check_starts(self, dae, reduced, kept, demoted, values):
         """Record why each demoted state is no state, and check a start the user gave it
         against the constraint (at t = 0 and the parameters' values): one that disagrees,
         or that depends on signals the network has not built yet, is refused."""
-        net, problems = self.b.net, []
-        kept = [states[i] for i in reduced.states]
-        starts = [self._at_values(ca.SX(net.start[self.b._at(x)])) for x in kept]
-        for i, v in zip(reduced.demoted, values):
-            comp, k = labels[i]
-            key = _start_key(comp, k)
-            name = net.names[self.b._at(states[i])]
-            self.demoted[name] = self._why(reduced, comp, v, kept, states, labels)
-            if key not in comp.given:
+        problems = []
+        xs = ca.vertcat(*[c.x for c in kept])
+        starts = ca.vertcat(*[self._at_values(ca.SX(c.start)) for c in kept])
+        for cand, v in zip(demoted, values):
+            self.demoted[cand.name] = self._why(dae, reduced, cand, v, kept)
+            if cand.key not in cand.comp.given:
                 continue
             at0 = self._at_values(ca.substitute(v, self.b.t, ca.SX(0)))
             if kept:
-                at0 = ca.substitute(at0, ca.vertcat(*kept), ca.vertcat(*starts))
-            given = float(self._at_values(ca.SX(self.b.bound[comp.name].initial()[k])))
-            where = self.model.place(comp, key)
+                at0 = self._at_values(ca.substitute(at0, xs, starts))
+            given = float(self._at_values(ca.SX(cand.start)))
+            where = self.model.place(cand.comp, cand.key)
+            why = self.demoted[cand.name]
             if not at0.is_constant():
-                problems.append(f"{where}: {name} is no state ({self.demoted[name]}); its "
-                                f"start follows from signals, so it cannot be given: remove "
-                                f"{key}")
+                problems.append(f"{where}: {cand.name} is no state ({why}); its start follows "
+                                f"from signals, so it cannot be given: remove {cand.key}")
                 continue
             fixed = float(at0)
             if abs(fixed - given) > START_TOL * (1 + abs(fixed)):
-                problems.append(f"{where} = {given:g}: {name} is no state "
-                                f"({self.demoted[name]}), and the constraint gives {fixed:g} "
-                                f"at the start: remove {key} or make it agree")
+                problems.append(f"{where} = {given:g}: {cand.name} is no state ({why}), and "
+                                f"the constraint gives {fixed:g} at the start: remove "
+                                f"{cand.key} or make it agree")
         if problems:
             raise ModelError(problems)
 
-    def _why(self, reduced, comp, value, kept, states, labels):
-        """What fixes ``comp``'s state: the kept states and the sources its value follows
+    def _why(self, dae, reduced, cand, value, kept):
+        """What fixes a demoted state: the kept states and the sources its value follows
         from, and the components of the constraint (the laws differentiated in the step
         that found it, with the components of those states), grounds left out."""
-        reads = [i for i, x in zip(reduced.states, kept) if ca.depends_on(value, x)]
-        group = {labels[i][0].name for i in reads} | {comp.name}
+        reads = [c for c in kept if ca.depends_on(value, c.x)]
+        group = {c.comp.name for c in reads} | {cand.comp.name}
         for eqs in reduced.constraints:
-            if any(self._owners[e] is comp for e in eqs):
-                group |= {self._owners[e].name for e in eqs if self._owners[e] is not None}
-        group = [c.name for c in self.comps if c.name in group
-                 and c.type_name != "electrical.Ground"]
-        names = [self.b.net.names[self.b._at(states[i])] for i in reads]
-        driven = [c for c in group if getattr(type(self.model.components[c]),
-                                              "reference_key", None)]
-        follows = ", ".join(names + [f"the source {c}" for c in driven]) or "the sources"
-        return f"follows from {follows} through the constraint of {', '.join(group)}"
+            if any(ca.depends_on(dae.equations[e], cand.x) for e in eqs):
+                group |= {dae.owners[e].name for e in eqs if dae.owners[e] is not None}
+        group = [name for name in self.model.components if name in group
+                 and self.model.components[name].type_name != "electrical.Ground"]
+        driven = [name for name in group if getattr(
+            type(self.model.components[name]), "reference_key", None)]
+        follows = ", ".join([c.name for c in reads] + [f"the source {n}" for n in driven])
+        return f"follows from {follows or 'the sources'} through the constraint of " \
+               f"{', '.join(group)}"
 
     def _drop(self, x):
         """Take the state ``x`` out of the network: a constraint gives its value."""
@@ -366,13 +400,16 @@ class Circuit:
                 return f"{ref.path}.i"
         return z.name()
 
-    def _summary(self, reduced, solved, unknowns, states):
-        n_pot = len(self.potential)
+    def _summary(self, dae, reduced, solved):
         loops = [n for n in solved.sizes if n > 1]
-        out = (f"circuits: {n_pot} node potentials and {len(self.current)} pin currents in "
-               f"{len(solved.sizes)} blocks" + ("" if solved.kept else " solved symbolically")
+        out = (f"circuits: {len(self.potential)} node potentials and {len(self.current)} "
+               f"pin currents in {len(solved.sizes)} blocks"
+               + ("" if solved.kept else " solved symbolically")
                + (f" (linear loops of {', '.join(map(str, loops))})" if loops else "")
                + f", {len(reduced.states)} states")
+        if self.coupled:
+            out += (f"; with the rotors (masses) the EMFs turn: "
+                    + ", ".join(c.candidate.name for c in self.coupled.values()))
         if reduced.demoted:
             out += (f"; index reduction (Pantelides, dummy derivatives): "
                     f"{len(reduced.constraints)} constraints differentiated, "
@@ -382,23 +419,24 @@ class Circuit:
                     f"variables")
         return out
 
-    def _refusal(self, exc, n_unknowns, reduced=None):
+    def _refusal(self, exc, dae, reduced=None):
         """The ModelError of a circuit that cannot be solved: the components whose laws
         over-determine it and the unknowns left undetermined, each sorted."""
         eqs = exc.equations if reduced is None else sorted({reduced.origin[e]
                                                             for e in exc.equations})
-        comps = sorted({self._owners[e].name for e in eqs if self._owners[e] is not None})
-        kcl = any(self._owners[e] is None for e in eqs)
-        if reduced is None:
-            lost = [self._names[v] for v in exc.unknowns]
-        else:
-            lost = [self._names[reduced.base[v][0]] for v in exc.unknowns]
+        comps = sorted({dae.owners[e].name for e in eqs if dae.owners[e] is not None})
+        kcl = any(dae.owners[e] is None for e in eqs)
+        lost = [dae.described(v if reduced is None else reduced.base[v][0])
+                for v in exc.unknowns]
         what = (", ".join(comps) or "the circuit") + (
             " and Kirchhoff's current law" if kcl and comps else "")
         if exc.reason:
-            return ModelError(f"circuit: the equations of {what} cannot be solved: "
-                              f"{exc.reason}" + (f"; undetermined: {', '.join(lost)}"
-                                                 if lost else ""))
+            reason = exc.reason
+            if "rest_g" in reason:
+                reason = ("it needs the derivative of the forces on a rotor the circuit "
+                          "constrains (a constraint of the mechanism's accelerations)")
+            return ModelError(f"circuit: the equations of {what} cannot be solved: {reason}"
+                              + (f"; undetermined: {', '.join(lost)}" if lost else ""))
         return ModelError(
             f"circuit: the equations of {what} constrain their unknowns twice and leave "
             f"{', '.join(lost) or 'nothing'} undetermined: the circuit is structurally "

@@ -542,23 +542,28 @@ class _Builder:
         self.net.hybrid.append(Hybrid(comp, b, b._mode, b._F, refs[b.side_a] if b.side_a in
                                       refs else None, refs[b.side_b], u))
 
-    def _applied(self, s, roles=("compliant", "source")):
+    def _applied(self, s, roles=("compliant", "source"), exclude=()):
         """Flows into the non-rigid elements at a connection set (compliant, sources; with
-        ``prescribed`` in ``roles``, motion sources too)."""
+        ``prescribed`` in ``roles``, motion sources too), but those of ``exclude``."""
         return sum((self.net.flow.get(r, 0) for r in self.topo.sets[s]
-                    if r.component.role in roles), ca.SX(0))
-
-    def _generalized(self, group, roles=("compliant", "source")):
-        return sum((-self.kt[s] * self._applied(s, roles) for s, _, _ in group.sets),
+                    if r.component.role in roles and r.component.name not in exclude),
                    ca.SX(0))
+
+    def _generalized(self, group, roles=("compliant", "source"), exclude=()):
+        return sum((-self.kt[s] * self._applied(s, roles, exclude) for s, _, _ in group.sets),
+                   ca.SX(0))
+
+    def group_inertia(self, group):
+        """sum(J k kt) over the group's inertias: its inertia on its coordinate."""
+        at = self.topo.set_of
+        return sum((self.bound[e.name].inertia() * self.k[at[e.port_ref("flange_a")]] *
+                    self.kt[at[e.port_ref("flange_a")]] for e in group.rigid
+                    if e.has_inertia), ca.SX(0))
 
     def _inertia(self, group):
         """The group's inertia; on a joint, its armature, and the passive generalized force
         (springs and dampers) that an InverseDynamics block compensates."""
-        at = self.topo.set_of
-        inertia = sum((self.bound[e.name].inertia() * self.k[at[e.port_ref("flange_a")]] *
-                       self.kt[at[e.port_ref("flange_a")]] for e in group.rigid
-                       if e.has_inertia), ca.SX(0))
+        inertia = self.group_inertia(group)
         self.inertia[group.index] = inertia
         if group.kind == "joint":
             u = self._speed(group)
@@ -576,6 +581,12 @@ class _Builder:
         theta, w, a = self.coord[group.index]
         if group.kind == "joint":
             self.net.Q[self._speed(group)] += gen
+        elif group.kind == "free" and group.index in self.circuit.coupled:
+            # a rotor a circuit's constraint holds: its acceleration came with the circuit's
+            # solution, in the generalized force of all but the circuit's EMFs
+            coupled = self.circuit.coupled[group.index]
+            self.pending[coupled.rest] = self._generalized(group, exclude=coupled.emfs)
+            self.pending[a] = coupled.acc
         elif group.kind == "free":
             self.pending[a] = gen / self.inertia[group.index]
         elif group.kind == "massless":

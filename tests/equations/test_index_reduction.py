@@ -268,3 +268,92 @@ def test_a_structurally_singular_system_names_its_parts():
     with pytest.raises(Singular) as info:
         reduce_index([a - 1, a - 2], [a, b], [], [], [], t, [], None)
     assert info.value.equations == [0, 1] and info.value.unknowns == [1]
+
+
+# -- constraints of the 1-D network through the circuit -------------------------------------
+R = kn.rotational
+
+
+def _electric_gear(**j2):
+    """Two free rotors, each turned by an EMF, the EMFs' pins wired to each other: an ideal
+    electric gear of ratio k2/k1 (k1 w1 = k2 w2), J1 driven by 1.5 N m."""
+    return _circuit([R.Inertia("J1", J=2.0), R.Inertia("J2", J=0.5, **j2),
+                     E.EMF("e1", k=0.3), E.EMF("e2", k=0.6), E.Ground("g"),
+                     R.Torque("T", tau=1.5), kn.Probe("p1", quantities=["speed", "angle"]),
+                     kn.Probe("p2", quantities=["speed"]), kn.Probe("pi", quantities=["current"])],
+                    [("e1.flange", "J1.flange_a"), ("e2.flange", "J2.flange_a"),
+                     ("e1.p", "e2.p"), ("e1.n", "e2.n"), ("g.p", "e1.n"),
+                     ("T.flange", "J1.flange_b"), ("p1.port", "J1.flange_a"),
+                     ("p2.port", "J2.flange_a"), ("pi.port", "e1.p")])
+
+
+def test_two_rotors_tied_by_an_electric_gear_share_one_speed():
+    """Today's 1-D rigid groups tie flanges through gears; two EMFs wired to each other tie
+    two rotors through the circuit, a constraint the index reduction finds: J2's speed is
+    demoted, the pair turns as one inertia J1 + J2 (k1/k2)^2, and the current is what J2's
+    acceleration needs (k2 i = -J2 a2)."""
+    m = _electric_gear()
+    system = m.compile()
+    assert system.state_names == ["J1.phi", "J1.w", "J2.phi"]
+    assert system.demoted_states == {
+        "J2.w": "follows from J1.w through the constraint of J1, J2, e1, e2"}
+    res = kn.simulate(m, t_end=1.0, n_points=21, **TOL)
+    a1 = 1.5 / (2.0 + 0.5 * (0.3 / 0.6) ** 2)
+    assert np.max(abs(res["p1.speed"] - a1 * res.t)) < 1e-12
+    assert np.max(abs(res["p1.angle"] - a1 * res.t ** 2 / 2)) < 1e-10
+    assert np.max(abs(res["p2.speed"] - 0.3 / 0.6 * a1 * res.t)) < 1e-12
+    # J2 a2 = torque of e2 = k2 i2, i2 the current into e2.p = -(into e1.p)
+    assert np.max(abs(res["pi.current"] + 0.5 * 0.5 * a1 / 0.6)) < 1e-12
+
+
+def test_a_start_on_the_demoted_rotor_must_agree_with_the_gear():
+    assert _electric_gear(w0=0.0).compile().state_names == ["J1.phi", "J2.phi", "J2.w"]
+    m = _circuit([R.Inertia("J", J=2.0, w0=1.0), E.EMF("e", k=0.5), E.Ground("g"),
+                  E.VoltageSource("V", V="sin(t)")],
+                 [("e.flange", "J.flange_a"), ("V.p", "e.p"), ("V.n", "e.n"), ("g.p", "e.n")])
+    with pytest.raises(kn.ModelError, match=r"J\.w0 = 1: J\.w is no state \(follows from the "
+                                            r"source V .*gives 0 at the start"):
+        m.compile()
+
+
+def test_a_voltage_source_across_an_emf_turns_its_rotor_at_v_over_k():
+    m = _circuit([R.Inertia("J", J=2.0), E.EMF("e", k=0.5), E.Ground("g"),
+                  E.VoltageSource("V", V="sin(t)"), kn.Probe("p", quantities=["speed", "angle"]),
+                  kn.Probe("pi", quantities=["current"])],
+                 [("e.flange", "J.flange_a"), ("V.p", "e.p"), ("V.n", "e.n"), ("g.p", "e.n"),
+                  ("p.port", "J.flange_a"), ("pi.port", "e.p")])
+    system = m.compile()
+    assert system.state_names == ["J.phi"] and list(system.demoted_states) == ["J.w"]
+    res = kn.simulate(m, t_end=2.0, n_points=21, **TOL)
+    assert np.max(abs(res["p.speed"] - np.sin(res.t) / 0.5)) < 1e-12
+    assert np.max(abs(res["p.angle"] - (1 - np.cos(res.t)) / 0.5)) < 1e-9
+    # the torque J w' = k i: the current J cos(t) / k^2 into e.p
+    assert np.max(abs(res["pi.current"] - 2.0 * np.cos(res.t) / 0.25)) < 1e-12
+
+
+def test_a_capacitor_across_an_emf_adds_c_k_squared_to_the_rotor():
+    m = _circuit([R.Inertia("J", J=2.0), E.EMF("e", k=0.5), E.Ground("g"),
+                  E.Capacitor("C", C=4.0), R.Torque("T", tau=3.0),
+                  kn.Probe("p", quantities=["speed"]), kn.Probe("pc", quantities=["voltage"])],
+                 [("e.flange", "J.flange_a"), ("C.p", "e.p"), ("C.n", "e.n"), ("g.p", "e.n"),
+                  ("p.port", "J.flange_a"), ("T.flange", "J.flange_b"), ("pc.port", "C.p")])
+    system = m.compile()
+    assert system.state_names == ["J.phi", "J.w"] and list(system.demoted_states) == ["C.v"]
+    res = kn.simulate(m, t_end=1.0, n_points=11, **TOL)
+    a = 3.0 / (2.0 + 4.0 * 0.5 ** 2)
+    assert np.max(abs(res["p.speed"] - a * res.t)) < 1e-12
+    assert np.max(abs(res["pc.voltage"] - 0.5 * a * res.t)) < 1e-12
+
+
+def test_a_circuit_that_constrains_a_joint_is_refused_naming_it():
+    mb = kn.multibody
+    m = _circuit([mb.Ground("ground"), mb.Revolute("rev", axis=[0, 0, 1]),
+                  mb.RigidBody("body", mass=1.0, r_cm=[0.5, 0, 0], inertia=[0, 0, 0.1]),
+                  E.EMF("e", k=0.5), E.Ground("g"), E.VoltageSource("V", V="sin(t)")],
+                 [("ground.frame", "rev.frame_a"), ("rev.frame_b", "body.frame_a"),
+                  ("e.flange", "rev.axis"), ("e.support", "rev.support"), ("V.p", "e.p"),
+                  ("V.n", "e.n"), ("g.p", "e.n")])
+    with pytest.raises(kn.ModelError, match=r"e: the circuit fixes the voltage across e .*"
+                                            r"constrains the speed at e\.flange, which is a "
+                                            r"joint's axis"):
+        m.compile()
