@@ -106,7 +106,8 @@ class Circuit:
             except Singular as exc:
                 raise self._refusal(exc, dae) from None
         try:
-            solved = solve_blocks(reduced.equations, reduced.unknowns, self._regular)
+            solved = solve_blocks(reduced.equations, reduced.unknowns, self._regular,
+                                  self._sample)
         except Singular as exc:
             raise self._refusal(exc, dae, reduced) from None
         self._apply(dae, reduced, solved, sets)
@@ -256,13 +257,16 @@ class Circuit:
 
     def _regular(self, a):
         """Whether a block's matrix is regular at the parameters' values (a loop of zero
-        resistances is not); one whose entries vary in time is taken as regular (IDAS or
-        CVODES will say where it is not)."""
-        det = self._at_values(ca.det(a))
-        if not det.is_constant():
+        resistances is not): its rank, numerically (a symbolic determinant costs
+        exponential time in the block's size); one whose entries vary in time is taken as
+        regular (IDAS or CVODES will say where it is not)."""
+        a = self._at_values(ca.SX(a))
+        if not a.is_constant():
             return True
-        det = float(det)
-        return abs(det) >= 1e-300 and det == det
+        m = np.array(ca.evalf(a), dtype=float).reshape(a.shape)
+        if not np.all(np.isfinite(m)):
+            return False
+        return m[0, 0] != 0 if m.shape == (1, 1) else np.linalg.matrix_rank(m) == m.shape[0]
 
     # -- the solution -----------------------------------------------------------------------
     def _apply(self, dae, reduced, solved, sets):
@@ -368,7 +372,8 @@ class Circuit:
         """What fixes a demoted state: the kept states and the sources its value follows
         from, and the components of the constraint (the laws differentiated in the step
         that found it, with the components of those states), grounds left out."""
-        reads = [c for c in kept if ca.depends_on(value, c.x)]
+        symbols = {x.element_hash() for x in ca.symvar(value)}
+        reads = [c for c in kept if c.x.element_hash() in symbols]
         group = {c.comp.name for c in reads} | {cand.comp.name}
         for eqs in reduced.constraints:
             if any(ca.depends_on(dae.equations[e], cand.x) for e in eqs):

@@ -319,24 +319,38 @@ def _dummies(eqs, var, eq_der, eq_integ, der, integ, n_y, priority, sample):
     cols = [v for v in range(len(var)) if der[v] is None and integ[v] is not None]
     chosen_all = set()
     while rows:
-        cols = [v for v in cols if any(ca.depends_on(eqs[e], var[v]) for e in rows)]
-        cols.sort(key=lambda v: _rank_key(v, integ, n_y, priority))
+        read = set().union(*incidence([eqs[e] for e in rows], [var[v] for v in cols]))
+        cols = sorted((v for k, v in enumerate(cols) if k in read),
+                      key=lambda v: _rank_key(v, integ, n_y, priority))
         jac = sample(ca.jacobian(ca.vertcat(*[eqs[e] for e in rows]),
-                                 ca.vertcat(*[var[v] for v in cols])) if cols else None)
-        chosen, picked = [], np.zeros((len(rows), 0))
-        for c, v in enumerate(cols):
-            trial = np.column_stack([picked, jac[:, c]])
-            if _rank(trial) > picked.shape[1]:
-                picked = trial
-                chosen.append(v)
-                if len(chosen) == len(rows):
-                    break
+                                 ca.vertcat(*[var[v] for v in cols]))) if cols else None
+        chosen = [cols[c] for c in _independent(jac, len(rows))] if cols else []
         if len(chosen) < len(rows):
             raise Singular(sorted(rows), [], "its differentiated equations are singular")
         chosen_all.update(chosen)
         rows = [eq_integ[e] for e in rows if eq_integ[eq_integ[e]] is not None]
         cols = [integ[v] for v in chosen if integ[integ[v]] is not None]
     return chosen_all
+
+
+def _independent(jac, wanted):
+    """Indices of the first columns of ``jac``, in order, that are linearly independent of
+    those before them, up to ``wanted`` of them (Gram-Schmidt, twice for round-off)."""
+    basis, out = [], []
+    for c in range(jac.shape[1]):
+        v = np.array(jac[:, c], dtype=float)
+        norm = np.linalg.norm(v)
+        if norm == 0:
+            continue
+        for _ in range(2):
+            for q in basis:
+                v -= (q @ v) * q
+        if np.linalg.norm(v) > RANK_TOL * max(1.0, norm):
+            basis.append(v / np.linalg.norm(v))
+            out.append(c)
+            if len(out) == wanted:
+                break
+    return out
 
 
 def _rank_key(v, integ, n_y, priority):
@@ -352,13 +366,6 @@ def _rank_key(v, integ, n_y, priority):
     return (1, priority[base - n_y], -base)
 
 
-def _rank(a):
-    if a.size == 0:
-        return 0
-    s = np.linalg.svd(a, compute_uv=False)
-    return int(np.sum(s > RANK_TOL * max(1.0, s[0])))
-
-
 @dataclass
 class Solved:
     """The block-lower-triangular solve of a square system: ``values[j]``, unknown j in the
@@ -372,7 +379,7 @@ class Solved:
     nonlinear: int = 0
 
 
-def solve_blocks(equations, unknowns, regular):
+def solve_blocks(equations, unknowns, regular, sample=None):
     """Solve ``equations`` for ``unknowns`` block by block (Tarjan's strongly connected
     components of the matched dependency graph, in topological order): a linear block
     symbolically, a nonlinear block torn (the unknowns it reads nonlinearly stay unknowns,
@@ -380,7 +387,10 @@ def solve_blocks(equations, unknowns, regular):
 
     ``regular(matrix)`` says whether a block's matrix is regular at the parameters' values;
     a block where it is not, or a system that is not structurally regular, raises
-    ``Singular`` naming the equations.
+    ``Singular`` naming the equations. ``sample(matrix)``, numbers of a matrix at generic
+    values of its symbols, lets a large linear block be solved by sparse elimination (its
+    pivots chosen on those numbers) rather than by a dense symbolic factorisation, whose
+    expressions grow as the cube of the block.
     """
     n = len(unknowns)
     inc = incidence(equations, unknowns)
@@ -397,34 +407,100 @@ def solve_blocks(equations, unknowns, regular):
     dag = nx.condensation(dep)
     out = Solved([None] * n, [], [], sorted((len(dag.nodes[c]["members"]) for c in dag),
                                             reverse=True))
-    known_z, known_v = [], []
     for c in nx.lexicographical_topological_sort(dag, key=lambda c: min(
             dag.nodes[c]["members"])):
         block = sorted(dag.nodes[c]["members"])
         zs = [assigned[e] for e in block]
         res = ca.vertcat(*[equations[e] for e in block])
-        if known_z:
-            res = ca.substitute(res, ca.vertcat(*known_z), ca.vertcat(*known_v))
+        # the unknowns solved before that the block reads, their values put in
+        before = sorted({v for e in block for v in inc[e]} - set(zs))
+        if before:
+            res = ca.substitute(res, ca.vertcat(*[unknowns[j] for j in before]),
+                                ca.vertcat(*[out.values[j] for j in before]))
         zb = ca.vertcat(*[unknowns[j] for j in zs])
         a = ca.jacobian(res, zb)
         if not ca.depends_on(a, zb):
-            if not regular(a):
+            large = sample is not None and len(zs) > SMALL_BLOCK
+            if not large and not regular(a):    # a large one: its elimination checks
                 raise Singular(block, [], "singular at the parameters' values")
-            solved = _linear(a, res, zb)
+            try:
+                solved = _linear(a, res, zb, sample)
+            except Singular:
+                raise Singular(block, [], "singular at the parameters' values") from None
         else:
             out.nonlinear += 1
             solved = _tear(res, zb, a, regular, out)
         for k, j in enumerate(zs):
             out.values[j] = solved[k]
-            known_z.append(unknowns[j])
-            known_v.append(solved[k])
     return out
 
 
-def _linear(a, res, z):
+def _linear(a, res, z, sample=None):
     """z from res(z) = a z + res(0) = 0."""
     rest = ca.substitute(res, z, ca.SX.zeros(z.shape[0]))
-    return -rest / a if z.shape[0] == 1 else -ca.solve(a, rest)
+    if z.shape[0] == 1:
+        return -rest / a
+    if sample is None or z.shape[0] <= SMALL_BLOCK:
+        return -ca.solve(a, rest)
+    return -sparse_solve(a, rest, sample(a))
+
+
+#: a linear block up to this size is solved by CasADi's dense symbolic solve
+SMALL_BLOCK = 4
+#: a pivot at least this fraction of its column's largest entry keeps elimination stable
+PIVOT_THRESHOLD = 0.1
+
+
+def sparse_solve(a, b, numbers):
+    """x with a x = b for a square SX matrix ``a``: Gaussian elimination in Markowitz's
+    order (the pivot that makes the least fill among those of at least PIVOT_THRESHOLD of
+    their column's largest, on ``numbers``, the matrix's values at generic symbols): the
+    expressions grow with the fill, a few entries per row for a circuit, not with the cube
+    of the size."""
+    n = a.shape[0]
+    rows = [{} for _ in range(n)]
+    vals = [{} for _ in range(n)]
+    readers = [set() for _ in range(n)]
+    for i, j in zip(*a.sparsity().get_triplet()):
+        rows[i][j], vals[i][j] = a[i, j], float(numbers[i, j])
+        readers[j].add(i)
+    rhs = [b[i] for i in range(n)]
+    free_rows, free_cols, order = set(range(n)), set(range(n)), []
+    # below this a pivot is round-off of a cancellation (a loop of zero resistances)
+    tiny = 1e-12 * max((abs(v) for row in vals for v in row.values()), default=0.0)
+    for _ in range(n):
+        best = None
+        for c in sorted(free_cols):
+            cand = [r for r in readers[c] if r in free_rows]
+            big = max((abs(vals[r][c]) for r in cand), default=0.0)
+            for r in sorted(cand):
+                v = abs(vals[r][c])
+                if v > tiny and v >= PIVOT_THRESHOLD * big:
+                    cost = (len(rows[r]) - 1) * (len(cand) - 1)
+                    if best is None or cost < best[0]:
+                        best = (cost, r, c)
+        if best is None:
+            raise Singular(sorted(free_rows), sorted(free_cols), "singular at the "
+                           "parameters' values")
+        _, r, c = best
+        free_rows.discard(r)
+        free_cols.discard(c)
+        order.append((r, c))
+        for i in sorted(readers[c] & free_rows):
+            f, fv = rows[i][c] / rows[r][c], vals[i][c] / vals[r][c]
+            for j in rows[r]:
+                if j != c:
+                    rows[i][j] = rows[i].get(j, 0) - f * rows[r][j]
+                    vals[i][j] = vals[i].get(j, 0.0) - fv * vals[r][j]
+                    readers[j].add(i)
+            del rows[i][c], vals[i][c]
+            readers[c].discard(i)
+            rhs[i] = rhs[i] - f * rhs[r]
+    x = [None] * n
+    for r, c in reversed(order):
+        x[c] = (rhs[r] - sum((rows[r][j] * x[j] for j in rows[r] if j != c), ca.SX(0))) \
+            / rows[r][c]
+    return ca.vertcat(*x)
 
 
 def _tear(res, zb, a, regular, out):

@@ -357,3 +357,64 @@ def test_a_circuit_that_constrains_a_joint_is_refused_naming_it():
                                             r"constrains the speed at e\.flange, which is a "
                                             r"joint's axis"):
         m.compile()
+
+
+# -- large circuits ----------------------------------------------------------------------------
+def ladder(n):
+    """A Cauer-like ladder of n sections (L || C in series, C to ground): n + 1 capacitor
+    loops, so the differentiated constraints make one linear block across the ladder."""
+    parts = [E.Ground("g"), E.VoltageSource("V", V="sin(t)"), E.Resistor("R1", R=1.0),
+             E.Resistor("R2", R=1.0), E.Capacitor("Cs0", C=1.0),
+             kn.Probe("out", quantities=["voltage"])]
+    wires = [("V.n", "g.p"), ("V.p", "R1.p"), ("Cs0.p", "R1.n"), ("Cs0.n", "g.p")]
+    node = "R1.n"
+    for k in range(n):
+        parts += [E.Inductor(f"L{k}", L=1.0), E.Capacitor(f"Cp{k}", C=0.3),
+                  E.Capacitor(f"Cs{k + 1}", C=1.0)]
+        wires += [(f"L{k}.p", node), (f"Cp{k}.p", node), (f"L{k}.n", f"Cp{k}.n"),
+                  (f"Cs{k + 1}.p", f"L{k}.n"), (f"Cs{k + 1}.n", "g.p")]
+        node = f"L{k}.n"
+    wires += [("R2.p", node), ("R2.n", "g.p"), ("out.port", node)]
+    return _circuit(parts, wires, "ladder")
+
+
+def test_a_large_block_is_eliminated_sparsely_and_gives_the_dense_answer(monkeypatch):
+    """The differentiated constraints of a ladder couple every section in one linear block:
+    solved by sparse elimination its right-hand side grows linearly with the ladder
+    (a dense symbolic solve grows as its cube), and gives the dense solve's answer."""
+    import kinetwork.equations.structure as structure
+    sizes = {n: ladder(n).compile().size()["operations"] for n in (5, 20)}
+    assert sizes[20] < 5 * sizes[5]
+    sparse = kn.simulate(ladder(6), t_end=10.0, n_points=51, **TOL)
+    monkeypatch.setattr(structure, "SMALL_BLOCK", 10 ** 6)
+    dense = kn.simulate(ladder(6), t_end=10.0, n_points=51, **TOL)
+    assert 0.1 < np.max(abs(dense["out.voltage"])) < 1
+    assert np.max(abs(sparse["out.voltage"] - dense["out.voltage"])) < 1e-12
+
+
+def test_a_singular_part_of_a_large_circuit_is_named():
+    """Two voltage sources in parallel across a section of the ladder: named, with the
+    ladder's other hundred unknowns left out of the message."""
+    m = ladder(5)
+    m.add(E.VoltageSource("short", V=0.0))
+    m.connect("short.p", "L0.p")
+    m.connect("short.n", "L0.n")
+    m.add(E.VoltageSource("short2", V=0.0))
+    m.connect("short2.p", "L0.p")
+    m.connect("short2.n", "L0.n")
+    with pytest.raises(kn.ModelError, match="circuit: the equations of .*short, short2"):
+        m.compile()
+
+
+def test_a_loop_of_zero_resistances_is_singular_at_the_values():
+    """Structurally regular (R a parameter), singular at R = 0: refused naming the block;
+    the same circuit at R = 1 builds."""
+    def loop(r):
+        return _circuit([E.Ground("g"), E.VoltageSource("src", V=1.0), E.Resistor("r1", R="R"),
+                         E.Resistor("r2", R="R")],
+                        [("src.p", "r1.p"), ("r1.n", "r2.p"), ("r2.n", "src.n"),
+                         ("g.p", "src.n")], parameters={"R": r})
+    with pytest.raises(kn.ModelError, match=r"circuit: the equations of r1, r2.* cannot be "
+                                            r"solved: singular at the parameters' values"):
+        loop(0.0).compile()
+    assert loop(1.0).compile().n_states == 0
