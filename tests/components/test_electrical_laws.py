@@ -168,3 +168,12 @@ def test_help_shows_the_laws_units():
     assert "Ids : A, >= 0, default 1e-06" in kn.electrical.Diode.__doc__
     assert "G : S" in kn.electrical.Conductor.__doc__
     assert "i : expression in A, required" in kn.electrical.NonlinearResistor.__doc__
+
+
+def test_an_ode_method_on_a_diode_circuit_says_why_not():
+    m = _circuit([E.Ground("g"), E.VoltageSource("src", V=1.0), E.Resistor("r", R=10.0),
+                  E.Diode("d")],
+                 [("src.p", "r.p"), ("r.n", "d.p"), ("d.n", "src.n"), ("g.p", "src.n")])
+    with pytest.raises(kn.ModelError, match=r"integrates ODEs only.*algebraic variables "
+                                            r"\(r\.n\.v: .*nonlinear circuit"):
+        kn.simulate(m, t_end=0.1, method="cvodes")
