@@ -264,6 +264,27 @@ class IdealOpAmp(Component, library=LIB):
         return []
 
 
+class IdealOpAmp3Pin(Component, library=LIB):
+    """Ideal operational amplifier with three pins (MSL's Analog.Ideal.IdealOpAmp3Pin): no
+    voltage across and no current into the inputs in_p, in_n (a nullator); the output out
+    takes any voltage and current (a norator to ground)."""
+    role = "electrical"
+    in_p = Port("electrical", "Positive input pin")
+    in_n = Port("electrical", "Negative input pin")
+    out = Port("electrical", "Output pin")
+    n_states = 0
+    state_labels = state_units = ()
+
+    def laws(self, e):
+        return [e.v("in_p") - e.v("in_n"), e.i("in_p"), e.i("in_n")]
+
+    def rates(self, e):
+        return []
+
+    def initial(self):
+        return []
+
+
 class EMF(PartialTwoPin, library=LIB):
     """Ideal electromechanical converter (MSL's Analog.Basic.EMF): v = k w and the torque
     k i on the flange, w the speed of the flange relative to the support; its reaction goes

@@ -195,6 +195,131 @@ def test_cauer_low_pass_analog_matches_its_index_one_equations(starts, kept):
     assert np.max(abs(res["inp.voltage"] - (res.t >= 1))) == 0.0
 
 
+#: MSL's CauerLowPassOPV's connect() equations in its order, the interface pins n1..n14,
+#: p1..p4 and out1 it wires through standing for the nodes they join
+OPV_WIRES = """Op1.in_p, G.p
+G1.p, Op2.in_p
+R1.n, n1
+n1, Op1.in_n
+C2.n, n1
+R2.n, n2
+n1, n2
+n2, n3
+n3, C1.p
+n3, R3.p
+C1.n, n4
+R3.n, n4
+n4, Op1.out
+R4.p, Op1.out
+C5.p, Op1.out
+R4.n, n5
+n5, Op2.in_n
+C3.p, n5
+R5.n, n5
+R5.p, p1
+C2.p, p1
+C3.n, n6
+n6, Op2.out
+R2.p, n6
+Op2.out, R7.p
+R7.n, n7
+n7, Op3.in_n
+C5.n, n7
+R6.n, n8
+n7, n8
+C6.p, p2
+n8, p2
+C4.n, p2
+C6.n, Op3.out
+R9.p, Op3.out
+Op3.out, out1
+p1, out1
+out1, C8.p
+C4.p, p3
+p3, R8.p
+R8.n, n9
+n9, n10
+R9.n, n10
+n10, Op4.in_n
+n9, C7.p
+C7.n, n11
+R6.p, n11
+n11, Op4.out
+Op4.out, R10.p
+G2.p, Op3.in_p
+R11.n, n12
+p3, n12
+C9.n, n13
+n12, n13
+n13, Op5.out
+C9.p, p4
+R11.p, p4
+R10.n, n14
+p4, n14
+Op5.in_n, n14
+C8.n, n14
+Op4.in_p, G3.p
+Op5.in_p, G4.p
+V.p, Ground1.p
+V.n, R1.p"""
+
+
+def cauer_low_pass_opv():
+    """MSL's Electrical.Analog.Examples.CauerLowPassOPV: the same filter built of five ideal
+    3-pin op-amps, nine capacitors (C1, C2, C3, C4 and C7 with fixed starts) and resistors
+    of +-1 Ohm; the source wired reversed (a step of -1 V), so that the inverting network
+    gives the analog filter's response."""
+    m = kn.Model("CauerLowPassOPV", parameters=dict(l1=L1, l2=L2, c1=C1, c2=C2, c3=C3,
+                                                    c4=C4, c5=C5))
+    fixed = dict(v0=0.0)
+    for c in (E.Capacitor("C1", C="c1 + c2", **fixed), E.Capacitor("C2", C="c2", **fixed),
+              E.Capacitor("C3", C="l1", **fixed), E.Capacitor("C4", C="c4", **fixed),
+              E.Capacitor("C5", C="c2"), E.Resistor("R1", R=1), E.Resistor("R2", R=1),
+              E.Resistor("R3", R=1), E.IdealOpAmp3Pin("Op1"), E.Ground("G"),
+              E.Resistor("R4", R=-1), E.Resistor("R5", R=-1), E.IdealOpAmp3Pin("Op2"),
+              E.IdealOpAmp3Pin("Op3"), E.Ground("G1"), E.Resistor("R6", R=1),
+              E.Resistor("R7", R=1), E.Capacitor("C6", C="c2 + c3 + c4"),
+              E.Resistor("R8", R=-1), E.Resistor("R9", R=-1), E.Resistor("R10", R=1),
+              E.IdealOpAmp3Pin("Op4"), E.IdealOpAmp3Pin("Op5"),
+              E.Capacitor("C7", C="l2", **fixed), E.Capacitor("C8", C="c4"),
+              E.Capacitor("C9", C="c4 + c5"), E.Resistor("R11", R=1), E.Ground("G2"),
+              E.Ground("G3"), E.Ground("G4"), E.VoltageSource("V", V="if_else(t >= 1, 1, 0)"),
+              E.Ground("Ground1"), kn.Probe("out", quantities=["voltage"])):
+        m.add(c)
+    parent = {}
+
+    def root(x):
+        while parent.setdefault(x, x) != x:
+            x = parent[x]
+        return x
+    for line in OPV_WIRES.splitlines():
+        a, b = (x.strip() for x in line.split(","))
+        parent[root(a)] = root(b)
+    nodes = {}
+    for x in parent:
+        if "." in x:
+            nodes.setdefault(root(x), []).append(x)
+    for pins in nodes.values():
+        for other in pins[1:]:
+            m.connect(pins[0], other)
+    m.connect("out.port", "Op5.out")
+    m.simulation = {"t_end": 60.0}
+    return m
+
+
+def test_cauer_low_pass_opv_is_the_analog_filter():
+    """MSL: "identical to the CauerLowPassAnalog example": its output against the analog
+    filter's hand-written equations; the op-amps' virtual grounds make four capacitor loops,
+    and the capacitors MSL starts are the states."""
+    m = cauer_low_pass_opv()
+    system = m.compile()
+    assert system.state_names == ["C1.v", "C2.v", "C3.v", "C4.v", "C7.v"]
+    assert list(system.demoted_states) == ["C5.v", "C6.v", "C8.v", "C9.v"]
+    res = kn.simulate(m, t_end=60.0, n_points=601, **TOL)
+    ref = cauer_reference(res.t)
+    assert np.max(abs(res["out.voltage"] - ref)) < 1e-6 * np.max(abs(ref))
+
+
 def test_validate_shows_the_states_chosen_and_demoted(tmp_path, capsys):
     from kinetwork.cli import main
     path = tmp_path / "cauer.json"
