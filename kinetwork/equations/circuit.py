@@ -17,7 +17,7 @@ a Modelica tool does. Where the choice is free, a state whose start the user gav
 ground, two voltage sources in parallel, an open current source) is refused naming the
 components whose laws over-determine it, sorted.
 
-The index-1 system left is solved block by block (``structure.solve_blocks``): a linear
+The index-1 system left is solved block by block (``blocks.solve_blocks``): a linear
 block symbolically, a nonlinear one (a diode and its resistor) torn, its tearing unknowns
 left to IDAS as algebraic variables. Every current and potential so becomes an expression
 of the states, the mechanism's speeds, t and placeholders for the signals at the sources'
@@ -31,7 +31,8 @@ import numpy as np
 
 from ..errors import ModelError
 from .circuit_dae import Candidate, Dae, couple
-from .structure import Singular, reduce_index, solve_blocks
+from .blocks import solve_blocks
+from .structure import Singular, reduce_index
 
 DOMAIN = "electrical"
 #: a given start further than this (relative to 1 + |value|) from the value a constraint
@@ -413,7 +414,7 @@ class Circuit:
                + (f" (linear loops of {', '.join(map(str, loops))})" if loops else "")
                + f", {len(reduced.states)} states")
         if self.coupled:
-            out += (f"; with the rotors (masses) the EMFs turn: "
+            out += ("; with the rotors (masses) the EMFs turn: "
                     + ", ".join(c.candidate.name for c in self.coupled.values()))
         if reduced.demoted:
             out += (f"; index reduction (Pantelides, dummy derivatives): "

@@ -507,11 +507,11 @@ def test_a_large_block_is_eliminated_sparsely_and_gives_the_dense_answer(monkeyp
     """The differentiated constraints of a ladder couple every section in one linear block:
     solved by sparse elimination its right-hand side grows linearly with the ladder
     (a dense symbolic solve grows as its cube), and gives the dense solve's answer."""
-    import kinetwork.equations.structure as structure
+    import kinetwork.equations.blocks as blocks
     sizes = {n: ladder(n).compile().size()["operations"] for n in (5, 20)}
     assert sizes[20] < 5 * sizes[5]
     sparse = kn.simulate(ladder(6), t_end=10.0, n_points=51, **TOL)
-    monkeypatch.setattr(structure, "SMALL_BLOCK", 10 ** 6)
+    monkeypatch.setattr(blocks, "SMALL_BLOCK", 10 ** 6)
     dense = kn.simulate(ladder(6), t_end=10.0, n_points=51, **TOL)
     assert 0.1 < np.max(abs(dense["out.voltage"])) < 1
     assert np.max(abs(sparse["out.voltage"] - dense["out.voltage"])) < 1e-12
