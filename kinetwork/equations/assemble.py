@@ -16,6 +16,7 @@ from ..errors import ModelError
 from ..expr import casadi_functions, parse
 from ..spatial import vee
 from . import applied, junctions, network
+from . import starts as inertia_starts
 from .newton_euler import Body, aba, crba, motion_subspace, rnea, spatial_inertia
 from .signals import probe_signals
 
@@ -232,6 +233,11 @@ def assemble(model, topo, values):
         given += [v is not None for v in q0]
         u_start += [0 if v is None else v for v in u0]
         u_given += [v is not None for v in u0]
+    # an inertia rigidly on a joint axis gives the joint's start, unless the joint does
+    for kind, i, value in net.claims:
+        vals, flags = (starts, given) if kind == "q" else (u_start, u_given)
+        if not flags[i]:
+            vals[i], flags[i] = value, True
     if net.prescribed:
         starts, u_start = _prescribed_starts(model, net, t, q, u, starts, u_start, given,
                                              u_given, p, [values[k] for k in names])
@@ -253,6 +259,7 @@ def assemble(model, topo, values):
                          *[m.drive for m in asm.prescribed.values()])
     asm.qindex, asm.uindex, asm.Q_drive = qindex, uindex, net.axis_flow
     asm.signals = probe_signals(asm, topo, net, bound, model)
+    inertia_starts.check(model, topo, asm, bound, [values[k] for k in names])
     return asm
 
 
