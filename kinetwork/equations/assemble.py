@@ -15,7 +15,7 @@ import numpy as np
 from ..errors import ModelError
 from ..expr import casadi_functions, parse
 from ..spatial import vee
-from . import applied, junctions, network
+from . import applied, junctions, loopstart, network
 from . import starts as inertia_starts
 from .newton_euler import Body, aba, crba, motion_subspace, rnea, spatial_inertia
 from .signals import probe_signals
@@ -71,6 +71,8 @@ class Assembly:
     applied: object = None
     #: massless junctions of line forces (junctions.Junctions), None without any
     junctions: object = None
+    #: the rows a loop's cut joint's start values add to the start (loopstart.StartRows)
+    start_rows: object = None
 
     def mass_matrix(self):
         M = crba(self.bodies, self.u.shape[0], self.armature)
@@ -254,6 +256,7 @@ def assemble(model, topo, values):
     asm.cuts = [(cut, _closure(asm, cut, bound[cut.component.name], qindex))
                 for cut in topo.cuts]
     _place_cut_frames(asm, topo, bound)
+    asm.start_rows = loopstart.rows(asm, topo, bound)
     asm.prescribed = dict(sorted(net.prescribed.items()))
     asm.lam = ca.vertcat(ca.SX.sym("lambda", sum(r.shape[0] for _, r in asm.cuts)),
                          *[m.drive for m in asm.prescribed.values()])

@@ -59,6 +59,7 @@ import casadi as ca
 import numpy as np
 
 from ..errors import ModelError
+from . import loopstart
 from .newton_euler import aba, rnea
 
 def _qr(*args, **kwargs):
@@ -302,11 +303,20 @@ class _Loops:
                 f"quaternions cannot follow the closure; let one of them be the cut joint "
                 f"(mark it cut=True), or replace it by a Universal joint (a coupler between "
                 f"two ball joints spins freely about its own axis)")
-        self.free = [i for i in sorted(loop_coords)
+        # the start values of a cut joint (a FreeMotion's r0) are rows of the start's
+        # assembly too, after the closures (``loopstart.py``)
+        start = asm.start_rows
+        phi_start = self.phi if start is None else ca.vertcat(self.phi, start.position)
+        start_coords = set(np.nonzero(np.asarray(
+            ca.DM(ca.jacobian(phi_start, q).sparsity(), 1)).any(axis=0))[0])
+        self.free = [i for i in sorted(loop_coords | start_coords)
                      if asm.regular[i] and not asm.given[i]]
-        self.f_phi = ca.Function("closure", [q, asm.p], [self.phi])
+        self.f_phi = ca.Function("closure", [q, asm.p], [phi_start])
         self.f_jac = ca.Function("closure_jacobian", [q, asm.p],
-                                 [ca.jacobian(self.phi, q)[:, self.free]])
+                                 [ca.jacobian(phi_start, q)[:, self.free]])
+        self.f_speed = None if start is None or not start.speed.numel() else ca.Function(
+            "start_speeds", [q, u, asm.p], [ca.densify(start.speed),
+                                            ca.densify(ca.jacobian(start.speed, u))])
         self.f_start = asm.start_function()
         self.f_J = ca.Function("J", [q, asm.p], [ca.densify(self.J)])
         self.loop_coords = loop_coords
@@ -333,6 +343,11 @@ class _Loops:
         if not self._closed(r):
             q, r = self._search(start, p, q, r)
         worst = np.max(np.abs(r), initial=0.0)
+        n_closure = self.phi.shape[0]
+        if np.isfinite(worst) and worst > CLOSED and \
+                np.max(np.abs(r[:n_closure]), initial=0.0) <= CLOSED:
+            raise loopstart.unmet(self.asm.start_rows.position_labels, r[n_closure:],
+                                  "configuration")
         if not np.isfinite(worst) or worst > CLOSED:
             by_loop = {}
             for i, v in zip(self.owner, np.abs(r)):
@@ -655,7 +670,8 @@ class _Loops:
             def initial(p):
                 qc = self.close(p)
                 _, u0 = start(p)
-                un = np.asarray(f_u(qc, np.asarray(u0, dtype=float).ravel()[ind], p))
+                u0 = loopstart.speeds(self, qc, np.asarray(u0, dtype=float).ravel(), p)
+                un = np.asarray(f_u(qc, u0[ind], p))
                 return np.concatenate([qc[all_q], un.ravel()[all_u]]), np.zeros(0)
             note = (f"kinematic loops, Baumgarte formulation: all {len(all_q)} coordinates "
                     f"and {len(all_u)} speeds are states ({len(ind)} degrees of freedom; "
@@ -685,6 +701,7 @@ class _Loops:
                     f"fixed by the loop closure (it is a dependent coordinate); give the "
                     f"initial speed of an independent coordinate "
                     f"({', '.join(unames[k] for k in ind)}) instead")
+            u0 = loopstart.speeds(self, qc, u0, p)
             if projected:
                 return np.concatenate([qc[keep_q], qc[dep_q], u0[ind]]), np.zeros(0)
             return np.concatenate([qc[keep_q], u0[ind]]), qc[dep_q]

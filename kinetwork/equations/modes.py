@@ -147,7 +147,7 @@ def operating_modes(system, t, X, p, check=True):
     table = np.asarray(modes.f_values(t, x, p)).reshape(len(modes.comps), -1)
     for i, comp in enumerate(modes.comps):
         k = modes.mode_index[i]
-        if getattr(comp, "disengaged", None) and comp.disengaged(table[i, 4:6]):
+        if getattr(type(comp), "disengaged", None) and comp.disengaged(table[i, 4:6]):
             x[k] = comp.FREE                 # a clutch or brake with no normal force
         elif getattr(type(comp), "at_rest_modes", None):
             w = table[i, 2]
