@@ -85,9 +85,10 @@ class Closer:
                 break
         return z, norm, norm <= CLOSED
 
-    def close(self, x, p, start):
+    def close(self, x, p, start, where="at"):
         """The dependent coordinates at the differential states ``x`` on the branch of the
-        assembled configuration ``start`` = (x0, z0), by continuation from it."""
+        assembled configuration ``start`` = (x0, z0), by continuation from it; ``where``
+        names the input in a refusal."""
         x = np.asarray(x, dtype=float)
         x0, z0 = (np.asarray(v, dtype=float) for v in start)
         s, ds, z = 0.0, 1.0, z0.copy()
@@ -110,9 +111,9 @@ class Closer:
             ds /= 2.0
             if ds < SMALLEST:
                 break
-        self._refuse(x, x0, s, z, p)
+        self._refuse(x, x0, s, z, p, where)
 
-    def _refuse(self, x, x0, s, z, p):
+    def _refuse(self, x, x0, s, z, p, where):
         """The ModelError of a walk that stalled at fraction ``s`` of the way."""
         sys = self.system
         _, gz, gx = self._eval(x0 + s * (x - x0), z, p)
@@ -129,7 +130,7 @@ class Closer:
                             in zip(sys.state_names, x, x0) if v != v0)
         singular = _solve(gz, -gx @ (x - x0)) is None
         raise ModelError(
-            f"at: kinematic loop through {self.loop_names[bad]} cannot close at "
+            f"{where}: kinematic loop through {self.loop_names[bad]} cannot close at "
             f"{asked or 'the asked state'}: "
             f"followed from the assembled start on its branch, it closes only up to "
             f"{reached or 'the start'}"

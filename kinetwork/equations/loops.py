@@ -59,6 +59,7 @@ import casadi as ca
 import numpy as np
 
 from ..errors import ModelError
+from ..util import quiet, summary
 from . import loopstart
 from .newton_euler import aba, rnea
 
@@ -163,13 +164,17 @@ def formulate(asm, topo, values, formulation="partition", rate=BAUMGARTE_RATE,
         x0 = np.concatenate([x0, np.asarray(start(p), dtype=float).ravel()])
         if solve_z is None:
             return x0, z0
-        try:
-            zs = solve_z(np.zeros(len(net.alg_z)), np.concatenate([x0, z0, p]))
-        except RuntimeError:
+        with quiet() as said:
+            try:
+                zs = solve_z(np.zeros(len(net.alg_z)), np.concatenate([x0, z0, p]))
+            except RuntimeError:
+                zs = None
+        if zs is None:
+            chatter = summary(said["text"])
             raise ModelError("the nonlinear algebraic loop(s) through "
                              + "; ".join(", ".join(n) for n in net.loops_kept)
                              + " have no solution at the initial state (Newton from 0 "
-                               "failed)") from None
+                               "failed" + (f"; {chatter}" if chatter else "") + ")")
         return x0, np.concatenate([z0, np.asarray(zs, dtype=float).ravel()])
     eq.initial = initial
     return eq
@@ -325,6 +330,7 @@ class _Loops:
             return
         q0 = self.close(p_nom)
         self.rows, self.dep = self._partition(np.asarray(self.f_J(q0, p_nom)), loop_coords)
+        loopstart.branch(self, q0, p_nom)
 
     # -- consistent initial configuration ---------------------------------------------------
     def close(self, p):

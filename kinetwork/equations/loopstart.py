@@ -9,12 +9,13 @@ speeds not given (``speeds``). Rows that cannot all be met are refused, naming t
 values; redundant ones that agree (a planar pendulum's tip at z = 0) are fine.
 """
 
+import warnings
 from dataclasses import dataclass, field
 
 import casadi as ca
 import numpy as np
 
-from ..errors import ModelError
+from ..errors import AssemblyBranchWarning, ModelError
 from ..spatial import vee
 
 #: a start condition counts as met below this (m, m/s, rad/s, rotation-matrix entries)
@@ -84,3 +85,62 @@ def speeds(loops, q, u0, p):
     if np.max(np.abs(left), initial=0.0) > MET * (1 + np.max(np.abs(u), initial=0.0)):
         raise unmet(asm.start_rows.speed_labels, left, "set of start speeds")
     return u
+
+
+def branch(loops, q, p):
+    """Warn, per loop, where Newton from the guesses assembled the start on another branch
+    than the guesses point to (AssemblyBranchWarning), naming the loop's joints with where
+    they start and where the other assembly has them. The guesses point to another
+    assembly when it lies nearer them in every distance a prismatic joint of the loop has
+    (a piston: its stroke on one branch, outside it on the other), or, in a loop of angles
+    only, in every angle. The start is not changed: the warning says what to give."""
+    asm = loops.asm
+    start = np.asarray(loops.f_start(p)[0], dtype=float).ravel()
+    pattern = np.asarray(ca.DM(loops.f_jac.sparsity_out(0), 1))
+    n_closure = loops.phi.shape[0]
+    units = np.array(asm.coordinate_units)
+    for i, (cut, _) in enumerate(asm.cuts):
+        rows = [k for k, owner in enumerate(loops.owner) if owner == i]
+        others = [k for k in range(n_closure) if loops.owner[k] != i]
+        cols = [c for c in range(len(loops.free)) if pattern[rows, c].any()]
+        if not cols or pattern[np.ix_(others, cols)].any():
+            continue                      # no joint of its own, or shared with another loop
+        free = [loops.free[c] for c in cols]
+        angle = units[free] != "m"
+        judged = ~angle if (~angle).any() else angle
+
+        def off(z, free=free, angle=angle):
+            d = z - start[free]
+            return np.abs(np.where(angle, (d + np.pi) % (2 * np.pi) - np.pi, d))
+        mine = off(q[free])
+        if np.max(mine[judged], initial=0.0) <= 1e-6:
+            continue                      # assembled at its guesses: nothing is nearer
+        scale = np.where(angle, np.pi, max(1.0, np.max(np.abs(start[free]), initial=0.0)))
+        rng = np.random.default_rng(0)
+        nearest = None
+        for _ in range(SEARCH_STARTS):
+            trial = q.copy()
+            trial[free] = start[free] + rng.uniform(-1, 1, len(free)) * scale
+            found, r = loops._gauss_newton(trial, p, rows, free)
+            if not loops._closed(r):
+                continue
+            z = found[free]
+            theirs = off(z)
+            if np.all(theirs[judged] < mine[judged] - 1e-6 * (1 + mine[judged])) and (
+                    nearest is None or np.sum(theirs[judged]) < np.sum(nearest[0])):
+                nearest = (theirs[judged], z)
+        if nearest is None:
+            continue
+        names = asm.coordinate_names
+        listed = ", ".join(
+            f"{names[k]} = {q[k]:.6g}{' ' + units[k] if units[k] else ''} (other branch: "
+            f"{z:.6g}, guess {start[k]:.6g})" for k, z in zip(free, nearest[1]))
+        warnings.warn(
+            f"kinematic loop through {', '.join(cut.loop)}: Newton from the guesses "
+            f"(q0_guess) assembled the start on another branch than the one they point to "
+            f"({listed}): the start is the first; if the other is meant (a piston inside its "
+            f"cylinder), give its values as q0_guess", AssemblyBranchWarning, stacklevel=2)
+
+
+#: random starts of the search for other assemblies of a loop (Gauss-Newton from each)
+SEARCH_STARTS = 12
