@@ -14,11 +14,11 @@ equations it could not satisfy.
 import json
 
 import casadi as ca
-import networkx as nx
 import numpy as np
 
 from ..errors import ModelError
 from ..util import quiet, suggest, summary
+from .matching import maximum_matching
 from .modes import operating_modes
 
 #: a residual above this (scaled by 1 + |d|) after Newton is no solution
@@ -65,6 +65,7 @@ class _Problem:
                              "differential equations; this one has algebraic variables "
                              f"({', '.join(system.algebraic_names)}: kinematic or algebraic "
                              f"loops): give their start instead")
+        self.system = system
         states, params = list(system.state_names), list(system.param_names)
         steady = spec.get("steady", False)
         problems = []
@@ -133,16 +134,12 @@ class _Problem:
     def _undetermined(self, r, w):
         """Refuse unknowns that a maximum matching of the Jacobian's pattern leaves out."""
         rows, cols = ca.jacobian(r, w).sparsity().get_triplet()
-        g = nx.Graph()
-        eqs = [("r", k) for k in range(len(self.equations))]
-        g.add_nodes_from(eqs)
-        g.add_nodes_from(("w", j) for j in range(len(self.unknowns)))
-        g.add_edges_from((("r", i), ("w", j)) for i, j in zip(rows, cols))
-        matching = nx.bipartite.hopcroft_karp_matching(g, top_nodes=eqs)
-        lost = [self.unknowns[j] for j in range(len(self.unknowns)) if ("w", j) not in matching]
+        matching = maximum_matching(len(self.equations), len(self.unknowns), zip(rows, cols))
+        matched = set(matching.values())
+        lost = [self.unknowns[j] for j in range(len(self.unknowns)) if j not in matched]
         if lost:
             idle = [self.equations[k] for k in range(len(self.equations))
-                    if ("r", k) not in matching]
+                    if k not in matching]
             raise ModelError(f"initial: the equations do not determine {', '.join(lost)} "
                              f"(structurally singular: no equation left reads them; "
                              f"{', '.join(idle)} is one too many): fix those states, or "
