@@ -91,9 +91,10 @@ def branch(loops, q, p):
     """Warn, per loop, where Newton from the guesses assembled the start on another branch
     than the guesses point to (AssemblyBranchWarning), naming the loop's joints with where
     they start and where the other assembly has them. The guesses point to another
-    assembly when it lies nearer them in every distance a prismatic joint of the loop has
-    (a piston: its stroke on one branch, outside it on the other), or, in a loop of angles
-    only, in every angle. The start is not changed: the warning says what to give."""
+    assembly when it lies at most NEARER as far from them in every distance a prismatic
+    joint of the loop has (a piston: its stroke on one branch, outside it on the other), or,
+    in a loop of angles only, in every angle; a guess midway between two branches points to
+    neither. The start is not changed: the warning says what to give."""
     asm = loops.asm
     start = np.asarray(loops.f_start(p)[0], dtype=float).ravel()
     pattern = np.asarray(ca.DM(loops.f_jac.sparsity_out(0), 1))
@@ -126,7 +127,7 @@ def branch(loops, q, p):
                 continue
             z = found[free]
             theirs = off(z)
-            if np.all(theirs[judged] < mine[judged] - 1e-6 * (1 + mine[judged])) and (
+            if np.all(theirs[judged] < NEARER * mine[judged]) and (
                     nearest is None or np.sum(theirs[judged]) < np.sum(nearest[0])):
                 nearest = (theirs[judged], z)
         if nearest is None:
@@ -144,3 +145,6 @@ def branch(loops, q, p):
 
 #: random starts of the search for other assemblies of a loop (Gauss-Newton from each)
 SEARCH_STARTS = 12
+#: another assembly this much nearer the guesses (as a fraction of the distance of the one
+#: found), in every coordinate judged, is the one they point to
+NEARER = 0.4
