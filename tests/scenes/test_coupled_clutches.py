@@ -38,7 +38,7 @@ def test_a_clutch_with_no_normal_force_transmits_nothing():
                  ("clutch.flange_b", "b.flange_a")]:
         m.connect(x, y)
     res = kn.simulate(m, t_end=1.0, n_points=3, rtol=1e-10, atol=1e-12)
-    assert res["a.w"][-1] == np.float64(0.5) or abs(res["a.w"][-1] - 0.5) < 1e-9
+    assert abs(res["a.w"][-1] - 0.5) < 1e-9
     assert abs(res["b.w"][-1]) < 1e-12 and res["clutch.mode"][-1] == 2
     brake = kn.Model("brake")
     brake.add(rot.Inertia("a", J=1.0, w0=2.0))
