@@ -54,10 +54,10 @@ class Mass(PartialInertia, library=LIB):
     m = Param(unit="kg", min=0.0, doc="Mass")
     L = Param(0.0, unit="m", doc="Length, from flange_a to flange_b (flange_b.s - flange_a.s)")
     position0 = Param(None, optional=True, unit="m", name="s0",
-                      doc="Initial position of the centre when the mass moves freely "
-                          "(None: 0)")
+                      doc="Initial position of the centre (None: from what it is tied to, "
+                          "else 0)")
     speed0 = Param(None, optional=True, unit="m/s", name="v0",
-                   doc="Initial speed when the mass moves freely (None: 0)")
+                   doc="Initial speed (None: from what it is tied to, else 0)")
 
     def inertia(self):
         return self.m

@@ -36,6 +36,7 @@ import casadi as ca
 import networkx as nx
 
 from ..errors import ModelError
+from . import starts, supports
 from .circuit import Circuit
 from .signals import acceleration_unavailable
 
@@ -74,6 +75,8 @@ class Network:
     circuit: str = ""
     #: state name -> why it is no state: index reduction found a constraint that fixes it
     demoted: dict = field(default_factory=dict)
+    #: joint starts the inertias on joint axes give: (``"q"`` or ``"u"``, index, value)
+    claims: list = field(default_factory=list)
 
     def summary(self, topo):
         """A line on what structural analysis made of the 1-D network and the blocks."""
@@ -169,6 +172,8 @@ class _Builder:
         self.net = Network({}, {}, {}, {}, ca.SX.zeros(n), ca.SX.zeros(n), ca.SX.zeros(n))
         self.k = {}                  # connection set -> ratio to its group's coordinate
         self.c = {}                  # ... and offset: position = k theta + c (a Mass's L)
+        self.ride = {}               # ... and the shares of its carriers (``supports.ride``)
+        self.kin = {}                # connection set -> (position, speed, acceleration)
         self.kt = {}                 # ... and of its torques (differs through gear losses)
         self.losses = {}             # gear with a loss -> eta^mode
         self.group_of = {}           # connection set -> group
@@ -184,12 +189,12 @@ class _Builder:
             self._ratios(group)
         for group in self.topo.oned:
             self._coordinate(group)
-        for s, group in self.group_of.items():
-            theta, w, a = self.coord[group.index]
-            k = self.k[s]
+        self.kin = supports.kinematics(self)
+        for s, (pos, vel, acc) in self.kin.items():
             for ref in self.topo.sets[s]:
-                self.net.pos[ref] = k * theta + self.c[s]
-                self.net.vel[ref], self.net.acc[ref] = k * w, k * a
+                self.net.pos[ref], self.net.vel[ref], self.net.acc[ref] = pos, vel, acc
+        self.riding = supports.clusters(self)
+        starts.free(self)
         self._block_states()
         # circuits next: their currents are expressions of states and speeds, so EMF
         # torques are known before any balance (``circuit.py``)
@@ -218,14 +223,17 @@ class _Builder:
             if parent is None:
                 self.k[s] = self.kt[s] = ca.SX(1)
                 self.c[s] = ca.SX(0)
+                self.ride[s] = [] if group.base is None else [(ca.SX(1), group.base)]
                 continue
             r = self.bound[element.name].ratio()
             length = self.bound[element.name].length()
             a_here = self.topo.set_of[element.port_ref("flange_a")] == s
-            # position(flange_a) = r * (position(flange_b) - length)
+            # position(flange_a) = r * (position(flange_b) - length), relative to the
+            # gear's support
             self.k[s] = self.k[parent] * r if a_here else self.k[parent] / r
             self.c[s] = r * (self.c[parent] - length) if a_here else \
                 self.c[parent] / r + length
+            self.ride[s] = supports.ride(self, parent, element, a_here, r if a_here else 1 / r)
             # torques pass a gear with efficiency eta as torque_b = -r eta^m torque_a, m = +1
             # while flange_a drives (power from a to b), -1 while flange_b does
             loss = self._loss(element, group)
@@ -294,21 +302,20 @@ class _Builder:
                                     offset=self.c[at]))
 
     def _free(self, group):
-        inertias = [e for e in group.rigid if e.has_inertia]
-        first = self.bound[inertias[0].name]
+        """A coordinate and a speed, the position and speed of the group's first inertia
+        (the group's root), named after it; their starts follow from the inertias' own
+        (``starts.free``, once every position is known)."""
+        first = next(e for e in group.rigid if e.has_inertia)
         pos_unit, vel_unit = _units(group)
-        at = self.topo.set_of[inertias[0].port_ref("flange_a")]
-        k = self.k[at]
+        at = self.topo.set_of[first.port_ref("flange_a")]
         # the coordinate is the first inertia's centre (MSL's Mass.s, between its flanges
         # L apart), in the units of its flanges divided by their ratio
-        centre = self.c[at] + first.length() / 2
+        centre = self.c[at] + self.bound[first.name].length() / 2
         for s, _, _ in group.sets:
-            self.c[s] = self.c[s] - self.k[s] * centre / k
-        p0 = 0 if first.position0 is None else first.position0 / k
-        w0 = 0 if first.speed0 is None else first.speed0 / k
+            self.c[s] = self.c[s] - self.k[s] * centre / self.k[at]
         a = ca.SX.sym(f"g{group.index}_acc")
-        w = self._state(f"{first.name}.{_vel(group)}", vel_unit, w0, a)
-        theta = self._state(f"{first.name}.{_pos(group)}", pos_unit, p0, w,
+        w = self._state(f"{first.name}.{_vel(group)}", vel_unit, 0, a)
+        theta = self._state(f"{first.name}.{_pos(group)}", pos_unit, 0, w,
                             at=len(self.net.x) - 1)
         self.coord[group.index] = (theta, w, a)
 
@@ -493,9 +500,12 @@ class _Builder:
                 drive = ca.SX.sym(f"drive_{m.comp.name}")
                 self._drive(m, drive / m.k)
                 m.drive = drive
+        for cluster in self.riding:             # trains riding on a housing, solved together
+            supports.solve(self, cluster)
         # motions of free flanges first: the flow into their source is then known, and so
-        # the reaction on their support, before the fixed groups take it
-        for group in sorted(self.topo.oned, key=lambda g: g.kind != "prescribed"):
+        # the reaction on their support, before the fixed groups take it; a train on a
+        # housing before the housing, which takes its reaction
+        for group in supports.order(self):
             self._balance(group)
             if group.kind == "prescribed":
                 m = next(m for m in self.motions if m.group is group)
@@ -587,7 +597,7 @@ class _Builder:
             coupled = self.circuit.coupled[group.index]
             self.pending[coupled.rest] = self._generalized(group, exclude=coupled.emfs)
             self.pending[a] = coupled.acc
-        elif group.kind == "free":
+        elif group.kind == "free" and not any(group in c for c in self.riding):
             self.pending[a] = gen / self.inertia[group.index]
         elif group.kind == "massless":
             self._massless(group, gen)
@@ -620,10 +630,9 @@ class _Builder:
     def _rigid_flows(self, group):
         """Kirchhoff at every set of the group, leaves first: the flow into a rigid element at
         its far side balances what is beyond; its law gives the near side."""
-        flow, k = self.net.flow, self.k
-        theta, w, a = self.coord[group.index]
+        flow = self.net.flow
         beyond = {s: self._applied(s, ("compliant", "source", "prescribed"))
-                  for s, _, _ in group.sets}
+                  + supports.reactions(self, s) for s, _, _ in group.sets}
         for s, parent, element in reversed(group.sets):
             if parent is None:
                 if group.definer is not None:
@@ -635,11 +644,13 @@ class _Builder:
             flow[far] = -beyond[s]
             b = self.bound[element.name]
             if element.has_inertia:
-                flow[near] = b.inertia() * k[s] * a - flow[far]
+                flow[near] = b.inertia() * self.kin[s][2] - flow[far]
             elif far.name == "flange_a":          # torque_b = -ratio * torque_a
                 flow[near] = -b.ratio() * self.losses.get(element.name, 1) * flow[far]
             else:
                 flow[near] = -flow[far] / (b.ratio() * self.losses.get(element.name, 1))
+            if "support" in element.ports:        # MSL: support.tau = -flange_a.tau - flange_b.tau
+                flow[element.port_ref("support")] = -(flow[far] + flow[near])
             beyond[parent] = beyond[parent] + flow[near]
 
     def _finish(self):
@@ -655,7 +666,9 @@ class _Builder:
             ref, u = joint_ports
             net.axis_flow[u] += net.flow.get(ref, 0)
         self._motion_laws()
+        net.claims = starts.claims(self)
         if not self.pending:
+            starts.resolve(net, self.t)
             return
         sub = self._substitution()
         for d in (net.pos, net.vel, net.acc, net.flow, net.signal):
@@ -667,6 +680,7 @@ class _Builder:
         net.alg_res = [sub(r) for r in net.alg_res]
         for rec in net.prescribed.values():
             rec.pos, rec.vel, rec.acc = sub(rec.pos), sub(rec.vel), sub(rec.acc)
+        starts.resolve(net, self.t)
 
     def _input_rates(self):
         """The time derivative of each signal whose circuit constraint was differentiated (a
