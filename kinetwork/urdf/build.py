@@ -1,0 +1,186 @@
+"""Building the kinetwork Model of a checked URDF tree (see the package's docstring for what
+maps to what)."""
+
+import re
+import unicodedata
+
+import numpy as np
+
+from ..components import multibody as mb
+from ..components import rotational, translational
+from ..components.probe import Probe
+from ..graph.model import Model
+from .rotations import axis_angle, rpy_matrix
+
+#: what a probe on each joint records (the 1-D flange for 1-DOF joints, frame_b otherwise)
+PROBED = {"rotational": ["angle", "speed", "torque"],
+          "translational": ["position", "velocity", "force"],
+          "frame": ["position", "orientation", "velocity", "angular_velocity"]}
+NAME_ROOM = 180                   # a base name's length, leaving room for suffixes
+
+
+def build(robot, links, joints, tree, materials, *, probes, floating, gravity, name, where):
+    """The Model of a checked URDF tree (see the module's docstring for what maps to what)."""
+    root, order = tree
+    names = _Names()
+    ground_name = names.claim("ground")
+    jname = {j: names.claim(j) for j in joints}
+    lname = {link: names.claim(link) for link in links}
+    description = (f"{robot}, imported from the URDF file {where}: {len(links)} links, "
+                   f"{len(joints)} joints. What URDF gives that is not imposed here (joint "
+                   f"limits, friction, mimic couplings) is kept in layout.<joint>.urdf; the "
+                   f"map from URDF names to components in layout.{ground_name}.urdf.")
+    model = Model(name or robot, description=description)
+    model.add(mb.Ground(ground_name, gravity=list(gravity)))
+    frame = {root: f"{ground_name}.frame"}
+    mapped, base = {}, None
+    if floating:
+        free = model.add(mb.FreeMotion(names.claim(f"{lname[root]}_floating")))
+        model.connect(frame[root], f"{free.name}.frame_a")
+        frame[root], base = f"{free.name}.frame_b", free.name
+        model.layout[free.name] = {"urdf": {"joint": None, "type": "floating",
+                                            "note": f"joins the root link {root} to the world"}}
+        if probes:
+            _probe(model, names, free, "frame_b", "frame")
+    for j in order:
+        J = joints[j]
+        at = _fixed(model, names, f"{jname[j]}_origin", J["xyz"], rpy_matrix(J["rpy"]),
+                    frame[J["parent"]])
+        data = {"urdf": {"joint": j, "type": J["type"], **J["data"]}}
+        joint = _joint(jname[j], J)
+        if joint is None:                 # fixed: the origin is all of it
+            frame[J["child"]] = at
+            mapped[j] = None if at == frame[J["parent"]] else at.partition(".")[0]
+            if mapped[j] is not None:
+                model.layout[mapped[j]] = data
+            continue
+        model.add(joint)
+        model.connect(at, f"{joint.name}.frame_a")
+        frame[J["child"]] = f"{joint.name}.frame_b"
+        mapped[j] = joint.name
+        model.layout[joint.name] = data
+        _damper(model, names, joint, J["data"].get("dynamics", {}).get("damping", 0.0))
+        if probes:
+            _probe(model, names, joint, *(("axis", joint.domain) if joint.dof == 1
+                                          else ("frame_b", "frame")))
+    visuals = []
+    for link, L in links.items():
+        if L["inertial"] is not None:
+            mass, r_cm, inertia = L["inertial"]
+            if mass > 0 or np.any(inertia != 0):
+                body = model.add(mb.RigidBody(lname[link], mass=mass, r_cm=r_cm,
+                                              inertia=inertia.tolist()))
+                model.connect(f"{body.name}.frame_a", frame[link])
+                model.layout[body.name] = {"urdf": {"link": link}}
+        for visual in L["visuals"]:
+            visuals.append(_look(model, names, lname[link], visual, frame[link], materials,
+                                 link))
+    model.layout[ground_name] = {"urdf": {
+        "robot": robot, "file": where, "root": root, "base": base,
+        "links": {link: frame[link] for link in links}, "joints": mapped,
+        "visuals": visuals}}
+    return model
+
+
+def _fixed(model, names, base, xyz, R, at):
+    """The frame ``xyz``, ``R`` from the frame ``at``: a FixedRotation, a FixedTranslation or
+    ``at`` itself, as little as it takes."""
+    axis, angle = axis_angle(R)
+    if angle == 0.0 and not any(xyz):
+        return at
+    if angle == 0.0:
+        part = mb.FixedTranslation(names.claim(base), r=list(xyz))
+    else:
+        part = mb.FixedRotation(names.claim(base), r=list(xyz), axis=axis, angle=angle)
+    model.add(part)
+    model.connect(at, f"{part.name}.frame_a")
+    return f"{part.name}.frame_b"
+
+
+def _joint(name, J):
+    """The kinetwork joint of a URDF joint (None for a fixed one)."""
+    kind, axis = J["type"], J["axis"]
+    if kind in ("revolute", "continuous"):
+        return mb.Revolute(name, axis=axis)
+    if kind == "prismatic":
+        return mb.Prismatic(name, axis=axis)
+    if kind == "planar":              # q[0] along the joint frame's x made normal to axis
+        n_x = [1.0, 0.0, 0.0] if abs(axis[0]) < 0.9 else [0.0, 1.0, 0.0]
+        return mb.Planar(name, n=axis, n_x=n_x)
+    if kind == "floating":
+        return mb.FreeMotion(name)
+    return None
+
+
+def _damper(model, names, joint, d):
+    """URDF's viscous joint damping: a Damper between the joint's support and axis."""
+    if not d or joint.dof != 1:
+        return
+    lib = rotational if joint.domain == "rotational" else translational
+    damper = model.add(lib.Damper(names.claim(f"{joint.name}_damper"), d=d))
+    model.connect(f"{damper.name}.flange_a", f"{joint.name}.support")
+    model.connect(f"{damper.name}.flange_b", f"{joint.name}.axis")
+
+
+def _probe(model, names, joint, port, domain):
+    probe = model.add(Probe(names.claim(f"{joint.name}_probe"), quantities=PROBED[domain]))
+    model.connect(f"{probe.name}.port", f"{joint.name}.{port}")
+
+
+#: turns a frame so that its x axis lies along the original z: a URDF cylinder's axis is z,
+#: a RigidBody's cylinder runs along x
+Z_TO_X = np.array([[0.0, 0.0, -1.0], [0.0, 1.0, 0.0], [1.0, 0.0, 0.0]])
+#: a visual turned by less than this [rad] is drawn unturned (rpy="0 1.5708 0" of a
+#: cylinder along x leaves a rounding error, not a rotation worth a part)
+LOOKS_ANGLE = 1e-9
+
+
+def _look(model, names, base, visual, at, materials, link):
+    """The visual as data ({"link", "frame", "kind", "xyz", "rpy", "color", "component"},
+    and URDF's "size", "length" and "radius", or "filename" and "scale"); a box, cylinder or
+    sphere is drawn by a massless RigidBody ``component`` as well."""
+    colour = visual["color"] or materials.get(visual["material"])
+    data = {"link": link, "frame": at, "kind": visual["kind"], "xyz": visual["xyz"],
+            "rpy": visual["rpy"], "color": colour, "component": None}
+    if visual["kind"] == "mesh":
+        data.update(filename=visual["filename"], scale=visual["scale"])
+        return data
+    size, R = visual["size"], rpy_matrix(visual["rpy"])
+    if visual["kind"] == "box":
+        data["size"] = shape_size = list(size)
+    elif visual["kind"] == "cylinder":
+        data.update(length=size[0], radius=size[1])
+        shape_size = [size[0], 2 * size[1], 2 * size[1]]
+        R = R @ Z_TO_X
+    else:
+        data["radius"] = size[0]
+        shape_size = [2 * size[0]] * 3
+    turned = axis_angle(R)[1] > LOOKS_ANGLE
+    frame = (_fixed(model, names, f"{base}_visual_origin", visual["xyz"], R, at) if turned
+             else at)
+    body = model.add(mb.RigidBody(names.claim(f"{base}_visual"), mass=0.0,
+                                  r_cm=[0.0] * 3 if turned else list(visual["xyz"]),
+                                  shape=visual["kind"], shape_size=shape_size, color=colour))
+    model.connect(f"{body.name}.frame_a", frame)
+    data["component"] = body.name
+    return data
+
+
+# -- names --------------------------------------------------------------------------------------
+class _Names:
+    """kinetwork identifiers for URDF names: letters, digits and underscores; a clash with a
+    name already given gets ``_2``, ``_3``, ... in the order names are asked for."""
+
+    def __init__(self):
+        self.taken = set()
+
+    def claim(self, text):
+        base = unicodedata.normalize("NFKD", text).encode("ascii", "ignore").decode()
+        base = re.sub(r"[^A-Za-z0-9_]", "_", base)[:NAME_ROOM] or "_"
+        if base[0].isdigit():
+            base = "_" + base
+        name, k = base, 2
+        while name in self.taken:
+            name, k = f"{base}_{k}", k + 1
+        self.taken.add(name)
+        return name
