@@ -43,7 +43,8 @@ from .rotations import axis_angle, rpy_matrix
 __all__ = ["from_urdf", "cli_import", "rpy_matrix", "axis_angle", "JOINT_TYPES", "PROBED"]
 
 
-def from_urdf(path, probes=False, floating=False, gravity=(0.0, 0.0, -9.81), name=None):
+def from_urdf(path, probes=False, floating=False, gravity=(0.0, 0.0, -9.81), name=None,
+              limits=True):
     """The kinetwork model of the robot described in the URDF file ``path``.
 
     Parameters
@@ -61,6 +62,10 @@ def from_urdf(path, probes=False, floating=False, gravity=(0.0, 0.0, -9.81), nam
         Gravity of the Ground, in the root link's frame at rest (URDF's z is up).
     name : str, optional
         Model name (default: the robot's name).
+    limits : bool
+        Impose the revolute and prismatic joints' position limits as hard end stops (a
+        ``Stop`` ``<joint>_limits`` between the joint's support and axis; a joint whose zero
+        lies outside its limits starts at the nearer one). False leaves them as data only.
 
     Returns
     -------
@@ -85,7 +90,8 @@ def from_urdf(path, probes=False, floating=False, gravity=(0.0, 0.0, -9.81), nam
     if problems:
         raise ModelError([f"{where}: {p}" for p in problems])
     model = build(robot.get("name") or "robot", links, joints, shape, materials,
-                 probes=probes, floating=floating, gravity=gravity, name=name, where=where)
+                 probes=probes, floating=floating, gravity=gravity, name=name, where=where,
+                  limits=limits)
     model.validate()
     return model
 

@@ -17,9 +17,13 @@ PROBED = {"rotational": ["angle", "speed", "torque"],
           "translational": ["position", "velocity", "force"],
           "frame": ["position", "orientation", "velocity", "angular_velocity"]}
 NAME_ROOM = 180                   # a base name's length, leaving room for suffixes
+#: a joint that reaches its limit stays there (no bounce): URDF gives no restitution, and the
+#: simulators that read URDF (Gazebo, MuJoCo, PyBullet) hold a joint at its limit
+STOP_RESTITUTION = 0.0
 
 
-def build(robot, links, joints, tree, materials, *, probes, floating, gravity, name, where):
+def build(robot, links, joints, tree, materials, *, probes, floating, gravity, name, where,
+          limits=True):
     """The Model of a checked URDF tree (see the module's docstring for what maps to what)."""
     root, order = tree
     names = _Names()
@@ -47,7 +51,8 @@ def build(robot, links, joints, tree, materials, *, probes, floating, gravity, n
         at = _fixed(model, names, f"{jname[j]}_origin", J["xyz"], rpy_matrix(J["rpy"]),
                     frame[J["parent"]])
         data = {"urdf": {"joint": j, "type": J["type"], **J["data"]}}
-        joint = _joint(jname[j], J)
+        stops = _range(J) if limits else None
+        joint = _joint(jname[j], J, stops)
         if joint is None:                 # fixed: the origin is all of it
             frame[J["child"]] = at
             mapped[j] = None if at == frame[J["parent"]] else at.partition(".")[0]
@@ -59,7 +64,11 @@ def build(robot, links, joints, tree, materials, *, probes, floating, gravity, n
         frame[J["child"]] = f"{joint.name}.frame_b"
         mapped[j] = joint.name
         model.layout[joint.name] = data
-        _damper(model, names, joint, J["data"].get("dynamics", {}).get("damping", 0.0))
+        dynamics = J["data"].get("dynamics", {})
+        _between(model, names, joint, "damper", "Damper", dynamics.get("damping", 0.0))
+        _between(model, names, joint, "friction", "Friction", dynamics.get("friction", 0.0))
+        if stops is not None:
+            _between(model, names, joint, "limits", "Stop", *stops)
         if probes:
             _probe(model, names, joint, *(("axis", joint.domain) if joint.dof == 1
                                           else ("frame_b", "frame")))
@@ -97,13 +106,27 @@ def _fixed(model, names, base, xyz, R, at):
     return f"{part.name}.frame_b"
 
 
-def _joint(name, J):
-    """The kinetwork joint of a URDF joint (None for a fixed one)."""
+def _range(J):
+    """(lower, upper) of a revolute or prismatic joint's position limits, or None (a
+    continuous joint, no <limit>, or URDF's default lower = upper = 0: no range given)."""
+    limit = J["data"].get("limit", {})
+    lower, upper = limit.get("lower", 0.0), limit.get("upper", 0.0)
+    if J["type"] not in ("revolute", "prismatic") or not lower < upper:
+        return None
+    return lower, upper
+
+
+def _joint(name, J, stops=None):
+    """The kinetwork joint of a URDF joint (None for a fixed one); within ``stops``, it starts
+    at the zero position clamped into them (URDF has no start; 0 is its reference pose)."""
     kind, axis = J["type"], J["axis"]
+    start = {}
+    if stops is not None and not stops[0] <= 0.0 <= stops[1]:
+        start = {"q0": min(max(0.0, stops[0]), stops[1])}
     if kind in ("revolute", "continuous"):
-        return mb.Revolute(name, axis=axis)
+        return mb.Revolute(name, axis=axis, **start)
     if kind == "prismatic":
-        return mb.Prismatic(name, axis=axis)
+        return mb.Prismatic(name, axis=axis, **start)
     if kind == "planar":              # q[0] along the joint frame's x made normal to axis
         n_x = [1.0, 0.0, 0.0] if abs(axis[0]) < 0.9 else [0.0, 1.0, 0.0]
         return mb.Planar(name, n=axis, n_x=n_x)
@@ -112,14 +135,28 @@ def _joint(name, J):
     return None
 
 
-def _damper(model, names, joint, d):
-    """URDF's viscous joint damping: a Damper between the joint's support and axis."""
-    if not d or joint.dof != 1:
+def _between(model, names, joint, suffix, kind, *values):
+    """A 1-D element ``<joint>_<suffix>`` between a 1-DOF joint's support and its axis, in the
+    joint's domain: a Damper (``values``: d), a friction with stiction (the Coulomb force or
+    torque) or a Stop (lower, upper); none for a damping or friction of zero."""
+    if joint.dof != 1 or (kind != "Stop" and not values[0]):
         return
-    lib = rotational if joint.domain == "rotational" else translational
-    damper = model.add(lib.Damper(names.claim(f"{joint.name}_damper"), d=d))
-    model.connect(f"{damper.name}.flange_a", f"{joint.name}.support")
-    model.connect(f"{damper.name}.flange_b", f"{joint.name}.axis")
+    turning = joint.domain == "rotational"
+    lib = rotational if turning else translational
+    name = names.claim(f"{joint.name}_{suffix}")
+    if kind == "Damper":
+        part = lib.Damper(name, d=values[0])
+    elif kind == "Friction":
+        cls, key = ((rotational.BearingFriction, "tau_c") if turning
+                    else (translational.Friction, "f_c"))
+        part = cls(name, **{key: values[0]})
+    else:
+        low, high = ("phi_min", "phi_max") if turning else ("s_min", "s_max")
+        part = lib.Stop(name, **{low: values[0], high: values[1], "e": STOP_RESTITUTION})
+    model.add(part)
+    a, b = ("support", "flange") if kind == "Friction" else ("flange_a", "flange_b")
+    model.connect(f"{part.name}.{a}", f"{joint.name}.support")
+    model.connect(f"{part.name}.{b}", f"{joint.name}.axis")
 
 
 def _probe(model, names, joint, port, domain):
