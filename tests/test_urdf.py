@@ -16,8 +16,10 @@ moving frame, mapped the same way in 2-D. Mass matrices compare as
 T^T M_pin T (the same kinetic energy).
 """
 
+import importlib.metadata
 import json
 import pathlib
+import xml.etree.ElementTree as ET
 
 import numpy as np
 import pinocchio as pin
@@ -54,10 +56,10 @@ def quat_R(quat):
 class Pair:
     """A URDF robot in both libraries, and the maps between their coordinates."""
 
-    def __init__(self, name, floating=False, gravity=None):
-        path = DATA / f"{name}.urdf"
+    def __init__(self, name, floating=False, gravity=None, limits=True):
+        path = name if isinstance(name, pathlib.Path) else DATA / f"{name}.urdf"
         kwargs = {} if gravity is None else {"gravity": gravity}
-        self.model = kn.from_urdf(path, floating=floating, **kwargs)
+        self.model = kn.from_urdf(path, floating=floating, limits=limits, **kwargs)
         self.pmodel = (pin.buildModelFromUrdf(str(path), pin.JointModelFreeFlyer())
                        if floating else pin.buildModelFromUrdf(str(path)))
         if gravity is not None:
@@ -77,7 +79,11 @@ class Pair:
             self.damping[joint.name] = d
         self.system = self.model.compile()
         coords, speeds = self.system.coordinate_names, self.system.speed_names
-        assert self.system.state_names == coords + speeds
+        # the joints' end stops add their modes (0: free, as no stop is active here)
+        self.n_modes = self.system.n_states - len(coords) - len(speeds)
+        assert self.system.state_names[:len(coords) + len(speeds)] == coords + speeds
+        assert all(n.endswith("_limits.mode") for n in self.system.state_names[-self.n_modes:]
+                   if self.n_modes)
         self.joints = []              # (pin joint, component, coordinate and speed indices)
         for jid in range(1, self.pmodel.njoints):
             jname = self.pmodel.names[jid]
@@ -90,6 +96,11 @@ class Pair:
             self.joints.append((joint, comp, qi, ui))
         assert sum(len(j[3]) for j in self.joints) == len(speeds) == self.pmodel.nv
         self.nq, self.nu = len(coords), len(speeds)
+        self.ranges = {}
+        for comp in (c for c in self.model.components if c.endswith("_limits")):
+            stop = self.model.components[comp]
+            low, high = [v for k, v in stop.given.items() if k.endswith(("_min", "_max"))]
+            self.ranges[comp[:-len("_limits")]] = (low, high)
 
     def random_state(self, rng):
         q, u = np.zeros(self.nq), rng.uniform(-2.0, 2.0, self.nu)
@@ -98,6 +109,8 @@ class Pair:
             if kind == "FreeMotion":
                 q[qi] = np.concatenate([rng.uniform(-1, 1, 3), rng.normal(size=4)])
                 q[qi[3:]] /= np.linalg.norm(q[qi[3:]])
+            elif comp in self.ranges:      # within its end stops: none of them active
+                q[qi] = rng.uniform(*self.ranges[comp])
             elif kind == "Prismatic":
                 q[qi] = rng.uniform(-0.3, 0.5)
             else:
@@ -175,10 +188,10 @@ class Pair:
                 tau[joint.idx_v] = drive[ui[0]] - self.damping[comp] * u[ui[0]]
         a = pin.aba(self.pmodel, self.pmodel.createData(), q_pin, v_pin, tau).copy()
         ref = self.udot(q, u, a)
-        dx = np.asarray(self.system.rhs(0.0, np.concatenate([q, u]), params=params),
-                        dtype=float).ravel()
+        x = np.concatenate([q, u, np.zeros(self.n_modes)])
+        dx = np.asarray(self.system.rhs(0.0, x, params=params), dtype=float).ravel()
         e_M = np.abs(M - M_ref).max() / np.abs(M_ref).max()
-        e_a = np.abs(dx[self.nq:] - ref).max() / max(1.0, np.abs(ref).max())
+        e_a = np.abs(dx[self.nq:self.nq + self.nu] - ref).max() / max(1.0, np.abs(ref).max())
         return e_M, e_a
 
 
@@ -512,3 +525,52 @@ def test_every_problem_reported_at_once(tmp_path):
     assert len(info.value.problems) == 2          # the tree is checked once the parts parse
     assert "mass" in info.value.problems[0] and "hinge" in info.value.problems[1]
     json.dumps(info.value.problems)
+
+
+# ---------------------------------------------------------------------------------------------
+# Real robots: the Panda and the UR5 of example-robot-data (its URDFs and meshes on PyPI)
+# ---------------------------------------------------------------------------------------------
+ROBOT_DATA = pathlib.Path(importlib.metadata.distribution("example-robot-data").locate_file(
+    "cmeel.prefix/share/example-robot-data/robots"))
+REAL = {"panda": ROBOT_DATA / "panda_description/urdf/panda.urdf",
+        "ur5": ROBOT_DATA / "ur_description/urdf/ur5_robot.urdf"}
+
+
+@pytest.fixture(scope="module", params=sorted(REAL))
+def real(request):
+    return Pair(REAL[request.param])
+
+
+def test_real_robots_agree_with_pinocchio_while_no_stop_is_active(real):
+    """Within their limits (every end stop free), M(q) and the accelerations to 1e-10 of
+    Pinocchio's crba and aba, the URDF's damping added to its torques."""
+    assert real.ranges, "the robot's joint limits are imposed"
+    rng = np.random.default_rng(31)
+    for k in range(6):
+        q, u = real.random_state(rng)
+        drive = rng.uniform(-5.0, 5.0, real.nu)
+        e_M, e_a = real.compare(q, u, drive)
+        assert e_M < 1e-10, f"mass matrix, state {k}: relative error {e_M:.2e}"
+        assert e_a < 1e-10, f"accelerations, state {k}: relative error {e_a:.2e}"
+
+
+def test_panda_joints_stay_within_their_limits():
+    """Falling under gravity from its zero pose (joint 4, whose range excludes 0, starts at
+    its upper limit), every joint stays within the URDF's limits and the fingers within
+    0..0.04 m; without limits, joint 2 falls through its limit."""
+    model = kn.from_urdf(REAL["panda"])
+    res = kn.simulate(model, t_end=1.5, n_points=151)
+    joints = ET.parse(REAL["panda"]).getroot().findall("joint")
+    limited = {j.get("name"): (float(j.find("limit").get("lower")),
+                               float(j.find("limit").get("upper")))
+               for j in joints if j.get("type") in ("revolute", "prismatic")}
+    assert {"panda_finger_joint1", "panda_finger_joint2"} <= set(limited)
+    hit = set()
+    for name, (low, high) in limited.items():
+        q = res[f"{name}.q"]
+        assert q.min() >= low - 1e-9 and q.max() <= high + 1e-9, name
+        if np.isclose(q, low, atol=1e-9).any() or np.isclose(q, high, atol=1e-9).any():
+            hit.add(name)
+    assert {"panda_joint2", "panda_joint4"} <= hit     # they fall onto their stops
+    free = kn.simulate(kn.from_urdf(REAL["panda"], limits=False), t_end=1.5, n_points=151)
+    assert free["panda_joint2.q"].max() > limited["panda_joint2"][1] + 0.1
