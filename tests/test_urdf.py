@@ -4,7 +4,8 @@ Each robot in ``tests/data`` is read twice: by kinetwork and by ``pin.buildModel
 (urdfdom, an independent parser and an independent dynamics code). The joint-space mass
 matrix and the forward dynamics (``pin.crba``, ``pin.aba``) must agree to 1e-9 at random
 states, with random joint torques applied through 1-D sources on the joints' flanges and the
-URDF's viscous damping (which ``pin.aba`` leaves out) added to Pinocchio's torques.
+URDF's viscous damping and sliding Coulomb friction (which ``pin.aba`` leaves out) added to
+Pinocchio's torques; within the joints' limits, where their end stops are free.
 
 Conventions mapped (kinetwork.components.multibody): a 1-DOF joint's q and qd are
 Pinocchio's, but for a continuous joint, whose angle Pinocchio keeps as (cos q, sin q). A
@@ -65,7 +66,7 @@ class Pair:
         if gravity is not None:
             self.pmodel.gravity.linear = np.asarray(gravity, dtype=float)
         info = self.model.layout["ground"]["urdf"]
-        self.damping = {}
+        self.damping, self.friction = {}, {}
         # a 1-D source on every 1-DOF joint, its torque or force a model parameter
         for joint in list(self.model.components.values()):
             if getattr(joint, "role", "") != "joint" or joint.dof != 1:
@@ -75,15 +76,16 @@ class Pair:
             self.model.set_parameter(f"u_{joint.name}", 0.0)
             drive = self.model.add(lib(f"drive_{joint.name}", **{key: f"u_{joint.name}"}))
             self.model.connect(drive.flange, joint.axis)
-            d = self.model.layout[joint.name]["urdf"].get("dynamics", {}).get("damping", 0.0)
-            self.damping[joint.name] = d
+            dynamics = self.model.layout[joint.name]["urdf"].get("dynamics", {})
+            self.damping[joint.name] = dynamics.get("damping", 0.0)
+            self.friction[joint.name] = dynamics.get("friction", 0.0)
         self.system = self.model.compile()
         coords, speeds = self.system.coordinate_names, self.system.speed_names
         # the joints' end stops add their modes (0: free, as no stop is active here)
         self.n_modes = self.system.n_states - len(coords) - len(speeds)
         assert self.system.state_names[:len(coords) + len(speeds)] == coords + speeds
-        assert all(n.endswith("_limits.mode") for n in self.system.state_names[-self.n_modes:]
-                   if self.n_modes)
+        assert all(n.endswith(("_limits.mode", "_friction.mode"))
+                   for n in self.system.state_names[len(coords) + len(speeds):])
         self.joints = []              # (pin joint, component, coordinate and speed indices)
         for jid in range(1, self.pmodel.njoints):
             jname = self.pmodel.names[jid]
@@ -116,6 +118,15 @@ class Pair:
             else:
                 q[qi] = rng.uniform(-np.pi, np.pi, len(qi))
         return q, u
+
+    def state(self, q, u):
+        """kinetwork's state: q, u and the modes of the end stops (0: free) and of the joint
+        frictions (sliding the way the joint turns: +-1)."""
+        speed = {comp: u[ui[0]] for _, comp, _, ui in self.joints if len(ui) == 1}
+        modes = [np.sign(speed[name[:-len("_friction.mode")]])
+                 if name.endswith("_friction.mode") else 0.0
+                 for name in self.system.state_names[self.nq + self.nu:]]
+        return np.concatenate([q, u, modes])
 
     def to_pin(self, q, u):
         """Pinocchio's (q, v) and T with v = T u."""
@@ -185,11 +196,12 @@ class Pair:
         for joint, comp, qi, ui in self.joints:
             if comp in self.damping:
                 params[f"u_{comp}"] = drive[ui[0]]
-                tau[joint.idx_v] = drive[ui[0]] - self.damping[comp] * u[ui[0]]
+                tau[joint.idx_v] = (drive[ui[0]] - self.damping[comp] * u[ui[0]]
+                                    - self.friction[comp] * np.sign(u[ui[0]]))
         a = pin.aba(self.pmodel, self.pmodel.createData(), q_pin, v_pin, tau).copy()
         ref = self.udot(q, u, a)
-        x = np.concatenate([q, u, np.zeros(self.n_modes)])
-        dx = np.asarray(self.system.rhs(0.0, x, params=params), dtype=float).ravel()
+        dx = np.asarray(self.system.rhs(0.0, self.state(q, u), params=params),
+                        dtype=float).ravel()
         e_M = np.abs(M - M_ref).max() / np.abs(M_ref).max()
         e_a = np.abs(dx[self.nq:self.nq + self.nu] - ref).max() / max(1.0, np.abs(ref).max())
         return e_M, e_a
@@ -301,7 +313,7 @@ def test_visuals_sit_where_urdf_puts_them(robot):
         pair.model.connect(probe.port, f"{v['component']}.frame_a")
     system = pair.model.compile()
     q, u = pair.random_state(np.random.default_rng(4))
-    values = probe_values(system, np.concatenate([q, u]))
+    values = probe_values(system, pair.state(q, u))
     data = pair.pmodel.createData()
     pin.framesForwardKinematics(pair.pmodel, data, pair.to_pin(q, u)[0])
     for v in looks:
@@ -316,9 +328,9 @@ def test_visuals_sit_where_urdf_puts_them(robot):
 
 def test_visual_bodies_change_no_dynamics():
     """A massless shape body adds nothing: M equals that of the model without visuals."""
-    with_looks = Pair("planar_arm")
+    with_looks = Pair("planar_arm", limits=False)
     q, u = with_looks.random_state(np.random.default_rng(0))
-    model = kn.from_urdf(DATA / "planar_arm.urdf")
+    model = kn.from_urdf(DATA / "planar_arm.urdf", limits=False)
     for name in [v["component"] for v in model.layout["ground"]["urdf"]["visuals"]]:
         if name is not None:
             model.components[name].mass = 0.0
@@ -350,9 +362,9 @@ def test_floating_base_centre_of_mass_falls_at_g():
     rng = np.random.default_rng(7)
     for _ in range(3):
         q, u = pair.random_state(rng)
-        dx = np.asarray(pair.system.rhs(0.0, np.concatenate([q, u])), dtype=float).ravel()
+        dx = np.asarray(pair.system.rhs(0.0, pair.state(q, u)), dtype=float).ravel()
         q_pin, v_pin, _ = pair.to_pin(q, u)
-        a_pin = pair.pin_acceleration(q, u, dx[pair.nq:])
+        a_pin = pair.pin_acceleration(q, u, dx[pair.nq:pair.nq + pair.nu])
         data = pair.pmodel.createData()
         pin.centerOfMass(pair.pmodel, data, q_pin, v_pin, a_pin)
         np.testing.assert_allclose(data.acom[0], [0.3, -0.4, -9.81], rtol=1e-10, atol=1e-10)

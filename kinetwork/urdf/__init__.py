@@ -11,7 +11,13 @@ frame, and the child link's frame is the joint frame moved by the joint. So a jo
   q[0] along the joint frame's x projected into it), floating ``FreeMotion``; a fixed joint is
   its origin only;
 - with ``dynamics damping`` > 0, a rotational or translational ``Damper`` ``<joint>_damper``
-  between the joint's support and axis (the viscous damping the file asks for);
+  between the joint's support and axis (the viscous damping the file asks for); with
+  ``dynamics friction`` > 0, a ``BearingFriction`` (or translational ``Friction``)
+  ``<joint>_friction`` there (Coulomb friction with stiction);
+- for a revolute or prismatic joint with ``limit lower < upper`` (``limits=True``, the
+  default), a hard ``Stop`` ``<joint>_limits`` there with restitution 0: the joint comes to
+  rest on a limit it reaches, as the simulators that read URDF hold it; a joint whose zero
+  lies outside its limits starts at the nearer limit;
 
 and a link with an ``inertial`` becomes a ``RigidBody`` of the link's name on the link frame:
 the centre of mass at the inertial origin, the inertia turned from the inertial frame into the
@@ -19,84 +25,29 @@ link frame (R I R^T). The root link is fixed to the ``Ground`` (or, ``floating=T
 it by a ``FreeMotion`` ``<root>_floating``). Box, cylinder and sphere visuals become massless
 ``RigidBody`` parts ``<link>_visual`` with their shape, size and colour (a cylinder drawn along
 the URDF cylinder's z axis), on a fixed part ``<link>_visual_origin`` where their origin needs
-one.
+one. Mesh visuals (STL, OBJ, DAE) are found as ROS tools find them (``package://`` through
+``ROS_PACKAGE_PATH``, ``AMENT_PREFIX_PATH`` or the folders above the URDF: ``meshes.py``) and
+listed for the animation in ``layout.<ground>.meshes``, which draws them (with trimesh) in
+place of their links' bodies. With zero gravity the animation keeps URDF's z up.
 
-Kept as data, not physics, in the model's ``layout`` (which files keep as written): on each
-joint ``{"urdf": {"joint", "type", "limit", "dynamics", "mimic", ...}}`` (position, effort and
-velocity limits, friction and mimic couplings are not imposed); on the ground the robot's name,
-the map from URDF names to kinetwork ones (a joint to its component, a link to the frame that
-carries it) and every visual, meshes by file name. Collision geometry, transmissions and
-Gazebo tags are ignored.
+Kept as data in the model's ``layout`` (which files keep as written): on each joint
+``{"urdf": {"joint", "type", "limit", "dynamics", "mimic", ...}}`` (effort and velocity
+limits and mimic couplings are not imposed); on the ground the robot's name, the map from
+URDF names to kinetwork ones (a joint to its component, a link to the frame that carries it)
+and every visual, meshes by file name and the path found. Collision geometry, transmissions
+and Gazebo tags are ignored.
 
 The file is read with the standard library's ``xml.etree.ElementTree`` and checked here: the
 URDF libraries on PyPI check no more (a negative mass or a joint to a missing link passes
 them) and bring mesh stacks this module does not need.
 """
 
-import os
 
-from ..errors import ModelError
-from .build import PROBED, Z_TO_X, build
-from .parse import JOINT_TYPES, carried, parse, read, tree
+from .build import PROBED, Z_TO_X
+from .command import cli_import
+from .load import from_urdf
+from .parse import JOINT_TYPES
 from .rotations import axis_angle, rpy_matrix
 
-__all__ = ["from_urdf", "cli_import", "rpy_matrix", "axis_angle", "JOINT_TYPES", "PROBED"]
-
-
-def from_urdf(path, probes=False, floating=False, gravity=(0.0, 0.0, -9.81), name=None,
-              limits=True):
-    """The kinetwork model of the robot described in the URDF file ``path``.
-
-    Parameters
-    ----------
-    path : str or os.PathLike
-        URDF file (xacro already expanded).
-    probes : bool
-        A probe ``<joint>_probe`` on every moving joint: angle, speed, torque (revolute);
-        position, velocity, force (prismatic); pose and velocities of frame_b (planar,
-        floating).
-    floating : bool
-        Join the root link to the ground by a FreeMotion (a free-flying base) instead of
-        fixing it there.
-    gravity : 3 numbers, m/s^2
-        Gravity of the Ground, in the root link's frame at rest (URDF's z is up).
-    name : str, optional
-        Model name (default: the robot's name).
-    limits : bool
-        Impose the revolute and prismatic joints' position limits as hard end stops (a
-        ``Stop`` ``<joint>_limits`` between the joint's support and axis; a joint whose zero
-        lies outside its limits starts at the nearer one). False leaves them as data only.
-
-    Returns
-    -------
-    Model
-        Validated; ``model.layout["ground"]["urdf"]`` maps URDF names to kinetwork ones.
-
-    Raises
-    ------
-    ModelError
-        A missing or unreadable file, malformed XML, or a robot that is no valid URDF tree
-        (a joint to a missing link, a kinematic loop, a negative mass, an inertia that is not
-        positive definite, ...), each problem naming its element.
-    """
-    source = os.fspath(path)
-    robot = read(source)
-    where = os.path.basename(source)
-    problems = []
-    links, joints, materials = parse(robot, problems)
-    shape = tree(links, joints, problems) if not problems else None
-    if not problems:
-        carried(links, joints, shape[1], problems)
-    if problems:
-        raise ModelError([f"{where}: {p}" for p in problems])
-    model = build(robot.get("name") or "robot", links, joints, shape, materials,
-                 probes=probes, floating=floating, gravity=gravity, name=name, where=where,
-                  limits=limits)
-    model.validate()
-    return model
-
-
-def cli_import(args):
-    """``kinetwork import ROBOT.urdf -o MODEL.json`` (see :mod:`.command`)."""
-    from .command import cli_import as run
-    return run(args)
+__all__ = ["from_urdf", "cli_import", "rpy_matrix", "axis_angle", "JOINT_TYPES", "PROBED",
+           "Z_TO_X"]

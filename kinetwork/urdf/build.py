@@ -10,6 +10,7 @@ from ..components import multibody as mb
 from ..components import rotational, translational
 from ..components.probe import Probe
 from ..graph.model import Model
+from .meshes import resolve
 from .rotations import axis_angle, rpy_matrix
 
 #: what a probe on each joint records (the 1-D flange for 1-DOF joints, frame_b otherwise)
@@ -23,7 +24,7 @@ STOP_RESTITUTION = 0.0
 
 
 def build(robot, links, joints, tree, materials, *, probes, floating, gravity, name, where,
-          limits=True):
+          limits=True, folder="."):
     """The Model of a checked URDF tree (see the module's docstring for what maps to what)."""
     root, order = tree
     names = _Names()
@@ -72,7 +73,7 @@ def build(robot, links, joints, tree, materials, *, probes, floating, gravity, n
         if probes:
             _probe(model, names, joint, *(("axis", joint.domain) if joint.dof == 1
                                           else ("frame_b", "frame")))
-    visuals = []
+    visuals, bodies = [], {}
     for link, L in links.items():
         if L["inertial"] is not None:
             mass, r_cm, inertia = L["inertial"]
@@ -81,14 +82,29 @@ def build(robot, links, joints, tree, materials, *, probes, floating, gravity, n
                                               inertia=inertia.tolist()))
                 model.connect(f"{body.name}.frame_a", frame[link])
                 model.layout[body.name] = {"urdf": {"link": link}}
+                bodies[link] = body.name
         for visual in L["visuals"]:
             visuals.append(_look(model, names, lname[link], visual, frame[link], materials,
-                                 link))
+                                 link, folder))
     model.layout[ground_name] = {"urdf": {
         "robot": robot, "file": where, "root": root, "base": base,
         "links": {link: frame[link] for link in links}, "joints": mapped,
-        "visuals": visuals}}
+        "visuals": visuals},
+        # what the animation draws: the mesh files found, on their links' frames
+        "meshes": [_placed(v, bodies.get(v["link"])) for v in visuals if v.get("path")]}
+    if not any(gravity):
+        model.layout[ground_name]["up"] = [0.0, 0.0, 1.0]      # URDF's convention: z up
     return model
+
+
+def _placed(visual, body):
+    """A mesh visual as the animation reads it (``kinetwork.animation``'s mesh entries): the
+    file on its link's frame, placed by its origin and scaled; it stands in for the link's
+    body, which is then not drawn as a sphere."""
+    return {"path": visual["path"], "frame": visual["frame"],
+            "position": list(visual["xyz"]), "rotation": rpy_matrix(visual["rpy"]).tolist(),
+            "scale": list(visual["scale"]), "color": visual["color"],
+            "replaces": [body] if body else [], "source": visual["filename"]}
 
 
 def _fixed(model, names, base, xyz, R, at):
@@ -172,15 +188,17 @@ Z_TO_X = np.array([[0.0, 0.0, -1.0], [0.0, 1.0, 0.0], [1.0, 0.0, 0.0]])
 LOOKS_ANGLE = 1e-9
 
 
-def _look(model, names, base, visual, at, materials, link):
+def _look(model, names, base, visual, at, materials, link, folder):
     """The visual as data ({"link", "frame", "kind", "xyz", "rpy", "color", "component"},
-    and URDF's "size", "length" and "radius", or "filename" and "scale"); a box, cylinder or
-    sphere is drawn by a massless RigidBody ``component`` as well."""
+    and URDF's "size", "length" and "radius", or "filename", "scale" and the "path" of the
+    file found, or None); a box, cylinder or sphere is drawn by a massless RigidBody
+    ``component`` as well."""
     colour = visual["color"] or materials.get(visual["material"])
     data = {"link": link, "frame": at, "kind": visual["kind"], "xyz": visual["xyz"],
             "rpy": visual["rpy"], "color": colour, "component": None}
     if visual["kind"] == "mesh":
-        data.update(filename=visual["filename"], scale=visual["scale"])
+        data.update(filename=visual["filename"], scale=visual["scale"],
+                    path=resolve(visual["filename"], folder))
         return data
     size, R = visual["size"], rpy_matrix(visual["rpy"])
     if visual["kind"] == "box":

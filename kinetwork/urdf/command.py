@@ -1,6 +1,6 @@
 """``kinetwork import ROBOT.urdf -o MODEL.json``."""
 
-from . import from_urdf
+from .load import from_urdf
 
 
 def cli_import(args):
