@@ -414,6 +414,10 @@ def test_cli_import(tmp_path, capsys):
     model = kn.load(out)
     assert model.components["ground"].gravity == [0.0, 0.0, -1.62]
     assert type(model.components["torso_floating"]).__name__ == "FreeMotion"
+    assert [c for c in model.components if c.endswith("_limits")]
+    out = tmp_path / "unlimited.json"
+    assert main(["import", str(DATA / "floating_base.urdf"), "-o", str(out), "--no-limits"]) == 0
+    assert not [c for c in kn.load(out).components if c.endswith("_limits")]
 
 
 def test_cli_import_refuses(tmp_path, capsys):

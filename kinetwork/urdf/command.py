@@ -6,7 +6,8 @@ from .load import from_urdf
 def cli_import(args):
     """``kinetwork import ROBOT.urdf -o MODEL.json``: write the model; the exit code."""
     gravity = (0.0, 0.0, -9.81) if args.gravity is None else tuple(args.gravity)
-    model = from_urdf(args.source, probes=args.probes, floating=args.floating, gravity=gravity)
+    model = from_urdf(args.source, probes=args.probes, floating=args.floating, gravity=gravity,
+                      limits=not getattr(args, "no_limits", False))
     model.save(args.out)
     parts = model.components.values()
     states = sum(c.dof for c in parts if c.role == "joint")
