@@ -12,6 +12,7 @@ from __future__ import annotations
 import json
 import math
 import os
+import pathlib
 import stat
 from collections.abc import Iterable
 
@@ -47,6 +48,9 @@ def load(path: str | os.PathLike, validate: bool = True,
     Parameters
     ----------
     path : str or os.PathLike
+        A model file; a path that does not exist may name an example that ships with the
+        package (``"double_pendulum"``, or ``"models/double_pendulum.json"`` as in a
+        checkout: see ``kn.examples``).
     validate : bool, optional
         Also check the wiring (``Model.validate``; of a subsystem definition, a model with
         exposed ports, only its values); False reads a model saved half-built.
@@ -66,6 +70,8 @@ def load(path: str | os.PathLike, validate: bool = True,
         Every problem with the file, each message starting with the file name and the place.
     """
     source = os.fspath(path)
+    if not os.path.exists(source):
+        source = os.fspath(example_file(source) or source)
     text = _read(source)
     folder = os.path.dirname(os.path.abspath(source))
     model = loads(text, source=source, validate=validate, library=library, folder=folder)
@@ -93,6 +99,32 @@ def _read(source):
         return raw.decode("utf-8-sig")     # tolerate the BOM some editors write
     except UnicodeDecodeError as exc:
         raise ModelError(f"{source}: not UTF-8 text (byte {exc.start})") from None
+
+
+def examples_folder():
+    """Where the example models are: ``kinetwork/models`` inside the package (a link to the
+    source tree's ``models/`` in a checkout), else ``models/`` next to the package; None when
+    neither exists."""
+    package = pathlib.Path(__file__).resolve().parent.parent
+    for candidate in (package / "models", package.parent / "models"):
+        if candidate.is_dir():
+            return candidate.resolve()
+    return None
+
+
+def example_file(name):
+    """The installed example a relative path that does not exist names, or None: the
+    example's name (``"double_pendulum"``, ``"engine_v6/EngineV6"``), with ``.json`` or
+    as the checkout's ``models/...json`` (so the paths of the docs and of a checkout work
+    wherever the package is installed)."""
+    text = os.fspath(name).replace(os.sep, "/")
+    root = examples_folder()
+    if root is None or os.path.isabs(text) or not text or ".." in text.split("/"):
+        return None
+    key = text[len("models/"):] if text.startswith("models/") else text
+    key = key[:-len(".json")] if key.endswith(".json") else key
+    found = root / f"{key}.json"
+    return found if found.is_file() else None
 
 
 def loads(text: str | bytes, source: str | None = None, validate: bool = True,
