@@ -16,7 +16,7 @@ import pathlib
 import stat
 from collections.abc import Iterable
 
-from ..components.base import _NAME, NAME_LIMIT, REGISTRY
+from ..components.base import _NAME, NAME_LIMIT, REGISTRY, type_suggestion
 from ..errors import ModelError
 from ..util import QUOTE_LIMIT, quote, suggest
 from .initial import check_initial
@@ -310,7 +310,7 @@ def _component(entry, place, problems, context):
         return Subsystem.from_params(entry["name"], params, place=where, model=definition)
     if not isinstance(kind, str) or kind not in REGISTRY:
         # resolved only through the registry: a dotted path in a file is never imported
-        problems.append(f"{place}: unknown type {quote(kind, 60)}{suggest(kind, REGISTRY)}")
+        problems.append(f"{place}: unknown type {quote(kind, 60)}{type_suggestion(kind)}")
         return None
     return REGISTRY[kind].from_params(entry["name"], params, place=where)
 
@@ -483,7 +483,7 @@ class Context:
                 root = self.root if kind == "folder" else os.path.realpath(folder)
                 return self._file(name, f"{name}.json", root, kind, folder)
         looked = (f"; looked for {name}.json in " + ", ".join(folders)) if folders else ""
-        raise ModelError(f"unknown type {quote(name, 60)}{suggest(name, REGISTRY)}: no "
+        raise ModelError(f"unknown type {quote(name, 60)}{type_suggestion(name)}: no "
                          f"kinetwork component, nor a definition in this file{looked}")
 
     def _file(self, name, ref, root, kind, folder=None):
