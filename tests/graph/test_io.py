@@ -467,3 +467,9 @@ def test_a_component_looked_up_by_another_name_says_which_it_may_be(written, mea
     with pytest.raises(AttributeError, match=f"did you mean '{meant}'"):
         getattr(getattr(kn, library), name)
     assert getattr(getattr(kn, meant.split(".")[0]), meant.split(".")[1])     # it exists
+
+
+def test_what_validate_returns_prints_short():
+    # at a prompt, model.validate() echoes its result: a line, not the connection sets
+    shown = repr(kn.load("models/fourbar.json").validate())
+    assert shown == "<Topology: 4 joints, 3 bodies, 1 kinematic loop, 4 probes>"
