@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 from scenes import build_kinetwork, random_mechanism
 
-from kinetwork.solver import jit
+from kinetwork.solver import jit, jit_source
 
 pytestmark = pytest.mark.skipif(jit.compiler() is None, reason="no C compiler")
 
@@ -57,9 +57,9 @@ def test_a_split_that_cannot_apply_leaves_the_source_whole():
     gen = ca.CodeGenerator("f.c", {"with_header": False})
     gen.add(f)
     source = gen.dump()
-    assert jit._split(source, 1000) == {"main.c": source}          # short
+    assert jit_source.split(source, 1000) == {"main.c": source}          # short
     looped = source.replace("  return 0;\n}", "  for (;;) break;\n  return 0;\n}", 1)
-    assert jit._split(looped, 2) == {"main.c": looped}                # not straight-line
+    assert jit_source.split(looped, 2) == {"main.c": looped}                # not straight-line
 
 
 def test_a_cache_hit_generates_no_c(cache, monkeypatch, system):
