@@ -86,3 +86,14 @@ def test_the_key_follows_the_function_and_the_jacobian(system):
     assert name(f) == name(rebuilt)
     assert name(f) != name(f, True)
     assert name(f) != name(build_kinetwork(*random_mechanism(4, 3)).compile().f_rhs)
+
+
+def test_entry_points_become_swappable_only_in_casadis_usual_form():
+    x = ca.SX.sym("x", 3)
+    f = ca.Function("f", [x], [ca.sin(x) * x[0]])
+    source = jit_source.sources("f", f, ["-O0"])["f_main.c"][0]
+    swapped = jit_source.swappable(source)
+    assert swapped.count("f_kinetwork_swap") == 1 and "KINETWORK_LOAD(kinetwork_impl_f)" in swapped
+    odd = source.replace("  return casadi_f0(arg, res, iw, w, mem);",
+                         "  int r = casadi_f0(arg, res, iw, w, mem);\n  return r;")
+    assert jit_source.swappable(odd) is None                 # left as it is: no tier swap
