@@ -128,14 +128,15 @@ def evaluation_costs(spec, rounds=9):
     calls = {}
     saved = os.environ.get("KINETWORK_CACHE"), os.environ.get("KINETWORK_JIT_LEVEL")
     try:
-        for tier in ("quick", "optimised"):
+        for level in ("quick", "optimised"):
             os.environ["KINETWORK_CACHE"] = tempfile.mkdtemp()
-            os.environ["KINETWORK_JIT_LEVEL"] = tier
-            system = chains.chain_model(spec).compile()
-            f = compiled_of(system).rhs({"stats": {}, "required": True})
+            os.environ["KINETWORK_JIT_LEVEL"] = level
+            system, stats = chains.chain_model(spec).compile(), {}
+            f = compiled_of(system).rhs({"stats": stats, "required": True})
             rhs = numeric(f, system.param_vector(), system.n_states)
-            calls[f"kinetwork {'-O0 (quick tier)' if tier == 'quick' else '-O1 (optimised)'}"] \
-                = (lambda rhs=rhs: rhs(0.0, x))
+            if level == "optimised" or stats["jit_tier"] == "quick":   # a small one: -O1 only
+                calls[f"kinetwork {'-O0 (quick tier)' if level == 'quick' else '-O1 (optimised)'}"] \
+                    = (lambda rhs=rhs: rhs(0.0, x))
     finally:
         for key, value in zip(("KINETWORK_CACHE", "KINETWORK_JIT_LEVEL"), saved):
             if value is None:
@@ -252,7 +253,9 @@ def lines(first, costs, long_rows):
         out += ["", "### Long planar point-mass chains against independent references", "",
                 "1 s of each chain (a damper of 0.1 N m s/rad on every joint), default method; "
                 "the largest joint-angle difference at the end against each reference "
-                "(pinocchio up to 512 links: its Data needs 69 GB at 1024).", "",
+                "(pinocchio up to 512 links: its Data needs 69 GB at 1024). The first rtol's "
+                "run of each N pays the JIT and `auto`'s stiffness test (the eigenvalues of a "
+                "2N x 2N Jacobian: most of the 1024-link run's CPU).", "",
                 table(["N", "rtol", "method", "steps", "wall [s]", "CPU [s]", "load",
                        *(f"vs {k} [rad]" for k in refs)],
                       [[r["N"], f"{r['rtol']:g}", r["method"], r["steps"], f"{r['wall_s']:.1f}",

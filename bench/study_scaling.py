@@ -61,19 +61,20 @@ BATCHES = 11
 
 
 def per_call(fn, batches=BATCHES):
-    """Median time of one ``fn()`` call: batches of calls sized to ~BATCH_SECONDS each."""
+    """Median CPU time of one ``fn()`` call: batches of calls sized to ~BATCH_SECONDS each
+    (CPU time: on a machine shared past its core count, wall time counts the others' work)."""
     fn()
-    n, start = 1, time.perf_counter()
-    while time.perf_counter() - start < BATCH_SECONDS / 10:
+    n, start = 1, time.process_time()
+    while time.process_time() - start < BATCH_SECONDS / 10:
         fn()
         n += 1
-    calls = max(1, int(n * 10 * BATCH_SECONDS / max(time.perf_counter() - start, 1e-9)) // 10)
+    calls = max(1, int(n * 10 * BATCH_SECONDS / max(time.process_time() - start, 1e-9)) // 10)
     times = []
     for _ in range(batches):
-        start = time.perf_counter()
+        start = time.process_time()
         for _ in range(calls):
             fn()
-        times.append((time.perf_counter() - start) / calls)
+        times.append((time.process_time() - start) / calls)
     return statistics.median(times)
 
 
@@ -636,9 +637,9 @@ def report(rows, fits, tools, total, quick, extra=None, loops=()):
              f"process's CPU time for one build and for the cold JIT (code generation), and the "
              f"compilers' (children's) CPU time: on a shared machine whose load average is over "
              f"its core count, wall times stretch and these say what the work itself costs. "
-             f"Per-evaluation times from Python, "
-             f"median over batches of calls; they are noisy when the load average is over "
-             f"the core count. "
+             f"Per-evaluation times from Python, CPU time, "
+             f"median over batches of calls (wall times are the others' too when the load "
+             f"average is over the core count). "
              f"Study wall time {total:.0f} s.", "",
              table(header, body), "",
              *(strategy_lines(*extra) + [""] if extra else
