@@ -716,7 +716,7 @@ def _progress(progress, total):
 
 # -- the Dataset -------------------------------------------------------------------------------
 def _dataset(job, layout, outcome, attrs):
-    import xarray as xr
+    from .xrdata import dataset
     system = job.system
     dims, shape = layout["dims"], layout["shape"]
     time_ = job.grid
@@ -750,7 +750,7 @@ def _dataset(job, layout, outcome, attrs):
         coords[name] = ("member", vals, {"units": _param_unit(system, name),
                                          "distribution": layout["distributions"][name]})
     s = job.settings
-    ds = xr.Dataset(data, coords=coords, attrs={
+    ds = dataset(data, coords, {
         "model": system.model.name, "method": s["method"], "rtol": s["rtol"],
         "atol": s["atol"], "t_start": job.t_start, "t_end": float(s["t_end"]),
         "n_points": s["n_points"], "members": len(outcome.status),

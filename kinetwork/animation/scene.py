@@ -6,7 +6,7 @@ import math
 import casadi as ca
 import numpy as np
 
-from ..equations.system import mapped
+from ..equations.system import pointwise
 from ..errors import ModelError
 from .meshes import mesh as mesh_file
 
@@ -82,7 +82,7 @@ def animation_data(results, fps=None, model=None):
 
 def _frame_poses(system, results, params):
     """(frames, {frame set: index}, positions, rotations) of every frame connection set: one
-    mapped call of ``System.f_frames`` over the grid; positions (n, 3) and rotations
+    mapped evaluation of ``System.f_frames`` over the grid; positions (n, 3) and rotations
     (n, 3, 3) per frame."""
     t, sets = np.asarray(results.t, dtype=float), system.frame_sets
     if not sets:
@@ -90,8 +90,8 @@ def _frame_poses(system, results, params):
     if not len(t):
         raise ModelError("nothing to animate: the results hold no time point")
     p = system.param_vector(params)
-    out = np.asarray(mapped(system.f_frames, len(t))(t[None, :], results.states.T, p))
-    out = out.reshape(12, len(t), len(sets)).transpose(2, 1, 0)          # set, time, 12
+    out = pointwise(system.f_frames, t[:, None], results.states, p)[0]
+    out = out.reshape(len(t), len(sets), 12).transpose(1, 0, 2)          # set, time, 12
     bad = ~np.all(np.isfinite(out), axis=(0, 2))
     if bad.any():
         raise ModelError(f"cannot animate {system.model.name!r}: its poses are not finite from "
