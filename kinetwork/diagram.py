@@ -17,8 +17,8 @@ room.
 ``svg(model)`` draws the blocks, their ports in Modelica's colours, and wires routed
 orthogonally around the blocks (a shortest path with a price on bends, crossings and
 overlaps on a grid of lines beside the blocks), then spread apart where they share a track.
-Importing this module gives ``Model`` a ``_repr_svg_``: a model shows as its diagram in
-Jupyter.
+``Model._repr_svg_`` (a model shows as its diagram in Jupyter) calls ``svg`` through
+``kinetwork.upcalls``.
 """
 
 import bisect
@@ -1152,10 +1152,3 @@ def cli_diagram(args, model):
           f"{len(model.connections)} connections) to {path}")
     return 0
 
-
-def _repr_svg_(model):
-    """Jupyter shows a model as its diagram."""
-    return svg(model)
-
-
-Model._repr_svg_ = _repr_svg_

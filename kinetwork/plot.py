@@ -13,7 +13,6 @@ import numpy as np
 
 from .util import atomic_write, callable_module, suggest
 from .errors import ModelError
-from .solver.results import install_plotter
 
 #: a probe with more quantities than this wraps onto further rows (a frame probe has eight)
 MAX_COLUMNS = 4
@@ -435,9 +434,6 @@ def save_plot(results, path, *names, probes=None, title=None, dpi=150, **kwargs)
     options = {"pil_kwargs": {"compress_level": 1}} if fmt == "png" else {}
     # atomically: a full disk or a signal leaves an old image whole
     atomic_write(path, lambda tmp: fig.savefig(tmp, dpi=dpi, format=fmt, **options))
-
-
-install_plotter(plot_results)
 
 
 def warm_up():

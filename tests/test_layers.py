@@ -19,7 +19,7 @@ import pytest
 import kinetwork
 
 PACKAGE = pathlib.Path(kinetwork.__file__).resolve().parent
-LAYERS = [("errors", "util", "expr", "units", "spatial"), ("components",), ("graph",),
+LAYERS = [("errors", "util", "expr", "units", "spatial", "upcalls"), ("components",), ("graph",),
           ("equations",), ("solver", "simulation"),
           ("plot", "plotworker", "quickplot", "schema", "symbolic", "animation", "diagram", "urdf",
            "examples", "studio", "analysis", "cli", "__main__", "")]

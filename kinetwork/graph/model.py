@@ -18,6 +18,7 @@ from .subsystem import Subsystem, check_placement, check_port_name, flatten, has
 from .writer import save
 from ..errors import ModelError
 from ..expr import CONSTANTS, FUNCTIONS, parse
+from ..upcalls import upcall
 
 if TYPE_CHECKING:       # annotations only: a model does not import what compiles it
     from ..equations.system import System
@@ -34,17 +35,7 @@ RESERVED = {"t", *CONSTANTS, *FUNCTIONS}
 MODEL_NAME_LIMIT = 200
 _NOT_TEXT = re.compile("[\x00-\x1f\x7f-\x9f\ud800-\udfff\u2028\u2029]")
 
-#: what turns a validated model into a System: installed by ``kinetwork.equations`` when it
-#: is imported (layers only look down, so the model does not import what compiles it)
-_compiler = None
 _compile_lock = threading.RLock()
-
-
-def install_compiler(build):
-    """Set the function ``build(model, loops, baumgarte_rate, topology)`` -> System that
-    ``Model.compile`` calls."""
-    global _compiler
-    _compiler = build
 
 
 class Model:
@@ -351,11 +342,9 @@ class Model:
         key = (self.content_key(), loops, baumgarte_rate)
         with _compile_lock:
             if key not in self._compiled:
-                if _compiler is None:
-                    raise ModelError("no compiler installed: import kinetwork (its equations "
-                                     "layer installs one)")
-                system = _compiler(self, loops=loops, baumgarte_rate=baumgarte_rate,
-                                   topology=self.validate())
+                # the equations layer builds it: kinetwork.equations.system.System
+                system = upcall("compile")(self, loops=loops, baumgarte_rate=baumgarte_rate,
+                                           topology=self.validate())
                 # a System is built for one content: any other is stale now
                 self._compiled = {k: v for k, v in self._compiled.items() if k[0] == key[0]}
                 self._compiled[key] = system
@@ -364,6 +353,10 @@ class Model:
     def save(self, path: str | os.PathLike) -> None:
         """Write the model as JSON (atomically: a failed save leaves the old file whole)."""
         save(self, path)
+
+    def _repr_svg_(self):
+        """Jupyter shows a model as its wiring diagram (``kinetwork.diagram.svg``)."""
+        return upcall("diagram")(self)
 
     def __repr__(self):
         return (f"<Model {self.name!r}: {len(self.components)} components, "
