@@ -63,8 +63,11 @@ class Port:
         return self if instance is None else PortRef(instance, self.name)
 
     def __set__(self, instance, value):
+        also = [key for key, spec in instance.params.items() if self.name in spec.aliases]
+        where = (f"; the parameter of that name in files is {instance.name}.{also[0]}"
+                 if also else "")
         raise ModelError(f"{instance.name}.{self.name} is a port, not a parameter: wire it with "
-                         f"model.connect")
+                         f"model.connect{where}")
 
 
 class PortRef:
@@ -111,7 +114,7 @@ class Param:
 
     def __init__(self, default=REQUIRED, *, unit="", min=None, max=None, shape=(), doc="",
                  time=False, optional=False, nonzero=False, kind="real", choices=None,
-                 name=None, positive=False, signals=False):
+                 positive=False, signals=False, aliases=(), name=None):
         self.default, self.min, self.max = default, min, max
         # ``signals``: the expression may also read signal outputs of the model's components
         # by dotted name ("pos.y", "cyl1.pos.y"), as a force law in sensor signals
@@ -120,12 +123,20 @@ class Param:
         self.shape, self.doc, self.time, self.optional = tuple(shape), doc, time, optional
         self.nonzero, self.kind, self.choices = nonzero, kind, choices
         self.positive = positive
-        # ``name`` lets a parameter share its file name with a port (a joint's "axis")
+        # other names a keyword or a file may give it by, kept as written when saved: a
+        # joint's direction ``n`` (Modelica's name; its 1-D flange is ``axis``) was "axis"
+        self.aliases = tuple(aliases)
+        # a declaration in a class body is named by its attribute; ``name`` names one made
+        # outside a class (a subsystem's parameters)
         self.name = name
         self.__doc__ = self.describe()        # what help() shows under the attribute
 
     def __set_name__(self, owner, name):
-        self.name = self.name or name
+        if self.name not in (None, name):
+            # one name reads, writes, documents and files a parameter
+            raise TypeError(f"{owner.__name__}.{name}: a parameter declared in a class is "
+                            f"named by its attribute, not {self.name!r}")
+        self.name = name
 
     def __get__(self, instance, owner):
         return self if instance is None else instance._values[self.name]
@@ -165,7 +176,7 @@ class Param:
                 "default": None if self.required else _plain(self.default),
                 "min": self.min, "max": self.max, "positive": self.positive,
                 "nonzero": self.nonzero, "optional": self.optional, "time": self.time,
-                "signals": self.signals,
+                "signals": self.signals, "aliases": list(self.aliases),
                 "choices": list(self.choices) if self.choices else None, "doc": self.doc}
 
     def resolved(self, owner):
@@ -383,6 +394,10 @@ class Component:
     #: 1-D ports whose position is a joint coordinate (port -> coordinate index) or zero
     coordinate_ports = {}
     zero_ports = ()
+    #: another name a parameter is given by -> its name (``Param(aliases=...)``)
+    aliases = {}
+    #: parameter -> the alias it was given by, kept for the file it is saved to
+    _spelling = {}
     #: groups of signal ports that carry signals of one unit (an Add's inputs and output, a
     #: PID's set point and measurement): how units spread along signal wires to the plots
     same_unit_ports = ()
@@ -396,6 +411,7 @@ class Component:
         super().__init_subclass__(**kwargs)
         cls.ports = {}
         cls.params = {}
+        cls.aliases = {}
         for klass in reversed(cls.__mro__):
             for key, val in vars(klass).items():
                 if isinstance(val, Port):
@@ -405,6 +421,7 @@ class Component:
                     cls.ports[key] = val
                 elif isinstance(val, Param):
                     cls.params[val.name] = val.resolved(cls)
+        cls.aliases = {alias: key for key, spec in cls.params.items() for alias in spec.aliases}
         # a subclass declared without ``library=`` is not a file type (not its parent's either)
         cls.type_name = None
         cls._own_doc = inspect.cleandoc(vars(cls).get("__doc__") or "") or cls._own_doc
@@ -437,15 +454,24 @@ class Component:
                              f"(letters, digits, underscore; not starting with a digit{size})")
         object.__setattr__(self, "name", name)
         kind = self.type_name or type(self).__name__
-        problems = [f"{place(key)}: unknown parameter{suggest(key, self.params)}; "
-                    f"{kind} has {', '.join(self.params) or 'none'}"
-                    for key in params if key not in self.params]
+        problems = [f"{place(key)}: unknown parameter{suggest(key, [*self.params, *self.aliases])}"
+                    f"; {kind} has {self._listed()}"
+                    for key in params if key not in self.params and key not in self.aliases]
+        object.__setattr__(self, "_spelling", {})
+        for alias, key in self.aliases.items():
+            if alias in params and key in params:
+                problems.append(f"{place(alias)}: {alias} and {key} are one parameter; give "
+                                f"{key} alone")
+            elif alias in params:
+                params = {key if k == alias else k: v for k, v in params.items()}
+                self._spelling[key] = alias
         object.__setattr__(self, "given", {})
         object.__setattr__(self, "_values", {})
         for key, spec in self.params.items():
             try:
                 if key in params:
-                    self.given[key] = spec.normalize(params[key], place(key))
+                    written = self._spelling.get(key, key)
+                    self.given[key] = spec.normalize(params[key], place(written))
                     self._values[key] = spec.si(self.given[key])
                 elif spec.required:
                     problems.append(f"{place(key)}: a value is required ({spec.describe()})")
@@ -455,6 +481,13 @@ class Component:
                 problems.extend(exc.problems)
         if problems:
             raise ModelError(problems)
+
+    @classmethod
+    def _listed(cls):
+        """The parameters, each with its other names: "cut, n (or axis), q0"."""
+        also = {key: [a for a, k in cls.aliases.items() if k == key] for key in cls.params}
+        return ", ".join(f"{key} (or {', '.join(also[key])})" if also[key] else key
+                         for key in cls.params) or "none"
 
     def check_values(self, values, place):
         """Problems of the evaluated parameters ``values`` taken together (a hole no wider than
@@ -472,13 +505,24 @@ class Component:
         The new value is what ``Model.save``, ``numeric_values`` and ``simulate`` see; a
         compiled System of a model holding this component is rebuilt on its next use.
         """
-        if key not in self.params:
+        if key in self.aliases:
+            self._spelling = {**self._spelling, self.aliases[key]: key}
+            key = self.aliases[key]
+        elif key not in self.params:
             raise ModelError(f"{type(self).__name__} {self.name!r} has no parameter "
                              f"{quote(key)}{suggest(key, self.params)}; parameters: "
                              f"{', '.join(self.params) or 'none'}")
+        elif key in self._spelling:
+            self._spelling = {k: v for k, v in self._spelling.items() if k != key}
         value = self.params[key].normalize(value, f"{self.name}.{key}")
         self.given[key] = value
         self._values[key] = self.params[key].si(value)
+
+    def written_params(self):
+        """The given parameters as a file holds them: each by the name it was given by (a
+        joint's ``n`` given as ``axis`` is saved as ``axis``)."""
+        return {self._spelling.get(key, key): copy.deepcopy(value)
+                for key, value in self.given.items()}
 
     def __setattr__(self, key, value):
         declared = getattr(type(self), key, None)

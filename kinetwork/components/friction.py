@@ -23,6 +23,7 @@ Modes of friction: +1 sliding forward (w_rel > 0), -1 sliding backward, 0 stuck 
 import casadi as ca
 
 from .base import ONED, Component, Port
+from .oned import named
 
 #: a stuck friction holds up to its static limit and at it, to rounding: a load that keeps
 #: it exactly at the limit (a ramp that levels off there, a controller's steady torque)
@@ -137,6 +138,8 @@ class PartialTwoFlanges(PartialFriction):
 
 
 class PartialBearingFriction(PartialTwoFlanges):
+    """Coulomb friction of a constant force (torque): ``tau_c`` or ``f_c``."""
+    f_kinetic = named("{flow}_c", "Coulomb friction force or torque")
 
     def kinetic(self, u):
         return self.f_kinetic
@@ -157,6 +160,7 @@ class PartialElastoGap(PartialHybrid):
     """MSL's ElastoGap: a linear spring and damper acting only while the gap is closed
     (rel < rel0); the damping force is limited so that it never pulls (MSL 4.0's law)."""
     modes = {0: "open", 1: "contact"}
+    rel0 = named("{position}_rel0", "Relative position where contact begins")
     state_mode = True        # contact exactly while closed: a function of the state
     flange_a = Port(ONED, "Flange a")
     flange_b = Port(ONED, "Flange b")
@@ -185,6 +189,8 @@ class PartialStop(PartialHybrid):
     impact: an impulse through the mechanism); an impact slower than v_rest leaves it resting
     on the limit until the force holding it there would have to pull."""
     modes = {0: "free", 1: "resting"}
+    rel_min = named("{position}_min", "Lower limit")
+    rel_max = named("{position}_max", "Upper limit")
     hold_mode = 1
     flange_a = Port(ONED, "Flange a (the reference side: a joint's support)")
     flange_b = Port(ONED, "Flange b (a joint's axis)")

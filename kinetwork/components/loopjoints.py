@@ -159,11 +159,11 @@ class JointRRR(Component, library=MB):
         """The chain rev1 - rod1 - rev2 - rod2 - rev3 (cut), and its ports as this one's."""
         g = self.q0_guess
         revolute, rod = REGISTRY[f"{MB}.Revolute"], REGISTRY[f"{MB}.FixedTranslation"]
-        parts = [revolute("rev1", axis=self.n_a, q0_guess=g[0]),
+        parts = [revolute("rev1", n=self.n_a, q0_guess=g[0]),
                  rod("rod1", r=self.r_rod1),
-                 revolute("rev2", axis=self.n_a, q0_guess=g[1]),
+                 revolute("rev2", n=self.n_a, q0_guess=g[1]),
                  rod("rod2", r=_negated(self.r_rod2)),
-                 revolute("rev3", axis=self.n_a, q0_guess=g[2], cut=True)]
+                 revolute("rev3", n=self.n_a, q0_guess=g[2], cut=True)]
         comps = {c.name: c for c in parts}
 
         def port(path):

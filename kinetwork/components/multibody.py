@@ -100,12 +100,12 @@ class FixedTranslation(PartialRigidTransform, library=MB):
 class FixedRotation(PartialRigidTransform, library=MB):
     """frame_b = frame_a moved by ``r``, then rotated by ``angle`` about ``axis``."""
     r = Param([0.0, 0.0, 0.0], unit="m", shape=(3,), doc="Position of frame_b in frame_a")
-    direction = Param([0.0, 0.0, 1.0], unit="1", shape=(3,), nonzero=True, name="axis",
-                      doc="Rotation axis, resolved in frame_a")
+    axis = Param([0.0, 0.0, 1.0], unit="1", shape=(3,), nonzero=True,
+                 doc="Rotation axis, resolved in frame_a")
     angle = Param(unit="rad", doc="Rotation angle about axis")
 
     def transform(self, q):
-        return rotation(vec3(self.direction), self.angle), vec3(self.r)
+        return rotation(vec3(self.axis), self.angle), vec3(self.r)
 
 
 class PartialJoint(PartialRigidTransform):
@@ -164,17 +164,19 @@ class PartialJoint(PartialRigidTransform):
 
 
 class PartialAxisJoint(PartialJoint):
-    """One degree of freedom along or about ``axis``, with its two 1-D flanges.
+    """One degree of freedom along or about the direction ``n``, with two 1-D flanges.
 
-    ``axis`` (potential = q) drives the joint; ``support`` (potential 0) is its reaction side,
-    taken, as in Modelica MultiBody, to rest in the world frame.
+    As in Modelica MultiBody, ``n`` is the direction and ``axis`` the flange: ``axis``
+    (potential = q) drives the joint; ``support`` (potential 0) is its reaction side, taken
+    to rest in the world frame. ``n`` is also given as ``axis=[...]`` (its name in files
+    before, still read, and saved as written).
     """
     coordinate_ports = {"axis": 0}
     zero_ports = ("support",)
     axis = Port("1d", "Flange driving the joint coordinate", optional=True)
     support = Port("1d", "Reaction flange of the drive", optional=True)
-    direction = Param([0.0, 0.0, 1.0], unit="1", shape=(3,), nonzero=True, name="axis",
-                      doc="Joint axis, resolved in frame_a")
+    n = Param([0.0, 0.0, 1.0], unit="1", shape=(3,), nonzero=True, aliases=("axis",),
+              doc="Joint axis, resolved in frame_a")
     q0 = Param(None, optional=True, unit=COORDINATES,
                doc="Initial coordinate (None: 0, or solved in a loop)")
     qd0 = Param(None, optional=True, unit=RATES, doc="Initial coordinate speed (None: 0)")
@@ -183,23 +185,23 @@ class PartialAxisJoint(PartialJoint):
 
 
 class Revolute(PartialAxisJoint, library=MB):
-    """frame_b is frame_a rotated by q about ``axis`` (resolved in frame_a)."""
+    """frame_b is frame_a rotated by q about ``n`` (resolved in frame_a)."""
     domain = "rotational"
     units = ("rad",)
 
     def transform(self, q):
-        return rotation(vec3(self.direction), q[0]), ca.SX.zeros(3)
+        return rotation(vec3(self.n), q[0]), ca.SX.zeros(3)
 
 
 class Prismatic(PartialAxisJoint, library=MB):
-    """frame_b is frame_a moved by q along ``axis`` (resolved in frame_a)."""
+    """frame_b is frame_a moved by q along ``n`` (resolved in frame_a)."""
     domain = "translational"
     units = ("m",)
-    direction = Param([1.0, 0.0, 0.0], unit="1", shape=(3,), nonzero=True, name="axis",
-                      doc="Direction of motion, resolved in frame_a")
+    n = Param([1.0, 0.0, 0.0], unit="1", shape=(3,), nonzero=True, aliases=("axis",),
+              doc="Direction of motion, resolved in frame_a")
 
     def transform(self, q):
-        return ca.SX.eye(3), unit(vec3(self.direction)) * q[0]
+        return ca.SX.eye(3), unit(vec3(self.n)) * q[0]
 
 
 def _pair(doc, unit_=COORDINATES):
@@ -244,15 +246,15 @@ class Cylindrical(PartialJoint, library=MB):
     support_phi = Port("rotational", "Reaction flange of the rotation", optional=True)
     axis_s = Port("translational", "Flange driving the distance q[1]", optional=True)
     support_s = Port("translational", "Reaction flange of the translation", optional=True)
-    direction = Param([0.0, 0.0, 1.0], unit="1", shape=(3,), nonzero=True, name="axis",
-                      doc="Axis of rotation and translation, resolved in frame_a")
+    axis = Param([0.0, 0.0, 1.0], unit="1", shape=(3,), nonzero=True,
+                 doc="Axis of rotation and translation, resolved in frame_a")
     q0 = _pair("Initial angle and distance (None: 0, or solved in a loop)")
     qd0 = _pair("Initial angular and linear speed (None: 0)", RATES)
     q0_guess = Param([0.0, 0.0], shape=(2,), unit=COORDINATES,
                      doc="Start of the search for q0 in a loop")
 
     def transform(self, q):
-        n = vec3(self.direction)
+        n = vec3(self.axis)
         return rotation(n, q[0]), unit(n) * q[1]
 
 

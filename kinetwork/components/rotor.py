@@ -93,7 +93,7 @@ class Rotor1D(Component, library=MB):
 
     def expand(self):
         """A revolute about n with the inertia J n n^T, and -J n n^T on frame_a."""
-        spin = REGISTRY[f"{MB}.Revolute"]("spin", axis=self.n, q0=self.phi0, qd0=self.w0)
+        spin = REGISTRY[f"{MB}.Revolute"]("spin", n=self.n, q0=self.phi0, qd0=self.w0)
         rotor = REGISTRY[f"{MB}.RigidBody"]("rotor", mass=0.0,
                                             inertia=_axial(self.J, self.n, 1))
         housing = RotorHousing("housing", J=self.J, n=self.n)

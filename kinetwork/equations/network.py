@@ -211,7 +211,7 @@ class _Builder:
             if parent is None:
                 self.k[s] = self.kt[s] = ca.SX(1)
                 continue
-            r = self.bound[element.name].ratio()
+            r = self.bound[element.name].position_ratio()
             a_here = self.topo.set_of[element.port_ref("flange_a")] == s
             # position(flange_a) = r * position(flange_b)
             self.k[s] = self.k[parent] * r if a_here else self.k[parent] / r
@@ -607,9 +607,9 @@ class _Builder:
             if element.has_inertia:
                 flow[near] = b.inertia() * k[s] * a - flow[far]
             elif far.name == "flange_a":          # torque_b = -ratio * torque_a
-                flow[near] = -b.ratio() * self.losses.get(element.name, 1) * flow[far]
+                flow[near] = -b.position_ratio() * self.losses.get(element.name, 1) * flow[far]
             else:
-                flow[near] = -flow[far] / (b.ratio() * self.losses.get(element.name, 1))
+                flow[near] = -flow[far] / (b.position_ratio() * self.losses.get(element.name, 1))
             beyond[parent] = beyond[parent] + flow[near]
 
     def _finish(self):

@@ -462,7 +462,7 @@ def _motions(model, topo, problems):
     for comp in model.components.values():
         if comp.role != "prescribed":
             continue
-        key = type(comp).reference.name
+        key = comp.reference_param
         wired = topo.set_of[comp.port_ref("u")] in topo.signal_source
         given = comp.reference is not None
         if wired and given:

@@ -57,7 +57,8 @@ def type_info(type_name, cls):
                     "min": plain(spec.min), "max": plain(spec.max), "shape": list(spec.shape),
                     "kind": spec.kind,
                     "choices": None if spec.choices is None else plain(list(spec.choices)),
-                    "doc": spec.doc, "required": spec.required, "time": bool(spec.time)}
+                    "doc": spec.doc, "required": spec.required, "time": bool(spec.time),
+                    "aliases": list(spec.aliases)}
                    for name, spec in cls.params.items()],
     }
 
