@@ -19,7 +19,8 @@ package.
 
 import importlib
 
-from .errors import IdealisedInertiaWarning, ModelError, SimulationError
+from .errors import (IdealisedInertiaWarning, KinetworkWarning, ModelError, Problem,
+                     SimulationError)
 
 __version__ = "0.1.0"
 
@@ -57,7 +58,8 @@ _LAZY = {
     "uniform": ("analysis.sweep", "uniform"),
 }
 
-__all__ = ["IdealisedInertiaWarning", "ModelError", "SimulationError", *_LAZY]
+__all__ = ["IdealisedInertiaWarning", "KinetworkWarning", "ModelError", "Problem",
+           "SimulationError", *_LAZY]
 
 
 def __getattr__(name):

@@ -13,9 +13,9 @@ import re
 import numpy as np
 
 from .. import units
-from ..errors import ModelError
+from ..errors import ModelError, Problem
 from ..expr import parse
-from ..util import check_number, quote, suggest
+from ..util import check_number, hint, quote, suggest
 from .reference import docstring, signature
 
 
@@ -67,7 +67,7 @@ class Port:
         where = (f"; the parameter of that name in files is {instance.name}.{also[0]}"
                  if also else "")
         raise ModelError(f"{instance.name}.{self.name} is a port, not a parameter: wire it with "
-                         f"model.connect{where}")
+                         f"model.connect{where}", component=instance.name, port=self.name)
 
 
 class PortRef:
@@ -454,40 +454,43 @@ class Component:
                              f"(letters, digits, underscore; not starting with a digit{size})")
         object.__setattr__(self, "name", name)
         kind = self.type_name or type(self).__name__
-        problems = [f"{place(key)}: unknown parameter{suggest(key, [*self.params, *self.aliases])}"
-                    f"; {kind} has {self._listed()}"
-                    for key in params if key not in self.params and key not in self.aliases]
+        problems = [Problem(f"{place(key)}: unknown parameter{close}; {kind} has "
+                            f"{self._listed()}", component=name, parameter=_cut(key),
+                            hint=hint(close))
+                    for key in params if key not in self.params and key not in self.aliases
+                    for close in [suggest(key, [*self.params, *self.aliases])]]
         object.__setattr__(self, "_spelling", {})
         for alias, key in self.aliases.items():
             if alias in params and key in params:
-                problems.append(f"{place(alias)}: {alias} and {key} are one parameter; give "
-                                f"{key} alone")
+                problems.append(Problem(f"{place(alias)}: {alias} and {key} are one "
+                                        f"parameter; give {key} alone", component=name,
+                                        parameter=alias, hint=f"remove {alias}"))
             elif alias in params:
                 params = {key if k == alias else k: v for k, v in params.items()}
                 self._spelling[key] = alias
         object.__setattr__(self, "given", {})
         object.__setattr__(self, "_values", {})
         for key, spec in self.params.items():
+            written = self._spelling.get(key, key)
             try:
                 if key in params:
-                    written = self._spelling.get(key, key)
                     self.given[key] = spec.normalize(params[key], place(written))
                     self._values[key] = spec.si(self.given[key])
                 elif spec.required:
-                    problems.append(f"{place(key)}: a value is required ({spec.describe()})")
+                    problems.append(Problem(f"{place(key)}: a value is required "
+                                            f"({spec.describe()})", parameter=key))
                 else:
                     self._values[key] = spec.si(spec.normalize(spec.default, place(key)))
             except ModelError as exc:
-                problems.extend(exc.problems)
+                problems.extend(p.where(parameter=written) for p in exc.problems)
         if problems:
-            raise ModelError(problems)
+            raise ModelError(problems, component=name)
 
-    @classmethod
-    def _listed(cls):
+    def _listed(self):
         """The parameters, each with its other names: "cut, n (or axis), q0"."""
-        also = {key: [a for a, k in cls.aliases.items() if k == key] for key in cls.params}
+        also = {key: [a for a, k in self.aliases.items() if k == key] for key in self.params}
         return ", ".join(f"{key} (or {', '.join(also[key])})" if also[key] else key
-                         for key in cls.params) or "none"
+                         for key in self.params) or "none"
 
     def check_values(self, values, place):
         """Problems of the evaluated parameters ``values`` taken together (a hole no wider than
@@ -509,12 +512,17 @@ class Component:
             self._spelling = {**self._spelling, self.aliases[key]: key}
             key = self.aliases[key]
         elif key not in self.params:
+            close = suggest(key, self.params)
             raise ModelError(f"{type(self).__name__} {self.name!r} has no parameter "
-                             f"{quote(key)}{suggest(key, self.params)}; parameters: "
-                             f"{', '.join(self.params) or 'none'}")
+                             f"{quote(key)}{close}; parameters: {self._listed()}",
+                             component=self.name, hint=hint(close),
+                             parameter=_cut(key) if isinstance(key, str) else None)
         elif key in self._spelling:
             self._spelling = {k: v for k, v in self._spelling.items() if k != key}
-        value = self.params[key].normalize(value, f"{self.name}.{key}")
+        try:
+            value = self.params[key].normalize(value, f"{self.name}.{key}")
+        except ModelError as exc:
+            raise ModelError(exc.problems, component=self.name, parameter=key) from None
         self.given[key] = value
         self._values[key] = self.params[key].si(value)
 
@@ -531,31 +539,38 @@ class Component:
             return
         if key == "name":
             raise ModelError(f"{self.name!r}: a component cannot be renamed; build a new one "
-                             f"(a model refers to its components by name)")
-        if key in self.params:         # a parameter whose attribute has another name
+                             f"(a model refers to its components by name)",
+                             component=self.name)
+        if key in self.params or key in self.aliases:     # a subsystem's, or another name
             self.set_param(key, value)
             return
+        close = suggest(key, [*self.params, *self.ports])
         raise ModelError(f"{type(self).__name__} {self.name!r} has no parameter "
-                         f"{quote(key)}{suggest(key, [*self.params, *self.ports])}; change a "
-                         f"parameter with comp.<parameter> = value or comp.set_param(name, "
-                         f"value); parameters: {', '.join(self.params) or 'none'}")
+                         f"{quote(key)}{close}; change a parameter with comp.<parameter> = "
+                         f"value or comp.set_param(name, value); parameters: "
+                         f"{self._listed()}", component=self.name, hint=hint(close))
 
     def __delattr__(self, key):
-        raise ModelError(f"{self.name}.{key}: parameters and ports cannot be deleted")
+        raise ModelError(f"{self.name}.{key}: parameters and ports cannot be deleted",
+                         component=self.name)
 
     def __getattr__(self, key):
         # reached only when normal lookup fails: a misspelt port or parameter
         if key.startswith("_"):
             raise AttributeError(key)
+        close = suggest(key, [*self.ports, *self.params])
         raise ModelError(f"{type(self).__name__} {self.name!r} has no port or parameter "
-                         f"{key!r}{suggest(key, [*self.ports, *self.params])}; ports: "
-                         f"{', '.join(self.ports)}")
+                         f"{key!r}{close}; ports: {', '.join(self.ports)}",
+                         component=self.name, hint=hint(close))
 
     def port_ref(self, name):
         """The ``PortRef`` called ``name``; a ModelError suggesting close names otherwise."""
         if name not in self.ports:
+            close = suggest(name, self.ports)
             raise ModelError(f"{type(self).__name__} {self.name!r} has no port {quote(name)}"
-                             f"{suggest(name, self.ports)}; ports: {', '.join(self.ports)}")
+                             f"{close}; ports: {', '.join(self.ports)}", component=self.name,
+                             port=_cut(name) if isinstance(name, str) else None,
+                             hint=hint(close))
         return PortRef(self, name)
 
     def bound(self, values):

@@ -16,8 +16,8 @@ import stat
 from collections.abc import Iterable
 
 from ..components.base import _NAME, NAME_LIMIT, REGISTRY
-from ..errors import ModelError
-from ..util import QUOTE_LIMIT, quote, suggest
+from ..errors import ModelError, Problem
+from ..util import QUOTE_LIMIT, hint, quote, suggest
 from .initial import check_initial
 from .model import Model, model_name_problem, text_problem
 from .settings import check_setting, check_steps
@@ -170,34 +170,36 @@ def _build(data, problems, context):
     _repeated(data, "", problems)
     fmt, version = data.get("format", FORMAT), data.get("version", VERSION)
     keys = KEYS_V2 if version == 2 else KEYS
-    problems.extend(f"{quote(key)}: unknown key{suggest(key, keys)}; keys are "
-                    f"{', '.join(keys)}" + (" (ports and definitions need version 2)"
-                                            if key in KEYS_V2 else "")
-                    for key in data if key not in keys)
-    problems.extend(f"{key}: required key missing" for key in REQUIRED if key not in data)
+    problems.extend(Problem(f"{quote(key)}: unknown key{close}; keys are {', '.join(keys)}"
+                            + (" (ports and definitions need version 2)"
+                               if key in KEYS_V2 else ""), path=_cut(str(key)),
+                            hint=hint(close))
+                    for key in data if key not in keys for close in [suggest(key, keys)])
+    problems.extend(Problem(f"{key}: required key missing", path=key)
+                    for key in REQUIRED if key not in data)
     # another format or version: whatever else looks wrong is noise, so stop here
     if fmt != FORMAT:
-        problems.append(f"format: {quote(fmt)} is not a kinetwork model file "
-                        f"(expected {FORMAT!r})")
+        problems.append(Problem(f"format: {quote(fmt)} is not a kinetwork model file "
+                                f"(expected {FORMAT!r})", path="format"))
         return None
     if type(version) is not int or version not in SUPPORTED:
-        problems.append(f"version: {quote(version)} is not supported; this kinetwork reads "
-                        f"version "
-                        f"{', '.join(map(str, SUPPORTED))}")
+        problems.append(Problem(f"version: {quote(version)} is not supported; this "
+                                f"kinetwork reads version {', '.join(map(str, SUPPORTED))}",
+                                path="version"))
         return None
     name = data.get("name", "unnamed")
     problem = model_name_problem(name)
     if problem:
-        problems.append(f"name: {problem}")
+        problems.append(Problem(f"name: {problem}", path="name"))
         name = "unnamed"
     model = Model(name)
     context = context.file(_attempt(problems, "definitions", _entries,
-                                    data.get("definitions", {})) or {})
+                                    data.get("definitions", {}), path="definitions") or {})
     model.definitions = context.build_all(problems)
     _body(model, data, problems, context)
     model.simulation = _simulation(data.get("simulation", {}), problems)
     found = check_initial(data.get("initial", {}))
-    problems.extend(found)
+    problems.extend(Problem.of(p, path="initial") for p in found)
     if not found:
         model.initial = data.get("initial", {})
     return model
@@ -208,41 +210,51 @@ def _body(model, data, problems, context):
     ports, components, connections and layout."""
     model.description = data.get("description", "")
     if not isinstance(model.description, str):
-        problems.append(f"description: must be a string, got {_kind(model.description)}")
+        problems.append(Problem(f"description: must be a string, got "
+                                f"{_kind(model.description)}", path="description"))
     elif (problem := text_problem(model.description, allowed="\t\n\r")):
-        problems.append(f"description: {problem}")
+        problems.append(Problem(f"description: {problem}", path="description"))
     parameters = data.get("parameters", {})
     if not isinstance(parameters, dict):
-        problems.append(f"parameters: must be an object of numbers (or numbers with "
-                        f"units, '500 mm'), got {_kind(parameters)}")
+        problems.append(Problem(f"parameters: must be an object of numbers (or numbers with "
+                                f"units, '500 mm'), got {_kind(parameters)}",
+                                path="parameters"))
     else:
         for key, value in parameters.items():
             if not _NAME.fullmatch(key):     # said here with the name cut
-                problems.append(f"parameters: parameter name {quote(key)}: must be an "
-                                f"identifier (letters, digits, underscore; not starting with a "
-                                f"digit; at most {NAME_LIMIT} characters)")
+                problems.append(Problem(f"parameters: parameter name {quote(key)}: must be an "
+                                        f"identifier (letters, digits, underscore; not "
+                                        f"starting with a digit; at most {NAME_LIMIT} "
+                                        f"characters)", path="parameters"))
             else:
-                _attempt(problems, "parameters", model.set_parameter, key, value)
+                _attempt(problems, "parameters", model.set_parameter, key, value,
+                         path=f"parameters.{key}", parameter=key)
     broken = (_components(model, data["components"], problems, context)
               if "components" in data else {UNNAMED})
     _connections(model, data.get("connections", []), broken, problems)
     _ports(model, data.get("ports", {}), broken, problems)
+    before = len(problems)
     model.layout = _attempt(problems, "layout", _layout, model, data.get("layout", {}),
                             broken, problems)
+    _fill(problems, before, path="layout")
 
 
 def _components(model, entries, problems, context):
     """Add each entry; return the names of the failed ones, whose wiring goes unchecked."""
     if not isinstance(entries, list):
-        problems.append(f"components: must be a list, got {_kind(entries)}")
+        problems.append(Problem(f"components: must be a list, got {_kind(entries)}",
+                                path="components"))
         return {UNNAMED}
     broken, seen = set(), {}
     for i, entry in enumerate(entries):
         name = entry.get("name") if isinstance(entry, dict) else None
         place = f'components[{i}] "{_cut(name)}"' if isinstance(name, str) else \
             f"components[{i}]"
+        at = {"path": f"components[{i}]",
+              "component": _cut(name) if isinstance(name, str) else None}
         if isinstance(name, str) and name in seen:
-            problems.append(f"{place}: duplicate name, already used by components[{seen[name]}]")
+            problems.append(Problem(f"{place}: duplicate name, already used by "
+                                    f"components[{seen[name]}]", **at))
             continue
         before = len(problems)
         comp = _attempt(problems, place, _component, entry, place, problems, context)
@@ -253,6 +265,12 @@ def _components(model, entries, problems, context):
         else:
             _attempt(problems, place, model.add, comp)
             model.places[comp.name] = context.where + place
+            model.paths[comp.name] = at["path"]
+        # a parameter's problem is at its own key, the others at the entry
+        problems[before:] = [Problem.of(p).where(**at) if not getattr(p, "parameter", None)
+                             else Problem.of(p).where(path=f"{at['path']}.params.{p.parameter}",
+                                                      component=at["component"])
+                             for p in problems[before:]]
     return broken
 
 
@@ -278,27 +296,36 @@ def _component(entry, place, problems, context):
         return Subsystem.from_params(entry["name"], params, place=where, model=definition)
     if not isinstance(kind, str) or kind not in REGISTRY:
         # resolved only through the registry: a dotted path in a file is never imported
-        problems.append(f"{place}: unknown type {quote(kind, 60)}{suggest(kind, REGISTRY)}")
+        close = suggest(kind, REGISTRY)
+        problems.append(Problem(f"{place}: unknown type {quote(kind, 60)}{close}",
+                                hint=hint(close)))
         return None
     return REGISTRY[kind].from_params(entry["name"], params, place=where)
 
 
 def _connections(model, pairs, broken, problems):
     if not isinstance(pairs, list):
-        problems.append(f"connections: must be a list of pairs, got {_kind(pairs)}")
+        problems.append(Problem(f"connections: must be a list of pairs, got {_kind(pairs)}",
+                                path="connections"))
         return
     for i, pair in enumerate(pairs):
         if not isinstance(pair, list) or len(pair) != 2:
-            problems.append(f'connections[{i}]: must be a pair ["component.port", '
-                            f'"component.port"], got {quote(pair, 80)}')
+            problems.append(Problem(f'connections[{i}]: must be a pair ["component.port", '
+                                    f'"component.port"], got {quote(pair, 80)}',
+                                    path=f"connections[{i}]"))
             continue
-        refs = []
+        refs, before = [], len(problems)
         for j, ref in enumerate(pair):
             place = f'connections[{i}][{j}] "{_cut(ref)}"' if isinstance(ref, str) else \
                 f"connections[{i}][{j}]"
-            refs.append(_attempt(problems, place, _port, model, ref, broken))
+            refs.append(_attempt(problems, place, _port, model, ref, broken,
+                                 path=f"connections[{i}][{j}]"))
         if all(refs):
-            _attempt(problems, f"connections[{i}]", model.connect, *refs)
+            _attempt(problems, f"connections[{i}]", model.connect, *refs,
+                     path=f"connections[{i}]")
+        # a wire's problem is on the wire (its path), not on the block it names
+        problems[before:] = [Problem(p.message, path=p.path, hint=p.hint)
+                             for p in map(Problem.of, problems[before:])]
 
 
 def _port(model, ref, broken):
@@ -316,25 +343,29 @@ def _port(model, ref, broken):
 def _ports(model, ports, broken, problems):
     """The exposed ports: name -> "component.port"."""
     if not isinstance(ports, dict):
-        problems.append(f"ports: must be an object of \"name\": \"component.port\", got "
-                        f"{_kind(ports)}")
+        problems.append(Problem(f"ports: must be an object of \"name\": \"component.port\","
+                                f" got {_kind(ports)}", path="ports"))
         return
     for name, ref in ports.items():
         place = f'ports.{_cut(name)} "{_cut(ref)}"' if isinstance(ref, str) else \
             f"ports.{_cut(name)}"
-        target = _attempt(problems, place, _port, model, ref, broken)
+        at = f"ports.{_cut(name)}"
+        target = _attempt(problems, place, _port, model, ref, broken, path=at)
         if target is not None:
-            _attempt(problems, f"ports.{_cut(name)}", model.expose, name, target)
+            _attempt(problems, at, model.expose, name, target, path=at)
 
 
 def _simulation(settings, problems):
     """The experiment settings, checked as ``simulate`` will use them."""
     if not isinstance(settings, dict):
-        problems.append(f"simulation: must be an object, got {_kind(settings)}")
+        problems.append(Problem(f"simulation: must be an object, got {_kind(settings)}",
+                                path="simulation"))
         return {}
-    found = [p for p in (check_setting(k, v) for k, v in settings.items()) if p]
+    found = [Problem(p, path=f"simulation.{_cut(str(k))}")
+             for k, v in settings.items() if (p := check_setting(k, v))]
     if not found and "step" in settings and "t_end" in settings:     # what they cost together
-        found = [p for p in [check_steps(settings["t_end"], settings["step"])] if p]
+        found = [Problem(p, path="simulation.step")
+                 for p in [check_steps(settings["t_end"], settings["step"])] if p]
     problems.extend(found)
     return dict(settings)
 
@@ -393,7 +424,7 @@ class Context:
         out = {}
         for name in self.entries:
             model = _attempt(problems, f"definitions.{_cut(name)}", self.definition, name,
-                             f"definitions.{_cut(name)}")
+                             f"definitions.{_cut(name)}", path=f"definitions.{_cut(name)}")
             if model is not None:
                 out[name] = model
         return out
@@ -437,7 +468,9 @@ class Context:
         model = Model(name)
         inner = []
         _body(model, entry, inner, self.inline(name))
-        problems.extend(p if p.startswith(where) else f"{where}.{p}" for p in inner)
+        # an inline definition's paths are in the file too, under it
+        problems.extend((p if p.startswith(where) else p.where(f"{where}.")).under(where)
+                        for p in map(Problem.of, inner))
         if problems:
             raise ModelError(problems)
         return model
@@ -531,18 +564,29 @@ def _repeated(value, where, problems):
             _repeated(item, f"{where}[{j}]", problems)
 
 
-def _attempt(problems, place, fn, *args):
-    """``fn(*args)``, or None with its failure recorded as a problem at ``place``."""
+def _attempt(problems, place, fn, *args, **fields):
+    """``fn(*args)``, or None with its failure recorded as a problem at ``place`` (its unset
+    fields filled from ``fields``: ``path=``, ``parameter=``)."""
+    before = len(problems)
     try:
         return fn(*args)
     except ModelError as exc:
-        problems.extend(p if p.startswith(place) else f"{place}: {p}" for p in exc.problems)
+        problems.extend(p if p.startswith(place) else p.where(f"{place}: ")
+                        for p in exc.problems)
     except Exception as exc:    # noqa: BLE001
         # odd shapes in a file reach code written for well-formed values: a file may be
         # refused, but never crash the loader
         problems.append(f"{place}: cannot be read ({type(exc).__name__}: "
                         f"{_cut(str(exc), QUOTE_LIMIT)})")
+    finally:
+        _fill(problems, before, **fields)
     return None
+
+
+def _fill(problems, before, **fields):
+    """Fill the unset fields of the problems recorded since ``before`` from ``fields``."""
+    if fields:
+        problems[before:] = [Problem.of(p, **fields) for p in problems[before:]]
 
 
 def _int(text):
@@ -563,7 +607,8 @@ def _copy(value):
 
 
 def _at(source, problem):
-    return f"{source}: {problem}" if source else problem
+    """``problem`` (a Problem) as read from file ``source``: its message after the name."""
+    return Problem.of(problem).where(f"{source}: ") if source else Problem.of(problem)
 
 
 def _cut(text, limit=NAME_LIMIT):

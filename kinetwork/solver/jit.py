@@ -53,7 +53,7 @@ import warnings
 
 import casadi as ca
 
-from ..errors import ModelError
+from ..errors import KinetworkWarning, ModelError
 
 #: -O1 runs as fast as -O2/-O3 on CasADi's straight-line code and compiles 30 % sooner
 #: (N = 128 chain: 2.5 s against 3.6 s); -O0 compiles 4x sooner but runs 2.7x slower there
@@ -87,7 +87,7 @@ _WARNED = set()                               # the reasons already warned of in
 _WARNED_LOCK = threading.Lock()               # not _LOCK: a build may hold that for minutes
 
 
-class JitFallbackWarning(UserWarning):
+class JitFallbackWarning(KinetworkWarning):
     """C compilation was not possible: CasADi's virtual machine runs instead (same numbers)."""
 
 

@@ -322,9 +322,16 @@ def test_a_run_gives_what_kn_simulate_gives(client, root):
     for signal in results["signals"]:
         assert signal["unit"] == expected.units[signal["name"]]
         assert tuple(signal["shape"]) == expected[signal["name"]].shape[1:]
+        # the descriptor, so the page never splits names
+        described = expected.signals[signal["name"]]
+        assert (signal["probe"], signal["quantity"], signal["port"]) == \
+            (described.probe, described.quantity, described.target)
         np.testing.assert_allclose(signal["values"], expected[signal["name"]], rtol=0,
                                    atol=1e-12)
     assert results["partial"] is None
+    angle = next(s for s in results["signals"] if s["name"] == "probe1.angle")
+    assert (angle["probe"], angle["quantity"], angle["port"]) == \
+        ("probe1", "angle", "shoulder.axis")
 
 
 def test_results_carry_the_animation_or_null_without_its_module(client, monkeypatch):
