@@ -129,3 +129,19 @@ def test_the_two_plot_renderers_share_one_layout_module():
                           ("kinetwork.quickplot", "kinetwork.plot")):
         targets = {target for _, target in imports(module)}
         assert other not in targets and "kinetwork.plotlayout" in targets
+
+
+def test_components_are_free_of_casadi_at_import():
+    """A component declares; it builds CasADi expressions only when the equations ask (its
+    methods import CasADi): importing every library, building components and reading a model
+    file without validating it load no CasADi (``components/quantities.py`` says so)."""
+    import subprocess
+    import sys
+    seed = PACKAGE.parent / "models" / "double_pendulum.json"
+    program = ("import sys, kinetwork as kn, kinetwork.components, kinetwork.spatial\n"
+               "kn.multibody.Revolute('j', n=[0, 0, 1]); kn.rotational.IdealGear('g', ratio=2)\n"
+               f"kn.load({str(seed)!r}, validate=False)\n"
+               "print('casadi' in sys.modules)\n")
+    done = subprocess.run([sys.executable, "-c", program], capture_output=True, text=True)
+    assert done.returncode == 0, done.stderr[-2000:]
+    assert done.stdout.strip() == "False"

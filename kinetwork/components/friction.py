@@ -20,8 +20,6 @@ Modes of friction: +1 sliding forward (w_rel > 0), -1 sliding backward, 0 stuck 
 ``Forward``, ``Backward``, ``Stuck``). No regularisation: a stuck element is exactly stuck.
 """
 
-import casadi as ca
-
 from .base import ONED, Component, Port
 from .oned import named
 
@@ -41,19 +39,23 @@ class PartialHybrid(Component):
 
     def held(self, mode):
         """1 where the mode holds the flanges together, else 0 (an SX of the mode)."""
+        import casadi as ca
         return ca.SX(0)
 
     def law(self, rel, w_rel, mode, u):
         """The force into flange b when not held."""
+        import casadi as ca
         return ca.SX(0)
 
     def free_mode(self, rel, w_rel):
         """The mode the state itself gives, without events (the equations shown as M, V, G:
         ``equations/modes.py``)."""
+        import casadi as ca
         return ca.SX(0)
 
     def values(self, t, u):
         """Two numbers the events read (a static limit, a restitution), as SX."""
+        import casadi as ca
         return ca.SX(0), ca.SX(0)
 
     def indicator(self, mode, rel, w_rel, force, values, power=None):
@@ -94,14 +96,17 @@ class PartialFriction(PartialHybrid):
         return mode * self.kinetic(u) + self.d * w_rel
 
     def free_mode(self, rel, w_rel):
+        import casadi as ca
         return ca.sign(w_rel)
 
     def values(self, t, u):
+        import casadi as ca
         return self.peak * self.kinetic(u), ca.SX(0)
 
     def indicator(self, mode, rel, w_rel, force, values, power=None):
         # sliding: the speed in the direction of sliding; stuck: the margin to the limit,
         # which holds up to and at the limit itself (MSL: stuck while |f| <= f_static)
+        import casadi as ca
         margin = values[0] * (1 + EDGE) - ca.fabs(force)
         return mode * mode * (mode * w_rel) + (1 - mode * mode) * margin
 
@@ -152,6 +157,7 @@ class PartialNormalForceFriction(PartialFriction):
                           "parameter)", optional=True)
 
     def kinetic(self, u):
+        import casadi as ca
         fn = self.fn_max * (self.f_normalized if u is None else u)
         return self.mu * self.cgeo * ca.fmax(fn, 0)
 
@@ -166,6 +172,7 @@ class PartialElastoGap(PartialHybrid):
     flange_b = Port(ONED, "Flange b")
 
     def law(self, rel, w_rel, mode, u):
+        import casadi as ca
         spring = self.c * (rel - self.rel0)
         reach = ca.fabs(spring)
         return mode * (spring + ca.fmin(ca.fmax(self.d * w_rel, -reach), reach))
@@ -174,6 +181,7 @@ class PartialElastoGap(PartialHybrid):
         return (1 - 2 * mode) * (rel - self.rel0)
 
     def free_mode(self, rel, w_rel):
+        import casadi as ca
         return ca.if_else(rel < self.rel0, 1, 0)
 
     def first_mode(self, ev):
@@ -200,6 +208,7 @@ class PartialStop(PartialHybrid):
 
     def _side(self, rel):
         """+1 nearer the lower limit, -1 nearer the upper."""
+        import casadi as ca
         if self.rel_min is None:
             return ca.SX(-1)
         if self.rel_max is None:
@@ -207,12 +216,14 @@ class PartialStop(PartialHybrid):
         return ca.if_else(rel - self.rel_min <= self.rel_max - rel, 1, -1)
 
     def _gap(self, rel):
+        import casadi as ca
         gaps = [g for g in (None if self.rel_min is None else rel - self.rel_min,
                             None if self.rel_max is None else self.rel_max - rel)
                 if g is not None]
         return gaps[0] if len(gaps) == 1 else ca.fmin(*gaps)
 
     def values(self, t, u):
+        import casadi as ca
         return ca.SX(self.e), ca.SX(self.v_rest)
 
     def indicator(self, mode, rel, w_rel, force, values, power=None):
@@ -248,6 +259,7 @@ class GearModes:
         return 0
 
     def values(self, t, u):
+        import casadi as ca
         return ca.SX(0), ca.SX(0)
 
     def indicator(self, mode, rel, w_rel, force, values, power=None):

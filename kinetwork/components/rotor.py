@@ -21,8 +21,6 @@ of frames near the rotor take the reaction to rest in the world, as for any join
 
 import numbers
 
-import casadi as ca
-
 from ..spatial import unit, vec3
 from .base import REGISTRY, Component, Param, Port, PortRef
 from .loopjoints import Expansion
@@ -49,6 +47,7 @@ class RotorHousing(Component):
               doc="Rotor axis, in frame_a")
 
     def mass_properties(self):
+        import casadi as ca
         e = unit(vec3(self.n))
         return 0.0, ca.DM.zeros(3), -self.J * (e @ e.T)
 
