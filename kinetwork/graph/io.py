@@ -10,16 +10,17 @@ when the whole file is sound.
 from __future__ import annotations
 
 import json
-import math
 import os
 import stat
 from collections.abc import Iterable
 
 from ..components.base import _NAME, NAME_LIMIT, REGISTRY
 from ..errors import ModelError, Problem
-from ..util import QUOTE_LIMIT, hint, quote, suggest
+from ..util import hint, quote, suggest
 from .initial import check_initial
 from .model import Model, model_name_problem, text_problem
+from .reading import (JSONObject, at_source, attempt, cut, fill, plain_copy, read_int,
+                      repeated_keys)
 from .settings import check_setting, check_steps
 from .subsystem import Subsystem
 from .writer import (DEFINITION_KEYS, FORMAT, KEYS, KEYS_V2, VERSION, _kind, _plain, dumps,
@@ -112,9 +113,9 @@ def loads(text: str | bytes, source: str | None = None, validate: bool = True,
         without it a text may not reference files.
     """
     if not isinstance(text, (str, bytes, bytearray)):
-        raise ModelError(_at(source, f"expected JSON text, got {type(text).__name__}"))
+        raise ModelError(at_source(source, f"expected JSON text, got {type(text).__name__}"))
     if len(text) > MAX_FILE_SIZE:
-        raise ModelError(_at(source, f"{len(text)} characters, more than the "
+        raise ModelError(at_source(source, f"{len(text)} characters, more than the "
                                      f"{MAX_FILE_SIZE} a model may have"))
     return model_from_dict(_parse(text, source), source=source, validate=validate,
                            context=Context.top(folder, library))
@@ -124,13 +125,13 @@ def _parse(text, source):
     """The JSON of a model text (keys given twice remembered), or a ModelError saying where
     it stops being JSON."""
     try:
-        return json.loads(text, object_pairs_hook=_Object.from_pairs, parse_int=_int)
+        return json.loads(text, object_pairs_hook=JSONObject.from_pairs, parse_int=read_int)
     except json.JSONDecodeError as exc:
         end = " (the text ends early: truncated?)" if exc.pos >= len(text.rstrip()) else ""
-        raise ModelError(_at(source, f"line {exc.lineno} column {exc.colno}: invalid JSON: "
+        raise ModelError(at_source(source, f"line {exc.lineno} column {exc.colno}: invalid JSON: "
                                      f"{exc.msg}{end}")) from None
     except (ValueError, RecursionError) as exc:
-        raise ModelError(_at(source, f"invalid JSON ({exc})")) from None
+        raise ModelError(at_source(source, f"invalid JSON ({exc})")) from None
 
 
 def model_from_dict(data, source=None, validate=True, context=None):
@@ -150,16 +151,16 @@ def model_from_dict(data, source=None, validate=True, context=None):
     """
     problems = []
     context = context or Context.top(None, None)
-    model = _attempt(problems, "top level", _build, data, problems, context)
+    model = attempt(problems, "top level", _build, data, problems, context)
     if problems:
-        raise ModelError([_at(source, p) for p in problems])
+        raise ModelError([at_source(source, p) for p in problems])
     if validate:
         try:
             # a definition (a model with exposed ports) is wired where it is placed: alone,
             # only its values are checked
             model.numeric_values() if model.exposed else model.validate()
         except ModelError as exc:
-            raise ModelError([_at(source, p) for p in exc.problems]) from None
+            raise ModelError([at_source(source, p) for p in exc.problems]) from None
     return model
 
 
@@ -167,12 +168,12 @@ def _build(data, problems, context):
     if not isinstance(data, dict):
         problems.append(f"top level: must be an object {{...}}, got {_kind(data)}")
         return None
-    _repeated(data, "", problems)
+    repeated_keys(data, "", problems)
     fmt, version = data.get("format", FORMAT), data.get("version", VERSION)
     keys = KEYS_V2 if version == 2 else KEYS
     problems.extend(Problem(f"{quote(key)}: unknown key{close}; keys are {', '.join(keys)}"
                             + (" (ports and definitions need version 2)"
-                               if key in KEYS_V2 else ""), path=_cut(str(key)),
+                               if key in KEYS_V2 else ""), path=cut(str(key)),
                             hint=hint(close))
                     for key in data if key not in keys for close in [suggest(key, keys)])
     problems.extend(Problem(f"{key}: required key missing", path=key)
@@ -193,7 +194,7 @@ def _build(data, problems, context):
         problems.append(Problem(f"name: {problem}", path="name"))
         name = "unnamed"
     model = Model(name)
-    context = context.file(_attempt(problems, "definitions", _entries,
+    context = context.file(attempt(problems, "definitions", _entries,
                                     data.get("definitions", {}), path="definitions") or {})
     model.definitions = context.build_all(problems)
     _body(model, data, problems, context)
@@ -227,16 +228,16 @@ def _body(model, data, problems, context):
                                         f"starting with a digit; at most {NAME_LIMIT} "
                                         f"characters)", path="parameters"))
             else:
-                _attempt(problems, "parameters", model.set_parameter, key, value,
+                attempt(problems, "parameters", model.set_parameter, key, value,
                          path=f"parameters.{key}", parameter=key)
     broken = (_components(model, data["components"], problems, context)
               if "components" in data else {UNNAMED})
     _connections(model, data.get("connections", []), broken, problems)
     _ports(model, data.get("ports", {}), broken, problems)
     before = len(problems)
-    model.layout = _attempt(problems, "layout", _layout, model, data.get("layout", {}),
+    model.layout = attempt(problems, "layout", _layout, model, data.get("layout", {}),
                             broken, problems)
-    _fill(problems, before, path="layout")
+    fill(problems, before, path="layout")
 
 
 def _components(model, entries, problems, context):
@@ -248,22 +249,22 @@ def _components(model, entries, problems, context):
     broken, seen = set(), {}
     for i, entry in enumerate(entries):
         name = entry.get("name") if isinstance(entry, dict) else None
-        place = f'components[{i}] "{_cut(name)}"' if isinstance(name, str) else \
+        place = f'components[{i}] "{cut(name)}"' if isinstance(name, str) else \
             f"components[{i}]"
         at = {"path": f"components[{i}]",
-              "component": _cut(name) if isinstance(name, str) else None}
+              "component": cut(name) if isinstance(name, str) else None}
         if isinstance(name, str) and name in seen:
             problems.append(Problem(f"{place}: duplicate name, already used by "
                                     f"components[{seen[name]}]", **at))
             continue
         before = len(problems)
-        comp = _attempt(problems, place, _component, entry, place, problems, context)
+        comp = attempt(problems, place, _component, entry, place, problems, context)
         if isinstance(name, str):
             seen[name] = i
         if comp is None or len(problems) > before:
             broken.add(name if isinstance(name, str) else UNNAMED)
         else:
-            _attempt(problems, place, model.add, comp)
+            attempt(problems, place, model.add, comp)
             model.places[comp.name] = context.where + place
             model.paths[comp.name] = at["path"]
         # a parameter's problem is at its own key, the others at the entry
@@ -290,7 +291,7 @@ def _component(entry, place, problems, context):
     if not isinstance(params, dict):
         problems.append(f"{place} params: must be an object, got {_kind(params)}")
         return None
-    where = (lambda key: f"{place} params.{_cut(key)}")
+    where = (lambda key: f"{place} params.{cut(key)}")
     if isinstance(kind, str) and kind not in REGISTRY and _NAME.fullmatch(kind):
         definition = context.definition(kind, place)      # a subsystem
         return Subsystem.from_params(entry["name"], params, place=where, model=definition)
@@ -316,12 +317,12 @@ def _connections(model, pairs, broken, problems):
             continue
         refs, before = [], len(problems)
         for j, ref in enumerate(pair):
-            place = f'connections[{i}][{j}] "{_cut(ref)}"' if isinstance(ref, str) else \
+            place = f'connections[{i}][{j}] "{cut(ref)}"' if isinstance(ref, str) else \
                 f"connections[{i}][{j}]"
-            refs.append(_attempt(problems, place, _port, model, ref, broken,
+            refs.append(attempt(problems, place, _port, model, ref, broken,
                                  path=f"connections[{i}][{j}]"))
         if all(refs):
-            _attempt(problems, f"connections[{i}]", model.connect, *refs,
+            attempt(problems, f"connections[{i}]", model.connect, *refs,
                      path=f"connections[{i}]")
         # a wire's problem is on the wire (its path), not on the block it names
         problems[before:] = [Problem(p.message, path=p.path, hint=p.hint)
@@ -347,12 +348,12 @@ def _ports(model, ports, broken, problems):
                                 f" got {_kind(ports)}", path="ports"))
         return
     for name, ref in ports.items():
-        place = f'ports.{_cut(name)} "{_cut(ref)}"' if isinstance(ref, str) else \
-            f"ports.{_cut(name)}"
-        at = f"ports.{_cut(name)}"
-        target = _attempt(problems, place, _port, model, ref, broken, path=at)
+        place = f'ports.{cut(name)} "{cut(ref)}"' if isinstance(ref, str) else \
+            f"ports.{cut(name)}"
+        at = f"ports.{cut(name)}"
+        target = attempt(problems, place, _port, model, ref, broken, path=at)
         if target is not None:
-            _attempt(problems, at, model.expose, name, target, path=at)
+            attempt(problems, at, model.expose, name, target, path=at)
 
 
 def _simulation(settings, problems):
@@ -361,7 +362,7 @@ def _simulation(settings, problems):
         problems.append(Problem(f"simulation: must be an object, got {_kind(settings)}",
                                 path="simulation"))
         return {}
-    found = [Problem(p, path=f"simulation.{_cut(str(k))}")
+    found = [Problem(p, path=f"simulation.{cut(str(k))}")
              for k, v in settings.items() if (p := check_setting(k, v))]
     if not found and "step" in settings and "t_end" in settings:     # what they cost together
         found = [Problem(p, path="simulation.step")
@@ -377,10 +378,10 @@ def _layout(model, layout, broken, problems):
         return {}
     for key, value in layout.items():
         if key not in model.components and key not in broken and UNNAMED not in broken:
-            problems.append(f"layout.{_cut(key)}: no component {quote(key)}"
+            problems.append(f"layout.{cut(key)}: no component {quote(key)}"
                             f"{suggest(key, model.components)}")
-        _plain(value, f"layout.{_cut(key)}", problems)
-    return _copy(layout)
+        _plain(value, f"layout.{cut(key)}", problems)
+    return plain_copy(layout)
 
 
 # -- subsystem definitions ---------------------------------------------------------------------
@@ -423,8 +424,8 @@ class Context:
         """Every definition of the file (a file keeps those no component uses yet)."""
         out = {}
         for name in self.entries:
-            model = _attempt(problems, f"definitions.{_cut(name)}", self.definition, name,
-                             f"definitions.{_cut(name)}", path=f"definitions.{_cut(name)}")
+            model = attempt(problems, f"definitions.{cut(name)}", self.definition, name,
+                             f"definitions.{cut(name)}", path=f"definitions.{cut(name)}")
             if model is not None:
                 out[name] = model
         return out
@@ -451,7 +452,7 @@ class Context:
         return model
 
     def _entry(self, name, entry):
-        where = f"definitions.{_cut(name)}"
+        where = f"definitions.{cut(name)}"
         if isinstance(entry, dict) and "file" in entry:
             extra = [k for k in entry if k != "file"]
             if extra:
@@ -489,7 +490,7 @@ class Context:
 
     def _file(self, name, ref, root, kind, folder=None):
         """Read the definition file ``ref`` (relative to the file being read)."""
-        where = f"definitions.{_cut(name)}" if kind == "file" else f"{name}.json"
+        where = f"definitions.{cut(name)}" if kind == "file" else f"{name}.json"
         if not isinstance(ref, str) or not ref:
             raise ModelError(f"{where}: file must be a relative path, got {quote(ref)}")
         if "://" in ref or ref.startswith(("/", "\\")) or os.path.isabs(ref) or \
@@ -536,85 +537,3 @@ def _entries(definitions):
     if problems:
         raise ModelError(problems)
     return dict(definitions)
-
-
-# -- helpers ----------------------------------------------------------------------------------
-class _Object(dict):
-    """A parsed JSON object that remembers keys given twice (``json`` keeps the last)."""
-
-    @classmethod
-    def from_pairs(cls, pairs):
-        obj = cls()
-        obj.repeated = []
-        for key, value in pairs:
-            if key in obj:
-                obj.repeated.append(key)
-            obj[key] = value
-        return obj
-
-
-def _repeated(value, where, problems):
-    if isinstance(value, dict):
-        problems.extend(f"{where or 'top level'}: key {quote(key)} appears more than once"
-                        for key in getattr(value, "repeated", ()))
-        for key, item in value.items():
-            _repeated(item, f"{where}.{_cut(key)}" if where else _cut(key), problems)
-    elif isinstance(value, list):
-        for j, item in enumerate(value):
-            _repeated(item, f"{where}[{j}]", problems)
-
-
-def _attempt(problems, place, fn, *args, **fields):
-    """``fn(*args)``, or None with its failure recorded as a problem at ``place`` (its unset
-    fields filled from ``fields``: ``path=``, ``parameter=``)."""
-    before = len(problems)
-    try:
-        return fn(*args)
-    except ModelError as exc:
-        problems.extend(p if p.startswith(place) else p.where(f"{place}: ")
-                        for p in exc.problems)
-    except Exception as exc:    # noqa: BLE001
-        # odd shapes in a file reach code written for well-formed values: a file may be
-        # refused, but never crash the loader
-        problems.append(f"{place}: cannot be read ({type(exc).__name__}: "
-                        f"{_cut(str(exc), QUOTE_LIMIT)})")
-    finally:
-        _fill(problems, before, **fields)
-    return None
-
-
-def _fill(problems, before, **fields):
-    """Fill the unset fields of the problems recorded since ``before`` from ``fields``."""
-    if fields:
-        problems[before:] = [Problem.of(p, **fields) for p in problems[before:]]
-
-
-def _int(text):
-    # an integer beyond float range would overflow in later bounds checks: read it as the
-    # infinity it amounts to, then refused as non-finite at its place
-    try:
-        value = int(text)
-        float(value)
-        return value
-    except (ValueError, OverflowError):
-        return -math.inf if text.startswith("-") else math.inf
-
-
-def _copy(value):
-    # plain dicts and lists in the model, not the parser's _Object
-    return ({k: _copy(v) for k, v in value.items()} if isinstance(value, dict) else
-            [_copy(v) for v in value] if isinstance(value, list) else value)
-
-
-def _at(source, problem):
-    """``problem`` (a Problem) as read from file ``source``: its message after the name."""
-    return Problem.of(problem).where(f"{source}: ") if source else Problem.of(problem)
-
-
-def _cut(text, limit=NAME_LIMIT):
-    """Text from the file for a message's place: as it is when short, else cut; characters
-    that do not print (a newline, a lone surrogate) escaped as in Python."""
-    text = text if len(text) <= limit else text[:limit - 3] + "..."
-    return "".join(c if c.isprintable() else repr(c)[1:-1] for c in text)
-
-
