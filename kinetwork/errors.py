@@ -116,9 +116,6 @@ class ModelError(ValueError):
                 f"  - {p.message}" for p in self.problems)
         super().__init__(message)
 
-    def __reduce__(self):
-        return (type(self), (self.problems,))
-
 
 class SimulationError(RuntimeError):
     """A failed integration; ``results`` holds what was computed up to ``t_reached``."""
