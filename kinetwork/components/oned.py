@@ -9,6 +9,7 @@ into the component, as in Modelica.
 
 import math
 
+from ..errors import ModelError
 from .base import ONED, Component, Port
 from .quantities import QUANTITIES
 
@@ -33,17 +34,36 @@ def _unit(domain, which):
     return None if quantity is None else QUANTITIES[domain][quantity].unit
 
 
-def named(template, doc):
-    """A role of a partial's law (``rel0``): the value of the parameter the library names
-    ``template`` with its symbols ("{position}_rel0": phi_rel0 in rotational, s_rel0 in
-    translational). Read-only: a parameter is set by its own name."""
-    def read(self):
-        return getattr(self, parameter_name(self, template))
-    return property(read, doc=f"{doc} (the parameter {template})")
+class named:
+    """A role of a partial's law (``rel0``): the parameter the library names ``template``
+    with its symbols ("{position}_rel0": phi_rel0 in rotational, s_rel0 in translational).
+    On an instance it reads that parameter's value; on a library's class it is that
+    parameter's declaration (``Inertia.position0.name == "phi0"``). Read-only: a parameter is
+    set by its own name."""
+
+    def __init__(self, template, doc):
+        self.template, self.__doc__ = template, f"{doc} (the parameter {template})"
+        self.role = None
+
+    def __set_name__(self, owner, name):
+        self.role = name
+
+    def __get__(self, instance, owner):
+        if instance is None:
+            if getattr(owner, "domain", None) not in SYMBOLS:
+                return self                         # a partial, before a library names it
+            return owner.params[parameter_name(owner, self.template)]
+        return getattr(instance, parameter_name(instance, self.template))
+
+    def __set__(self, instance, value):
+        key = parameter_name(instance, self.template)
+        raise ModelError(f"{instance.name}.{self.role} is {instance.name}.{key}: set it by "
+                         f"that name", component=instance.name, parameter=key)
 
 
 def parameter_name(comp, template):
-    """The name of the parameter ``template`` ("{position}0") in ``comp``'s library."""
+    """The name of the parameter ``template`` ("{position}0") in the library of ``comp`` (a
+    component or its class)."""
     return template.format(**SYMBOLS[comp.domain])
 
 #: Modelica's second-order Bessel filter of a position source (Rotational.Sources.Position):
@@ -185,7 +205,9 @@ class PartialMotion(Component):
     its expression and of the signal blocks feeding it); otherwise it is filtered, with the
     filter's states giving the position, speed and acceleration: Modelica's second-order
     Bessel filter of cut-off ``f_crit`` for a position, first-order for a speed. The
-    reaction, through the optional support, rests in the world.
+    reaction, through the optional support, rests in the world; wired to a free rotor (an
+    inertia), the support takes it and the motion is relative to the rotor (MSL's
+    useSupport).
     """
     role = "prescribed"
     derivative = 0
