@@ -143,7 +143,8 @@ class PartialFixed(Component):
 
 
 class PartialRigid(Component):
-    """A rigid 1-D element: its two flanges move together, position(a) = ratio * position(b).
+    """A rigid 1-D element: its two flanges move together,
+    position(a) = ratio * (position(b) - length).
 
     Rigid elements join connection sets into rigid groups that share one coordinate
     (``kinetwork.graph.topology``); an inertia adds ``inertia()`` to its group.
@@ -156,6 +157,10 @@ class PartialRigid(Component):
     def position_ratio(self):
         """position(flange_a) / position(flange_b)."""
         return 1.0
+
+    def length(self):
+        """position(flange_b) - position(flange_a) / ratio: a translational Mass's L."""
+        return 0.0
 
     def inertia(self):
         return 0.0
