@@ -19,8 +19,9 @@ package.
 
 import importlib
 
-from .errors import (AssemblyBranchWarning, IdealisedInertiaWarning, KinetworkWarning,
-                     ModelError, Problem, SimulationError)
+from .errors import (AssemblyBranchWarning, IdealisedInertiaWarning,
+                     KinetworkDeprecationWarning, KinetworkWarning, ModelError, Problem,
+                     SimulationError)
 
 __version__ = "0.1.0"
 
@@ -58,8 +59,8 @@ _LAZY = {
     "uniform": ("analysis.sweep", "uniform"),
 }
 
-__all__ = ["AssemblyBranchWarning", "IdealisedInertiaWarning", "KinetworkWarning", "ModelError",
-           "Problem", "SimulationError", *_LAZY]
+__all__ = ["AssemblyBranchWarning", "IdealisedInertiaWarning", "KinetworkDeprecationWarning",
+           "KinetworkWarning", "ModelError", "Problem", "SimulationError", *_LAZY]
 
 
 def __getattr__(name):

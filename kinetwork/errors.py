@@ -152,3 +152,9 @@ class AssemblyBranchWarning(KinetworkWarning):
     (the pistons of MSL's EngineV6 below the crankshaft, with the default guesses): the
     model simulates that assembly; the warning names the loop, its joints and where they
     start, so that guesses (q0_guess) can pick the one meant."""
+
+
+class KinetworkDeprecationWarning(KinetworkWarning, DeprecationWarning):
+    """A name kinetwork still accepts for a release (``kinetwork.simulation``, now
+    ``kinetwork.solver``): a DeprecationWarning, filtered as Python filters those, carrying
+    its Problem like every kinetwork warning."""
