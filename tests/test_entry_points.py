@@ -83,6 +83,23 @@ import kinetwork as kn
 lin = kn.linearize(SEED_MODEL(), outputs=["probe1.angle"])
 assert lin.A.shape == (4, 4)
 """,
+    "sensitivity": """
+import kinetwork as kn
+sens = kn.sensitivity(SEED_MODEL(), ["c"], t_end=0.1, n_points=3, outputs=["probe1.angle"])
+assert sens.S.shape == (3, 1, 1)
+""",
+    "modes": """
+import kinetwork as kn
+assert len(kn.modes(SEED_MODEL())) == 2
+""",
+    "cli run": """
+import os, subprocess, sys
+done = subprocess.run([sys.executable, "-m", "kinetwork", "run", SEED, "--t-end", "0.1",
+                       "--n-points", "3", "--out", "out.csv", "--quiet"],
+                      capture_output=True, text=True)
+assert done.returncode == 0, done.stderr
+assert open("out.csv").readline().startswith("t,")
+""",
     "plot module": """
 import kinetwork as kn
 res = kn.simulate(SEED_MODEL(), t_end=0.1, n_points=11)
