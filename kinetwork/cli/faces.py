@@ -55,6 +55,8 @@ def add(sub):
     parser.add_argument("--probes", action="store_true", help="a probe on every joint")
     parser.add_argument("--floating", action="store_true",
                         help="a free-floating base (default: the root link fixed to the ground)")
+    parser.add_argument("--no-limits", action="store_true",
+                        help="leave the joints' position limits out (default: hard end stops)")
     parser.add_argument("--gravity", type=float, nargs=3, metavar=("GX", "GY", "GZ"),
                         default=None, help="gravity of the ground (default 0 0 -9.81)")
     add_sweep(sub)

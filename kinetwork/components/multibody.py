@@ -9,7 +9,7 @@ and rotor (``rotor.py``) are declared in modules of their own and are part of it
 
 from ..spatial import (cardan_quat, eye3, quat_rate, quat_rotation, rotation, unit, vec3,
                        zero3)
-from .base import COORDINATES, RATES, Component, Param, Port
+from .base import COORDINATES, RATES, Component, Param, Port, library_attribute
 from .frames import PartialRigidTransform
 
 MB = "multibody"
@@ -389,3 +389,5 @@ from .loopjoints import JointRRR, SphericalSpherical, UniversalSpherical  # noqa
 from .forces import (Damper, Force, ForceAndTorque, LineForceWithTwoMasses,  # noqa: E402,F401
                      Spring, SpringDamper, Torque, WorldForce, WorldTorque)
 from .rotor import Rotor1D  # noqa: E402,F401
+
+__getattr__ = library_attribute("multibody")
