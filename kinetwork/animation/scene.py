@@ -310,7 +310,7 @@ class Scene:
                 dict(_axes(k, self.L / 6), component=None)]
 
     # what each kind of component looks like
-    def joint(self, comp, v, axis="axis"):
+    def joint(self, comp, v, axis="n"):
         n = unit_vector(_get(v, axis, _Z))
         length, width = self.L / 10, self.L / 20
         return [_shape("cylinder", self.frame(comp, "frame_a"), -n * length / 2, n, length,
@@ -332,7 +332,7 @@ class Scene:
         return [e for e in ends if e is not None] + rod
 
     def prismatic(self, comp, v):
-        n = unit_vector(_get(v, "axis", _X))
+        n = unit_vector(_get(v, "n", _X))
         name = f"{comp.name}.q"
         q = self.results[name] if name in self.results else np.zeros(1)
         lo, hi = min(q.min(), 0.0), max(q.max(), 0.0)
@@ -459,7 +459,7 @@ def _color(value, default):
 #: type name -> how it looks; a subclass looks like its nearest registered ancestor
 VISUALS = {
     "multibody.Revolute": Scene.joint,
-    "multibody.Cylindrical": Scene.joint,
+    "multibody.Cylindrical": lambda s, c, v: s.joint(c, v, axis="axis"),
     "multibody.Prismatic": Scene.prismatic,
     "multibody.Spherical": Scene.ball,
     "multibody.Universal": Scene.ball,

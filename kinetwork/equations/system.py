@@ -132,7 +132,13 @@ class System:
         raise ModelError(f"the mass matrix is singular at the initial state: "
                          f"{', '.join(joints)} move(s) no mass or inertia in the direction of "
                          f"{', '.join(involved)} (give the bodies they carry mass or inertia, "
-                         f"or lock the joint)")
+                         f"or lock the joint)", **self._fields_of(joints[0]))
+
+    def _fields_of(self, name):
+        """The fields of a Problem about component ``name`` of the model (none if it is no
+        component of it)."""
+        comp = self.model.components.get(name)
+        return {} if comp is None else self.model.fields(comp)
 
     def polish(self, X, p, t=None):
         """Full states X (n_points, n_states + n_algebraic) with the algebraic variables

@@ -59,7 +59,7 @@ import warnings
 
 import casadi as ca
 
-from ..errors import ModelError
+from ..errors import KinetworkWarning, ModelError
 from . import jit_source, jit_tiers
 from .jit_build import (BUILD_PREFIX, Unavailable as _Unavailable, build, cores as _cores,
                         os_error as _os_error, record as _record, sha256 as _sha256,
@@ -97,7 +97,7 @@ _WARNED_LOCK = threading.Lock()               # not _LOCK: a build may hold that
 _PENDING = {}                                 # quick library -> jit_tiers.Pending
 
 
-class JitFallbackWarning(UserWarning):
+class JitFallbackWarning(KinetworkWarning):
     """C compilation was not possible: CasADi's virtual machine runs instead (same numbers)."""
 
 

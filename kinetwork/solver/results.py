@@ -15,6 +15,7 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
+from ..upcalls import upcall
 from ..util import atomic_write, suggest
 
 if TYPE_CHECKING:                     # annotations only
@@ -213,9 +214,9 @@ class Results:
         table = ("<table><thead><tr><th>signal</th><th>unit</th><th>at the end</th></tr>"
                  f"</thead><tbody>{''.join(rows)}</tbody></table>") if rows else ""
         figure = ""
-        if self.signals and _plotter is not None and len(self.t) > 1:
+        if self.signals and len(self.t) > 1:
             try:
-                figure = _svg(_plotter(self, _detached=True))
+                figure = _svg(upcall("plot")(self, _detached=True))
             except Exception as exc:        # a display must never raise in a notebook
                 figure = f"<p>(no plot: {html.escape(str(exc))})</p>"
         return f"<div class='kinetwork-results'><p>{text}</p>{table}{figure}</div>"
@@ -224,17 +225,13 @@ class Results:
         """Probe plots (a matplotlib Figure): every probe, or the probes and signals named
         (``res.plot("probe1.angle", "probe2")``); options as ``kinetwork.plot.plot_results``
         (``title``, ``hide_flat``, ``columns``, ...)."""
-        if _plotter is None:
-            raise RuntimeError("no plotter installed: import kinetwork")
-        return _plotter(self, *names, **kwargs)
+        return upcall("plot")(self, *names, **kwargs)
 
     def animate(self, path: str | os.PathLike | None = None, **kwargs: Any) -> Any:
         """3-D animation of the run: a self-contained HTML page at ``path`` (the three.js
         player inlined, opens without a network) and ``gif=``/``mp4=`` videos; returns the
         Animation (see ``kinetwork.animation.animate`` for the options)."""
-        if _animator is None:
-            raise RuntimeError("no animator installed: import kinetwork")
-        return _animator(self, path, **kwargs)
+        return upcall("animate")(self, path, **kwargs)
 
     def __repr__(self):
         return (f"<Results {len(self.t)} points, t = {self.t[0]:g} .. {self.t[-1]:g}, "
@@ -257,25 +254,3 @@ def _svg(fig):
     fig.savefig(buffer, format="svg")
     text = buffer.getvalue()
     return text[text.index("<svg"):]
-
-
-#: what draws ``Results.plot``: installed by ``kinetwork.plot`` when it is imported (the plot
-#: is a face over the results, a layer above them)
-_plotter = None
-
-
-def install_plotter(plot):
-    """Set the function ``plot(results, probes=None, **kwargs)`` -> Figure of
-    ``Results.plot``."""
-    global _plotter
-    _plotter = plot
-
-
-#: what draws ``Results.animate``: installed by ``kinetwork.animation`` when it is imported
-_animator = None
-
-
-def install_animator(animate):
-    """Set the function ``animate(results, path=None, **kwargs)`` of ``Results.animate``."""
-    global _animator
-    _animator = animate

@@ -268,6 +268,10 @@ def test_default_guesses_that_assemble_a_piston_outside_its_cylinder_are_warned(
     assert float(s5) == pytest.approx(0.189722, abs=1e-6)
     x0 = dict(zip(system.state_names, system.x0))
     assert x0["cyl5_cylinder.q"] == pytest.approx(0.550278, abs=1e-6)
+    # its place as data: the joint whose guess picks the branch
+    problem = caught[0].message.problem
+    assert (problem.component, problem.parameter, problem.severity) == \
+        ("cyl5_cylinder", "q0_guess", "warning")
     import warnings
     with warnings.catch_warnings():
         warnings.simplefilter("error")
