@@ -89,7 +89,7 @@ class _HelpFormatter(argparse.HelpFormatter):
 def build_parser():
     """The argument parser of the ``kinetwork`` command."""
     from .analysis import commands as analysis_commands
-    from .analysis.sweep import add_command as add_sweep
+    from .analysis.sweep_cli import add_command as add_sweep
     from .solver.methods import METHODS
 
     parser = argparse.ArgumentParser(
@@ -316,7 +316,7 @@ def _fit(args):
 
 
 def _sweep(args):
-    from .analysis.sweep import run_command
+    from .analysis.sweep_cli import run_command
     return run_command(args, _load(args.model, args.library))
 
 

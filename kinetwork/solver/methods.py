@@ -152,6 +152,14 @@ class _CasadiRun:
         """An integrator over ``times`` in the time since ``self.t``: on an output grid of
         equal intervals, the same one for every chunk of as many intervals (unless
         ``exact``: times an event is looked for at, which must not be rounded to the grid)."""
+        key, build = self.recipe(times, opts, exact)
+        if self.method.plugin == "idas":    # its options hold the state's rate: not reusable
+            return build()
+        return self.run.compiled.integrator(key, build)
+
+    def recipe(self, times, opts, exact=False):
+        """(the key its System keeps it by, the function that builds it) of ``integrator``:
+        a batch of members maps the very integrator a run builds (``batch.py``)."""
         m, run = self.method, self.run
         dae = run.compiled.dae(run.jit, m.newton)
         n = len(times)
@@ -163,10 +171,7 @@ class _CasadiRun:
             grid = tuple((np.asarray(times, dtype=float) - self.t).tolist())
             taus = lambda: list(grid)  # noqa: E731
         key = ("integrator", m.plugin, grid, tuple(sorted(opts.items())), bool(run.jit))
-        build = lambda: ca.integrator("simulate", m.plugin, dae, 0.0, taus(), opts)  # noqa: E731
-        if m.plugin == "idas":          # its options hold the state's rate: not reusable
-            return build()
-        return run.compiled.integrator(key, build)
+        return key, lambda: ca.integrator("simulate", m.plugin, dae, 0.0, taus(), opts)
 
     def advance(self, times, exact=False):
         m, run = self.method, self.run

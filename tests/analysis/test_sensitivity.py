@@ -68,5 +68,5 @@ def test_a_loop_starts_where_the_values_asked_put_it():
 
 
 def test_unknown_parameters_are_refused():
-    with pytest.raises(kn.ModelError, match="'cc' is not a model parameter.*'c'"):
+    with pytest.raises(kn.ModelError, match="'cc' is no model parameter.*'c'"):
         kn.sensitivity(double_pendulum(), ["cc"], t_end=1.0)
