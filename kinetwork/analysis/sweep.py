@@ -20,6 +20,7 @@ import time
 import numpy as np
 
 from ..errors import ModelError
+from ..graph.settings import MAX_OUTPUT_BYTES
 from ..solver.batch import Members, run_members
 from ..solver.plan import Plan
 from . import sweep_dask
@@ -170,6 +171,7 @@ def _run(plan, names, values, layout, params, outputs, workers, batch, scheduler
             (os.cpu_count() or 1)
     job = Job(plan, names, params, outputs)
     n = len(values)
+    _check_size(n, len(plan.grid), job.keep)
     out = Members(plan, n, job.keep)
     report = _progress(progress, n)
     started = time.perf_counter()
@@ -192,6 +194,18 @@ def _run(plan, names, values, layout, params, outputs, workers, batch, scheduler
         "interrupted": int(interrupted), "seconds": time.perf_counter() - started,
         "scheduler": _scheduler_name(scheduler),
         "workers": workers if scheduler is None else 0, "batch": batch or 0})
+
+
+def _check_size(members, points, keep):
+    """Refuse, before any member runs, a sweep whose results would not fit the memory a run
+    may keep (``graph.settings.MAX_OUTPUT_BYTES``)."""
+    need = 8 * members * points * (keep.n_states + keep.n_columns)
+    if need > MAX_OUTPUT_BYTES:
+        raise ModelError(f"sweep: {members} members of {points} points of "
+                         f"{keep.n_states + keep.n_columns} values would need "
+                         f"{need / 2**30:.1f} GiB, more than the "
+                         f"{MAX_OUTPUT_BYTES / 2**30:.0f} GiB a sweep may keep: keep fewer "
+                         f"signals (outputs=[...]), fewer points (n_points) or fewer members")
 
 
 def _local(job, values, out, workers, batch, stop, report):

@@ -26,6 +26,7 @@ import math
 import casadi as ca
 import numpy as np
 
+from ..equations.system import mapped
 from ..errors import ModelError, SimulationError
 from ..expr import parse
 from ..graph.model import evaluate
@@ -271,7 +272,7 @@ def _method(plan, template, p, x0):
     if plan.key != "auto":
         return plan.key
     template.p, template.x0 = p, x0
-    names, _ = plan.methods(template)
+    names, _ = plan.methods(template, keep=False)
     method = METHODS[names[0]]
     return names[0] if getattr(method, "plugin", None) in MAPPED else None
 
@@ -349,11 +350,31 @@ def _mapped(plan, template, key, call, out, workers, stop):
             return False
         X[:, k + 1:k + 1 + len(times)] = rows
         k += len(times)
-    f_out = compiled(system).outputs(template.jit)
-    for (i, p, _), states in zip(call, X):
-        Y = system.outputs_p(grid, states, p, f_out) if out.keep.n_columns else None
-        out.store(i, states, Y, key, float(grid[-1]))
+    Y = _outputs(system, compiled(system).outputs(template.jit), grid, X, P) \
+        if out.keep.n_columns else [None] * b
+    for (i, _, _), states, signals in zip(call, X, Y):
+        out.store(i, states, signals, key, float(grid[-1]))
     return True
+
+
+def _outputs(system, f_out, grid, X, P):
+    """The probe signals (b, n_t, n_signals) of a call's members, states X (b, n_t, nx), in
+    one evaluation of the output function mapped over every member and time, read through
+    ``Function.buffer`` (a DM's conversion to numpy costs more than the evaluation)."""
+    b, m, nx = X.shape
+    n = b * m
+    f = mapped(f_out, n)
+    # column-major (rows, n) blocks are C-ordered (n, rows) arrays
+    t = np.tile(grid, b)
+    x = np.ascontiguousarray(X.reshape(n, nx))
+    p = np.ascontiguousarray(np.repeat(P, m, axis=0))
+    y = np.empty((n, f.size1_out(0)))
+    buffer, evaluate_ = f.buffer()
+    for k, value in enumerate((t, x, p)):
+        buffer.set_arg(k, memoryview(value.ravel()))
+    buffer.set_res(0, memoryview(y.ravel()))
+    evaluate_()
+    return y.reshape(b, m, -1)
 
 
 def _one_by_one(plan, members, out, stop, done, params):

@@ -452,7 +452,7 @@ def stiffness(rhs, t_start, t_end, x0):
     return stiff, sigma, omega
 
 
-def choose(run):
+def choose(run, keep=True):
     """What ``auto`` runs: (method names to try in order, why). IDAS for models with
     algebraic variables (loops compiled with ``loops="partition"``, massless junctions); else
     Adams (loops too: their default formulation is the projected ODE) unless the stiffness
@@ -461,6 +461,9 @@ def choose(run):
     A model without damping (generalized forces independent of the speeds) is conservative
     up to its time-dependent drives: its eigenvalues come in ±λ pairs and it is never stiff by
     the test, so the test (an eigenvalue problem of 2n x 2n) is not run.
+
+    ``keep``: the answer is kept per start, horizon and parameter values (a model run again
+    asks the same); a sweep's members, each asking once, do not fill that table.
     """
     system = run.system
     if system.n_algebraic:
@@ -473,7 +476,7 @@ def choose(run):
         # once per start, horizon and parameter values: a model run again asks the same
         key = ("stiffness", float(run.t_start), float(run.t_end),
                np.asarray(run.x0, float).tobytes(), np.asarray(run.p, float).tobytes())
-        stiff, sigma, omega = run.compiled.memo(key, test)
+        stiff, sigma, omega = run.compiled.memo(key, test) if keep else test()
         why.update(stiff=bool(stiff), decay_rate=sigma, motion_rate=omega)
     return (["cvodes"] if why["stiff"] else ["cvodes-adams", "cvodes"]), why
 

@@ -156,11 +156,12 @@ class Plan:
         _check_finite_start(system, self.t_start, x0, p)
         return x0
 
-    def methods(self, run):
-        """The methods a run tries in order, and why (``auto``: the stiffness test)."""
+    def methods(self, run, keep=True):
+        """The methods a run tries in order, and why (``auto``: the stiffness test, its
+        answer kept for the next run of the same parameters unless not ``keep``)."""
         if self.key != "auto":
             return [self.key], {}
-        return choose(run)
+        return choose(run, keep)
 
     # -- one run ------------------------------------------------------------------------------
     def new_run(self, p, x0, cancel=None, progress=None):

@@ -354,6 +354,9 @@ def test_bad_input_is_refused_by_name():
         kn.sweep(model, {"c": [1.0]}, scheduler="nowhere", **FAST)
     with pytest.raises(kn.ModelError, match="'c' is varied already"):
         kn.sweep(model, {"c": [1.0]}, params={"c": 2.0}, **FAST)
+    with pytest.raises(kn.ModelError, match=r"would need .* GiB.*outputs=\[\.\.\.\]"):
+        kn.sweep(model, {"c": np.ones(10**4).tolist()}, t_end=1.0, n_points=10**5,
+                 jit=False, progress=False)
 
 
 def test_command_line_sweep_writes_netcdf(seed_file, tmp_path, capsys):
