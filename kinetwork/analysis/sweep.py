@@ -21,12 +21,15 @@ import numpy as np
 
 from ..errors import ModelError
 from ..graph.settings import MAX_OUTPUT_BYTES
-from ..solver.batch import Members, run_members
+from ..solver.batch import MAX_BATCH, Members, run_members
 from ..solver.plan import Plan
 from . import sweep_dask
 from .distributions import Distribution, draw, normal, real, uniform
 from .sweep_job import Job, prepare
 from .sweep_results import dataset, param_unit, summary, to_netcdf
+
+#: members prepared (parameters checked, start found) and run at a time in this process
+WINDOW = 4 * MAX_BATCH
 
 __all__ = ["Distribution", "normal", "sample", "summary", "sweep", "to_netcdf", "uniform"]
 
@@ -209,16 +212,23 @@ def _check_size(members, points, keep):
 
 
 def _local(job, values, out, workers, batch, stop, report):
-    """The members in this process, ``workers`` threads sharing each mapped call; True when
-    stopped."""
-    members = prepare(job, values, out, range(len(values)))
-    for i, status in enumerate(out.status):
-        if status == "failed":          # refused: said at once
-            report(i)
+    """The members in this process, ``workers`` threads sharing each mapped call, WINDOW at
+    a time (each member's parameters and start are found just before it runs: a large sweep
+    starts at once and stops at once); True when stopped."""
     names, base = job.names, job.base
-    return run_members(job.plan, members, out, workers=workers, batch=batch, stop=stop,
-                       done=report,
-                       params=lambda i: {**base, **dict(zip(names, map(float, values[i])))})
+    for start in range(0, len(values), WINDOW):
+        if stop():
+            return True
+        index = range(start, min(len(values), start + WINDOW))
+        members = prepare(job, values[index], out, index)
+        for i in index:
+            if out.status[i] == "failed":          # refused: said at once
+                report(i)
+        if run_members(job.plan, members, out, workers=workers, batch=batch, stop=stop,
+                       done=report, params=lambda i: {**base, **dict(zip(
+                           names, map(float, values[i])))}):
+            return True
+    return False
 
 
 class _stop_flag:

@@ -210,28 +210,33 @@ def run_members(plan, members, out, *, workers=1, batch=None, stop=None, done=No
     template = _template(plan, members)
     if template is None:
         return _one_by_one(plan, members, out, stop, done, params)
-    groups = {}
-    for i, p, x0 in members:
-        groups.setdefault(_method(plan, template, p, x0), []).append((i, p, x0))
     size = batch or default_batch(plan, template, len(members), workers)
-    for key, group in groups.items():
-        if key is None:                 # auto's choice asks for a method a map cannot run
-            if _one_by_one(plan, group, out, stop, done, params):
+    for start in range(0, len(members), size):
+        if stop():
+            return True
+        groups = {}                     # auto may choose BDF for some members
+        for i, p, x0 in members[start:start + size]:
+            groups.setdefault(_method(plan, template, p, x0), []).append((i, p, x0))
+        for key, call in groups.items():
+            if key is None:             # auto's choice asks for a method a map cannot run
+                stopped = _one_by_one(plan, call, out, stop, done, params)
+            else:
+                stopped = _call(plan, template, key, call, out, workers, stop, done, params)
+            if stopped:
                 return True
-            continue
-        for start in range(0, len(group), size):
-            if stop():
-                return True
-            call = group[start:start + size]
-            ok = _mapped(plan, template, key, call, out, workers, stop)
-            if ok is None:              # stopped between chunks
-                return True
-            if not ok:                  # a member failed: every one on its own
-                if _one_by_one(plan, call, out, stop, done, params):
-                    return True
-                continue
-            for i, _, _ in call:
-                done(i)
+    return False
+
+
+def _call(plan, template, key, call, out, workers, stop, done, params):
+    """One mapped call of ``call``'s members; its members on their own when it fails.
+    Returns True when stopped."""
+    ok = _mapped(plan, template, key, call, out, workers, stop)
+    if ok is None:                      # stopped between chunks
+        return True
+    if not ok:                          # a member failed: every one on its own
+        return _one_by_one(plan, call, out, stop, done, params)
+    for i, _, _ in call:
+        done(i)
     return False
 
 
@@ -331,7 +336,7 @@ def _mapped(plan, template, key, call, out, workers, stop):
         single_key, build = stepper.recipe(times, opts)
         single = compiled(system).integrator(single_key, build)
         f = compiled(system).integrator(("members", single_key, b, threads),
-                                        lambda: single.map(b, "thread", threads))
+                                        lambda one=single: one.map(b, "thread", threads))
         # CasADi reads and writes column-major (n, b) blocks: a member's row of a C-ordered
         # (b, n) array; its outputs (nx, T) side by side, a (b, T, nx) array
         x0 = np.ascontiguousarray(X[:, k])

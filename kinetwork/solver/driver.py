@@ -466,11 +466,3 @@ def _running(run):
         for sig, handler in saved.items():
             _signal.signal(sig, handler)
 
-
-def __getattr__(name):
-    """``simulate`` was defined here before the plan (``plan.py``) took it: the old import
-    path keeps working."""
-    if name == "simulate":
-        from .plan import simulate
-        return simulate
-    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")

@@ -87,3 +87,16 @@ def test_linearize_and_trim_by_path():
     pushed.connect("push.flange", "mass.flange_a")
     eq = kn.equilibrium(pushed, free=["spring.c"], fix={"mass.s": 0.2})
     assert eq.params == {"spring.c": pytest.approx(10.0)}
+
+
+def test_a_member_with_events_is_simulates_run():
+    """MSL's friction example (clutch and brake events, no model parameter): each member of
+    a sweep of its spring is the run simulate makes, events and all."""
+    model = kn.load("models/msl_friction.json")
+    settings = {"t_end": 0.6, "n_points": 61, "jit": False}
+    ds = kn.sweep(model, {"spring.c": [1e4, 2e4]}, progress=False, **settings)
+    for c in (1e4, 2e4):
+        res = kn.simulate(model, params={"spring.c": c}, **settings)
+        assert res.stats["events"]
+        for name in res.state_names:
+            np.testing.assert_array_equal(ds[name].sel({"spring.c": c}).values, res[name])

@@ -137,7 +137,7 @@ def test_a_member_is_as_accurate_as_simulate_whatever_the_batch(rtol, references
     for c in cs:
         res = kn.simulate(model, params={"c": c}, **settings)
         assert np.abs(res.states[:, :2] - refs[c][:, :2]).max() <= 100 * rtol
-        for size, ds in runs.items():
+        for ds in runs.values():
             np.testing.assert_allclose(ds["shoulder.q"].sel(c=c).values, res["shoulder.q"],
                                        rtol=0, atol=rtol)
 
