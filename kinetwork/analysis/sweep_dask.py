@@ -12,6 +12,7 @@ again and again, its task was cancelled or timed out.
 """
 
 import math
+from concurrent.futures import CancelledError
 
 import numpy as np
 
@@ -79,10 +80,14 @@ def run_dask(job, values, out, scheduler, batch, stop, done):
                 finished, _ = wait(list(futures), timeout=POLL, return_when="FIRST_COMPLETED")
             except TimeoutError:
                 continue
+            except CancelledError:      # a scheduler's restart cancels them: lost, anew
+                finished = [fut for fut in futures if fut.done() or fut.cancelled()]
             for fut in finished:
                 index, tries = futures.pop(fut)
                 part, why, lost = _outcome(fut)
                 if part is None and lost and tries < RESUBMITS:
+                    if remote.status in ("cancelled", "lost", "error"):   # a restart: anew
+                        remote = client.submit(_job, job, pure=False)
                     futures[_submit(client, remote, values[index], size)] = (index, tries + 1)
                     continue
                 if part is None:
