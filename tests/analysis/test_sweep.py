@@ -15,13 +15,13 @@ import threading
 import numpy as np
 import pytest
 import scipy.stats
+import xarray as xr
+from close import assert_same_numbers
 from scenes import double_pendulum
 from scenes.reference import seed_reference
 
 import kinetwork as kn
 from kinetwork.solver import batch as batch_module
-
-xr = pytest.importorskip("xarray")
 
 FAST = {"t_end": 1.5, "n_points": 151, "jit": False, "progress": False}
 
@@ -174,7 +174,7 @@ def test_the_time_dimension_is_named_as_results_name_it():
     ds = kn.sweep(model, {"c": [1.0, 2.0]}, **FAST)
     one = kn.simulate(model, params={"c": 2.0}, t_end=1.5, n_points=151, jit=False).to_xarray()
     assert ds["probe1.angle"].dims == ("c",) + one["probe1.angle"].dims
-    np.testing.assert_array_equal(ds["t"].values, one["t"].values)
+    assert_same_numbers(ds["t"].values, one["t"].values)
 
 
 def test_outputs_keeps_only_the_named_signals():
@@ -210,7 +210,7 @@ def test_members_of_other_methods_are_simulate_runs():
     for c in (0.5, 2.0):
         res = kn.simulate(model, params={"c": c}, method="dop853", rtol=1e-8, atol=1e-10,
                           t_end=1.5, n_points=151, jit=False)
-        np.testing.assert_array_equal(ds["probe1.angle"].sel(c=c).values, res["probe1.angle"])
+        assert_same_numbers(ds["probe1.angle"].sel(c=c).values, res["probe1.angle"])
     assert set(ds.method.values) == {"dop853"}
 
 
@@ -220,9 +220,9 @@ def test_sample_draws_repeatably_and_each_member_is_its_own_run():
              "d": [0.1, 0.5, 0.9, 1.3, "1.7 N*m*s/rad"]}
     ds = kn.sample(model, draws, n=5, seed=3, rtol=1e-10, atol=1e-12, **FAST)
     again = kn.sample(model, draws, n=5, seed=3, rtol=1e-10, atol=1e-12, **FAST)
-    np.testing.assert_array_equal(ds.m2.values, again.m2.values)
+    assert_same_numbers(ds.m2.values, again.m2.values)
     rng = np.random.default_rng(3)      # the draw, in the order of the dict
-    np.testing.assert_array_equal(ds.m2.values, rng.normal(1.0, 0.05, 5))
+    assert_same_numbers(ds.m2.values, rng.normal(1.0, 0.05, 5))
     assert np.all((ds.c.values >= 0.5) & (ds.c.values <= 2.0))
     assert ds.d.values[-1] == 1.7
     assert ds.m2.attrs["distribution"] == "normal(1, 0.05)"
@@ -249,7 +249,7 @@ def test_a_failing_member_is_marked_and_the_others_kept():
     with pytest.raises(kn.SimulationError) as err:
         kn.simulate(model, params={"T": 0.5}, t_end=1.0, n_points=11, jit=False)
     partial = err.value.results["probe.angle"]
-    np.testing.assert_array_equal(failed["probe.angle"].values[:len(partial)], partial)
+    assert_same_numbers(failed["probe.angle"].values[:len(partial)], partial)
     assert np.all(np.isnan(failed["probe.angle"].values[len(partial):]))
     ref = kn.simulate(model, params={"T": 3.0}, t_end=1.0, n_points=11, jit=False,
                       rtol=1e-11, atol=1e-13)["probe.angle"]
@@ -302,8 +302,9 @@ def test_ctrl_c_stops_a_sweep_between_mapped_calls_and_keeps_what_finished():
 def test_a_mapped_call_is_chunked_to_a_fraction_of_a_second_of_work():
     """Ctrl-C waits for the call running: a call is CHUNK_WORK per thread at most,
     whatever the batch (an expensive model's call covers few output intervals)."""
-    from kinetwork.solver.plan import Plan
     from scenes import chains
+
+    from kinetwork.solver.plan import Plan
     for model, members in ((double_pendulum(), 64), (chains.chain(16), 64)):
         plan = Plan(model, t_end=10.0, n_points=1001, jit=False)
         p = plan.vector()
@@ -359,6 +360,29 @@ def test_bad_input_is_refused_by_name():
                  jit=False, progress=False)
 
 
+def test_a_job_travels_as_the_model_text():
+    """What a Dask worker in another process gets: the job pickled as the model's text and
+    the plan's settings, its plan built again there (a component path lifted again); the
+    numbers are the same."""
+    import pickle
+
+    from kinetwork.analysis.sweep_job import Job, run_block
+    from kinetwork.solver.plan import Plan
+    plan = Plan(double_pendulum(), names=["c", "spring.d"], t_end=0.5, n_points=51,
+                rtol=1e-8, atol=1e-10, jit=False)
+    job = Job(plan, ["c"], {"spring.d": 0.3})
+    copy = pickle.loads(pickle.dumps(job))
+    assert copy.plan.system is not plan.system
+    assert copy.plan.system.state_names == plan.system.state_names
+    values = np.array([[0.5], [3.0]])
+    a, b = run_block(job, values, 2), run_block(copy, values, 2)
+    assert a["status"] == b["status"] == ["ok", "ok"]
+    assert_same_numbers(a["outputs"], b["outputs"])
+    res = kn.simulate(double_pendulum(), params={"c": 3.0, "d": 0.3}, t_end=0.5,
+                      n_points=51, rtol=1e-8, atol=1e-10, jit=False)
+    assert_same_numbers(b["states"][1], res.states)
+
+
 def test_command_line_sweep_writes_netcdf(seed_file, tmp_path, capsys):
     from kinetwork.cli import main
     out = tmp_path / "sweep.nc"
@@ -398,7 +422,7 @@ def test_a_swept_initial_angle_starts_each_member_there():
     model.components["shoulder"].q0 = "a0"
     tight = {"rtol": 1e-10, "atol": 1e-12, "t_end": 0.5, "n_points": 51, "jit": False}
     ds = kn.sweep(model, {"a0": [0.05, 0.3], "c": [1.0, 3.0]}, progress=False, **tight)
-    np.testing.assert_array_equal(ds["shoulder.q"].values[:, :, 0], [[0.05, 0.05], [0.3, 0.3]])
+    assert_same_numbers(ds["shoulder.q"].values[:, :, 0], [[0.05, 0.05], [0.3, 0.3]])
     res = kn.simulate(model, params={"a0": 0.3, "c": 3.0}, **tight)
     np.testing.assert_allclose(ds["probe1.angle"].sel(a0=0.3, c=3.0).values,
                                res["probe1.angle"], atol=1e-12)

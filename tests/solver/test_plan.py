@@ -5,6 +5,7 @@ wrote is left as it was."""
 
 import numpy as np
 import pytest
+from close import assert_same_numbers
 from scenes.oscillator import closed_form, oscillator, stage
 
 import kinetwork as kn
@@ -101,7 +102,7 @@ def test_simulate_is_its_plan_run_and_settings_are_checked_once():
     plan = Plan(model, names=["spring.c"], **TIGHT)
     a = plan.run({"spring.c": 9.0})
     b = kn.simulate(model, params={"spring.c": 9.0}, **TIGHT)
-    np.testing.assert_array_equal(a.states, b.states)
+    assert_same_numbers(a.states, b.states)
     with pytest.raises(kn.ModelError, match="'rtool': no setting of a run.*'rtol'"):
         Plan(model, rtool=1e-3)
     with pytest.raises(kn.ModelError, match="is no model parameter"):
