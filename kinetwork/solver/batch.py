@@ -357,6 +357,8 @@ def _mapped(plan, template, key, call, out, workers, stop):
         k += len(times)
     Y = _outputs(system, compiled(system).outputs(template.jit), grid, X, P) \
         if out.keep.n_columns else [None] * b
+    if Y is None:                       # the outputs failed: each member on its own says why
+        return False
     for (i, _, _), states, signals in zip(call, X, Y):
         out.store(i, states, signals, key, float(grid[-1]))
     return True
@@ -365,7 +367,8 @@ def _mapped(plan, template, key, call, out, workers, stop):
 def _outputs(system, f_out, grid, X, P):
     """The probe signals (b, n_t, n_signals) of a call's members, states X (b, n_t, nx), in
     one evaluation of the output function mapped over every member and time, read through
-    ``Function.buffer`` (a DM's conversion to numpy costs more than the evaluation)."""
+    ``Function.buffer`` (a DM's conversion to numpy costs more than the evaluation); None
+    when that evaluation failed (its return status)."""
     b, m, nx = X.shape
     n = b * m
     f = mapped(f_out, n)
@@ -379,6 +382,8 @@ def _outputs(system, f_out, grid, X, P):
         buffer.set_arg(k, memoryview(value.ravel()))
     buffer.set_res(0, memoryview(y.ravel()))
     evaluate_()
+    if buffer.ret() != 0:
+        return None
     return y.reshape(b, m, -1)
 
 
