@@ -232,7 +232,7 @@ class Plan:
         if parts is not None and parts.events:     # re-partitioned: each part by its equations
             X, outputs = parts.finish(t, X)
         else:
-            X = system.polish(X, p)
+            X = system.polish(X, p, t)
             f_out = compiled(system).outputs(run.jit)
             outputs = system.outputs_p(t, X, p, f_out) if len(t) else np.zeros((0, 0))
         return Results(t, X, system.state_names + system.algebraic_names, outputs,
