@@ -12,6 +12,7 @@ again and again, its task was cancelled or timed out.
 """
 
 import math
+import time
 from concurrent.futures import CancelledError
 
 import numpy as np
@@ -25,6 +26,12 @@ from .sweep_job import run_block, store
 RESUBMITS = 2
 #: seconds between looks at the cancel flag (Ctrl-C) while blocks run
 POLL = 0.25
+#: seconds a finished block's result may take to reach this process: longer, it was lost
+#: with its worker (Dask then waits for a worker to compute it again) and is submitted anew
+FETCH = 60.0
+#: seconds the sweep waits for a cluster that has no worker left (nannies that cannot start
+#: one again) before it marks the members not yet run failed, saying so
+NO_WORKERS = 300.0
 
 
 def client_of(scheduler):
@@ -73,9 +80,18 @@ def run_dask(job, values, out, scheduler, batch, stop, done):
         for start in range(0, len(values), size):
             index = np.arange(start, min(len(values), start + size))
             futures[_submit(client, remote, values[index], size)] = (index, 0)
+        alone = _Workerless(client)
         while futures:
             if stop():
                 return True
+            if alone.too_long():
+                why = (f"no Dask worker left to run it: the cluster has had none for "
+                       f"{NO_WORKERS:g} s (its workers were lost, and none came back)")
+                for index, _ in futures.values():
+                    for i in index:
+                        out.status[i], out.reason[i] = "failed", why
+                        done(i)
+                return False
             try:
                 finished, _ = wait(list(futures), timeout=POLL, return_when="FIRST_COMPLETED")
             except TimeoutError:
@@ -106,6 +122,28 @@ def run_dask(job, values, out, scheduler, batch, stop, done):
             thing.close()
 
 
+class _Workerless:
+    """How long the cluster has had no worker: asked once a second at most."""
+
+    def __init__(self, client):
+        self.client, self.since, self.asked = client, None, 0.0
+
+    def too_long(self):
+        now = time.monotonic()
+        if now - self.asked < 1.0:
+            return False
+        self.asked = now
+        try:
+            workers = self.client.scheduler_info().get("workers", {})
+        except Exception:  # noqa: BLE001 -- the scheduler cannot say: none known
+            workers = {}
+        if workers:
+            self.since = None
+        elif self.since is None:
+            self.since = now
+        return self.since is not None and now - self.since > NO_WORKERS
+
+
 def _job(job):
     """The job on a worker (the task whose result every block reads)."""
     return job
@@ -120,7 +158,7 @@ def _outcome(fut):
     from distributed import KilledWorker
     if fut.status == "finished":
         try:
-            return fut.result(), "", False
+            return fut.result(timeout=FETCH), "", False
         except Exception as exc:  # noqa: BLE001 -- its result was lost with its worker
             return None, _lost(exc), True
     exc = None

@@ -80,3 +80,17 @@ def test_a_sweep_survives_losing_every_worker():
     assert ds.status.values.tolist() == ["ok"] * 12, ds.reason.values
     local = kn.sweep(model, grid, workers=1, progress=False, **settings)
     assert_same_numbers(ds["probe1.angle"].values, local["probe1.angle"].values)
+
+
+def test_a_cluster_left_without_workers_fails_its_members_saying_so(monkeypatch):
+    """Nannies that cannot start a worker again leave a cluster with none: the sweep waits
+    NO_WORKERS seconds for one, then marks its members failed with that reason (it never
+    waits for ever)."""
+    from kinetwork.analysis import sweep_dask
+    monkeypatch.setattr(sweep_dask, "NO_WORKERS", 1.0)
+    with distributed.LocalCluster(n_workers=0, processes=False, dashboard_address=":0") \
+            as cluster, distributed.Client(cluster) as client:
+        ds = kn.sweep(double_pendulum(), {"c": [1.0, 2.0]}, batch=1, scheduler=client,
+                      t_end=0.5, n_points=11, jit=False, progress=False)
+    assert ds.status.values.tolist() == ["failed", "failed"]
+    assert all(r.startswith("no Dask worker left to run it") for r in ds.reason.values)
