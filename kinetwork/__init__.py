@@ -39,7 +39,7 @@ _LAZY = {
     "electrical": ("components.electrical", None),
     "signals": ("components.signals", None),
     "System": ("equations.system", "System"),
-    "simulate": ("solver.driver", "simulate"),
+    "simulate": ("solver.plan", "simulate"),
     "METHODS": ("solver.methods", "METHODS"),
     "Results": ("solver.results", "Results"),
     "schema": ("schema", None),       # the module, callable: kn.schema()

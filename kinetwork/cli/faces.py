@@ -12,7 +12,7 @@ def add(sub):
     """The parsers of the commands other modules carry out (``animate``, ``diagram``,
     ``studio``, ``import``, ``sweep``, ``linearize``, ``fit``); {name: handler}."""
     from ..analysis import commands
-    from ..analysis.sweep import add_command as add_sweep
+    from ..analysis.sweep_cli import add_command as add_sweep
     parser = sub.add_parser(
         "animate", help="write a 3-D animation of a model's motion",
         description="Simulate MODEL.json and write its motion as a self-contained HTML file "
@@ -87,7 +87,7 @@ def import_urdf(args):
 
 
 def sweep(args):
-    from ..analysis.sweep import run_command
+    from ..analysis.sweep_cli import run_command
     return run_command(args, load_model(args.model, args.library))
 
 

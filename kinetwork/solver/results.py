@@ -26,6 +26,28 @@ if TYPE_CHECKING:                     # annotations only
     from matplotlib.figure import Figure
 
 
+#: the name of the time dimension of every xarray kinetwork gives (``Results.to_xarray``,
+#: ``kn.sweep``, ``kn.sample``): ``t``, as ``res.t`` and the CSV's first column
+TIME = "t"
+
+
+def signal_dims(shape):
+    """The xarray dimensions of one value of a signal of ``shape``: none for a scalar,
+    ``axis`` (x, y, z) for a vector, ``row`` and ``col`` for an orientation."""
+    return {0: (), 1: ("axis",), 2: ("row", "col")}[len(shape)]
+
+
+def signal_coords(signals):
+    """The coordinates of the dimensions ``signal_dims`` gives ``signals``."""
+    shapes = {len(sig.shape): sig.shape for sig in signals}
+    coords = {}
+    if 1 in shapes and shapes[1] == (3,):
+        coords["axis"] = ["x", "y", "z"]
+    if 2 in shapes:
+        coords.update(row=[1, 2, 3], col=[1, 2, 3])
+    return coords
+
+
 class Results:
     """Simulation output: ``res.t``, ``res["probe1.angle"]``, ``res.states``.
 
@@ -152,7 +174,7 @@ class Results:
         xr = _optional("xarray", "to_xarray")
         variables = {}
         for name, sig in self.signals.items():
-            dims = ("t",) + {0: (), 1: ("axis",), 2: ("row", "col")}[len(sig.shape)]
+            dims = (TIME,) + signal_dims(sig.shape)
             attrs = {"units": sig.unit, "probe": sig.probe, "quantity": sig.quantity}
             target = self.probe_targets.get(sig.probe)
             if target:
@@ -160,14 +182,10 @@ class Results:
             variables[name] = xr.Variable(dims, self._values[name], attrs)
         if states:
             for name in self.state_names:
-                variables[name] = xr.Variable(("t",), self[name],
+                variables[name] = xr.Variable((TIME,), self[name],
                                               {"units": self.units.get(name, "")})
-        coords = {"t": ("t", self.t, {"units": "s", "long_name": "time"})}
-        shapes = {len(sig.shape): sig.shape for sig in self.signals.values()}
-        if 1 in shapes and shapes[1] == (3,):
-            coords["axis"] = ["x", "y", "z"]
-        if 2 in shapes:
-            coords.update(row=[1, 2, 3], col=[1, 2, 3])
+        coords = {TIME: (TIME, self.t, {"units": "s", "long_name": "time"}),
+                  **signal_coords(self.signals.values())}
         return xr.Dataset(variables, coords=coords, attrs=self._attrs())
 
     def _attrs(self):

@@ -16,7 +16,8 @@ import threading
 import numpy as np
 
 from ..errors import ModelError, SimulationError
-from ..solver.driver import DEFAULTS, simulate
+from ..solver.driver import DEFAULTS
+from ..solver.plan import simulate
 from .checks import build, plain, problems_of
 from .files import StudioError
 
