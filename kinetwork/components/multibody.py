@@ -801,6 +801,8 @@ class BodySphere(Component, library=MB):
 
 
 from .loopjoints import JointRRR, SphericalSpherical, UniversalSpherical  # noqa: E402,F401
+from .assemblies import (JointRRP, JointSSP, JointSSR, JointUPS, JointUSP,  # noqa: E402,F401
+                         JointUSR)
 from .forces import (Damper, Force, ForceAndTorque, LineForceWithTwoMasses,  # noqa: E402,F401
                      Spring, SpringDamper, Torque, WorldForce, WorldTorque)
 from .rotor import Rotor1D  # noqa: E402,F401

@@ -102,8 +102,12 @@ class Network:
 
 
 def build(model, topo, bound, q, u, udot, qindex, uindex, t, inverse=None, p=None,
-          p_values=None, reads=None):
+          p_values=None, reads=None, derived=None):
     """The Network of a validated model, in the symbols of the Assembly.
+
+    ``derived``: the flanges whose position an assembly gives (its axis, the angle or
+    distance that closes its loop), PortRef -> (position, speed, acceleration) in (q, u,
+    udot); the generalized force on such a flange reaches the speeds by virtual work.
 
     ``inverse(a, armature, Q)`` is the tree's inverse dynamics (for InverseDynamics blocks):
     the generalized forces for speeds' rates ``a`` with the given armature, less ``Q``.
@@ -113,6 +117,7 @@ def build(model, topo, bound, q, u, udot, qindex, uindex, t, inverse=None, p=Non
     builder = _Builder(model, topo, bound, q, u, udot, qindex, uindex, t, inverse, p,
                        p_values)
     builder.reads = reads or {}
+    builder.derived = derived or {}
     return builder.run()
 
 
@@ -272,6 +277,8 @@ class _Builder:
             self._motion(group, group.definer, placeholders)
         elif kind == "free":
             self._free(group)
+        elif kind == "assembly":
+            self.coord[group.index] = tuple(ca.SX(v) for v in self.derived[group.definer])
         elif kind == "massless":
             theta, w = ca.SX.sym(f"g{group.index}_pos"), ca.SX.sym(f"g{group.index}_vel")
             a = ca.SX.sym(f"g{group.index}_acc")
@@ -555,6 +562,13 @@ class _Builder:
             u = self._speed(group)
             self.net.armature[u] += inertia
             self._passive[u] += self._generalized(group, ("compliant",))
+        elif group.kind == "assembly":
+            self._passive += self._virtual(group, self._generalized(group, ("compliant",)))
+
+    def _virtual(self, group, gen):
+        """The generalized forces on the speeds of a force ``gen`` on an assembly's axis:
+        (d(speed of the axis)/du)^T gen, by virtual work."""
+        return ca.jtimes(self.coord[group.index][1], self.u, ca.SX(gen), True)
 
     def _speed(self, group):
         joint = group.definer.component
@@ -567,6 +581,8 @@ class _Builder:
         theta, w, a = self.coord[group.index]
         if group.kind == "joint":
             self.net.Q[self._speed(group)] += gen
+        elif group.kind == "assembly":
+            self.net.Q += self._virtual(group, gen)
         elif group.kind == "free" and not any(group in c for c in self.riding):
             self.pending[a] = gen / self.inertia[group.index]
         elif group.kind == "massless":

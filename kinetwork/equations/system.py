@@ -87,6 +87,14 @@ class System:
             "dependent_jacobian", [ca.vertcat(eq.x, eq.z), asm.p],
             [ca.densify(ca.substitute(jd, asm.q, ca.densify(coords)))])
         self.dependent_names = eq.dependent_names or []
+        checks = asm.placed.checks if asm.placed is not None else []
+        #: what stays positive away from the singular positions of assemblies that close
+        #: their loops in closed form, of the full state (None: no assembly)
+        self.f_assembly_checks = None if not checks else ca.Function(
+            "assembly_checks", [asm.t, ca.vertcat(eq.x, eq.z), asm.p],
+            [ca.densify(ca.substitute(ca.vertcat(*[c for c, _ in checks]), asm.q,
+                                      ca.densify(coords)))])
+        self.assembly_check_messages = [m for _, m in checks]
         if self.formulation in ("tree", "hybrid") and self.speed_names and \
                 not self.n_algebraic:
             self._check_mass_matrix()
@@ -188,6 +196,23 @@ class System:
         if self.eq.residual is None:
             return np.zeros(len(X))
         return np.asarray(mapped(self._f_residual, len(X))(X.T, p)).ravel()
+
+    def assembly_singular(self, times, X, p):
+        """(row, messages): the first row of full states X (at ``times``) at which an
+        assembly that closes its loop in closed form is at (or past) a singular position,
+        and what is singular there; (None, []) where none is."""
+        if self.f_assembly_checks is None or not len(X):
+            return None, []
+        X = np.atleast_2d(np.asarray(X, dtype=float))
+        values = np.asarray(mapped(self.f_assembly_checks, len(X))(
+            np.atleast_1d(times)[None, :], X.T, p)).T
+        with np.errstate(invalid="ignore"):
+            bad = ~(values > 0)
+        rows = np.nonzero(bad.any(axis=1))[0]
+        if not len(rows):
+            return None, []
+        return int(rows[0]), [m for m, b in zip(self.assembly_check_messages, bad[rows[0]])
+                              if b]
 
     @functools.cached_property
     def _f_residual(self):
