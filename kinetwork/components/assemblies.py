@@ -38,8 +38,9 @@ class Placement:
 
     ``frames``: inner port -> (orientation, origin) in frame_a; ``coordinate``: the position
     of its ``axis`` flange (an angle or a distance), or None; ``masses``: (mass, position in
-    frame_a) of the point masses it carries; ``checks``: (expression, message) that must stay
-    positive, or the assembly is at a singular position."""
+    frame_a) of the point masses it carries; ``checks``: (expression, what) that must stay
+    positive (a dimensionless measure, 1 far from trouble), or the assembly is at a singular
+    position: ``what`` says which."""
     frames: dict
     coordinate: object = None
     masses: list = field(default_factory=list)
@@ -124,24 +125,25 @@ def _revolute_roots(e, r_a, r_b, length, branch):
     """Angle of MSL's RevoluteWithLengthConstraint: frame_b of the joint is its frame_a
     turned by it about ``e``, and |r_b - T r_a| = length, with r_a fixed in the joint's
     frame_a and r_b in its frame_b (T resolves frame_a vectors in frame_b). A cos + B sin + C
-    = 0, solved for sine and cosine apart (any angle in -pi..pi); also the discriminant."""
+    = 0, solved for sine and cosine apart (any angle in -pi..pi); also the discriminant
+    over A^2 + B^2 (dimensionless: 1 - C^2 / (A^2 + B^2), 1 far from a singular position)."""
     e_r_a, e_r_b = ca.dot(e, r_a), ca.dot(e, r_b)
     A = -2 * (ca.dot(r_b, r_a) - e_r_b * e_r_a)
     B = 2 * ca.dot(r_b, ca.cross(e, r_a))
     C = ca.dot(r_a, r_a) + ca.dot(r_b, r_b) - length**2 - 2 * e_r_b * e_r_a
     k1a = A * A + B * B - C * C
     k2 = _root(k1a)
-    return ca.atan2(-B * C - branch * A * k2, -A * C + branch * B * k2), k1a
+    return ca.atan2(-B * C - branch * A * k2, -A * C + branch * B * k2), k1a / (A * A + B * B)
 
 
 def _prismatic_roots(e, r_a, r_b, length, branch):
     """Distance of MSL's PrismaticWithLengthConstraint: frame_b of the joint is its frame_a
     moved by d along ``e``, and |d e + r_b - r_a| = length: d^2 + B d + C = 0; also the
-    discriminant."""
+    discriminant over length^2 (dimensionless, 1 where the rod is along ``e``)."""
     rbra = r_b - r_a
     k1 = ca.dot(e, rbra)
     k1a = k1 * k1 - (ca.dot(rbra, rbra) - length**2)
-    return -k1 + branch * _root(k1a), k1a
+    return -k1 + branch * _root(k1a), k1a / length**2
 
 
 class _RodAndEndJoint(PartialAssembly):
@@ -181,14 +183,13 @@ class _RodAndEndJoint(PartialAssembly):
         p_im = p_ib + R_ib @ vec3(self.rRod2_ib)
         frames = {"frame_ib": (R_ib, p_ib), "frame_im": (R_ib, p_im)}
         joint = "revolute" if self.rotational_end else "prismatic"
-        checks = [(k1a - SINGULAR, f"{self.name} is at a singular position of its loop: the "
-                                   f"two positions of its {joint} joint meet (or none exists), "
-                                   f"and the mechanism loses a degree of freedom there")]
+        checks = [(k1a - SINGULAR, f"the two positions of its {joint} joint meet (or none "
+                                   f"exists): the mechanism loses a degree of freedom")]
         if "frame_ia" in self.placed_frames:
             R_ia, n2 = _universal(self.universal_axis(), self.rRod1_ia, p_im)
             frames["frame_ia"] = (R_ia, ca.SX.zeros(3))
-            checks.append((n2 - SINGULAR, f"{self.name}'s universal joint is singular: rod 1 "
-                                          f"lies along its axis 1 (n1_a)"))
+            checks.append((n2 - SINGULAR, "its universal joint is singular: rod 1 lies along "
+                                          "its axis 1"))
         masses = []
         if "rod1Mass" in self.params:
             masses.append((self.rod1Mass, p_im / 2))
@@ -386,8 +387,8 @@ class JointUPS(PartialAssembly, library=MB):
         length = ca.norm_2(rel_p)
         R_ia, n2 = _universal(self.n1_a, self.nAxis_ia, rel_p)
         frames = {"frame_ia": (R_ia, ca.SX.zeros(3)), "frame_ib": (R_ia, rel_p)}
-        checks = [(length - 1e-15, f"{self.name}: frame_a and frame_b meet, where the leg has "
-                                   f"no direction"),
-                  (n2 - SINGULAR, f"{self.name}'s universal joint is singular: the leg lies "
-                                  f"along its axis 1 (n1_a)")]
+        checks = [(length - 1e-15, "frame_a and frame_b meet, where the leg has no "
+                                   "direction"),
+                  (n2 - SINGULAR, "its universal joint is singular: the leg lies along its "
+                                  "axis 1")]
         return Placement(frames, length - self.s_offset, [], checks)

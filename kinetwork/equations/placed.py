@@ -28,8 +28,8 @@ class Placed:
     """What the assemblies of a model place: ``sets``, the inner frame sets (and those of
     parts hanging from them); ``coordinates``, each assembly's axis PortRef -> its position
     in q; ``masses``, (assembly, mass, body index, position in that body) of the point masses
-    they carry; ``checks``, (expression in q, message) that stay positive away from a
-    singular position; ``branches``, assembly name -> the chosen root (+1 or -1, in p)."""
+    they carry; ``checks``, (expression in q, assembly, what) that stay positive away from
+    a singular position; ``branches``, assembly name -> the chosen root (+1 or -1, in p)."""
     sets: set = field(default_factory=set)
     coordinates: dict = field(default_factory=dict)
     masses: list = field(default_factory=list)
@@ -92,7 +92,7 @@ def place_assemblies(topo, bound, bodies, place, q, q_start):
         if placement.coordinate is not None:
             out.coordinates[item.component.port_ref("axis")] = placement.coordinate
         out.masses += [(comp.name, m, k, p + R @ pos) for m, pos in placement.masses]
-        out.checks += placement.checks
+        out.checks += [(c, comp.name, what) for c, what in placement.checks]
     return out
 
 

@@ -92,9 +92,10 @@ class System:
         #: their loops in closed form, of the full state (None: no assembly)
         self.f_assembly_checks = None if not checks else ca.Function(
             "assembly_checks", [asm.t, ca.vertcat(eq.x, eq.z), asm.p],
-            [ca.densify(ca.substitute(ca.vertcat(*[c for c, _ in checks]), asm.q,
+            [ca.densify(ca.substitute(ca.vertcat(*[c for c, _, _ in checks]), asm.q,
                                       ca.densify(coords)))])
-        self.assembly_check_messages = [m for _, m in checks]
+        #: (assembly, what is singular) of each check
+        self.assembly_check_names = [(name, what) for _, name, what in checks]
         if self.formulation in ("tree", "hybrid") and self.speed_names and \
                 not self.n_algebraic:
             self._check_mass_matrix()
@@ -197,22 +198,23 @@ class System:
             return np.zeros(len(X))
         return np.asarray(mapped(self._f_residual, len(X))(X.T, p)).ravel()
 
-    def assembly_singular(self, times, X, p):
+    def assembly_singular(self, times, X, p, margin=0.0):
         """(row, messages): the first row of full states X (at ``times``) at which an
-        assembly that closes its loop in closed form is at (or past) a singular position,
-        and what is singular there; (None, []) where none is."""
+        assembly that closes its loop in closed form is at (or past, or within ``margin``
+        of) a singular position, and what is singular there; (None, []) where none is."""
         if self.f_assembly_checks is None or not len(X):
             return None, []
         X = np.atleast_2d(np.asarray(X, dtype=float))
         values = np.asarray(mapped(self.f_assembly_checks, len(X))(
             np.atleast_1d(times)[None, :], X.T, p)).T
         with np.errstate(invalid="ignore"):
-            bad = ~(values > 0)
+            bad = ~(values > margin)
         rows = np.nonzero(bad.any(axis=1))[0]
         if not len(rows):
             return None, []
-        return int(rows[0]), [m for m, b in zip(self.assembly_check_messages, bad[rows[0]])
-                              if b]
+        return int(rows[0]), [f"{name} {'is at' if not margin else 'nears'} a singular "
+                              f"position of its loop: {what}" for (name, what), b in
+                              zip(self.assembly_check_names, bad[rows[0]]) if b]
 
     @functools.cached_property
     def _f_residual(self):

@@ -71,9 +71,9 @@ CHUNK_GROWTH = 16
 MAX_RESTARTS = 3
 #: a restarted run must keep the loops closed to this (m, or rotation-matrix entries)
 RESTART_CLOSURE = 1e-6
-#: an assembly whose singularity measure (a discriminant, in m^2 or m^4) is below this at the
-#: last output of a failed run is named as near its singular position
-NEAR_SINGULAR_ASSEMBLY = 1e-6
+#: an assembly whose (dimensionless) measure of a singular position is below this at the last
+#: output of a failed run is named as near its singular position there
+NEAR_SINGULAR_ASSEMBLY = 1e-3
 
 
 _SINK = {}
@@ -500,11 +500,10 @@ def _assembly_watch(run, X, new, failure):
         return new[:i], f"at t = {times[i]:g} s, " + "; ".join(singular)
     if failure is not None:
         last, t = (new[-1], times[-1]) if len(new) else (X[-1], run.grid[len(X) - 1])
-        values = np.asarray(system.f_assembly_checks(t, last, run.p), dtype=float).ravel()
-        near = [m for m, v in zip(system.assembly_check_messages, values)
-                if not v > NEAR_SINGULAR_ASSEMBLY]
+        _, near = system.assembly_singular([t], np.atleast_2d(last), run.p,
+                                           NEAR_SINGULAR_ASSEMBLY)
         if near:
-            failure += "; at the last output " + "; ".join(near)
+            failure += f"; at the last output (t = {t:g} s) " + "; ".join(near)
     return new, failure
 
 
