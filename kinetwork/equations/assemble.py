@@ -176,8 +176,11 @@ def assemble(model, topo, values, branch_start=None):
     env_r = {**env_t, **{n: sym for r in reads.values() for n, (sym, _) in r.items()}}
 
     def bind(comp, env):
-        return comp.bound({k: _symbolic(v, env, funcs) if comp.params[k].kind == "real"
+        twin = comp.bound({k: _symbolic(v, env, funcs) if comp.params[k].kind == "real"
                            else v for k, v in comp._values.items()})
+        # the names its expressions of other variables may read (a Ground's gravity field)
+        object.__setattr__(twin, "_environment", env)
+        return twin
     bound = {name: bind(comp, env_r if name in reads else env_t)
              for name, comp in model.components.items()}
 
@@ -359,6 +362,8 @@ def _symbols(names, suffix):
 
 
 def _speed_units(joint):
+    if hasattr(joint, "speed_units"):
+        return joint.speed_units()
     return ["m/s"] * 3 + ["rad/s"] * 3 if joint.dof == 6 else ["rad/s"] * joint.dof
 
 

@@ -341,6 +341,41 @@ def _tree(model, topo, roles, problems):
     topo.forces = [f for f in roles.get("frame_force", [])
                    if all(topo.set_of[f.port_ref(pn)] in placed for pn, port in f.ports.items()
                           if port.domain == "frame" and not _dangling(topo, f, pn))]
+    _point_masses_alone(model, topo, roles, problems)
+
+
+#: what may act on a point mass alone on a FreeMotion: forces at its origin, never a torque
+_FORCES_AT_A_POINT = ("multibody.Spring", "multibody.Damper", "multibody.SpringDamper",
+                      "multibody.LineForceWithTwoMasses", "multibody.WorldForce")
+
+
+def _point_masses_alone(model, topo, roles, problems):
+    """Mark the FreeMotions of the tree whose frame_b carries only PointMasses (and forces at
+    their origin): nothing they move has rotational inertia or takes a torque, so they move
+    without turning and their orientation is no state (MSL's PointMass on a FreeMotion)."""
+    for comp in roles.get("joint", []):
+        if comp.type_name == "multibody.FreeMotion":
+            object.__setattr__(comp, "_translation_only", False)
+    parents = {e.parent for e in topo.tree}
+    ends = {s for c in topo.cuts for s in (c.set_a, c.set_b)} | set(topo.inner)
+    for edge in topo.tree:
+        comp = edge.component
+        if comp.type_name != "multibody.FreeMotion":
+            continue
+        carried = [b for b, s in topo.bodies if s == edge.child]
+        forces = [f for f in roles.get("frame_force", [])
+                  if any(topo.set_of[f.port_ref(pn)] == edge.child for pn, port in
+                         f.ports.items() if port.domain == "frame")]
+        if edge.reversed or edge.child in parents | ends or not carried or \
+                any(b.type_name != "multibody.PointMass" for b in carried) or \
+                any(f.type_name not in _FORCES_AT_A_POINT for f in forces):
+            continue
+        object.__setattr__(comp, "_translation_only", True)
+        w0 = comp._values.get("w0")
+        if w0 is not None and any(not isinstance(v, (int, float)) or v != 0 for v in w0):
+            problems.append(f"{model.place(comp, 'w0')}: {comp.name} carries only point "
+                            f"masses, which do not turn (no rotational inertia): its "
+                            f"orientation is held at angles0, so w0 must be zero or None")
 
 
 def _place_assemblies(model, topo, frames, analytic, reached, problems):
