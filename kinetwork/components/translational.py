@@ -1,9 +1,9 @@
 """1-D translational library: position s [m] and force f [N] on flanges."""
 
-from .base import Param
+from .base import Param, Port
 from .oned import (PartialDamper, PartialFixed, PartialFlowSensor, PartialInertia,
-                   PartialMotion, PartialSensor, PartialSource, PartialSpring,
-                   PartialSpringDamper)
+                   PartialMotion, PartialPowerSensor, PartialSensor, PartialSource,
+                   PartialSpring, PartialSpringDamper)
 
 LIB = "translational"
 
@@ -87,6 +87,25 @@ class AccSensor(PartialSensor, library=LIB):
 class ForceSensor(PartialFlowSensor, library=LIB):
     """The force through the sensor (into flange_a) as a signal; wire it in series."""
     domain = LIB
+
+
+class PowerSensor(PartialPowerSensor, library=LIB):
+    """The power flowing from flange_a to flange_b, flange_a.f * der(flange_a.s), as the
+    signal ``power`` (MSL's Translational.Sensors.PowerSensor); wire it in series."""
+    domain = LIB
+    power = Port("signal_out", "Power from flange_a to flange_b [W]", optional=True)
+    outputs = {"power": "power"}
+
+
+class MultiSensor(PartialPowerSensor, library=LIB):
+    """The force into flange_a (``f``), the flanges' velocity (``v``) and the power flowing
+    from flange_a to flange_b, f * v (``power``), as MSL's Translational.Sensors.MultiSensor;
+    wire it in series."""
+    domain = LIB
+    power = Port("signal_out", "Power from flange_a to flange_b [W]", optional=True)
+    f = Port("signal_out", "Force into flange_a [N]", optional=True)
+    v = Port("signal_out", "Velocity of the flanges [m/s]", optional=True)
+    outputs = {"power": "power", "f": "flow", "v": "speed"}
 
 
 class Position(PartialMotion, library=LIB):

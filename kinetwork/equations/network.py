@@ -365,6 +365,14 @@ class _Builder:
 
     def _output(self, comp):
         """Evaluate a block's or a sensor's output into its signal set."""
+        if getattr(type(comp), "outputs", None):
+            # a power or multi sensor: the flow into flange_a, its speed, their product
+            ref = comp.port_ref("flange_a")
+            read = {"flow": self.net.flow[ref], "speed": self.net.vel[ref]}
+            read["power"] = read["flow"] * read["speed"]
+            for pname, what in comp.outputs.items():
+                self.net.signal[self.topo.set_of[comp.port_ref(pname)]] = ca.SX(read[what])
+            return
         s = self.topo.set_of[comp.port_ref("y")]
         b = self.bound[comp.name]
         if comp.role == "block":

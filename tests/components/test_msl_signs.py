@@ -64,3 +64,38 @@ def test_speed_and_accelerate_integrate_from_their_start_values():
     np.testing.assert_allclose(res["pa.angle"], 0.5 + t**2, atol=1e-10)
     np.testing.assert_allclose(res["pb.angle"], -0.2 + 3 * t + t**2 / 2, atol=1e-10)
     np.testing.assert_allclose(res["pb.speed"], 3 + t, atol=1e-10)
+
+
+@pytest.mark.parametrize("lib, speed, flow", [(rot, "w", "tau"), (tr, "v", "f")])
+def test_multi_and_power_sensors_read_flange_a_and_their_product(lib, speed, flow):
+    """MSL's MultiSensor and PowerSensor in series between J1 (1) and J2 (3), J1 driven by
+    +2 from the world: both move at a = 2 / 4; into flange_a flows J2 a = 1.5, and the power
+    passed on is 1.5 a t, the rate of J2's kinetic energy; a reversed PowerSensor reads its
+    negative."""
+    body = "Inertia" if lib is rot else "Mass"
+    key = "J" if lib is rot else "m"
+    m = kn.Model("power")
+    m.add(getattr(lib, body)("J1", **{key: 1.0}))
+    m.add(getattr(lib, body)("J2", **{key: 3.0}))
+    m.add(getattr(lib, "Torque" if lib is rot else "Force")(
+        "push", **{"tau" if lib is rot else "f": 2.0}))
+    m.add(lib.MultiSensor("multi"))
+    m.add(lib.PowerSensor("power"))
+    m.add(lib.PowerSensor("back"))
+    wires = [("push.flange", "J1.flange_a"), ("J1.flange_b", "multi.flange_a"),
+             ("multi.flange_b", "power.flange_a"), ("power.flange_b", "back.flange_b"),
+             ("back.flange_a", "J2.flange_a")]
+    for port in ("multi.power", f"multi.{speed}", f"multi.{flow}", "power.power",
+                 "back.power"):
+        name = port.replace(".", "_")
+        m.add(kn.Probe(name, quantities=["value"]))
+        wires.append((f"{name}.port", port))
+    for a, b in wires:
+        m.connect(a, b)
+    res = kn.simulate(m, t_end=1.0, n_points=5, **TIGHT)
+    t, a = res.t, 2.0 / 4.0
+    np.testing.assert_allclose(res[f"multi_{flow}.value"], 3.0 * a, atol=1e-10)
+    np.testing.assert_allclose(res[f"multi_{speed}.value"], a * t, atol=1e-10)
+    for probe in ("multi_power", "power_power"):
+        np.testing.assert_allclose(res[f"{probe}.value"], 3.0 * a * a * t, atol=1e-10)
+    np.testing.assert_allclose(res["back_power.value"], -3.0 * a * a * t, atol=1e-10)
