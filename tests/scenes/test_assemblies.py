@@ -13,6 +13,8 @@ import kinetwork as kn
 from scenes import assemblies
 from scenes.multiplier import Mechanism, rot
 
+mb = kn.multibody
+
 MODELS = pathlib.Path(__file__).resolve().parents[2] / "models"
 
 
@@ -55,3 +57,59 @@ def test_fourbar_analytic_follows_the_multiplier_lagrangian():
     np.testing.assert_allclose(res["j2_probe.velocity"], Qd[:, 1], atol=1e-7)
     np.testing.assert_allclose(res["b2_tip.position"][:, 0], 1.2 + Q[:, 1], atol=1e-8)
     assert np.ptp(Q[:, 0]) > 10 and np.ptp(Q[:, 1]) > 0.2        # it turns round and slides
+
+
+def _slider_crank():
+    """A crank (about z, 0.1 m) and MSL's JointRRP from its tip to a rail along x: the
+    coupler (0.3 m) on frame_ia, the piston on frame_ib, a damper on the slider's axis."""
+    m = kn.Model("rrp")
+    m.add(mb.Ground("world"))
+    m.add(mb.Revolute("crank", axis=[0, 0, 1], q0=0.3, qd0=2.0))
+    m.add(mb.RigidBody("crank_body", mass=2.0, r_cm=[0.05, 0, 0], inertia=[1e-3, 2e-3, 3e-3]))
+    m.add(mb.FixedTranslation("tip", r=[0.1, 0, 0]))
+    m.add(mb.FixedTranslation("rail", r=[0, -0.02, 0]))
+    m.add(mb.JointRRP("loop", n_a=[0, 0, 1], n_b=[1, 0, 0], rRod1_ia=[0.3, 0, 0],
+                      rRod2_ib=[0, 0.02, 0], s_guess=0.4))
+    m.add(mb.RigidBody("piston", mass=1.5))
+    m.add(mb.RigidBody("coupler", mass=0.5, r_cm=[0.15, 0, 0], inertia=[1e-4, 4e-3, 4e-3]))
+    m.add(kn.translational.Damper("damper", d=0.5))
+    m.add(kn.Probe("crank_p", quantities=["angle", "speed"]))
+    m.add(kn.Probe("slider", quantities=["position", "velocity"]))
+    m.add(kn.Probe("pin", quantities=["position"]))
+    for a, b in [("world.frame", "crank.frame_a"), ("crank.frame_b", "crank_body.frame_a"),
+                 ("crank.frame_b", "tip.frame_a"), ("tip.frame_b", "loop.frame_a"),
+                 ("world.frame", "rail.frame_a"), ("rail.frame_b", "loop.frame_b"),
+                 ("loop.frame_ib", "piston.frame_a"), ("loop.frame_ia", "coupler.frame_a"),
+                 ("damper.flange_a", "loop.bearing"), ("damper.flange_b", "loop.axis"),
+                 ("crank_p.port", "crank.axis"), ("slider.port", "loop.axis"),
+                 ("pin.port", "loop.frame_im")]:
+        m.connect(a, b)
+    return m
+
+
+def test_joint_rrp_slider_crank_follows_the_multiplier_lagrangian():
+    res = kn.simulate(_slider_crank(), t_end=2.0, n_points=21, rtol=1e-11, atol=1e-12,
+                      jit=False)
+    assert res.state_names == ["crank.q", "crank.qd"]
+    th, s = sp.symbols("theta s")
+    Rz = rot((0, 0, 1), th)
+    A = Rz * sp.Matrix([0.1, 0, 0])
+    pin = sp.Matrix([s, 0, 0])                           # frame_ib at (s, -0.02) + rRod2_ib
+    e = (pin - A) / 0.3                                  # the coupler's x axis, |pin - A| = 0.3
+    R_c = sp.Matrix.hstack(e, sp.Matrix([-e[1], e[0], 0]), sp.Matrix([0, 0, 1]))
+    mech = Mechanism([th, s], [(2.0, np.diag([1e-3, 2e-3, 3e-3]).tolist(), Rz,
+                                Rz * sp.Matrix([0.05, 0, 0])),
+                               (1.5, np.zeros((3, 3)).tolist(), sp.eye(3),
+                                sp.Matrix([s, -0.02, 0])),
+                               (0.5, np.diag([1e-4, 4e-3, 4e-3]).tolist(), R_c, A + 0.15 * e)],
+                     [(pin - A).dot(pin - A) - 0.09], forces=[0, -0.5 * sp.Symbol("qd1")])
+    q0, qd0 = mech.start([0.3, 0.38], [1], [2.0, 0.0], [1])
+    Q, Qd = mech.solve(q0, qd0, res.t)
+    assert mech.drift(Q) < 1e-9
+    np.testing.assert_allclose(res["crank_p.angle"], Q[:, 0], atol=1e-8)
+    np.testing.assert_allclose(res["crank_p.speed"], Qd[:, 0], atol=1e-7)
+    np.testing.assert_allclose(res["slider.position"], Q[:, 1], atol=1e-8)
+    np.testing.assert_allclose(res["slider.velocity"], Qd[:, 1], atol=1e-7)
+    np.testing.assert_allclose(res["pin.position"][:, 0], Q[:, 1], atol=1e-8)
+    np.testing.assert_allclose(res["pin.position"][:, 1:], 0, atol=1e-10)
+    assert np.ptp(Q[:, 0]) > 1.0
