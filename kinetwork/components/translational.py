@@ -2,8 +2,8 @@
 
 from .base import Param, Port
 from .oned import (PartialDamper, PartialFixed, PartialFlowSensor, PartialInertia,
-                   PartialMotion, PartialPowerSensor, PartialSensor, PartialSource,
-                   PartialSpring, PartialSpringDamper)
+                   PartialMotion, PartialPowerSensor, PartialRigid, PartialSensor,
+                   PartialSource, PartialSpring, PartialSpringDamper)
 
 LIB = "translational"
 
@@ -43,6 +43,17 @@ class Fixed(PartialFixed, library=LIB):
     """Flange fixed at a position in the world."""
     domain = LIB
     position0 = Param(0.0, unit="m", name="s0", doc="Fixed position")
+
+
+class Rod(PartialRigid, library=LIB):
+    """A rigid massless rod of length L between flange_a and flange_b, MSL's
+    Translational.Components.Rod: flange_b.s = flange_a.s + L, and the force it takes at one
+    flange it passes whole to the other."""
+    domain = LIB
+    L = Param(0.0, unit="m", doc="Length, from flange_a to flange_b (flange_b.s - flange_a.s)")
+
+    def length(self):
+        return self.L
 
 
 class Mass(PartialInertia, library=LIB):
