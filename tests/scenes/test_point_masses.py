@@ -137,3 +137,21 @@ def test_a_gravity_field_names_its_place_when_wrong():
     model.components["world"].gravity_type = "uniform"
     with pytest.raises(kn.ModelError, match="field"):
         kn.simulate(model, t_end=1.0)
+
+
+def test_point_masses_joined_by_rigid_parts_turn_with_their_arrangements_inertia():
+    """Two PointMasses 0.5 m either side of a revolute's axis (no gravity), 1 N m on the
+    axis: J = 2 m 0.5^2 = 0.5 kg m^2, so phi = t^2."""
+    m = kn.Model("dumbbell")
+    m.add(mb.Ground("world", gravity=[0, 0, 0]))
+    m.add(mb.Revolute("rev", axis=[0, 0, 1]))
+    m.add(kn.rotational.Torque("drive", tau=1.0))
+    for side, x in (("left", -0.5), ("right", 0.5)):
+        m.add(mb.FixedTranslation(f"arm_{side}", r=[x, 0, 0]))
+        m.add(mb.PointMass(side, m=1.0))
+        m.connect("rev.frame_b", f"arm_{side}.frame_a")
+        m.connect(f"arm_{side}.frame_b", f"{side}.frame_a")
+    m.connect("world.frame", "rev.frame_a")
+    m.connect("drive.flange", "rev.axis")
+    res = kn.simulate(m, t_end=1.0, n_points=5, rtol=1e-11, atol=1e-12, jit=False)
+    np.testing.assert_allclose(res["rev.q"], res.t**2, atol=1e-10)
