@@ -113,3 +113,38 @@ def test_joint_rrp_slider_crank_follows_the_multiplier_lagrangian():
     np.testing.assert_allclose(res["pin.position"][:, 0], Q[:, 1], atol=1e-8)
     np.testing.assert_allclose(res["pin.position"][:, 1:], 0, atol=1e-10)
     assert np.ptp(Q[:, 0]) > 1.0
+
+
+@pytest.mark.parametrize("assembly", ["JointSSR", "JointSSP", "JointUSR", "JointUSP"])
+def test_spatial_assemblies_follow_the_multiplier_lagrangian(assembly):
+    """A crank closed to a tilted base by each assembly (``scenes/assemblies.py``): bodies on
+    its inner frames (or rod 1's point mass), a damper on its axis, a full turn of the crank;
+    the crank, the end joint and the middle spherical joint against the reference's."""
+    res = kn.simulate(assemblies.build(assembly), t_end=1.0, n_points=11, rtol=1e-11,
+                      atol=1e-12, jit=False)
+    assert res.state_names == ["crank.q", "crank.qd"]
+    theta, end, middle, drift = assemblies.reference(assembly, res.t)
+    assert drift < 1e-9
+    np.testing.assert_allclose(res["crank_p.angle"], theta, atol=1e-8)
+    key = "end_p.angle" if assembly.endswith("R") else "end_p.position"
+    np.testing.assert_allclose(np.ravel(res[key]), end, atol=1e-8)
+    np.testing.assert_allclose(res["middle.position"], middle, atol=1e-8)
+    assert np.ptp(theta) > 1.0
+
+
+def test_an_assembly_takes_the_root_nearer_its_guess():
+    """The other root of JointSSR's length constraint, guessed: the end joint starts there,
+    the loop closed the other way round (rod 1 keeps its length from the crank's tip)."""
+    near = kn.simulate(assemblies.build("JointSSR"), t_end=0.01, n_points=2, jit=False)
+    other = kn.simulate(assemblies.build("JointSSR", guess_other=True), t_end=0.01,
+                        n_points=2, jit=False)
+    start = assemblies.END0["revolute"] - assemblies.OFFSET["revolute"]
+    np.testing.assert_allclose(near["end_p.angle"][0], start, atol=1e-12)
+    assert abs(other["end_p.angle"][0] - start) > 0.1
+    tip = assemblies.TIP * np.array([math.cos(assemblies.THETA0),
+                                     math.sin(assemblies.THETA0), 0.0])
+    length = np.linalg.norm(assemblies.rod1_ia("revolute"))
+    for res in (near, other):
+        np.testing.assert_allclose(np.linalg.norm(res["middle.position"][0] - tip), length,
+                                   atol=1e-12)
+    assert np.linalg.norm(other["middle.position"][0] - near["middle.position"][0]) > 0.05
