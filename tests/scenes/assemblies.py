@@ -62,10 +62,11 @@ def rod1_ia(kind):
     return Rz.T @ (S - Rz @ np.array([TIP, 0, 0]))
 
 
-def build(assembly, guess_other=False):
+def build(assembly, guess=None):
     """The kinetwork model with ``assembly`` ("JointUSR", "JointSSR", "JointUSP",
     "JointSSP"), MSL's parameters as MSL names them; probes on the crank, the assembly's axis
-    and frames. ``guess_other`` guesses the other root of the length constraint."""
+    and frames. ``guess``: phi_guess (s_guess), by default the axis where the loop is
+    assembled (END0 less the offset)."""
     kind = "revolute" if assembly.endswith("R") else "prismatic"
     universal = assembly.startswith("JointU")
     rod = rod1_ia(kind).tolist()
@@ -77,7 +78,7 @@ def build(assembly, guess_other=False):
     m.add(mb.FixedTranslation("tip", r=[TIP, 0, 0]))
     m.add(mb.FixedRotation("base", r=list(B), axis=[1, 0, 0], angle=BASE_TILT))
     offset = OFFSET[kind]
-    guess = END0[kind] - offset + (1.0 if guess_other else 0.0)
+    guess = END0[kind] - offset if guess is None else guess
     params = {"n_b": list(N_B), "rRod2_ib": list(R_ROD2[kind])}
     if kind == "revolute":
         params.update(phi_offset=offset, phi_guess=guess)
@@ -109,6 +110,23 @@ def build(assembly, guess_other=False):
     for a, b in wires:
         m.connect(a, b)
     return m
+
+
+def closing_angles(kind="revolute"):
+    """The end joint's angles (or distances) at which rod 1 reaches the crank's tip at THETA0,
+    found apart from kinetwork: sign changes of |S(x) - A| - length on a grid, refined."""
+    from scipy.optimize import brentq
+    A = TIP * np.array([math.cos(THETA0), math.sin(THETA0), 0.0])
+    length = np.linalg.norm(rod1_ia(kind))
+
+    def gap(x):
+        R, p = _end_frame(kind, x)
+        return np.linalg.norm(np.array(B) + _tilt() @ (p + R @ np.array(R_ROD2[kind])) - A) \
+            - length
+    xs = np.linspace(-math.pi, math.pi, 721)
+    g = [gap(x) for x in xs]
+    return [brentq(gap, a, b, xtol=1e-14) for a, b, ga, gb in zip(xs, xs[1:], g, g[1:])
+            if ga * gb < 0]
 
 
 def reference(assembly, t):

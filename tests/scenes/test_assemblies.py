@@ -133,18 +133,18 @@ def test_spatial_assemblies_follow_the_multiplier_lagrangian(assembly):
 
 
 def test_an_assembly_takes_the_root_nearer_its_guess():
-    """The other root of JointSSR's length constraint, guessed: the end joint starts there,
-    the loop closed the other way round (rod 1 keeps its length from the crank's tip)."""
-    near = kn.simulate(assemblies.build("JointSSR"), t_end=0.01, n_points=2, jit=False)
-    other = kn.simulate(assemblies.build("JointSSR", guess_other=True), t_end=0.01,
-                        n_points=2, jit=False)
-    start = assemblies.END0["revolute"] - assemblies.OFFSET["revolute"]
-    np.testing.assert_allclose(near["end_p.angle"][0], start, atol=1e-12)
-    assert abs(other["end_p.angle"][0] - start) > 0.1
+    """JointSSR's two closing angles at the start, found apart (``closing_angles``): a guess
+    near either one starts the end joint there (its axis reads the angle less phi_offset)."""
+    roots = assemblies.closing_angles("revolute")
+    assert len(roots) == 2
+    offset = assemblies.OFFSET["revolute"]
     tip = assemblies.TIP * np.array([math.cos(assemblies.THETA0),
                                      math.sin(assemblies.THETA0), 0.0])
     length = np.linalg.norm(assemblies.rod1_ia("revolute"))
-    for res in (near, other):
+    for root in roots:
+        res = kn.simulate(assemblies.build("JointSSR", guess=root - offset + 0.05),
+                          t_end=0.01, n_points=2, jit=False)
+        np.testing.assert_allclose(res["end_p.angle"][0], root - offset, atol=1e-10)
         np.testing.assert_allclose(np.linalg.norm(res["middle.position"][0] - tip), length,
                                    atol=1e-12)
-    assert np.linalg.norm(other["middle.position"][0] - near["middle.position"][0]) > 0.05
+    assert min(abs(r - assemblies.END0["revolute"]) for r in roots) < 1e-9
