@@ -19,7 +19,6 @@ MSL's ``phi_offset`` and ``phi_guess`` are in degrees; here, as every angle, in 
 
 from dataclasses import dataclass, field
 
-import casadi as ca
 import numpy as np
 
 from ..errors import ModelError
@@ -84,6 +83,7 @@ class PartialAssembly(Component):
                          f"ends, so it must close a kinematic loop")
 
     def closure(self, rel_R, rel_p, q):
+        import casadi as ca
         return ca.SX(0, 1)
 
     def coordinate_labels(self):
@@ -103,6 +103,7 @@ def _universal(n1_a, r_ia, rod_a):
     UniversalSpherical: axis 1 is n1_a, axis 2 is normal to it and to the rod; frame_ia is
     parallel to frame_a where the rod lies along ``r_ia``. Also |n1_a x e|^2, which vanishes
     where the rod lies along axis 1 (the joint's singularity)."""
+    import casadi as ca
     n = unit(vec3(n1_a))
     e_ia = unit(vec3(r_ia))
     e2_ia = unit(ca.cross(n, e_ia))
@@ -118,6 +119,7 @@ def _root(discriminant):
     """The square root of a length constraint's discriminant; not a number where it is
     negative (no configuration closes the loop there), so a run that gets there stops
     rather than go on with a clamped, wrong one."""
+    import casadi as ca
     return ca.sqrt(ca.if_else(discriminant > 0, discriminant, ca.SX.nan()))
 
 
@@ -127,6 +129,7 @@ def _revolute_roots(e, r_a, r_b, length, branch):
     frame_a and r_b in its frame_b (T resolves frame_a vectors in frame_b). A cos + B sin + C
     = 0, solved for sine and cosine apart (any angle in -pi..pi); also the discriminant
     over A^2 + B^2 (dimensionless: 1 - C^2 / (A^2 + B^2), 1 far from a singular position)."""
+    import casadi as ca
     e_r_a, e_r_b = ca.dot(e, r_a), ca.dot(e, r_b)
     A = -2 * (ca.dot(r_b, r_a) - e_r_b * e_r_a)
     B = 2 * ca.dot(r_b, ca.cross(e, r_a))
@@ -140,6 +143,7 @@ def _prismatic_roots(e, r_a, r_b, length, branch):
     """Distance of MSL's PrismaticWithLengthConstraint: frame_b of the joint is its frame_a
     moved by d along ``e``, and |d e + r_b - r_a| = length: d^2 + B d + C = 0; also the
     discriminant over length^2 (dimensionless, 1 where the rod is along ``e``)."""
+    import casadi as ca
     rbra = r_b - r_a
     k1 = ca.dot(e, rbra)
     k1a = k1 * k1 - (ca.dot(rbra, rbra) - length**2)
@@ -155,6 +159,7 @@ class _RodAndEndJoint(PartialAssembly):
 
     def rod1_length(self):
         """Length of rod 1, the distance the end joint's angle or distance keeps."""
+        import casadi as ca
         return ca.norm_2(vec3(self.rRod1_ia))
 
     def universal_axis(self):
@@ -163,6 +168,7 @@ class _RodAndEndJoint(PartialAssembly):
 
     def _end(self, rel_R, rel_p, branch):
         """(R, p) of frame_ib in frame_b, the axis coordinate and the discriminant."""
+        import casadi as ca
         e = unit(vec3(self.n_b))
         r_a = -rel_R.T @ rel_p          # frame_a's origin from frame_b, in frame_b
         r_b = vec3(self.rRod2_ib)
@@ -178,6 +184,7 @@ class _RodAndEndJoint(PartialAssembly):
         return plus, minus, guess
 
     def place(self, rel_R, rel_p, branch):
+        import casadi as ca
         R_ib, p_ib, coordinate, k1a = self._end(rel_R, rel_p, branch)
         R_ib, p_ib = rel_R @ R_ib, rel_p + rel_R @ p_ib
         p_im = p_ib + R_ib @ vec3(self.rRod2_ib)
@@ -384,6 +391,7 @@ class JointUPS(PartialAssembly, library=MB):
     s_offset = Param(0.0, unit="m", doc="Distance offset (|r_ab| = axis.s + s_offset)")
 
     def place(self, rel_R, rel_p, branch):
+        import casadi as ca
         length = ca.norm_2(rel_p)
         R_ia, n2 = _universal(self.n1_a, self.nAxis_ia, rel_p)
         frames = {"frame_ia": (R_ia, ca.SX.zeros(3)), "frame_ib": (R_ia, rel_p)}

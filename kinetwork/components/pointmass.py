@@ -1,7 +1,5 @@
 """A mass point: MSL's MultiBody.Parts.PointMass."""
 
-import casadi as ca
-
 from .base import Component, Param, Port
 
 MB = "multibody"
@@ -38,4 +36,5 @@ class PointMass(Component, library=MB):
 
     def mass_properties(self):
         """(mass, centre of mass, inertia about it) as CasADi values: no inertia."""
+        import casadi as ca
         return self.m, ca.DM.zeros(3), ca.DM.zeros(3, 3)
