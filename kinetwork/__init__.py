@@ -51,6 +51,7 @@ _LAZY = {
     "sweep": ("analysis.sweep", "sweep"),
     "sample": ("analysis.sweep", "sample"),
     "normal": ("analysis.sweep", "normal"),
+    "export_fmu": ("fmu.build", "export_fmu"),
     "uniform": ("analysis.sweep", "uniform"),
 }
 
