@@ -6,7 +6,8 @@ coordinates, :func:`simulate` it and read the probes from the :class:`Results`.
 Layers, each importing only those before it: ``errors``, ``util``, ``expr``, ``spatial``
 (helpers) -> ``components`` (what a user places) -> ``graph`` (model, topology, files) ->
 ``equations`` (the System) -> ``simulation`` (driver, methods, JIT cache, Results) -> the
-faces: ``plot``, ``schema``, ``symbolic``, ``animation``, ``diagram``, ``analysis``, ``cli``.
+faces: ``plot``, ``schema``, ``symbolic``, ``animation``, ``diagram``, ``analysis``,
+``fmu``, ``cli``.
 
 ``import kinetwork`` is quick: the names below are imported on first use (PEP 562), so a
 script pays for CasADi, networkx and scipy when it builds a model, not when it imports the

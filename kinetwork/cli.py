@@ -90,6 +90,7 @@ def build_parser():
     """The argument parser of the ``kinetwork`` command."""
     from .analysis import commands as analysis_commands
     from .analysis.sweep import add_command as add_sweep
+    from .fmu import command as fmu_command
     from .solver.methods import METHODS
 
     parser = argparse.ArgumentParser(
@@ -256,7 +257,8 @@ def build_parser():
     imp.add_argument("--gravity", type=float, nargs=3, metavar=("GX", "GY", "GZ"),
                      default=None, help="gravity of the ground (default 0 0 -9.81)")
     lin, fit = analysis_commands.add_commands(sub)
-    for command in (run, val, eqs, anim, dia, studio, lin, fit):
+    export = fmu_command.add_command(sub)
+    for command in (run, val, eqs, anim, dia, studio, lin, fit, export):
         command.add_argument("--library", action="append", default=[], metavar="DIR",
                              help="a folder of subsystem files (TYPE.json), searched after "
                                   "the model's own definitions and folder (repeat for "
@@ -285,7 +287,8 @@ def _main(argv, worker):
                "methods": _methods, "bench": _bench, "schema": _schema,
                "cache": _cache, "animate": _animate, "diagram": _diagram,
                "studio": _studio, "import": _import, "sweep": _sweep,
-               "examples": _examples, "linearize": _linearize, "fit": _fit}[args.command]
+               "examples": _examples, "linearize": _linearize, "fit": _fit,
+               "export": _export}[args.command]
     try:
         return command(args)
     except kn.ModelError as exc:
@@ -313,6 +316,11 @@ def _fit(args):
     except kn.SimulationError as exc:
         _error(exc)
         return EXIT_SIMULATION
+
+
+def _export(args):
+    from .fmu import command as fmu_command
+    return fmu_command.run_command(args, _load(args.model, args.library))
 
 
 def _sweep(args):

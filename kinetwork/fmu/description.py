@@ -63,7 +63,7 @@ def model_description(c, identifier, guid):
     ex = c.experiment
     ET.SubElement(root, "DefaultExperiment", {
         "startTime": "0.0", "stopTime": _number(ex["t_end"]),
-        "tolerance": _number(c.solver_rtol), "stepSize": _number(ex["step"])})
+        "tolerance": _number(c.tolerance), "stepSize": _number(ex["step"])})
     variables = ET.SubElement(root, "ModelVariables")
     for vr, v in enumerate(c.variables):
         attrs = {"name": fmi_variable_name(v.name), "valueReference": str(vr),

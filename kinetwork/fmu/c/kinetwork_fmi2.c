@@ -60,6 +60,9 @@
 #define NEWTON_ITERATIONS 50
 /* a projected loop whose closure is off by more than this no longer closes */
 #define CLOSURE_LIMIT 1e-6
+/* the shortest step (relative to the time, at least absolutely) Co-Simulation's error
+ * control asks for: one this short is taken as it is */
+#define MIN_STEP 1e-12
 /* Dormand-Prince steps in one doStep at most (bounded work) */
 #define MAX_STEPS 10000000L
 
@@ -594,7 +597,10 @@ static fmi2Status advance(Instance *m, double t_end)
             return fail(m, "t = %.17g s: more than %ld steps in one communication step", t,
                         MAX_STEPS);
         e = trial(m, t, n->x, h);
-        if (e < 0 || !(e <= 1.0)) {
+        /* a step no longer than MIN_STEP is taken whatever its error estimate: a rate that
+         * jumps at a known instant (a Step at a communication point, seen by the last stage
+         * of every step that ends there) costs it at most MIN_STEP times the jump */
+        if (!(e >= 0 && isfinite(e)) || !(e <= 1.0 || h <= MIN_STEP * fmax(1.0, fabs(t)))) {
             double factor = e < 0 || !isfinite(e) ? 0.25 : fmax(0.2, 0.9 * pow(e, -0.2));
             n->h = h * factor;
             if (n->h < 1e-14 * fmax(1.0, fabs(t)))
