@@ -232,6 +232,7 @@ def _config(c, uid):
         f"#define KN_SZ_W {w}",
         f"#define KN_RTOL {_c_number(c.solver_rtol)}",
         f"#define KN_PROJECTED {int(c.projected)}", f"#define KN_CLOCK {int(c.clock)}",
+        f"#define KN_ND {c.n_dependent}",
         f"#define KN_ALGEBRAIC_NAMES {_c_string(', '.join(s.algebraic_names))}",
         _array("int", "kn_par_index", c.param_index, str),
         _array("int", "kn_u_index", c.input_index, str),

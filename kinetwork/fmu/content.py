@@ -8,9 +8,12 @@ parameter vector in the FMU is the System's: model parameters and inputs, each b
 Every Function has the arguments (t, x, z, p): time, the states, the algebraic variables of a
 DAE formulation (none for an ODE) and that parameter vector.
 
-- ``kn_rhs``: (xdot, alg, closure): the rates, the algebraic residual and, of the projected
-  loops' formulation, how far the projected coordinates are from closing the loops (the FMU
-  stops rather than integrate a loop that no longer closes: a dead point it cannot cross);
+- ``kn_rhs``: (xdot, alg, closure, jd): the rates, the algebraic residual and, of the
+  projected loops' formulation, how far the projected coordinates are from closing the loops
+  and the closure's Jacobian in the dependent speeds (``System.f_dependent``, column-major):
+  the FMU stops rather than integrate a loop that no longer closes, or whose Jacobian's
+  determinant changed sign or vanished (a dead point of its partition, where ``kn.simulate``
+  re-partitions and the FMU cannot);
 - ``kn_newton``: (z after one Newton step on the algebraic equations, its residual);
 - ``kn_out``: the probe quantities, one column each, as the CSV names them;
 - ``kn_start``: the initial state from the parameters, as ``System.initial_state`` gives it
@@ -102,6 +105,7 @@ class Content:
     frozen: dict = field(default_factory=dict)   # parameter -> why it cannot change
     functions: dict = field(default_factory=dict)
     projected: bool = False         # kn_project is a projection onto loop closures
+    n_dependent: int = 0            # dependent speeds of the loops' partition (0: none)
     clock: bool = False             # a state is time itself: runs start at t = 0
     experiment: dict = field(default_factory=dict)
     solver_rtol: float = 1e-10      # the rtol the FMU's own integrator gets by default
@@ -217,10 +221,14 @@ def _functions(out, system, inputs, flat):
     if system.formulation == "projected" and eq.residual is not None:
         closure = ca.norm_inf(eq.residual)
         out.projected = True
+    jd = ca.SX(0, 1)
+    if out.projected and system.f_dependent is not None:
+        jd = ca.vec(ca.densify(system.f_dependent(ca.vertcat(x, z), p)))
+    out.n_dependent = int(round(jd.numel() ** 0.5))
     ode, alg = ca.densify(eq.ode), ca.densify(eq.alg)
     f = {}
-    f["kn_rhs"] = ca.Function("kn_rhs", args, [ode, alg, closure], names,
-                              ["xdot", "alg", "closure"])
+    f["kn_rhs"] = ca.Function("kn_rhs", args, [ode, alg, closure, jd], names,
+                              ["xdot", "alg", "closure", "jd"])
     if z.numel():
         step = newton(alg, z, 1)
         f["kn_newton"] = ca.Function("kn_newton", args, [ca.densify(step),

@@ -224,3 +224,44 @@ def test_nothing_else_overwritten(tmp_path):
         kn.export_fmu(kn.load(MODELS / "double_pendulum.json"), tmp_path / "o.fmu",
                       kind="fmi3")
     assert sorted(p.name for p in tmp_path.iterdir()) == ["notes.fmu"]
+
+
+def test_dead_point_stops_the_fmu(tmp_path):
+    """The five-revolute loop meets a dead point of its partition at t = 1.07 s, where
+    kn.simulate re-partitions: the FMU, which keeps its partition, stops there with an error
+    saying so, in Co-Simulation and under FMPy's CVode, rather than integrate on."""
+    model = kn.load(MODELS / "five_revolute_loop.json")
+    path = kn.export_fmu(model, tmp_path / "five.fmu")
+    for kind in ("CoSimulation", "ModelExchange"):
+        messages = []
+        with pytest.raises(Exception):
+            fmpy.simulate_fmu(str(path), fmi_type=kind, stop_time=1.5, output_interval=0.01,
+                              logger=lambda *args: messages.append(args[-1]))
+        words = b" ".join(m if isinstance(m, bytes) else str(m).encode() for m in messages)
+        assert b"dead point" in words, kind
+        assert b"t = 1.0" in words, kind
+
+
+def test_rebuilt_from_its_sources(exported, tmp_path):
+    """FMPy builds the binary again from sources/ and buildDescription.xml alone (CMake and
+    this machine's compiler), and the rebuilt FMU gives the same answer."""
+    build = pytest.importorskip("fmpy.build")
+    import shutil
+    if shutil.which("cmake") is None:
+        pytest.skip("FMPy builds FMUs with CMake, which this machine lacks")
+    model, path = exported["arm_pid"]
+    folder = tmp_path / "unzipped"
+    with zipfile.ZipFile(path) as z:
+        z.extractall(folder)
+    shutil.rmtree(folder / "binaries")
+    (tmp_path / "build").mkdir()
+    build.build_platform_binary(folder, build_dir=tmp_path / "build")
+    rebuilt = tmp_path / "rebuilt.fmu"
+    with zipfile.ZipFile(rebuilt, "w") as z:
+        for file in folder.rglob("*"):
+            if file.is_file():
+                z.write(file, file.relative_to(folder).as_posix())
+    assert any(n.startswith("binaries/") for n in zipfile.ZipFile(rebuilt).namelist())
+    t, ref = reference(model)
+    err, col = worst(t, ref, run_fmu(rebuilt, "CoSimulation", t))
+    assert err < TOL, f"{col} off by {err:.3g} of its scale"

@@ -60,9 +60,17 @@
 #define NEWTON_ITERATIONS 50
 /* a projected loop whose closure is off by more than this no longer closes */
 #define CLOSURE_LIMIT 1e-6
+/* ... and one whose Jacobian in the dependent speeds has a health (|det| over the product
+ * of its rows' norms: 1 for orthogonal rows, 0 when singular) below this, or whose
+ * determinant changed sign since the start, is at or past a dead point of its partition */
+#define HEALTH_LIMIT 1e-8
+#define ND KN_ND
 /* the shortest step (relative to the time, at least absolutely) Co-Simulation's error
  * control asks for: one this short is taken as it is */
 #define MIN_STEP 1e-12
+/* ... but no more than this many such steps in a row: a jump is crossed by one, the rates
+ * near a singularity (a dead point, a force that blows up) would take them without end */
+#define FORCED_STEPS 8
 /* Dormand-Prince steps in one doStep at most (bounded work) */
 #define MAX_STEPS 10000000L
 
@@ -81,6 +89,7 @@ typedef struct {
     int stop_defined;
     int mode;
     double h;                   /* last step size of the Co-Simulation's integrator */
+    double health0;             /* the loops' health at the start (0: not yet known) */
     long steps, events;
 } Numbers;
 
@@ -98,6 +107,7 @@ typedef struct {
     double dx[NX + 1], alg[NZ + 1];
     double k[7][NX + 1], x1[NX + 1], xt[NX + 1], err[NX + 1];
     double y[NY + 1], g[NG + 1], g1[NG + 1], r[NR + 1];
+    double jd[ND * ND + 1], lu[ND * ND + 1];
     double tg[NT + 1], tdg[NT + 1];
     char why[512];              /* why the equations could not be evaluated, last time */
 } Instance;
@@ -151,7 +161,51 @@ static int call(Instance *m, int (*f)(const casadi_real **, casadi_real **, casa
     m->res[0] = out0;
     m->res[1] = out1;
     m->res[2] = out2;
+    m->res[3] = m->jd;          /* kn_rhs's fourth output; no other Function has one */
     return f(m->arg, m->res, m->iw, m->w, 0);
+}
+
+/* The signed health of the n-by-n column-major matrix J: det(J) over the product of its
+ * rows' norms (Gaussian elimination with partial pivoting on a copy). */
+static double health(Instance *m, const double *J, int n)
+{
+    double *a = m->lu, sign = 1, value = 1;
+    int i, j, k;
+    for (i = 0; i < n * n; i++)
+        a[i] = J[i];
+    for (i = 0; i < n; i++) {           /* rows scaled to unit norm */
+        double norm = 0;
+        for (j = 0; j < n; j++)
+            norm += a[i + j * n] * a[i + j * n];
+        norm = sqrt(norm);
+        if (!(norm > 0))
+            return 0;
+        for (j = 0; j < n; j++)
+            a[i + j * n] /= norm;
+    }
+    for (k = 0; k < n; k++) {
+        int pivot = k;
+        for (i = k + 1; i < n; i++)
+            if (fabs(a[i + k * n]) > fabs(a[pivot + k * n]))
+                pivot = i;
+        if (a[pivot + k * n] == 0)
+            return 0;
+        if (pivot != k) {
+            for (j = 0; j < n; j++) {
+                double tmp = a[k + j * n];
+                a[k + j * n] = a[pivot + j * n];
+                a[pivot + j * n] = tmp;
+            }
+            sign = -sign;
+        }
+        value *= a[k + k * n];
+        for (i = k + 1; i < n; i++) {
+            double factor = a[i + k * n] / a[k + k * n];
+            for (j = k + 1; j < n; j++)
+                a[i + j * n] -= factor * a[k + j * n];
+        }
+    }
+    return sign * value;
 }
 
 /* The inputs the environment has not set follow their blocks' own values at time t. */
@@ -228,6 +282,21 @@ static int rates(Instance *m, double t, const double *x, double *z, double *dx, 
                      "(off by %g): the mechanism reached a dead point, where kinetwork's own "
                      "run re-partitions its coordinates; an FMU keeps those it was exported "
                      "with", t, closure);
+#if ND > 0
+        else {
+            double now = health(m, m->jd, ND);
+            if (m->n.health0 == 0)
+                m->n.health0 = now;
+            if (!(fabs(now) >= HEALTH_LIMIT) || now * m->n.health0 < 0)
+                snprintf(m->why, sizeof m->why, "t = %.17g s: the kinematic loops reach a "
+                         "dead point of the partition of their speeds this FMU was exported "
+                         "with (the closure's Jacobian in the dependent speeds %s); "
+                         "kinetwork's own run re-partitions there, an FMU cannot: stop "
+                         "before it, or choose other independent coordinates", t,
+                         now * m->n.health0 < 0 ? "changed the sign of its determinant"
+                                                : "turned singular");
+        }
+#endif
     }
     if (!m->why[0])
         return 1;
@@ -572,7 +641,7 @@ static fmi2Status advance(Instance *m, double t_end)
 {
     Numbers *n = &m->n;
     double x0[NX + 1];
-    int fresh = 1, i;
+    int fresh = 1, forced = 0, i;
     long steps = 0;
     while (t_end - n->time > 1e-15 * fmax(1.0, fabs(t_end))) {
         double t = n->time, bound = t_end, h, e;
@@ -602,14 +671,21 @@ static fmi2Status advance(Instance *m, double t_end)
          * of every step that ends there) costs it at most MIN_STEP times the jump */
         if (!(e >= 0 && isfinite(e)) || !(e <= 1.0 || h <= MIN_STEP * fmax(1.0, fabs(t)))) {
             double factor = e < 0 || !isfinite(e) ? 0.25 : fmax(0.2, 0.9 * pow(e, -0.2));
+            /* the equations fail however short the step: whatever they failed on (a dead
+             * point, a force that blows up) lies within MIN_STEP, not ahead of it */
+            if (h <= MIN_STEP * fmax(1.0, fabs(t)))
+                return fail(m, "%s (the step size collapsed to %g s there)",
+                            m->why[0] ? m->why : "the error estimate is not finite", h);
             n->h = h * factor;
-            if (n->h < 1e-14 * fmax(1.0, fabs(t)))
-                return e < 0 ? fail(m, "the step size collapsed near the state where %s",
-                                    m->why)
-                             : fail(m, "t = %.17g s: the step size collapsed (%g s) at the "
-                                       "tolerance %g", t, n->h, n->tolerance);
             continue;
         }
+        if (!(e <= 1.0) && ++forced > FORCED_STEPS)
+            return fail(m, "t = %.17g s: the step size collapsed (%g s) at the tolerance %g: "
+                           "the rates change faster than any step can follow%s", t, h,
+                        n->tolerance, KN_PROJECTED ? " (a kinematic loop near a dead point?)"
+                                                   : "");
+        if (e <= 1.0)
+            forced = 0;
         for (i = 0; i < NX; i++)
             x0[i] = n->x[i];
 #if NG > 0
@@ -637,7 +713,8 @@ static fmi2Status advance(Instance *m, double t_end)
         }
         n->time = stop_at_bound ? bound : t + h;
         n->steps++;
-        n->h = h * fmin(5.0, fmax(0.2, 0.9 * pow(fmax(e, 1e-10), -0.2)));
+        n->h = fmax(h * fmin(5.0, fmax(0.2, 0.9 * pow(fmax(e, 1e-10), -0.2))),
+                    forced ? MIN_STEP * fmax(1.0, fabs(t)) : 0.0);
         if (stop_at_bound && n->h < h)
             n->h = fmax(n->h, h);
 #if NR > 0
