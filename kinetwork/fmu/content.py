@@ -121,7 +121,9 @@ class Content:
 
 @dataclass
 class Held:
-    """The relations of the equations as the FMU holds them (none: all lists empty). Each
+    """The relations of the equations as the FMU holds them: none today (all lists empty,
+    as the System locates no events on its relations and kn.simulate integrates through them);
+    the runtime's event handling runs on what these lists name. Each
     node k has a held value p[NP + k]; ``time_node`` lists those switching at instants known
     in closed form (``time_level``: at whole numbers of their indicator), ``indicator_node``
     those located by an event indicator (``indicator_le``: a ``<=``; ``indicator_state``: a

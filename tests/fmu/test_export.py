@@ -226,6 +226,9 @@ def test_nothing_else_overwritten(tmp_path):
     assert sorted(p.name for p in tmp_path.iterdir()) == ["notes.fmu"]
 
 
+# FMPy's CVode calls the FMU from a ctypes callback, whose exception Python reports as
+# unraisable before FMPy raises its own
+@pytest.mark.filterwarnings("ignore::pytest.PytestUnraisableExceptionWarning")
 def test_dead_point_stops_the_fmu(tmp_path):
     """The five-revolute loop meets a dead point of its partition at t = 1.07 s, where
     kn.simulate re-partitions: the FMU, which keeps its partition, stops there with an error
@@ -265,3 +268,20 @@ def test_rebuilt_from_its_sources(exported, tmp_path):
     t, ref = reference(model)
     err, col = worst(t, ref, run_fmu(rebuilt, "CoSimulation", t))
     assert err < TOL, f"{col} off by {err:.3g} of its scale"
+
+
+def test_command_line(tmp_path, capsys):
+    """kinetwork export MODEL --fmu out.fmu writes a valid FMU; refuses, exit 1, to replace
+    a file that is not one."""
+    from kinetwork.cli import main
+    out = tmp_path / "pendulum.fmu"
+    assert main(["export", "double_pendulum", "--fmu", str(out), "--kind", "cs"]) == 0
+    assert "wrote the FMU of double_pendulum" in capsys.readouterr().out
+    assert validate_fmu(str(out)) == []
+    root, _ = description(out)
+    assert root.find("CoSimulation") is not None and root.find("ModelExchange") is None
+    mine = tmp_path / "mine.fmu"
+    mine.write_text("keep me")
+    assert main(["export", "double_pendulum", "--fmu", str(mine)]) == 1
+    assert "not an FMU; not replaced" in capsys.readouterr().err
+    assert mine.read_text() == "keep me"

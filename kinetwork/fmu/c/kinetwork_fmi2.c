@@ -10,8 +10,10 @@
  * Value references: states 0..NX-1, their rates NX..2NX-1, then the parameters, the inputs
  * and the outputs, in that order (the model description lists them the same way).
  *
- * Events. A relation of the equations (a < b, a Step, a limiter: kinetwork.equations.
- * relations) is held at a value r between events, as kinetwork's own runs hold it. A relation
+ * Events. A relation of the equations (a < b, a Step, a limiter) is held at a value r
+ * between events. Today's equations hold none (NR = 0: kn.simulate integrates through them
+ * and so does the FMU, with the relations inside the rates); the machinery below is what the
+ * FMU runs once content.py hands it the relations the equations locate events on. A relation
  * on time whose switching instants are known in closed form gives time events (nextEventTime:
  * at each, it is held at its value in the middle of the stretch that begins there); any other
  * gives an event indicator, positive while the value it is held at is its own, which flips
@@ -227,7 +229,7 @@ static void inputs_at(Instance *m, double t)
 #endif
 }
 
-static int finite(const double *v, int n)
+static int all_finite(const double *v, int n)
 {
     int i;
     for (i = 0; i < n; i++)
@@ -250,7 +252,7 @@ static int solve_z(Instance *m, double t, const double *x, double *z)
             size = fmax(size, fabs(step[i]));
             z[i] = step[i];
         }
-        if (!finite(z, NZ))
+        if (!all_finite(z, NZ))
             return 0;
         if (change <= 1e-12 * (1 + size))
             return 1;
@@ -273,7 +275,7 @@ static int rates(Instance *m, double t, const double *x, double *z, double *dx, 
                  "converge", t, KN_ALGEBRAIC_NAMES);
     else {
         call(m, kn_rhs, t, x, z, dx, m->alg, &closure);
-        if (!finite(dx, NX))
+        if (!all_finite(dx, NX))
             snprintf(m->why, sizeof m->why, "t = %.17g s: the rates of the states are not "
                      "finite (a force or a parameter expression blows up%s)", t,
                      KN_PROJECTED ? ", or a kinematic loop reached a dead point" : "");
@@ -502,7 +504,7 @@ static fmi2Status initialize(Instance *m)
     }
     for (i = 0; i < NZ; i++)
         m->n.z[i] = kn_z0[i];
-    if (!finite(m->n.x, NX))
+    if (!all_finite(m->n.x, NX))
         return fail(m, "the initial state is not finite for these parameters");
 #if NR > 0
     if (!start_relations(m, m->n.time))
