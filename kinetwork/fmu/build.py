@@ -3,7 +3,7 @@ descriptions in ``sources/``, compiled into ``binaries/<platform>/``, zipped.
 
 The FMI 2.0 headers (fmi2Functions.h, fmi2FunctionTypes.h, fmi2TypesPlatform.h; BSD-2-Clause,
 Modelica Association) are copied from the FMPy installation (the ``fmu`` extra), licence
-notices and all, so that the sources compile anywhere (``fmpy.util.compile_platform_binary``
+notices and all, so that the sources compile anywhere (``fmpy.build.build_platform_binary``
 rebuilds the binary from them for another platform).
 """
 

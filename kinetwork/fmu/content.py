@@ -244,7 +244,8 @@ def _functions(out, system, inputs, flat):
     start = _start(out, system)
     f["kn_start"] = ca.Function("kn_start", [p], [start], ["p"], ["x_start"])
     projection = _projection(system) if out.projected else x
-    f["kn_project"] = ca.Function("kn_project", args, [ca.densify(projection)], names, ["x_projected"])
+    f["kn_project"] = ca.Function("kn_project", args, [ca.densify(projection)], names,
+                                  ["x_projected"])
     f["kn_input"] = ca.Function("kn_input", [t, p], [_input_values(flat, inputs, system, t, p)],
                                 ["t", "p"], ["u"])
     out.relations = Held()
