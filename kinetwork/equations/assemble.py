@@ -362,7 +362,7 @@ def _symbols(names, suffix):
 
 
 def _speed_units(joint):
-    if hasattr(joint, "speed_units"):
+    if hasattr(type(joint), "speed_units"):
         return joint.speed_units()
     return ["m/s"] * 3 + ["rad/s"] * 3 if joint.dof == 6 else ["rad/s"] * joint.dof
 
