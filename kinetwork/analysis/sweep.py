@@ -356,7 +356,7 @@ def run_batch(job, values, batch=None):
     key = job.settings["method"]
     batched = key in BATCHED and not job.system.n_algebraic and job.system.n_states and \
         getattr(job.system, "modes", None) is None and \
-        job.system.eq.clock is None
+        getattr(job.system, "relations", None) is None and job.system.eq.clock is None
     if batched and prepared:
         prepared = _finite_start(job, prepared, out)
     if not batched or not prepared:

@@ -151,9 +151,17 @@ class Limiter(PartialSISO, library=LIB):
 
 class Table(PartialBlock, library=LIB):
     """y interpolated linearly in ``table`` rows [x, y] at u (or at time t when u is not
-    wired), extrapolated linearly from the end rows."""
+    wired), extrapolated linearly from the end rows. Two rows with the same x are a step,
+    as in MSL's CombiTimeTable: the first row's y up to x, the second's from x on.
+
+    Read in time, every breakpoint is a time event (the integration stops there, as MSL's
+    CombiTimeTable's do): a table of up to ``expression_rows`` rows; a longer one at its
+    steps only. Read at a signal of the states, its kinks are taken as they are (as MSL's
+    CombiTable1D: the integrator's error control follows them) and its steps are state
+    events."""
     u = Port("signal_in", "Abscissa (unwired: time)", optional=True)
-    table = Param(kind="table", doc="Rows [x, y], x increasing (at most 100 000)")
+    table = Param(kind="table", doc="Rows [x, y], x increasing; two rows with the same x "
+                                    "are a step (at most 100 000 rows)")
     #: a table of up to this many rows is an expression (``kinetwork equations`` prints it);
     #: a longer one a CasADi interpolant, which costs time linear in the rows to build and
     #: compile to C, where the expression's cost grows with their square (10 000 rows:
@@ -165,8 +173,11 @@ class Table(PartialBlock, library=LIB):
         xs = [row[0] for row in self.table]
         ys = [row[1] for row in self.table]
         if len(xs) <= self.expression_rows:
-            return ca.pw_lin(at, ca.DM(xs), ca.DM(ys))
-        return ca.interpolant(f"{self.name}_table", "linear", [xs], ys)(at)
+            return piecewise_linear(at, xs, ys)
+        knots, left, jumps = _steps(xs, ys)
+        # the table less its steps is continuous: an interpolant, the steps added to it
+        smooth = ca.interpolant(f"{self.name}_table", "linear", [knots], left)(at)
+        return smooth + sum((j * (k <= at) for k, j in zip(knots, jumps) if j), ca.SX(0))
 
 
 class Integrator(PartialSISO, library=LIB):
@@ -431,7 +442,44 @@ def _hats(at, grid):
     """The piecewise-linear hat functions of ``grid`` at ``at``, extrapolated linearly (they
     sum to one): a linear interpolant is their product with the values."""
     eye = np.eye(len(grid))
-    return ca.vertcat(*[ca.pw_lin(at, ca.DM(grid), ca.DM(eye[k])) for k in range(len(grid))])
+    return ca.vertcat(*[piecewise_linear(at, grid, eye[k]) for k in range(len(grid))])
+
+
+def _steps(xs, ys):
+    """(knots, values, jumps) of a table whose equal x's are steps: at each distinct x, the
+    value of the table less the steps before it (continuous), and the step there (0:
+    none)."""
+    knots, left, jumps = [], [], []
+    total = 0.0
+    i = 0
+    while i < len(xs):
+        equal = i + 1 < len(xs) and xs[i + 1] == xs[i]
+        step = ys[i + 1] - ys[i] if equal else 0.0
+        knots.append(xs[i])
+        left.append(ys[i] - total)
+        jumps.append(step)
+        total += step
+        i += 2 if equal else 1
+    return knots, left, jumps
+
+
+def piecewise_linear(at, xs, ys):
+    """The linear interpolation of the rows (xs, ys) at ``at`` (extrapolated linearly from
+    the end segments; two equal x's a step to the second y), as kinks ``fmax(at - x, 0)``
+    and steps ``x <= at``: on time both are time events, on the states the kinks are taken
+    as they are and the steps are state events (``kinetwork.equations.relations``)."""
+    knots, left, jumps = _steps(list(xs), list(ys))
+    if len(knots) == 1:
+        return ca.SX(left[0]) + jumps[0] * (knots[0] <= at)
+    slopes = [(left[j + 1] - left[j]) / (knots[j + 1] - knots[j]) for j in range(len(knots) - 1)]
+    y = left[0] + slopes[0] * (at - knots[0])
+    for j in range(1, len(knots) - 1):
+        if slopes[j] != slopes[j - 1]:
+            y = y + (slopes[j] - slopes[j - 1]) * ca.fmax(at - knots[j], 0)
+    for k, jump in zip(knots, jumps):
+        if jump:
+            y = y + jump * (k <= at)
+    return y
 
 
 class VectorParam(Param):

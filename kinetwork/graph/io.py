@@ -333,8 +333,9 @@ def _simulation(settings, problems):
         problems.append(f"simulation: must be an object, got {_kind(settings)}")
         return {}
     found = [p for p in (check_setting(k, v) for k, v in settings.items()) if p]
-    if not found and "step" in settings and "t_end" in settings:     # what they cost together
-        found = [p for p in [check_steps(settings["t_end"], settings["step"])] if p]
+    for key in ("step", "max_step"):                              # what they cost together
+        if not found and key in settings and "t_end" in settings:
+            found = [p for p in [check_steps(settings["t_end"], settings[key], key)] if p]
     problems.extend(found)
     return dict(settings)
 

@@ -55,7 +55,7 @@ if TYPE_CHECKING:                     # annotations only
     from ..graph.model import Model
 
 DEFAULTS = {"t_end": 10.0, "n_points": 1001, "method": "auto", "rtol": 1e-6, "atol": 1e-8,
-            "step": None}
+            "step": None, "max_step": None}
 #: a chunk of a CasADi integration is sized to about this much work (evaluations of the
 #: equations times their instructions: ~1 ns an instruction compiled, ~10 in CasADi's virtual
 #: machine, so 0.1 to 1 s): cancellation, time limits and progress are served between
@@ -102,7 +102,10 @@ class Run:
         self.t_start, self.t_end = float(grid[0]), float(grid[-1])
         self.spacing = float(grid[1] - grid[0])
         self.rtol, self.atol = settings["rtol"], settings["atol"]
+        self.max_step = settings["max_step"]
         self.step = settings["step"]
+        if self.max_step is not None and self.max_step < (self.step or self.spacing):
+            self.step = self.max_step        # a fixed step is a largest step too
         self.steps_per_interval = max(1, math.ceil(self.spacing / (self.step or self.spacing)
                                                    * (1 - 1e-12)))
         self.max_steps = settings["max_steps"]
@@ -116,7 +119,10 @@ class Run:
         self.said = []                  # what the solvers printed
         self.quiet = False              # nothing to watch: one call over the grid
         self.abortable = False          # a signal now aborts the compiled call
-        self.events = None              # friction and stops: events.Events
+        self.events = None              # friction, stops, relations: events.Events
+        #: the parameters of the equations the integrators see (``compiled.Held``): the
+        #: model's, then the values the relations are held at (``switches.py``)
+        self.p_solver = p
 
     # -- what methods use --------------------------------------------------------------------
     @contextlib.contextmanager
@@ -147,8 +153,13 @@ class Run:
     def rate(self, t, X):
         """d(x)/dt at a consistent full state X = (x, z), as IDAS's ``init_xdot``."""
         nx = self.system.n_states
-        rate = self.system.f_dae(t, X[:nx], X[nx:], self.p)[0]
+        rate = self.compiled.held.f_dae(t, X[:nx], X[nx:], self.p_solver)[0]
         return tuple(float(v) for v in np.asarray(rate).ravel())
+
+    def bound(self, t):
+        """The time a method started at t must not step past: the next time event, or the
+        end of the run."""
+        return self.t_end if self.events is None else self.events.bound(t)
 
     def stop_reason(self):
         """Why the run must stop now (cancelled, interrupted, out of time), or None."""
@@ -170,7 +181,8 @@ class Run:
 def simulate(model: Model | System, t_end: float | None = None, n_points: int | None = None,
              method: str | None = None, rtol: float | None = None, atol: float | None = None,
              params: Mapping[str, float | str] | None = None, t_start: float = 0.0,
-             step: float | None = None, jit: bool | None = None, max_steps: int | None = None,
+             step: float | None = None, max_step: float | None = None,
+             jit: bool | None = None, max_steps: int | None = None,
              time_limit: float | None = None, progress: Callable[[float], object] | None = None,
              cancel: Callable[[], object] | None = None, restart: bool = False,
              repartition: bool = True, error_estimate: bool = False) -> Results:
@@ -194,6 +206,10 @@ def simulate(model: Model | System, t_end: float | None = None, n_points: int | 
     step : float, optional
         Largest step [s] of the fixed-step methods (``rk``, ``collocation``, ``midpoint``);
         default: the output spacing.
+    max_step : float, optional
+        Largest step [s] of every method: the variable-step ones never step further (an
+        input that no relation announces, a smooth pulse, cannot be stepped over), and a
+        fixed step is at most this long.
     params : dict, optional
         Model parameter values for this run, numbers (SI) or numbers with a unit
         (``{"c": "2 N*m/rad"}``, see ``Model.parameter_values``); no recompilation.
@@ -243,7 +259,7 @@ def simulate(model: Model | System, t_end: float | None = None, n_points: int | 
     """
     system = model if isinstance(model, System) else model.compile()
     given = {"t_end": t_end, "n_points": n_points, "method": method, "rtol": rtol,
-             "atol": atol, "step": step}
+             "atol": atol, "step": step, "max_step": max_step}
     settings = {**DEFAULTS, **system.model.simulation,
                 **{k: v for k, v in given.items() if v is not None}}
     key = _check(system, settings, t_start, max_steps, time_limit)
@@ -261,7 +277,8 @@ def simulate(model: Model | System, t_end: float | None = None, n_points: int | 
     jit_on = _jit.enabled(jit) and system.n_states > 0
     run = Run(system, p, x0, grid, settings, None, cancel, progress, restart)
     run.repartition = bool(repartition)
-    if system.modes is not None:       # modes consistent with the start, before any method
+    if system.modes is not None or system.relations is not None:
+        # modes consistent with the start, relations' values there, before any method
         run.events = Events(run)
         run.x0 = run.events.start(float(grid[0]), run.x0)
     with _running(run):
@@ -279,6 +296,7 @@ def simulate(model: Model | System, t_end: float | None = None, n_points: int | 
         stats["solver_output"] = "".join(run.said)
     if run.events is not None:
         stats["events"] = run.events.log
+        stats["time_events"] = run.events.time_events
     stats["jit"] = bool(run.jit) and not stats.get("jit_fallback")
     t = grid[:len(X)]
     parts = getattr(run, "partitions", None)
@@ -294,7 +312,8 @@ def simulate(model: Model | System, t_end: float | None = None, n_points: int | 
                       settings={"t_start": t_start, "t_end": settings["t_end"],
                                 "n_points": settings["n_points"], "method": key,
                                 "rtol": settings["rtol"], "atol": settings["atol"],
-                                "step": settings["step"], "jit": stats["jit"],
+                                "step": settings["step"], "max_step": settings["max_step"],
+                                "jit": stats["jit"],
                                 "max_steps": max_steps, "time_limit": time_limit,
                                 "restart": restart, "params": dict(params or {})},
                       probe_targets=system.probe_targets, system=system)
@@ -311,6 +330,7 @@ def simulate(model: Model | System, t_end: float | None = None, n_points: int | 
         again = {"t_end": settings["t_end"], "n_points": settings["n_points"],
                  "method": key if key in METHODS else None,
                  "rtol": settings["rtol"], "atol": settings["atol"], "step": settings["step"],
+                 "max_step": settings["max_step"],
                  "params": params, "t_start": t_start, "jit": jit, "max_steps": max_steps,
                  "time_limit": time_limit, "cancel": cancel, "restart": restart,
                  "repartition": repartition}
@@ -343,6 +363,17 @@ def _check(system, settings, t_start, max_steps, time_limit):
     if key not in METHODS:
         raise ModelError(f"method {settings['method']!r:.60}: unknown{suggest(key, METHODS)}; "
                          f"methods are {', '.join(METHODS)}")
+    rel = system.relations
+    located = [f"friction or stops ({', '.join(c.name for c in system.modes.comps)})"] \
+        if system.modes is not None else []
+    if rel is not None and len(rel.state):
+        located.append(f"a relation on the states, {rel.text(rel.state[0])}; write it in "
+                       f"noEvent(...) to take it as it is")
+    if located and "state" not in METHODS[key].events:
+        raise ModelError(
+            f"method {settings['method']!r} locates no state events, and "
+            f"{system.model.name!r} has them: {'; '.join(located)}. Use 'auto', a CVODES, "
+            f"IDAS or scipy method, 'rk' or 'collocation'")
     if system.n_algebraic and not METHODS[key].dae:
         raise ModelError(
             f"method {settings['method']!r} integrates ODEs only, and {system.model.name!r} "
@@ -404,8 +435,8 @@ def _integrate(run, method):
         and run.deadline is None
     chunk = n - 1 if method.stepper or run.quiet else _first_chunk(run, method, n - 1)
     if run.events is not None:
-        run.events.log = []            # of this method (auto may try another after it)
-        chunk = min(chunk, EVENT_CHUNK)
+        run.events.reset()             # of this method (auto may try another after it)
+        chunk = min(chunk, EVENT_CHUNK) if run.events.located else chunk
     k, failure = 0, None
     restart_at = None                   # with events: where the last one left the run
     while k < n - 1:
@@ -461,7 +492,8 @@ def _integrate(run, method):
             chunk = n - 1 - k
         elif not method.stepper:
             chunk = _next_chunk(run, m, _work(run, stepper.stats) - work_before, n - 1 - k)
-            chunk = chunk if run.events is None else min(chunk, EVENT_CHUNK)
+            chunk = chunk if run.events is None or not run.events.located \
+                else min(chunk, EVENT_CHUNK)
             chunk = parts.limit(chunk)
         elif run.events is not None:
             chunk = 1
