@@ -97,6 +97,76 @@ class Sine(PartialBlock, library=LIB):
         return self.offset + ca.if_else(t >= self.start_time, wave, 0)
 
 
+class PartialPeriodic(PartialBlock):
+    """A periodic signal from start_time on, as MSL's periodic sources: ``nperiod`` periods
+    (< 0: without end), ``offset`` before and after. Its edges and kinks are time events."""
+    period = Param(1.0, unit="s", positive=True, doc="Time for one period")
+    nperiod = Param(-1.0, unit="1", doc="Number of periods (< 0: without end)")
+    offset = Param(0.0, doc="Output before start_time (added to it after)")
+    start_time = Param(0.0, unit="s", doc="Start of the first period")
+
+    def wave(self, phase):
+        """The output less the offset, at ``phase`` in [0, period) of a period."""
+        raise NotImplementedError
+
+    def output(self, u, x, t):
+        tau = t - self.start_time
+        running = tau >= 0
+        n = ca.SX(self.nperiod)
+        last = tau < n * self.period
+        if n.is_constant():
+            running = running * last if float(n) >= 0 else running
+        else:
+            running = running * ca.if_else(n < 0, 1, last)
+        return self.offset + running * self.wave(ca.fmod(tau, self.period))
+
+
+class Pulse(PartialPeriodic, library=LIB):
+    """A pulse train as MSL's Blocks.Sources.Pulse: amplitude for the first ``width`` % of
+    each period, 0 for the rest (plus offset)."""
+    amplitude = Param(1.0, doc="Amplitude of the pulses")
+    width = Param(50.0, unit="1", min=0.0, max=100.0, doc="Width of a pulse, % of the period")
+
+    def wave(self, phase):
+        return self.amplitude * (phase < self.width / 100 * self.period)
+
+
+class SawTooth(PartialPeriodic, library=LIB):
+    """A saw tooth as MSL's Blocks.Sources.SawTooth: rising from 0 to amplitude over each
+    period, falling back at once (plus offset)."""
+    amplitude = Param(1.0, doc="Amplitude of the teeth")
+
+    def wave(self, phase):
+        return self.amplitude * phase / self.period
+
+
+class Trapezoid(PartialPeriodic, library=LIB):
+    """A trapezoid train as MSL's Blocks.Sources.Trapezoid: in each period, rising from 0 to
+    amplitude over ``rising``, holding it for ``width``, falling back over ``falling``, 0 for
+    the rest (plus offset)."""
+    amplitude = Param(1.0, doc="Amplitude of the trapezoids")
+    rising = Param(0.0, unit="s", min=0.0, doc="Rising duration")
+    width = Param(0.5, unit="s", min=0.0, doc="Duration at the amplitude")
+    falling = Param(0.0, unit="s", min=0.0, doc="Falling duration")
+
+    def check_values(self, values, place):
+        total = [values[k] for k in ("rising", "width", "falling", "period")]
+        if all(isinstance(v, (int, float)) for v in total) and \
+                sum(total[:3]) > total[3] * (1 + 1e-12):
+            return [f"{place('period')} = {total[3]}: shorter than rising + width + falling "
+                    f"= {sum(total[:3])}"]
+        return []
+
+    def wave(self, phase):
+        up, hold = self.rising, self.rising + self.width
+        down = hold + self.falling
+        rise = phase / ca.fmax(up, 1e-300)
+        fall = (down - phase) / ca.fmax(self.falling, 1e-300)
+        shape = ca.if_else(phase < up, rise,
+                           ca.if_else(phase < hold, 1, ca.if_else(phase < down, fall, 0)))
+        return self.amplitude * shape
+
+
 class Gain(PartialSISO, library=LIB):
     """y = k u."""
     k = Param(doc="Gain")

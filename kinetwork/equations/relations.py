@@ -214,8 +214,11 @@ def find(system):
     g_time = ca.vertcat(*[_indicator(nodes[i][0], nodes[i][3]) for i in time]) \
         if len(time) else ca.SX(0, 1)
     d_time = ca.jacobian(g_time, t)
-    # affine in t: its derivative is constant (no relation inside, no curve)
-    affine = np.array([not ca.depends_on(d_time[j], t) for j in range(len(time))], dtype=bool)
+    # affine in t: no event node inside it (held, it reads none of r) and its derivative
+    # constant (no curve)
+    held_time = [_indicator(nodes[i][0], nodes[i][2]) for i in time]
+    affine = np.array([not ca.depends_on(d_time[j], t) and not ca.depends_on(held_time[j], r)
+                       for j in range(len(time))], dtype=bool)
     names = ["t"] + list(system.state_names) + list(system.algebraic_names)
     symbols = [t] + list(inputs[1]) + list(inputs[2])
     out = Relations(

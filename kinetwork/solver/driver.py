@@ -426,6 +426,10 @@ def _integrate(run, method):
                              f"is smaller than the {run.steps_per_interval} steps of "
                              f"{run.step or run.spacing:g} s that the fixed-step method "
                              f"takes"), stats
+    if run.events is not None:
+        # as at the start, with the values held there (auto may try another method after
+        # one that failed, later in the run)
+        run.events.reset()
     try:
         stepper = method.start(run, grid[0], X[0])
     except Failure as failure:
@@ -434,9 +438,8 @@ def _integrate(run, method):
         run.system.f_dependent is None and run.progress is None and run.cancel is None \
         and run.deadline is None
     chunk = n - 1 if method.stepper or run.quiet else _first_chunk(run, method, n - 1)
-    if run.events is not None:
-        run.events.reset()             # of this method (auto may try another after it)
-        chunk = min(chunk, EVENT_CHUNK) if run.events.located else chunk
+    if run.events is not None and run.events.located:
+        chunk = min(chunk, EVENT_CHUNK)
     k, failure = 0, None
     restart_at = None                   # with events: where the last one left the run
     while k < n - 1:

@@ -313,7 +313,7 @@ class Events:
         self._last = (t, count)
         if count > ZENO_LIMIT:
             raise Failure(f"{ZENO_LIMIT} events at t = {t:.15g} s without time passing: "
-                          f"{source.name(k)} chatter(s)")
+                          f"{source.chatter(k)}")
         return source.apply(t, x, k)
 
 

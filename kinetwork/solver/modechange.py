@@ -62,8 +62,9 @@ class ModeChanges:
             self.run.p)).reshape(k, len(rows), -1)
         return table[:, :, 0].T, table[:, :, RATE].T
 
-    def name(self, i):
-        return f"the modes of {self.modes.comps[i].name}"
+    def chatter(self, i):
+        """Why events of element i pile up at one instant, in words."""
+        return f"the modes of {self.modes.comps[i].name} chatter"
 
     def values(self, t, x):
         """(k, 6): indicator, rel, w_rel, force, value0, value1 of every element."""

@@ -8,7 +8,9 @@ where it crosses a whole number: those instants are exact. Any other (``sin(w*t)
 scanned at SCAN points over the run, and between two of them a switch is found where the
 indicator changes sign, or where it has an extremum (its derivative changes sign) beyond
 zero: two switches close together, a pulse shorter than the scan's spacing. Each is then
-located by Brent's method to about 1e-15 s.
+located by Brent's method to about 1e-15 s. (A curved pulse so narrow that its indicator and
+derivative are flat zero at the scan's points, exp(-((t - t0)/1e-6)^2), is not seen: write
+such a pulse's edges as relations on t, which are exact.)
 """
 
 import math
@@ -82,7 +84,7 @@ class Schedule:
         grid = np.union1d(np.linspace(self.t_start, self.t_end, SCAN + 1),
                           [t for t in known if self.t_start < t < self.t_end])
         table = np.asarray(mapped(f, len(grid))(grid[None, :], p), dtype=float)
-        table = table.reshape(k, len(grid), 2, order="F")
+        table = table.reshape(k, len(grid), 2)        # (k, 2n): [g, rate] per time
         out = []
         for j in others:
             g, rate = table[j, :, 0], table[j, :, 1]

@@ -82,8 +82,12 @@ class Switches:
         sign = np.where(self.r[self.relations.state] > 0.5, 1.0, -1.0)[None, :]
         return sign * g.T, sign * rate.T
 
-    def name(self, i):
-        return f"the relation {self.relations.text(self.relations.state[i])}"
+    def chatter(self, i):
+        """Why events of relation i pile up at one instant, in words."""
+        return (f"the relation {self.relations.text(self.relations.state[i])} chatters: the "
+                f"motion crosses it back at once each time (a Coulomb law written as if_else "
+                f"on a speed, at rest); use a friction element, which sticks, or write the "
+                f"relation in noEvent(...) to integrate it as it is")
 
     # -- the held values -------------------------------------------------------------------
     def start(self, t, x):
