@@ -1,0 +1,141 @@
+"""Time events (``solver/schedule.py``, ``solver/events.py``): every method stops at the
+breakpoints of the inputs and starts afresh there, so a short input is never stepped over.
+Against hand-written equations integrated by scipy's DOP853 piecewise across the breakpoints
+(``scenes/bumps.py``), with the default settings."""
+
+import json
+
+import numpy as np
+import pytest
+
+import kinetwork as kn
+from kinetwork.solver.methods import METHODS
+from scenes.bumps import BUMP, T_END, quarter_car, quarter_car_reference
+
+ROADS = ["expression", "table", "steps", "pulse", "pulse_blocks"]
+#: the methods that take a quarter car (midpoint: a multibody tree's joints only)
+VARIABLE = [m for m in METHODS if not METHODS[m].fixed]
+#: fixed steps: RK4 needs 1 ms for the 50 Hz filter of the tables (at the default, the
+#: output spacing of 3 ms, its error is 5e-5 m on the steps: the step's, not the events')
+FIXED = {"rk": 1e-3, "collocation": None}
+
+
+@pytest.fixture(scope="module")
+def references():
+    t = np.linspace(0.0, T_END, 1001)
+    return {road: quarter_car_reference(t, road) for road in ROADS}
+
+
+@pytest.fixture(scope="module")
+def systems():
+    return {road: quarter_car(road).compile() for road in ROADS}
+
+
+@pytest.mark.parametrize("method", [*VARIABLE, *FIXED])
+@pytest.mark.parametrize("road", ROADS)
+def test_the_quarter_car_over_a_bump_matches_the_piecewise_reference(systems, references,
+                                                                     road, method):
+    system = systems[road]
+    res = kn.simulate(system, t_end=T_END, method=method, step=FIXED.get(method))
+    ref = references[road]
+    for name, column in (("wheel.s", -4), ("body.s", -2)):
+        error = np.max(np.abs(res[name] - ref[:, column]))
+        assert error < 1e-6, (name, error)
+    assert res["body.s"].max() > 1e-3          # the bump was felt (it was not: 0 exactly)
+    assert res.stats["time_events"] == {"table": 3}.get(road, 2)
+
+
+def test_the_bump_is_not_stepped_over_whatever_the_output_grid():
+    # 4 outputs over 3 s: the integrator's steps are its own, the events still stop it
+    res = kn.simulate(quarter_car(), t_end=T_END, n_points=4)
+    ref = quarter_car_reference(res.t)
+    np.testing.assert_allclose(res["body.s"], ref[:, 2], atol=1e-6)
+    assert res.stats["time_events"] == 2
+
+
+def test_a_skipped_input_has_an_error_estimate_of_what_was_missed():
+    # the bump in noEvent: no event, and the default run steps over it (6 steps); its
+    # estimate, from repetitions that step at most the output spacing, is what it missed
+    model = quarter_car()
+    model.components["road"].set_param("s_ref", f"noEvent({BUMP})")
+    assert model.compile().relations is None
+    res = kn.simulate(model, t_end=T_END, error_estimate=True)
+    ref = quarter_car_reference(res.t)
+    missed = np.max(np.abs(res["body.s"] - ref[:, 2]))
+    assert missed > 1e-2
+    estimate = res.stats["error_estimate"]["signals"]["body.s"]["error"]
+    assert 0.5 * missed < estimate < 2 * missed
+    # with the events, the estimate is the run's own small error
+    res = kn.simulate(quarter_car(), t_end=T_END, error_estimate=True)
+    error = np.max(np.abs(res["body.s"] - quarter_car_reference(res.t)[:, 2]))
+    estimate = res.stats["error_estimate"]["signals"]["body.s"]["error"]
+    assert 0 < estimate and error / 10 < estimate < 10 * error
+
+
+def free_mass(force, parameters=None):
+    """A 2 kg mass at rest pushed by ``force`` (an expression in t)."""
+    m = kn.Model("free", parameters=parameters or {})
+    m.add(kn.translational.Mass("mass", m=2.0))
+    m.add(kn.translational.Force("push", f=force))
+    m.connect("push.flange", "mass.flange_a")
+    return m
+
+
+@pytest.mark.parametrize("method", sorted(set(METHODS) - {"midpoint"}))
+def test_a_pulse_far_shorter_than_the_outputs_gives_its_whole_impulse(method):
+    # 1 ms of 5 N at t0 + 0.3 (t0 a parameter, set per run): the speed after is 5e-3 / 2
+    model = free_mass("if_else(t - t0 > 0.3, if_else(t - t0 < 0.301, 5, 0), 0)", {"t0": 0.1})
+    for t0 in (0.1, 0.45):
+        res = kn.simulate(model, t_end=2.0, n_points=3, method=method, params={"t0": t0})
+        # the whole impulse, at the right time (scipy's BDF: within 2 atol of the position)
+        assert res["mass.v"][-1] == pytest.approx(2.5e-3, abs=1e-9)
+        assert res["mass.s"][-1] == pytest.approx(2.5e-3 * (2.0 - t0 - 0.3005), abs=1e-7)
+
+
+@pytest.mark.parametrize("method", ["auto", "rk45", "rk", "midpoint"])
+def test_a_kinematic_ptp_drive_reaches_its_end_exactly(method):
+    # a joint driven through the torque an inertia needs for the PTP's acceleration: its
+    # angle is the PTP's own, phases switching at 0.25, 1 and 1.25 s
+    m = kn.Model("ptp")
+    m.add(kn.multibody.Ground("ground", gravity=[0, 0, 0]))
+    m.add(kn.multibody.Revolute("joint", axis=[0, 0, 1]))
+    m.add(kn.multibody.RigidBody("body", mass=1.0, r_cm=[0, 0, 0],
+                                 inertia=[0.0, 0.0, 0.5]))
+    m.add(kn.rotational.Torque("drive"))
+    m.add(kn.signals.KinematicPTP("ptp", q_begin=[0], q_end=[1], qd_max=[1], qdd_max=[4],
+                                  quantity="qdd"))
+    m.add(kn.signals.Gain("J", k=0.5))
+    m.add(kn.Probe("p", quantities=["angle"]))
+    for a, b in [("ground.frame", "joint.frame_a"), ("joint.frame_b", "body.frame_a"),
+                 ("ptp.y", "J.u"), ("J.y", "drive.u"), ("drive.flange", "joint.axis"),
+                 ("p.port", "joint.axis")]:
+        m.connect(a, b)
+    step = {"rk": 0.01, "midpoint": 0.01}.get(method)
+    res = kn.simulate(m, t_end=2.0, n_points=9, method=method, rtol=1e-10, atol=1e-12,
+                      step=step)
+    tau = res.t
+    exact = np.where(tau < 0.25, 2 * tau**2, np.where(
+        tau < 1.0, 0.125 + (tau - 0.25), np.where(tau < 1.25, 1 - 2 * (1.25 - tau)**2, 1.0)))
+    np.testing.assert_allclose(res["p.angle"], exact, atol=1e-9)
+    assert res.stats["time_events"] == 3
+
+
+def test_a_table_with_steps_in_a_model_file_round_trips_and_runs(tmp_path):
+    model = quarter_car("steps")
+    model.simulation.update(t_end=T_END, max_step=0.5)
+    path = tmp_path / "steps.json"
+    model.save(path)
+    data = json.loads(path.read_text())
+    table = next(c for c in data["components"] if c["name"] == "profile")["params"]["table"]
+    assert [row[0] for row in table].count(0.5) == 2
+    assert data["simulation"]["max_step"] == 0.5
+    again = kn.load(path)
+    res = kn.simulate(again)
+    assert res.settings["max_step"] == 0.5
+    np.testing.assert_allclose(res["body.s"], quarter_car_reference(res.t, "steps")[:, -2],
+                               atol=1e-6)
+
+
+def test_a_table_refuses_three_equal_abscissae():
+    with pytest.raises(kn.ModelError, match=r"table\[3\]: x = 1 a third time"):
+        kn.signals.Table("t", table=[[0, 0], [1, 1], [1, 2], [1, 3]])
