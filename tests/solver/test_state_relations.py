@@ -12,8 +12,8 @@ from scenes.bumps import CONTACT, ball, ball_reference
 
 TAKES_STATE_EVENTS = sorted(m for m in METHODS if "state" in METHODS[m].events)
 #: scipy's BDF and LSODA get rtol as asked (only SUNDIALS' is tightened: tolerance.py); at
-#: 1e-9 their global error here is 3e-7 m, the contacts' times still within 1e-7 s
-HEIGHT = {"bdf": 1e-6, "lsoda": 1e-6}
+#: 1e-9 their global error here is 3e-7 m and 4e-5 m/s, the contacts' times within 1e-7 s
+LOOSE = {"bdf": (1e-6, 1e-4), "lsoda": (1e-6, 1e-4)}
 
 
 @pytest.fixture(scope="module")
@@ -37,8 +37,9 @@ def test_a_ball_bouncing_on_an_if_else_contact_matches_the_event_located_referen
     kinds = [e["kind"] for e in res.stats["events"]]
     assert kinds == ["relation true", "relation false"] * 4
     np.testing.assert_allclose(times, contacts, atol=1e-7)
-    np.testing.assert_allclose(res["ball.s"], states[:, 0], atol=HEIGHT.get(method, 1e-7))
-    np.testing.assert_allclose(res["ball.v"], states[:, 1], atol=1e-5)
+    height, speed = LOOSE.get(method, (1e-7, 1e-5))
+    np.testing.assert_allclose(res["ball.s"], states[:, 0], atol=height)
+    np.testing.assert_allclose(res["ball.v"], states[:, 1], atol=speed)
 
 
 @pytest.mark.parametrize("method", ["auto", "cvodes", "idas", "rk45", "dop853", "radau"])
