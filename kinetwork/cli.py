@@ -117,6 +117,9 @@ def build_parser():
     run.add_argument("--step", type=float, metavar="H",
                      help="largest step [s] of the fixed-step methods (rk, collocation, "
                           "midpoint; default: the output spacing)")
+    run.add_argument("--max-step", type=float, metavar="H",
+                     help="largest step [s] of every method (the variable-step ones too: an "
+                          "input no event announces cannot be stepped over)")
     run.add_argument("--jit", action=argparse.BooleanOptionalAction,
                      help="compile the equations to C with the system's compiler, cached on "
                           "disk (default: when a compiler is found)")
@@ -423,7 +426,8 @@ def _run(args):
         else:
             params[name] = value
     given = {"t_end": args.t_end, "n_points": args.n_points, "method": args.method,
-             "rtol": args.rtol, "atol": args.atol, "step": args.step}
+             "rtol": args.rtol, "atol": args.atol, "step": args.step,
+             "max_step": args.max_step}
     settings = {**DEFAULTS, **model.simulation,
                 **{k: v for k, v in given.items() if v is not None}}
     problems = check_settings(settings)     # before building anything
@@ -440,7 +444,8 @@ def _run(args):
         with _progress_bar(args, model, settings["t_end"]) as progress:
             results = kn.simulate(system, t_end=args.t_end, n_points=args.n_points,
                                   method=args.method, rtol=args.rtol, atol=args.atol,
-                                  step=args.step, jit=args.jit, params=params,
+                                  step=args.step, max_step=args.max_step, jit=args.jit,
+                                  params=params,
                                   max_steps=args.max_steps, time_limit=args.time_limit,
                                   progress=progress, error_estimate=args.error_estimate)
     except kn.SimulationError as exc:
@@ -698,8 +703,9 @@ def _methods(args):
     print(f"default: {DEFAULTS['method']}, rtol {DEFAULTS['rtol']:g}, atol {DEFAULTS['atol']:g}")
     for name, method in METHODS.items():
         kind = "fixed step" if method.fixed else "variable step"
+        events = " and ".join(method.events)
         print(f"  {name:<{width}}  {kind:<13}  " + textwrap.fill(
-            method.doc, 88, initial_indent=" " * (width + 19),
+            f"{method.doc}; events: {events}", 88, initial_indent=" " * (width + 19),
             subsequent_indent=" " * (width + 19)).lstrip())
     return 0
 

@@ -151,10 +151,10 @@ class Events:
         nxt = self.switches.next_time(t0) if self.switches is not None else None
         if nxt is not None and nxt <= times[-1] + _gap(times[-1]):
             j = int(np.searchsorted(times, nxt - _gap(nxt)))
-            if j < len(times) and abs(times[j] - nxt) <= _gap(nxt):
-                stops, at, at_output = times[:j + 1], float(times[j]), True   # an output's
-            else:
-                stops, at = np.append(times[:j], nxt), nxt
+            # at the event's own instant, which is an output's too when one is as close as
+            # rounding (0.6 and 0.6000000000000001): never a step past it
+            at, at_output = nxt, j < len(times) and abs(times[j] - nxt) <= _gap(nxt)
+            stops = np.append(times[:j], nxt)
         if self.located:
             # as often over a run whatever its output grid (a sparse grid must not miss a
             # short stick that a dense one sees); a fixed-step method keeps its own steps

@@ -356,6 +356,13 @@ class _ScipyRun:
                     while len(out) < len(times) and times[len(out)] <= solver.t:
                         out.append(dense(times[len(out)]))
                     continue
+                if solver.status == "finished":     # at its bound: the time asked is it
+                    if times[len(out)] - solver.t > 1e-13 * max(1.0, abs(solver.t)):
+                        raise Failure(f"asked for t = {times[len(out)]:.17g} s, past the time "
+                                      f"event at {solver.t:.17g} s the method stops at",
+                                      np.array(out).reshape(-1, len(solver.y)))
+                    out.append(np.array(solver.y))
+                    continue
                 message = solver.step()
                 in_interval, self.steps = in_interval + 1, self.steps + 1
                 if solver.status == "failed":

@@ -139,3 +139,19 @@ def test_a_table_with_steps_in_a_model_file_round_trips_and_runs(tmp_path):
 def test_a_table_refuses_three_equal_abscissae():
     with pytest.raises(kn.ModelError, match=r"table\[3\]: x = 1 a third time"):
         kn.signals.Table("t", table=[[0, 0], [1, 1], [1, 2], [1, 3]])
+
+
+def test_the_command_takes_max_step_and_shows_what_each_method_takes(tmp_path, capsys):
+    from kinetwork.cli import main
+    path = tmp_path / "car.json"
+    quarter_car().save(path)
+    out = tmp_path / "car.csv"
+    assert main(["run", str(path), "--t-end", "1", "--n-points", "11", "--method", "rk45",
+                 "--max-step", "0.001", "--out", str(out), "-q"]) == 0
+    data = np.loadtxt(out, delimiter=",", skiprows=1)
+    assert len(data) == 11
+    assert main(["run", str(path), "--max-step", "-1", "-q"]) == 1
+    assert "simulation.max_step: must be a finite number > 0" in capsys.readouterr().err
+    assert main(["methods"]) == 0
+    listing = capsys.readouterr().out
+    assert "events: time and state" in listing and "events: time\n" in listing
