@@ -434,7 +434,8 @@ def _integrate(run, method):
         stepper = method.start(run, grid[0], X[0])
     except Failure as failure:
         return np.array(X), failure.reason, stats
-    run.quiet = method.interruptible and run.events is None and \
+    # (time events alone: each call goes to the next of them, the method restarts there)
+    run.quiet = method.interruptible and (run.events is None or not run.events.located) and \
         run.system.f_dependent is None and run.progress is None and run.cancel is None \
         and run.deadline is None
     chunk = n - 1 if method.stepper or run.quiet else _first_chunk(run, method, n - 1)
