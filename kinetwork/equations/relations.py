@@ -152,7 +152,7 @@ def find(system):
             return _MODE if nz in modes else _X
         return _Z if i == 2 else 0
 
-    expressions = f.instructions_sx()
+    expressions = ca.vertsplit(f.instructions_sx())       # (indexing one by one: O(n) each)
     held = {}              # work slot -> its expression rebuilt with the nodes held
     flags = {}             # work slot -> what it depends on
     nodes = []             # (op, kind, rebuilt arguments, original arguments)
@@ -185,21 +185,22 @@ def find(system):
                 flags[slot] = flag
                 held.pop(slot, None)
             continue
-        e = expressions[k]
-        original = [e.dep(j) for j in range(len(ins_k))]
-        args = [held.get(slot, original[j]) for j, slot in enumerate(ins_k)]
         kind = _kind(op, flag)
         out = outs_k[0]
         flags[out] = flag
+        if kind is None and not any(slot in held for slot in ins_k):
+            held.pop(out, None)             # as it is
+            continue
+        e = expressions[k]
+        original = [e.dep(j) for j in range(len(ins_k))]
+        args = [held.get(slot, original[j]) for j, slot in enumerate(ins_k)]
         if kind is not None:
             r = ca.SX.sym(f"r{len(nodes)}")
             nodes.append((op, kind, args, original))
             r_all.append(r)
             held[out] = _held(op, args, r)
-        elif any(slot in held for slot in ins_k):
-            held[out] = ca.SX.binary(op, *args) if len(args) == 2 else ca.SX.unary(op, *args)
         else:
-            held.pop(out, None)
+            held[out] = ca.SX.binary(op, *args) if len(args) == 2 else ca.SX.unary(op, *args)
     if not nodes:
         return None
     r = ca.vertcat(*r_all)
