@@ -92,6 +92,12 @@ class Relations:
 
     def text(self, i):
         """Node i in words, for messages: what it compares or takes, and what it reads."""
+        texts = self.__dict__.setdefault("_texts", {})
+        if i not in texts:
+            texts[i] = self._text(i)
+        return texts[i]
+
+    def _text(self, i):
         args, names, symbols = self.reading[i]
         reads = [n for n, s in zip(names, symbols) if any(ca.depends_on(a, s) for a in args)]
         shown = " and ".join(_short(a) for a in args)

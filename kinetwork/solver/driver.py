@@ -496,8 +496,8 @@ def _integrate(run, method):
             chunk = n - 1 - k
         elif not method.stepper:
             chunk = _next_chunk(run, m, _work(run, stepper.stats) - work_before, n - 1 - k)
-            chunk = chunk if run.events is None or not run.events.located \
-                else min(chunk, EVENT_CHUNK)
+            if run.events is not None and run.events.located:
+                chunk = run.events.chunk(chunk, restart_at is not None)
             chunk = parts.limit(chunk)
         elif run.events is not None:
             chunk = 1

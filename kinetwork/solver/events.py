@@ -24,9 +24,10 @@ component, kind) for ``res.stats["events"]``; time events are counted
 Two crossings between two sampled points, which cancel out, are seen when the indicator has
 one minimum between them, not when it also has a maximum there (right after an event, an
 indicator at zero counts as positive, so a bounce within the first interval is found). Runs
-with state events go in short chunks of at most EVENT_CHUNK output intervals, as what follows
-an event in a chunk is computed again; a fixed-step method steps each sampled interval, so its
-steps are SAMPLES times shorter than without them.
+with state events go in chunks of EVENT_CHUNK output intervals after an event, as what
+follows an event in a chunk is computed again, twice as many after each chunk without one, up
+to MAX_EVENT_CHUNK (each chunk restarts a multistep method); a fixed-step method steps each
+sampled interval, so its steps are SAMPLES times shorter than without them.
 """
 
 import itertools
@@ -39,9 +40,10 @@ from .methods import Failure
 from .modechange import ModeChanges
 from .switches import Switches
 
-#: output intervals per chunk at most, in a run with state events (what follows an event in
-#: a chunk is computed again from it)
+#: output intervals of a chunk after an event, in a run with state events (what follows an
+#: event in a chunk is computed again from it), and at most after chunks without one
 EVENT_CHUNK = 8
+MAX_EVENT_CHUNK = 128
 #: points per output interval at least where the indicators are looked at
 SAMPLES = 4
 #: points over a run, at least, where the indicators are looked at (however sparse its
@@ -75,6 +77,7 @@ class Events:
         self._last = (None, 0)          # time of the last event, events at it
         self._held = None               # the held values of the start (``reset``)
         self._f_rhs = None
+        self._chunk = EVENT_CHUNK
 
     @property
     def located(self):
@@ -99,6 +102,12 @@ class Events:
                 return source, i
             i -= k
         raise IndexError(i)
+
+    def chunk(self, chunk, event):
+        """Output intervals of the next chunk of a run with state events, at most ``chunk``:
+        EVENT_CHUNK after an ``event``, else twice the last, up to MAX_EVENT_CHUNK."""
+        self._chunk = EVENT_CHUNK if event else min(2 * self._chunk, MAX_EVENT_CHUNK)
+        return min(chunk, self._chunk)
 
     def bound(self, t):
         """The time a method started at t must not step past: the next time event, or the
@@ -135,6 +144,7 @@ class Events:
         """Back to the start, for another method over the same run (``auto``)."""
         self.log = []
         self._last = (None, 0)
+        self._chunk = EVENT_CHUNK
         if self.switches is not None:
             self.switches.r = self._held.copy()
             self.switches.time_events = 0
