@@ -470,8 +470,10 @@ def _run(args):
     code = ("C, cached" if stats.get("jit_cached") else
             f"C, compiled in {stats['jit_seconds']:.2g} s" if "jit_seconds" in stats else
             "C" if stats.get("jit") else "CasADi virtual machine")
-    work = ", ".join(f"{stats[k]} {k.replace('_', ' ')}" for k in ("steps", "rhs_evaluations")
-                     if k in stats)
+    work = ", ".join([f"{stats[k]} {k.replace('_', ' ')}" for k in ("steps", "rhs_evaluations")
+                      if k in stats] + [f"{n} {what}" for what, n in (
+                          ("events", len(stats.get("events", ()))),
+                          ("time events", stats.get("time_events", 0))) if n])
     print(f"simulated t = {t[0]:g} .. {t[-1]:g} s ({len(t)} points) with {results.method} "
           f"({code}{'; ' + work if work else ''}) in {done - compiled:.3g} s wall time "
           f"(build {compiled - start:.3g} s)")

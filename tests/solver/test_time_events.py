@@ -150,6 +150,9 @@ def test_the_command_takes_max_step_and_shows_what_each_method_takes(tmp_path, c
                  "--max-step", "0.001", "--out", str(out), "-q"]) == 0
     data = np.loadtxt(out, delimiter=",", skiprows=1)
     assert len(data) == 11
+    capsys.readouterr()
+    assert main(["run", str(path), "--t-end", "1", "--n-points", "11"]) == 0
+    assert ", 2 time events) in" in capsys.readouterr().out
     assert main(["run", str(path), "--max-step", "-1", "-q"]) == 1
     assert "simulation.max_step: must be a finite number > 0" in capsys.readouterr().err
     assert main(["methods"]) == 0
