@@ -278,7 +278,11 @@ class _CasadiRun:
         event is looked for at (an integrator for each costs ~10 ms of CasADi's set-up)."""
         m, run = self.method, self.run
         if m.plugin == "idas":          # its options hold the state's rate: not reusable
-            return self.advance(np.array([t]), exact=True)[0]
+            fresh = _CasadiRun(m, run, self.t, self.x)      # from the start, every time
+            fresh.p = self.p
+            x = fresh.advance(np.array([t]), exact=True)[0]
+            _add_counts(self.stats, fresh.stats)
+            return x
         nx = run.system.n_states
         opts = self.options([t])
         key = ("stretch", m.plugin, tuple(sorted(opts.items())), bool(run.jit))
@@ -309,6 +313,13 @@ class _CasadiRun:
         else:
             self.stats["steps"] += self.run.steps_per_interval
             self.stats["step"] = self.run.spacing / self.run.steps_per_interval
+
+
+def _add_counts(total, more):
+    """The counters of ``more`` added into ``total``."""
+    for key, value in more.items():
+        if isinstance(value, int) and not isinstance(value, bool):
+            total[key] = total.get(key, 0) + value
 
 
 def _finite_rows(X):

@@ -114,3 +114,21 @@ def test_max_step_is_a_setting_of_files_and_is_checked():
     assert res.stats["step"] <= 0.01
     schema = kn.schema()["properties"]["simulation"]["properties"]
     assert schema["max_step"] == {"type": "number", "exclusiveMinimum": 0}
+
+
+def test_a_loop_as_a_dae_locates_the_events_of_its_ode():
+    # a one-sided spring on the four-bar's crank angle, written as if_else on its sensor:
+    # the partition's DAE under IDAS (algebraic variables, events located on IDAS's own
+    # integration from the interval's start) meets the projected ODE's events under Adams
+    m = kn.load("models/fourbar.json")
+    m.add(kn.rotational.AngleSensor("angle"))
+    m.add(kn.rotational.Torque("stop", tau="if_else(angle.y < 0.9, 200*(0.9 - angle.y), 0)"))
+    m.connect("angle.flange", "A.axis")
+    m.connect("stop.flange", "A.axis")
+    runs = [kn.simulate(m.compile(loops=loops), t_end=1.0, n_points=101, rtol=1e-10,
+                        atol=1e-12) for loops in ("projected", "partition")]
+    assert runs[1].method == "idas" and runs[1].system.n_algebraic == 3
+    times = [[e["t"] for e in r.stats["events"]] for r in runs]
+    assert len(times[0]) == len(times[1]) >= 4
+    np.testing.assert_allclose(times[0], times[1], atol=1e-8)
+    np.testing.assert_allclose(runs[0]["A.q"], runs[1]["A.q"], atol=1e-8)
