@@ -232,7 +232,8 @@ def simulate(model: Model | System, t_end: float | None = None, n_points: int | 
         After a solver failure, start the method afresh from the last state reached (at most
         MAX_RESTARTS times), if that state is sound: finite, the loops closed, and the
         restarted run continuing it without a jump. Each restart is in ``stats["restarts"]``.
-        Off by default: a failure is a SimulationError.
+        Off by default: a failure is a SimulationError. Not with events (friction, stops,
+        relations).
     repartition : bool, optional
         With kinematic loops: where the partition of the speeds into independent and
         dependent ones nears a singular configuration (a dead point of the independent
@@ -611,6 +612,8 @@ def _restart(run, method, X, restarts, failure):
     """With ``restart=True``: start ``method`` afresh from the last state, if it is sound and
     the restarted run continues it without a jump. Returns whether the run goes on."""
     if not run.restart or len(restarts) >= MAX_RESTARTS or len(X) < 2 or len(X) >= len(run.grid):
+        return False
+    if run.events is not None:      # its trial interval would not look for them
         return False
     system, last, before = run.system, X[-1], X[-2]
     if not np.all(np.isfinite(last)) or \
