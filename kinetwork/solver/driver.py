@@ -500,8 +500,9 @@ def _integrate(run, method):
             if run.events is not None and run.events.located:
                 chunk = run.events.chunk(chunk, restart_at is not None)
             chunk = parts.limit(chunk)
-        elif run.events is not None:
-            chunk = 1
+        elif run.events is not None and run.events.located:
+            # a stepper goes on between chunks: they bound what an event makes it do again
+            chunk = run.events.chunk(n - 1 - k, restart_at is not None)
     if failure is not None and run.system.f_dependent is not None and \
             run.stop_reason() is None and "singular" not in failure:
         failure += near_singular(run, np.array(X), grid)

@@ -30,8 +30,6 @@ to MAX_EVENT_CHUNK (each chunk restarts a multistep method); a fixed-step method
 sampled interval, so its steps are SAMPLES times shorter than without them.
 """
 
-import itertools
-import math
 
 import numpy as np
 
@@ -336,12 +334,17 @@ def _refined(t0, times, spacing=None):
     """The output ``times`` after ``t0`` with SAMPLES - 1 points between each and the one
     before, or more, to look at least every ``spacing`` seconds, and which of them are
     outputs."""
+    times = np.asarray(times, dtype=float)
     edges = np.concatenate([[t0], times])
-    parts, output = [], []
-    for a, b in itertools.pairwise(edges):
-        n = SAMPLES if not spacing else max(SAMPLES, math.ceil((b - a) / spacing - 1e-9))
-        part = np.linspace(a, b, n + 1)[1:]
-        part[-1] = b                        # exactly the output time, not rounded
-        parts.append(part)
-        output.append(np.arange(n) == n - 1)
-    return np.concatenate(parts), np.concatenate(output)
+    widths = np.diff(edges)
+    n = np.full(len(widths), SAMPLES)
+    if spacing:
+        n = np.maximum(SAMPLES, np.ceil(widths / spacing - 1e-9)).astype(int)
+    ends = np.cumsum(n) - 1
+    which = np.repeat(np.arange(len(widths)), n)
+    k = np.arange(ends[-1] + 1) - np.repeat(ends - n + 1, n) + 1     # 1..n in each interval
+    fine = edges[which] + widths[which] * (k / n[which])
+    fine[ends] = times                       # exactly the output times, not rounded
+    output = np.zeros(len(fine), dtype=bool)
+    output[ends] = True
+    return fine, output
