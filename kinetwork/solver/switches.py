@@ -29,7 +29,6 @@ class Switches:
 
     def __init__(self, events, run, relations):
         self.events, self.run, self.relations = events, run, relations
-        self.n_p = len(run.p)
         self.nx = run.system.n_states
         self.schedule = Schedule(relations, run.p, run.t_start, run.t_end)
         self.r = np.zeros(relations.n)
