@@ -136,11 +136,29 @@ def _grid(t, t_end, n_points):
     return grid
 
 
+def _refuse_events(system, grid):
+    """A ModelError when the run over ``grid`` meets events (``kinetwork.solver.events``),
+    which this one integration of the sensitivities does not stop at: its answer would be
+    the law of one side carried past them."""
+    from ..solver.schedule import Schedule
+    rel = system.relations
+    if rel is None:
+        return
+    times = Schedule(rel, system.param_vector(), grid[0], grid[-1]).times
+    if len(rel.state) or len(times):
+        what = f"a relation on the states, {rel.text(rel.state[0])}" if len(rel.state) \
+            else f"time events at {', '.join(f'{t:g}' for t in times[:4])} s"
+        raise ModelError(f"{system.model.name!r} has events in this run ({what}), which the "
+                         f"integration of sensitivities does not stop at yet: differentiate "
+                         f"runs of kn.simulate instead (central differences), which do")
+
+
 def trajectory(system, index, rows, grid, rtol, atol):
     """The Function (p[index], p, x0, z0) -> (outputs on the grid (n_rows, n_t), their
     Jacobian in p[index]): an integrator whose forward sensitivities CasADi derives. x0 and
     z0 are the initial state at p (``System.initial_full_p``), which a model without loops
     replaces by its start's own expressions in p (so that they are differentiated too)."""
+    _refuse_events(system, grid)
     eq, a = system.eq, system.asm
     w = ca.MX.sym("w", len(index))
     pm = ca.MX.sym("p", a.p.numel())

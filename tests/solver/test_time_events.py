@@ -158,3 +158,11 @@ def test_the_command_takes_max_step_and_shows_what_each_method_takes(tmp_path, c
     assert main(["methods"]) == 0
     listing = capsys.readouterr().out
     assert "events: time and state" in listing and "events: time\n" in listing
+
+
+def test_sensitivities_refuse_a_run_with_events_rather_than_carry_a_law_past_them():
+    with pytest.raises(kn.ModelError, match="time events at 0.5, 0.6 s.*central differences"):
+        kn.sensitivity(quarter_car(), ["h"], t_end=T_END)
+    # before the bump no event is met, and the road's height changes nothing yet
+    sens = kn.sensitivity(quarter_car(), ["h"], t_end=0.4, n_points=5, outputs=["body.s"])
+    assert np.all(sens.S == 0)
