@@ -191,18 +191,10 @@ class _CasadiRun:
         m, run = self.method, self.run
         dae = run.compiled.dae(run.jit, m.newton)
         n = len(times)
-        rel = np.asarray(times, dtype=float) - self.t
-        # equal intervals of the output grid, or of a subdivision of it (the points where
-        # the events' indicators are looked at): the step to 12 digits, so that every chunk
-        # of as many gets the same integrator (an outputs' time moves by 1e-12 of a step)
-        h = float(f"{rel[-1] / n:.12e}")
         if not exact and \
                 abs(times[-1] - self.t - n * run.spacing) <= 1e-9 * max(1.0, abs(times[-1])):
             grid = ("uniform", n, run.spacing)          # equal intervals: j * spacing
             taus = lambda: (np.arange(1, n + 1) * run.spacing).tolist()  # noqa: E731
-        elif not exact and np.max(np.abs(rel - h * np.arange(1, n + 1))) <= 1e-9 * h:
-            grid = ("uniform", n, h)
-            taus = lambda: (np.arange(1, n + 1) * h).tolist()  # noqa: E731
         else:
             grid = tuple((np.asarray(times, dtype=float) - self.t).tolist())
             taus = lambda: list(grid)  # noqa: E731
