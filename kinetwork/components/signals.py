@@ -8,6 +8,8 @@ Unwired optional inputs read as None. A block that needs the model's own dynamic
 computed-torque controller) overrides ``evaluate``, which is handed them.
 """
 
+import hashlib
+
 import casadi as ca
 import numpy as np
 
@@ -225,10 +227,9 @@ class Table(PartialBlock, library=LIB):
     as in MSL's CombiTimeTable: the first row's y up to x, the second's from x on.
 
     Read in time, every breakpoint is a time event (the integration stops there, as MSL's
-    CombiTimeTable's do): a table of up to ``expression_rows`` rows; a longer one at its
-    steps only. Read at a signal of the states, its kinks are taken as they are (as MSL's
-    CombiTable1D: the integrator's error control follows them) and its steps are state
-    events."""
+    CombiTimeTable's do), however long the table. Read at a signal of the states, its kinks
+    are taken as they are (as MSL's CombiTable1D: the integrator's error control follows
+    them) and its steps are state events."""
     u = Port("signal_in", "Abscissa (unwired: time)", optional=True)
     table = Param(kind="table", doc="Rows [x, y], x increasing; two rows with the same x "
                                     "are a step (at most 100 000 rows)")
@@ -246,8 +247,29 @@ class Table(PartialBlock, library=LIB):
             return piecewise_linear(at, xs, ys)
         knots, left, jumps = _steps(xs, ys)
         # the table less its steps is continuous: an interpolant, the steps added to it
-        smooth = ca.interpolant(f"{self.name}_table", "linear", [knots], left)(at)
+        smooth = ca.interpolant(_interpolant_name(self.name, knots), "linear", [knots],
+                                left)(at)
         return smooth + sum((j * (k <= at) for k, j in zip(knots, jumps) if j), ca.SX(0))
+
+
+#: the knots of each long Table's interpolant by its name: read in time, every knot is a
+#: time event (``kinetwork.equations.relations`` finds the interpolant's call in the
+#: equations, and its knots here), as each breakpoint of MSL's CombiTimeTable is
+_KNOTS = {}
+
+
+def _interpolant_name(name, knots):
+    """A name for the interpolant of ``knots`` that no other table's shares (their digest in
+    it), its knots recorded for ``interpolant_knots``."""
+    digest = hashlib.sha1(np.asarray(knots, dtype=float).tobytes()).hexdigest()[:16]
+    full = f"{name}_table_{digest}"
+    _KNOTS[full] = tuple(knots)
+    return full
+
+
+def interpolant_knots(name):
+    """The knots of the Table interpolant called ``name``, or None for any other function."""
+    return _KNOTS.get(name)
 
 
 class Integrator(PartialSISO, library=LIB):

@@ -31,6 +31,7 @@ from dataclasses import dataclass
 import casadi as ca
 import numpy as np
 
+from ..components.signals import interpolant_knots
 from ..errors import ModelError
 
 RELATIONS = (ca.OP_LT, ca.OP_LE)
@@ -58,6 +59,9 @@ class Relations:
         Indices of the nodes on time alone, and of the relations on the states.
     affine : numpy.ndarray of bool
         Per time node: its indicator is affine in t (its instants are found in closed form).
+    instants : numpy.ndarray
+        Time events of no node, sorted: the knots of the interpolants of long Tables read in
+        time (``kinetwork.components.signals.interpolant_knots``).
     reading : list
         Each node's arguments as written, and the names of what they may read (``text``).
     ode, alg : casadi.SX
@@ -78,6 +82,7 @@ class Relations:
     time: np.ndarray
     state: np.ndarray
     affine: np.ndarray
+    instants: np.ndarray
     reading: list
     ode: ca.SX
     alg: ca.SX
@@ -146,7 +151,7 @@ def find(system):
     f = ca.Function("equations", [t, x, z, p], [ode, alg])
     n_ins = f.n_instructions()
     ids = [f.instruction_id(k) for k in range(n_ins)]
-    if not set(ids) & {*RELATIONS, *TIME_ONLY}:
+    if not set(ids) & {*RELATIONS, *TIME_ONLY, ca.OP_CALL}:
         return None
     modes = set(system.modes.mode_index) if system.modes is not None else set()
     inputs = [ca.vertsplit(v) if v.numel() else [] for v in (t, x, z, p)]
@@ -163,6 +168,7 @@ def find(system):
     flags = {}             # work slot -> what it depends on
     nodes = []             # (op, kind, rebuilt arguments, original arguments)
     r_all = []             # the held values' symbols, one per node
+    instants = []          # time events of no node: the knots of tables read in time
     outputs = [list(ca.vertsplit(ode)), list(ca.vertsplit(alg))]
     for k, op in enumerate(ids):
         ins_k, outs_k = f.instruction_input(k), f.instruction_output(k)
@@ -182,6 +188,9 @@ def find(system):
         for slot in ins_k:
             flag |= flags.get(slot, 0)
         if op == ca.OP_CALL:
+            if flag == _T:                  # a Table read in time: its knots are events
+                instants.extend(interpolant_knots(expressions[k].which_function().name())
+                                or ())
             if any(slot in held for slot in ins_k):
                 raise ModelError("a function of the equations (a table of more than "
                                  "Table.expression_rows rows) reads a value that changes at "
@@ -207,9 +216,9 @@ def find(system):
             held[out] = _held(op, args, r)
         else:
             held[out] = ca.SX.binary(op, *args) if len(args) == 2 else ca.SX.unary(op, *args)
-    if not nodes:
+    if not nodes and not instants:
         return None
-    r = ca.vertcat(*r_all)
+    r = ca.vertcat(*r_all) if r_all else ca.SX(0, 1)
     ode_h, alg_h = (ca.vertcat(*o) if o else ca.SX(0, 1) for o in outputs)
     pr = ca.vertcat(p, r)
     time = np.array([i for i, n in enumerate(nodes) if n[1] == "time"], dtype=int)
@@ -230,6 +239,7 @@ def find(system):
     symbols = [t] + list(inputs[1]) + list(inputs[2])
     out = Relations(
         ops=[n[0] for n in nodes], time=time, state=state, affine=affine,
+        instants=np.unique(np.asarray(instants, dtype=float)),
         reading=[(n[3], names, symbols) for n in nodes],
         ode=ode_h, alg=alg_h, p=pr,
         f_select=ca.Function("relation_values", [t, ca.vertcat(x, z), pr],

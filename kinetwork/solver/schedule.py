@@ -34,7 +34,7 @@ class Schedule:
 
     def __init__(self, relations, p, t_start, t_end):
         self.t_start, self.t_end = float(t_start), float(t_end)
-        found = []
+        found = list(relations.instants)
         if len(relations.time):
             f = relations.f_time
             k = len(relations.time)

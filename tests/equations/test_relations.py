@@ -78,6 +78,36 @@ def test_signal_blocks_read_in_time_are_time_events():
     np.testing.assert_allclose(schedule.times, [0.25, 0.5, 0.7, 0.9, 1.0, 1.25], atol=1e-14)
 
 
+def long_table(read_at_state):
+    """A mass pushed by a Table of 201 rows (an interpolant), read in time or at the
+    mass's position."""
+    m = kn.Model("long")
+    m.add(kn.translational.Mass("mass", m=1.0))
+    m.add(kn.translational.Force("push"))
+    x = np.linspace(0.0, 2.0, 201)
+    m.add(kn.signals.Table("table", table=np.column_stack([x, np.abs(x - 1)]).tolist()))
+    m.connect("table.y", "push.u")
+    m.connect("push.flange", "mass.flange_a")
+    if read_at_state:
+        m.add(kn.translational.PositionSensor("pos"))
+        m.connect("pos.flange", "mass.flange_a")
+        m.connect("pos.y", "table.u")
+    return m, x
+
+
+def test_every_row_of_a_long_table_read_in_time_is_a_time_event():
+    # as MSL's CombiTimeTable: the interpolant's knots, with no node of their own
+    m, x = long_table(read_at_state=False)
+    system = m.compile()
+    rel = system.relations
+    assert rel.n == 0
+    np.testing.assert_array_equal(rel.instants, x)
+    times = Schedule(rel, system.param_vector(), 0.0, 3.0).times
+    np.testing.assert_allclose(times, x[1:], rtol=1e-15)
+    # read at a state, its kinks are taken as they are
+    assert long_table(read_at_state=True)[0].compile().relations is None
+
+
 def test_the_held_equations_are_the_equations_where_the_values_are_their_own():
     system = driven("if_else(pos.y < 0, -1e3*pos.y - 5*vel.y, 0) + if_else(t < 0.5, 2, "
                     "if_else(t < 0.6, 2 + sin(10*t), 0)) + max(0, t - 1)").compile()

@@ -6,8 +6,9 @@ Scenes
 ------
 quarter car   a body (300 kg) on a suspension spring-damper over a wheel (40 kg) on a tire
               spring, driven over a 0.1 s road bump at t = 0.5 s: the bump as an expression
-              in t (``BUMP``, an exact Position), as a Table of breakpoints or with steps
-              into a filtered Position, or the road flat and a force pulse on the body
+              in t (``BUMP``, an exact Position), as a Table of breakpoints (or of 301 rows)
+              or with steps into a filtered Position, or the road flat and a force pulse
+              on the body
 ball          a ball dropped onto a penalty contact written as ``if_else`` on its height
 """
 
@@ -23,6 +24,9 @@ BUMP = "if_else(t < 0.5, 0, if_else(t < 0.6, h/2*(1 - cos(2*pi*(t - 0.5)/0.1)), 
 #: a triangle 0.1 s wide, and a plateau with steps at both ends
 TRIANGLE = [[0.0, 0.0], [0.5, 0.0], [0.55, H], [0.6, 0.0], [T_END, 0.0]]
 PLATEAU = [[0.0, 0.0], [0.5, 0.0], [0.5, H], [0.6, H], [0.6, 0.0], [T_END, 0.0]]
+#: the triangle sampled every 10 ms: a long table (an interpolant), the same function
+LONG = np.linspace(0.0, T_END, 301)
+LONG_TRIANGLE = np.column_stack([LONG, np.interp(LONG, *np.array(TRIANGLE).T)]).tolist()
 #: the force pulse on the body: F for 20 ms from T0
 PULSE_F, PULSE_T0, PULSE_W = 3000.0, 0.5, 0.02
 F_CRIT = 50.0
@@ -31,7 +35,8 @@ TIGHT = {"method": "DOP853", "rtol": 1e-13, "atol": 1e-15}
 
 def quarter_car(road="expression"):
     """The quarter car over the bump: ``road`` "expression" (``BUMP`` in an exact Position),
-    "table" (TRIANGLE) or "steps" (PLATEAU) in a Table into a filtered Position, "pulse"
+    "table" (TRIANGLE), "long_table" (LONG_TRIANGLE, an interpolant) or "steps" (PLATEAU)
+    in a Table into a filtered Position, "pulse"
     (the road flat, a force pulse on the body written in t), "pulse_blocks" (the same pulse
     as two Step blocks into a Force)."""
     m = kn.Model("quarter_car", parameters={"h": H})
@@ -44,9 +49,10 @@ def quarter_car(road="expression"):
     m.connect("susp.flange_b", "body.flange_a")
     if road == "expression":
         m.add(kn.translational.Position("road", s_ref=BUMP))
-    elif road in ("table", "steps"):
+    elif road in ("table", "long_table", "steps"):
         m.add(kn.translational.Position("road", exact=False, f_crit=F_CRIT))
-        m.add(kn.signals.Table("profile", table=TRIANGLE if road == "table" else PLATEAU))
+        m.add(kn.signals.Table("profile", table={"table": TRIANGLE, "steps": PLATEAU,
+                                                 "long_table": LONG_TRIANGLE}[road]))
         m.connect("profile.y", "road.u")
     else:
         m.add(kn.translational.Fixed("road"))
@@ -70,16 +76,17 @@ def quarter_car_reference(t_out, road="expression"):
     """The states of ``quarter_car(road)`` on ``t_out`` (the filter's position and speed
     first for the tables, then wheel s, v, body s, v), integrated stretch by stretch between
     the road's breakpoints, each stretch with the branch it lies in."""
-    breaks = {"expression": [0.5, 0.6], "table": [0.5, 0.55, 0.6], "steps": [0.5, 0.6],
+    breaks = {"expression": [0.5, 0.6], "table": [0.5, 0.55, 0.6],
+              "long_table": [0.5, 0.55, 0.6], "steps": [0.5, 0.6],
               "pulse": [PULSE_T0, PULSE_T0 + PULSE_W],
               "pulse_blocks": [PULSE_T0, PULSE_T0 + PULSE_W]}[road]
-    filtered = road in ("table", "steps")
+    filtered = road in ("table", "long_table", "steps")
     w = 2 * np.pi * F_CRIT
     af, bf = BESSEL
 
     def rhs(t, y, mid):
         on = 0.5 <= mid < 0.6
-        if road == "table":
+        if road in ("table", "long_table"):
             u = np.interp(t, *np.array(TRIANGLE).T)
         elif road == "steps":
             u = H if on else 0.0
