@@ -59,9 +59,11 @@ class Relations:
         Indices of the nodes on time alone, and of the relations on the states.
     affine : numpy.ndarray of bool
         Per time node: its indicator is affine in t (its instants are found in closed form).
-    instants : numpy.ndarray
-        Time events of no node, sorted: the knots of the interpolants of long Tables read in
-        time (``kinetwork.components.signals.interpolant_knots``).
+    tables : list
+        The long Tables read in time, whose knots are time events of no node (their
+        interpolants', ``kinetwork.components.signals.interpolant_knots``): per table,
+        (the Function (t, p) -> (its argument, that argument's time derivative), whether
+        that argument is affine in t, the knots, increasing).
     reading : list
         Each node's arguments as written, and the names of what they may read (``text``).
     ode, alg : casadi.SX
@@ -82,7 +84,7 @@ class Relations:
     time: np.ndarray
     state: np.ndarray
     affine: np.ndarray
-    instants: np.ndarray
+    tables: list
     reading: list
     ode: ca.SX
     alg: ca.SX
@@ -168,7 +170,7 @@ def find(system):
     flags = {}             # work slot -> what it depends on
     nodes = []             # (op, kind, rebuilt arguments, original arguments)
     r_all = []             # the held values' symbols, one per node
-    instants = []          # time events of no node: the knots of tables read in time
+    tables = []            # (argument, knots) of each long Table read in time
     outputs = [list(ca.vertsplit(ode)), list(ca.vertsplit(alg))]
     for k, op in enumerate(ids):
         ins_k, outs_k = f.instruction_input(k), f.instruction_output(k)
@@ -189,8 +191,10 @@ def find(system):
             flag |= flags.get(slot, 0)
         if op == ca.OP_CALL:
             if flag == _T:                  # a Table read in time: its knots are events
-                instants.extend(interpolant_knots(expressions[k].which_function().name())
-                                or ())
+                e = expressions[k]
+                knots = interpolant_knots(e.which_function().name())
+                if knots is not None:
+                    tables.append((e.dep(0), knots))
             if any(slot in held for slot in ins_k):
                 raise ModelError("a function of the equations (a table of more than "
                                  "Table.expression_rows rows) reads a value that changes at "
@@ -216,7 +220,7 @@ def find(system):
             held[out] = _held(op, args, r)
         else:
             held[out] = ca.SX.binary(op, *args) if len(args) == 2 else ca.SX.unary(op, *args)
-    if not nodes and not instants:
+    if not nodes and not tables:
         return None
     r = ca.vertcat(*r_all) if r_all else ca.SX(0, 1)
     ode_h, alg_h = (ca.vertcat(*o) if o else ca.SX(0, 1) for o in outputs)
@@ -239,7 +243,9 @@ def find(system):
     symbols = [t] + list(inputs[1]) + list(inputs[2])
     out = Relations(
         ops=[n[0] for n in nodes], time=time, state=state, affine=affine,
-        instants=np.unique(np.asarray(instants, dtype=float)),
+        tables=[(ca.Function("table_argument", [t, p], [a, ca.jacobian(a, t)]),
+                 not ca.depends_on(ca.jacobian(a, t), t), np.asarray(knots, dtype=float))
+                for a, knots in tables],
         reading=[(n[3], names, symbols) for n in nodes],
         ode=ode_h, alg=alg_h, p=pr,
         f_select=ca.Function("relation_values", [t, ca.vertcat(x, z), pr],

@@ -34,7 +34,9 @@ class Schedule:
 
     def __init__(self, relations, p, t_start, t_end):
         self.t_start, self.t_end = float(t_start), float(t_end)
-        found = list(relations.instants)
+        found = []
+        for f, affine, knots in relations.tables:
+            found.extend(self._table(f, affine, knots, p))
         if len(relations.time):
             f = relations.f_time
             k = len(relations.time)
@@ -75,6 +77,31 @@ class Schedule:
         first, last = math.floor(low) + 1, math.ceil(high) - 1
         self._count(last - first + 1)
         return list(self.t_start + (np.arange(first, last + 1) - g0) / rate)
+
+    def _table(self, f, affine, knots, p):
+        """Where the argument of a long Table read in time (``f``: (t, p) -> (argument,
+        its rate)) crosses one of its knots: in closed form where the argument is affine in
+        t, else on the scan's points (the knots' positions interpolated, whole numbers at
+        the knots, crossed as a level)."""
+        self._count(len(knots))
+        a0, rate = (float(v) for v in f(self.t_start, p))
+        if affine:
+            if rate == 0 or not np.isfinite(rate) or not np.isfinite(a0):
+                return []
+            return list(self.t_start + (knots - a0) / rate)
+        from scipy.optimize import brentq
+
+        def at(t, shift=0.0):
+            return float(_position(float(f(t, p)[0]), knots)) - shift
+        grid = np.linspace(self.t_start, self.t_end, SCAN + 1)
+        args = np.asarray(mapped(f, len(grid))(grid[None, :], p)[0], dtype=float).ravel()
+        level = _position(args, knots)
+        out = []
+        for a in range(len(grid) - 1):
+            out.extend(_crossings(at, grid[a], grid[a + 1], level[a], level[a + 1], True,
+                                  brentq))
+            self._count(len(out))
+        return out
 
     def _scan(self, f, p, k, others, levels, values, known):
         """The switches of the nodes ``others`` (not affine in t), on SCAN points and the
@@ -135,6 +162,17 @@ def _crossings(at, ta, tb, ga, gb, level, brentq):
         found.append(brentq(lambda t, w=whole: at(t, shift=w), ta, tb, xtol=1e-15,
                             rtol=4 * np.finfo(float).eps, maxiter=200))
     return found
+
+
+def _position(a, knots):
+    """Where ``a`` lies among ``knots`` (at least two): i at knot i, linear between them,
+    and beyond the ends rising on within half a knot (crossing no other whole number)."""
+    n = len(knots)
+    inside = np.interp(a, knots, np.arange(n, dtype=float))
+    with np.errstate(over="ignore"):
+        below = -0.5 * -np.expm1((a - knots[0]) / (knots[1] - knots[0]))
+        above = n - 1 + 0.5 * -np.expm1(-(a - knots[-1]) / (knots[-1] - knots[-2]))
+    return np.where(a < knots[0], below, np.where(a > knots[-1], above, inside))
 
 
 def _gap(t):

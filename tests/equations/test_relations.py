@@ -100,12 +100,30 @@ def test_every_row_of_a_long_table_read_in_time_is_a_time_event():
     m, x = long_table(read_at_state=False)
     system = m.compile()
     rel = system.relations
-    assert rel.n == 0
-    np.testing.assert_array_equal(rel.instants, x)
+    assert rel.n == 0 and len(rel.tables) == 1
     times = Schedule(rel, system.param_vector(), 0.0, 3.0).times
     np.testing.assert_allclose(times, x[1:], rtol=1e-15)
     # read at a state, its kinks are taken as they are
     assert long_table(read_at_state=True)[0].compile().relations is None
+
+
+@pytest.mark.parametrize("argument, instants", [
+    ("2*t - t0", lambda x, t0: (x + t0) / 2),          # affine, a parameter in it
+    ("t^2", np.sqrt),                                  # curved: found on the scan
+])
+def test_a_long_table_read_at_a_function_of_time_has_its_instants_where_it_is_read(
+        argument, instants):
+    m, x = long_table(read_at_state=False)
+    m.set_parameter("t0", 0.4)
+    m.add(kn.signals.Expression("clock", expression=argument))
+    m.connect("clock.y", "table.u")
+    system = m.compile()
+    for t0 in (0.4, 0.7):
+        p = system.param_vector({"t0": t0})
+        times = Schedule(system.relations, p, 0.0, 1.5).times
+        expected = instants(x, t0) if argument != "t^2" else np.sqrt(x)
+        expected = expected[(expected > 0) & (expected < 1.5)]
+        np.testing.assert_allclose(times, expected, rtol=1e-13, atol=1e-14)
 
 
 def test_the_held_equations_are_the_equations_where_the_values_are_their_own():
