@@ -116,11 +116,16 @@ class PartialPeriodic(PartialBlock):
         running = tau >= 0
         n = ca.SX(self.nperiod)
         last = tau < n * self.period
+        # the phase runs from the start (and stops after the last period): no events of
+        # periods that are not shown
+        phase = ca.fmax(tau, 0)
         if n.is_constant():
             running = running * last if float(n) >= 0 else running
+            if float(n) >= 0:
+                phase = ca.fmin(phase, n * self.period)
         else:
             running = running * ca.if_else(n < 0, 1, last)
-        return self.offset + running * self.wave(ca.fmod(tau, self.period))
+        return self.offset + running * self.wave(ca.fmod(phase, self.period))
 
 
 class Pulse(PartialPeriodic, library=LIB):

@@ -93,6 +93,51 @@ def test_a_pulse_far_shorter_than_the_outputs_gives_its_whole_impulse(method):
         assert res["mass.s"][-1] == pytest.approx(2.5e-3 * (2.0 - t0 - 0.3005), abs=1e-7)
 
 
+def msl_periodic(kind, t, start=0.3, period=0.2, nperiod=-1):
+    """MSL's Pulse (amplitude 2, width 30 %), SawTooth (amplitude 2) and Trapezoid
+    (amplitude 2, rising 0.02, width 0.05, falling 0.04 s) with offset 0.5, written from
+    MSL's definitions in numpy."""
+    tau = t - start
+    phase = np.mod(tau, period)
+    shape = {"pulse": np.where(phase < 0.3 * period, 1.0, 0.0),
+             "sawtooth": phase / period,
+             "trapezoid": np.interp(phase, [0, 0.02, 0.07, 0.11, period], [0, 1, 1, 0, 0])}[kind]
+    on = (tau >= 0) & ((nperiod < 0) | (tau < nperiod * period))
+    return 0.5 + 2.0 * np.where(on, shape, 0.0)
+
+
+@pytest.mark.parametrize("nperiod", [-1, 3])
+@pytest.mark.parametrize("kind", ["pulse", "sawtooth", "trapezoid"])
+@pytest.mark.parametrize("method", ["auto", "rk45", "idas"])
+def test_periodic_blocks_push_with_their_exact_impulse(kind, nperiod, method):
+    # a 1 kg mass pushed by the block: its speed is the signal's integral, exact by the
+    # midpoint rule on a grid through every breakpoint (the signals are piecewise linear)
+    params = {"amplitude": 2.0, "offset": 0.5, "period": 0.2, "nperiod": nperiod,
+              "start_time": 0.3}
+    block = {"pulse": lambda: kn.signals.Pulse("y", width=30, **params),
+             "sawtooth": lambda: kn.signals.SawTooth("y", **params),
+             "trapezoid": lambda: kn.signals.Trapezoid("y", rising=0.02, width=0.05,
+                                                       falling=0.04, **params)}[kind]()
+    m = kn.Model("pushed")
+    m.add(kn.translational.Mass("mass", m=1.0))
+    m.add(kn.translational.Force("push"))
+    m.add(block)
+    m.connect("y.y", "push.u")
+    m.connect("push.flange", "mass.flange_a")
+    res = kn.simulate(m, t_end=1.5, n_points=7, method=method)
+    edges = 0.3 + 0.2 * np.arange(7)[:, None] + np.array([0, 0.02, 0.06, 0.07, 0.11])
+    fine = np.union1d(np.linspace(0, 1.5, 1501), edges.ravel())
+    fine = fine[(fine >= 0) & (fine <= 1.5)]
+    middles = (fine[1:] + fine[:-1]) / 2
+    speed = np.concatenate([[0], np.cumsum(np.diff(fine) * msl_periodic(kind, middles,
+                                                                           nperiod=nperiod))])
+    np.testing.assert_allclose(res["mass.v"], np.interp(res.t, fine, speed), atol=1e-6)
+    # events at its edges and kinks only while it runs
+    per_period = {"pulse": 2, "sawtooth": 1, "trapezoid": 4}[kind]
+    shown = 6 if nperiod < 0 else 3
+    assert res.stats["time_events"] <= per_period * shown + 2
+
+
 @pytest.mark.parametrize("method", ["auto", "rk45", "rk", "midpoint"])
 def test_a_kinematic_ptp_drive_reaches_its_end_exactly(method):
     # a joint driven through the torque an inertia needs for the PTP's acceleration: its
