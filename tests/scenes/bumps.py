@@ -167,7 +167,8 @@ def ball_reference(t_out):
                         events=height, dense_output=True, **TIGHT)
         end = sol.t_events[0][0] if sol.status == 1 else t_out[-1]
         reached = ahead[ahead < end] if sol.status == 1 else ahead
-        rows.extend(sol.sol(reached).T)
+        if len(reached):                # a contact may be shorter than the output spacing
+            rows.extend(sol.sol(reached).T)
         done += len(reached)
         if sol.status != 1:
             break
