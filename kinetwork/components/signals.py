@@ -14,7 +14,7 @@ import casadi as ca
 import numpy as np
 
 from ..errors import ModelError
-from ..expr import parse
+from ..expr import literal_functions, parse
 from ..util import check_number, quote
 from .base import REQUIRED, TABLE_ROWS_LIMIT, Component, Param, Port
 
@@ -232,12 +232,17 @@ class Table(PartialBlock, library=LIB):
     as in MSL's CombiTimeTable: the first row's y up to x, the second's from x on.
 
     Read in time, every breakpoint is a time event (the integration stops there, as MSL's
-    CombiTimeTable's do), however long the table. Read at a signal of the states, its kinks
-    are taken as they are (as MSL's CombiTable1D: the integrator's error control follows
-    them) and its steps are state events."""
+    CombiTimeTable's do by default), however long the table; with ``time_events="steps"``
+    only its steps are (MSL's AtDiscontinuities: a long, finely sampled smooth signal,
+    whose kinks the integrator's error control follows, without a restart at each row).
+    Read at a signal of the states, its kinks are taken as they are (as MSL's CombiTable1D)
+    and its steps are state events."""
     u = Port("signal_in", "Abscissa (unwired: time)", optional=True)
     table = Param(kind="table", doc="Rows [x, y], x increasing; two rows with the same x "
                                     "are a step (at most 100 000 rows)")
+    time_events = Param("always", kind="choice", choices=("always", "steps"),
+                        doc="Read in time, the rows that are time events: every one "
+                            "(always) or the steps only (steps)")
     #: a table of up to this many rows is an expression (``kinetwork equations`` prints it);
     #: a longer one a CasADi interpolant, which costs time linear in the rows to build and
     #: compile to C, where the expression's cost grows with their square (10 000 rows:
@@ -248,12 +253,13 @@ class Table(PartialBlock, library=LIB):
         at = t if u["u"] is None else u["u"]
         xs = [row[0] for row in self.table]
         ys = [row[1] for row in self.table]
+        kinks = self.time_events == "always"
         if len(xs) <= self.expression_rows:
-            return piecewise_linear(at, xs, ys)
+            return piecewise_linear(at, xs, ys, kinks)
         knots, left, jumps = _steps(xs, ys)
         # the table less its steps is continuous: an interpolant, the steps added to it
-        smooth = ca.interpolant(_interpolant_name(self.name, knots), "linear", [knots],
-                                left)(at)
+        name = _interpolant_name(self.name, knots) if kinks else f"{self.name}_table"
+        smooth = ca.interpolant(name, "linear", [knots], left)(at)
         return smooth + sum((j * (k <= at) for k, j in zip(knots, jumps) if j), ca.SX(0))
 
 
@@ -560,19 +566,21 @@ def _steps(xs, ys):
     return knots, left, jumps
 
 
-def piecewise_linear(at, xs, ys):
+def piecewise_linear(at, xs, ys, kinks=True):
     """The linear interpolation of the rows (xs, ys) at ``at`` (extrapolated linearly from
     the end segments; two equal x's a step to the second y), as kinks ``fmax(at - x, 0)``
     and steps ``x <= at``: on time both are time events, on the states the kinks are taken
-    as they are and the steps are state events (``kinetwork.equations.relations``)."""
+    as they are and the steps are state events (``kinetwork.equations.relations``).
+    ``kinks`` False: the kinks built as ``noEvent`` builds them, never events."""
     knots, left, jumps = _steps(list(xs), list(ys))
+    fmax = ca.fmax if kinks else literal_functions()["max"]
     if len(knots) == 1:
         return ca.SX(left[0]) + jumps[0] * (knots[0] <= at)
     slopes = [(left[j + 1] - left[j]) / (knots[j + 1] - knots[j]) for j in range(len(knots) - 1)]
     y = left[0] + slopes[0] * (at - knots[0])
     for j in range(1, len(knots) - 1):
         if slopes[j] != slopes[j - 1]:
-            y = y + (slopes[j] - slopes[j - 1]) * ca.fmax(at - knots[j], 0)
+            y = y + (slopes[j] - slopes[j - 1]) * fmax(at - knots[j], 0)
     for k, jump in zip(knots, jumps):
         if jump:
             y = y + jump * (k <= at)

@@ -107,6 +107,31 @@ def test_every_row_of_a_long_table_read_in_time_is_a_time_event():
     assert long_table(read_at_state=True)[0].compile().relations is None
 
 
+@pytest.mark.parametrize("rows", [5, 201])
+def test_a_table_whose_time_events_are_its_steps_has_no_others(rows):
+    # MSL's AtDiscontinuities: the same values, events at the step at 1 only
+    x = np.linspace(0.0, 2.0, rows)
+    table = np.column_stack([x, np.abs(x - 1)]).tolist()
+    table.insert(rows // 2 + 1, [1.0, 0.5])
+    values = []
+    for events in ("always", "steps"):
+        m = kn.Model("steps")
+        m.add(kn.translational.Mass("mass", m=1.0))
+        m.add(kn.translational.Force("push"))
+        m.add(kn.signals.Table("table", table=table, time_events=events))
+        m.connect("table.y", "push.u")
+        m.connect("push.flange", "mass.flange_a")
+        system = m.compile()
+        times = Schedule(system.relations, system.param_vector(), 0.0, 3.0).times
+        if events == "steps":
+            np.testing.assert_allclose(times, [1.0], rtol=1e-15)
+        else:       # the kinks too: of the short table where its slope changes
+            np.testing.assert_allclose(times, [1.0, 1.5] if rows == 5 else x[1:], rtol=1e-15)
+        values.append([float(system.rhs(t, [0.0, 0.0])[1]) for t in (0.3, 0.999, 1.0, 2.5)])
+    np.testing.assert_allclose(values[0], values[1], rtol=1e-14)
+    np.testing.assert_allclose(values[0], [0.7, 0.001, 0.5, 1.5], rtol=1e-12)
+
+
 @pytest.mark.parametrize("argument, instants", [
     ("2*t - t0", lambda x, t0: (x + t0) / 2),          # affine, a parameter in it
     ("t^2", np.sqrt),                                  # curved: found on the scan
