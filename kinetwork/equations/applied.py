@@ -147,7 +147,7 @@ def element_forces(asm, topo, bound):
             raise ModelError(f"algebraic loop through {comp.name} and the mechanics: a "
                              f"signal input of {comp.name} reads an acceleration or a force "
                              f"at the same instant; break it with a state (an Integrator, a "
-                             f"FirstOrder or a filtered Derivative)")
+                             f"FirstOrder or a filtered Derivative)", component=comp.name)
     return Q + asm.junctions.Q if junctions else Q
 
 

@@ -225,7 +225,7 @@ class _Builder:
                 self.c[s] = ca.SX(0)
                 self.ride[s] = [] if group.base is None else [(ca.SX(1), group.base)]
                 continue
-            r = self.bound[element.name].ratio()
+            r = self.bound[element.name].position_ratio()
             length = self.bound[element.name].length()
             a_here = self.topo.set_of[element.port_ref("flange_a")] == s
             # position(flange_a) = r * (position(flange_b) - length), relative to the
@@ -251,7 +251,8 @@ class _Builder:
             raise ModelError(f"{self.model.place(element, 'eta')}: a gear with a loss is "
                              f"taken between rotors that move freely (a drive train of "
                              f"inertias), not yet on a joint's axis or a prescribed motion; "
-                             f"set eta = 1 there, or put the loss in a BearingFriction")
+                             f"set eta = 1 there, or put the loss in a BearingFriction",
+                             **self.model.fields(element, "eta"))
         if element.name not in self.losses:
             from ..components.friction import GearModes
             mode = self._state(f"{element.name}.mode", "", 1, ca.SX(0))
@@ -370,7 +371,8 @@ class _Builder:
         else:
             ref = comp.port_ref("flange")
             if comp.quantity == "acceleration" and self._massless_at(ref):
-                raise ModelError(acceleration_unavailable(self.model.place(comp), ref))
+                raise ModelError(acceleration_unavailable(self.model.place(comp), ref),
+                                 **self.model.fields(comp, port="flange"))
             value = {"position": self.net.pos, "speed": self.net.vel,
                      "acceleration": self.net.acc}[comp.quantity][ref]
         self.net.signal[s] = ca.SX(value)
@@ -545,7 +547,8 @@ class _Builder:
             if group is not None and group.kind == "massless":
                 raise ModelError(f"{self.model.place(comp)}: {ref.path} is on a massless "
                                  f"flange, which has no acceleration for {comp.name} to hold "
-                                 f"or stop: give it an inertia or a mass")
+                                 f"or stop: give it an inertia or a mass",
+                                 **self.model.fields(comp, port=pn))
         b._mode = self._state(f"{comp.name}.mode", "", 0, ca.SX(0))
         b._F = ca.SX.sym(f"F_{comp.name}")
         u = self.topo.set_of[comp.port_ref("u")] if "u" in comp.ports else None
@@ -646,9 +649,9 @@ class _Builder:
             if element.has_inertia:
                 flow[near] = b.inertia() * self.kin[s][2] - flow[far]
             elif far.name == "flange_a":          # torque_b = -ratio * torque_a
-                flow[near] = -b.ratio() * self.losses.get(element.name, 1) * flow[far]
+                flow[near] = -b.position_ratio() * self.losses.get(element.name, 1) * flow[far]
             else:
-                flow[near] = -flow[far] / (b.ratio() * self.losses.get(element.name, 1))
+                flow[near] = -flow[far] / (b.position_ratio() * self.losses.get(element.name, 1))
             if "support" in element.ports:        # MSL: support.tau = -flange_a.tau - flange_b.tau
                 flow[element.port_ref("support")] = -(flow[far] + flow[near])
             beyond[parent] = beyond[parent] + flow[near]
@@ -742,7 +745,7 @@ class _Builder:
                         f"must follow time only (an expression in t, or signal blocks fed "
                         f"by time); the reference of {m.comp.name} depends on the motion of "
                         f"the model: set exact=False to follow it through its filter "
-                        f"(f_crit)")
+                        f"(f_crit)", **self.model.fields(m.source, "exact"))
                 states = [x for x in self.net.x if ca.depends_on(e, x)]
                 out = ca.jacobian(e, self.t)
                 if states:
@@ -754,7 +757,8 @@ class _Builder:
                 raise ModelError(f"{where}: the acceleration {m.comp.name} prescribes depends "
                                  f"on accelerations of the model at the same instant (an "
                                  f"algebraic loop through the mechanics): break it with a "
-                                 f"state (exact=False, a FirstOrder)")
+                                 f"state (exact=False, a FirstOrder)",
+                                 **self.model.fields(m.source))
             r0 = ca.substitute(sub(m.reference), self.t, ca.SX(0))
             for x, rate, start in zip(m.x, rates, m.comp.initial(r0)):
                 self.net.rate[self._at(x)] = rate

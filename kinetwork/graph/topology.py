@@ -8,15 +8,14 @@ Spherical joints) is walked breadth-first from the ground to order the Newton-Eu
 recursion; every edge left out is a cut joint that closes one independent kinematic loop.
 """
 
-import warnings
 from dataclasses import dataclass, field
 
 import networkx as nx
-import numpy as np
 
 from ..components.probe import QUANTITIES
-from ..errors import IdealisedInertiaWarning, ModelError
+from ..errors import ModelError, Problem
 from . import supports
+from .inertia import check_inertias
 
 ONED_DOMAINS = ("rotational", "translational")
 SIGNAL_DOMAINS = ("signal_in", "signal_out")
@@ -68,7 +67,7 @@ class OneDGroup:
     base: int = None
 
 
-@dataclass
+@dataclass(repr=False)
 class Topology:
     """What validation learned about a model; the solver's starting point."""
     world: object
@@ -86,11 +85,22 @@ class Topology:
     #: frame sets only line forces meet at (massless junctions), placed by their balance
     junctions: list = field(default_factory=list)
     signal_source: dict = field(default_factory=dict)   # signal set -> its output PortRef
+    #: what was accepted with a warning (each warned of too), as Problems: the studio's
+    warnings: list = field(default_factory=list)
 
     @property
     def dof(self):
         """Degrees of freedom of the joints, less the coordinates prescribed by motions."""
         return sum(j.dof for j in self.joints) - sum(1 for g in self.oned if g.motion)
+
+    def __repr__(self):
+        # short: ``model.validate()`` at a prompt echoes it (the dataclass's own repr
+        # spells out every connection set, kilobytes for a small model)
+        counts = [(len(self.joints), "joint"), (len(self.bodies), "body"),
+                  (len(self.loops), "kinematic loop"), (len(self.probes), "probe")]
+        return "<Topology: " + ", ".join(
+            f"{n} {word if n == 1 else ('bodies' if word == 'body' else word + 's')}"
+            for n, word in counts) + ">"
 
 
 def analyze(model):
@@ -110,9 +120,11 @@ def analyze(model):
     for i, (a, b) in enumerate(model.connections):
         gone = [p for p in (a, b) if model.components.get(p.component.name) is not p.component]
         if gone:                # a component taken out of model.components by hand
-            stale.append(f"connections[{i}] {a.path} - {b.path}: component "
-                         f"{gone[0].component.name!r} is not in the model any more "
-                         f"(remove its connections too)")
+            stale.append(Problem(f"connections[{i}] {a.path} - {b.path}: component "
+                                 f"{gone[0].component.name!r} is not in the model any more "
+                                 f"(remove its connections too)",
+                                 component=gone[0].component.name, port=gone[0].name,
+                                 hint="remove its connections too"))
         else:
             graph.add_edge(a, b)
     for comp in model.components.values():
@@ -138,16 +150,17 @@ def analyze(model):
             ref = comp.port_ref(pname)
             if (not port.optional or pname in comp.required_ports()) and all(
                     p.component.role == "probe" for p in sets[set_of[ref]] if p != ref):
-                problems.append(f"{model.place(comp)}: port {ref.path} ({port.domain}) "
-                                f"is not connected")
+                problems.append(model.problem(f"port {ref.path} ({port.domain}) is not "
+                                              f"connected", comp, port=pname))
 
     worlds = roles.get("world", [])
     frames = any(p.domain == "frame" for c in model.components.values() for p in
                  c.ports.values())
     if len(worlds) > 1 or (not worlds and frames):
         names = ", ".join(w.name for w in worlds)
-        problems.append("the model needs exactly one multibody.Ground, found "
-                        f"{len(worlds)}{': ' + names if names else ''}")
+        problems.append(Problem("the model needs exactly one multibody.Ground, found "
+                                f"{len(worlds)}{': ' + names if names else ''}",
+                                **(model.fields(worlds[-1]) if worlds else {})))
         if not worlds:
             raise ModelError(problems)
     world = worlds[0] if worlds else None          # a 1-D and signal model needs none
@@ -157,17 +170,17 @@ def analyze(model):
         _tree(model, topo, roles, problems)
     _oned(model, topo, values, problems)
     supports.check(model, topo, values, problems)
-    _signals(topo, problems)
+    _signals(model, topo, problems)
     _motions(model, topo, problems)
     supports.rings(topo, problems)
     if values is not None and topo.junctions:
         _junction_masses(model, topo, values, problems)
     if values is not None:
-        _inertias(model, [c for c in model.components.values() if c.role == "body" or (
-            c.role in ("joint", "part") and c.has_mass)], values, problems)
+        check_inertias(model, [c for c in model.components.values() if c.role == "body" or (
+            c.role in ("joint", "part") and c.has_mass)], values, problems, topo.warnings)
         for comp in model.components.values():
-            problems.extend(comp.check_values(values[comp.name],
-                                              lambda key, c=comp: model.place(c, key)))
+            problems.extend(Problem.of(p, **model.fields(comp)) for p in comp.check_values(
+                values[comp.name], lambda key, c=comp: model.place(c, key)))
     if problems:
         raise ModelError(problems)
     return topo
@@ -192,24 +205,28 @@ def _probes(model, graph, probes, problems):
         wired = list(graph.neighbors(ref))
         if len(wired) != 1:
             what = "nothing" if not wired else ", ".join(p.path for p in wired)
-            problems.append(f"{model.place(probe)}: a probe is wired to exactly one port; "
-                            f"{probe.name}.port is wired to {what}")
+            problems.append(model.problem(f"a probe is wired to exactly one port; "
+                                          f"{probe.name}.port is wired to {what}", probe,
+                                          port="port"))
             continue
         target = wired[0]
         if target.component.role == "probe":
-            problems.append(f"{model.place(probe)}: wired to another probe ({target.path})")
+            problems.append(model.problem(f"wired to another probe ({target.path})", probe,
+                                          port="port"))
             continue
         allowed = QUANTITIES.get(target.domain)
         if allowed is None:
-            problems.append(f"{model.place(probe)}: cannot measure {target.path} "
-                            f"({target.domain} ports are not measured by probes)")
+            problems.append(model.problem(f"cannot measure {target.path} ({target.domain} "
+                                          f"ports are not measured by probes)", probe,
+                                          port="port"))
             continue
         asked = probe.quantities if probe.quantities is not None else list(allowed)
         for q in asked:
             if q not in allowed:
-                problems.append(f"{model.place(probe, 'quantities')}: {q!r} is not a quantity "
-                                f"of a {target.domain} port ({target.path}); choose from "
-                                f"{', '.join(allowed)}")
+                problems.append(model.problem(f"{q!r} is not a quantity of a "
+                                              f"{target.domain} port ({target.path}); choose "
+                                              f"from {', '.join(allowed)}", probe,
+                                              "quantities"))
         out.append((probe, target))
     return out
 
@@ -229,8 +246,8 @@ def _tree(model, topo, roles, problems):
     for rank, comp in enumerate(joints):
         a, b = topo.set_of[comp.port_ref("frame_a")], topo.set_of[comp.port_ref("frame_b")]
         if a == b:
-            problems.append(f"{model.place(comp)}: frame_a and frame_b are connected to each "
-                            f"other, which locks the part")
+            problems.append(model.problem("frame_a and frame_b are connected to each other, "
+                                          "which locks the part", comp, port="frame_b"))
             continue
         # ties go to the part added first: the last joint of a loop closes it (is cut)
         tie = 0.5 * (len(joints) - rank) / len(joints)
@@ -250,20 +267,23 @@ def _tree(model, topo, roles, problems):
             stray = [p.path for p in topo.sets[topo.set_of[comp.port_ref(pname)]]
                      if p.component is not comp and p.component.role != "probe"]
             if stray:
-                problems.append(f"{model.place(comp)}: {comp.name}.{pname} is for probes "
-                                f"only, but {', '.join(stray)} is wired to it")
+                problems.append(model.problem(f"{comp.name}.{pname} is for probes only, but "
+                                              f"{', '.join(stray)} is wired to it", comp,
+                                              port=pname))
         for pname in comp.ports:
             if comp.ports[pname].domain == "frame" and pname not in by_cut and \
                     _dangling(topo, comp, pname) and \
                     len(topo.sets[topo.set_of[comp.port_ref(pname)]]) > 1 and \
                     topo.set_of[comp.port_ref(pname)] not in reached:
-                problems.append(f"{model.place(comp)}: {comp.name}.{pname} is not wired, so "
-                                f"it has no pose for a probe to measure")
+                problems.append(model.problem(f"{comp.name}.{pname} is not wired, so it has "
+                                              f"no pose for a probe to measure", comp,
+                                              port=pname))
             if comp.ports[pname].domain == "frame" and pname not in by_cut and \
                     not _dangling(topo, comp, pname) and \
                     topo.set_of[comp.port_ref(pname)] not in placed:
-                problems.append(f"{model.place(comp)}: {comp.name} is not connected to the "
-                                f"ground {topo.world.name!r} through joints or rigid parts")
+                problems.append(model.problem(f"{comp.name} is not connected to the ground "
+                                              f"{topo.world.name!r} through joints or rigid "
+                                              f"parts", comp, port=pname))
                 break
 
     sub = frames.subgraph(reached)
@@ -280,13 +300,14 @@ def _tree(model, topo, roles, problems):
         comp = data["component"]
         if comp.name in in_tree:
             if getattr(type(comp), "loop_only", False):
-                problems.append(f"{model.place(comp)}: {comp.name} closes no kinematic loop "
-                                f"(or its loop has another such joint): a {comp.type_name} "
-                                f"holds only the distance of its frames, so it must be the "
-                                f"one joint that closes its loop")
+                problems.append(model.problem(f"{comp.name} closes no kinematic loop (or its "
+                                              f"loop has another such joint): a "
+                                              f"{comp.type_name} holds only the distance of "
+                                              f"its frames, so it must be the one joint that "
+                                              f"closes its loop", comp))
             elif comp._values.get("cut", False):
-                problems.append(f"{model.place(comp, 'cut')}: {comp.name} is marked cut but "
-                                f"closes no kinematic loop")
+                problems.append(model.problem(f"{comp.name} is marked cut but closes no "
+                                              f"kinematic loop", comp, "cut"))
             continue
         a, b = topo.set_of[comp.port_ref("frame_a")], topo.set_of[comp.port_ref("frame_b")]
         path = nx.shortest_path(tree, a, b)
@@ -343,26 +364,28 @@ def _junctions(model, topo, forces, frames, reached, problems):
         if not touching:
             continue
         if not hasattr(type(comp), "law"):
-            problems.append(f"{model.place(comp)}: {comp.name} acts on {where(touching[0])}, a "
-                            f"frame no body, joint or rigid part holds (a massless junction); "
-                            f"only line forces (Spring, Damper, SpringDamper) may meet there, "
-                            f"since a {comp.type_name} needs that frame's orientation")
+            problems.append(model.problem(
+                f"{comp.name} acts on {where(touching[0])}, a frame no body, joint or rigid "
+                f"part holds (a massless junction); only line forces (Spring, Damper, "
+                f"SpringDamper) may meet there, since a {comp.type_name} needs that frame's "
+                f"orientation", comp))
             refused.update(touching)
             continue
         nodes = [s if s in candidates else "placed" for s in sets]
         nx.add_path(joined, nodes)
     out = []
     for s in sorted(candidates):
-        lines = [p.path for p in topo.sets[s] if p.component.role == "frame_force"]
+        lines = [p for p in topo.sets[s] if p.component.role == "frame_force"]
         if s in refused:
             continue
         if len({p.component.name for p in topo.sets[s] if p.component.role != "probe"}) < 2:
-            problems.append(f"{lines[0]}: wired only to the other end of the same line force, "
-                            f"with no body, joint or other line force there; wire it to a frame")
+            problems.append(_at(model, lines[0], f"{lines[0].path}: wired only to the other "
+                                f"end of the same line force, with no body, joint or other "
+                                f"line force there; wire it to a frame"))
         elif not nx.has_path(joined, s, "placed"):
-            problems.append(f"massless junction {where(s)}: its line forces reach no frame "
-                            f"that joints or rigid parts connect to the ground, so where it "
-                            f"sits is not determined")
+            problems.append(_at(model, lines[0], f"massless junction {where(s)}: its line "
+                                f"forces reach no frame that joints or rigid parts connect to "
+                                f"the ground, so where it sits is not determined"))
         else:
             out.append(s)
     return out
@@ -404,30 +427,33 @@ def _oned(model, topo, values, problems):
         held = [p for p in definers if p not in coords and p not in motions]
         definers = coords + motions + held        # the joint's flange roots its group
         if len(coords) > 1 or (coords and held):
-            problems.append(f"connection set {where} rigidly ties joint flange "
+            problems.append(_at(model, coords[-1], f"connection set {where} rigidly ties joint "
+                            f"flange "
                             f"{coords[0].path} to "
                             f"{', '.join(p.path for p in definers[1:] if p not in motions)}"
                             f"{through}: this locks or couples joints, which is not "
-                            f"supported yet")
+                            f"supported yet"))
         elif len(motions) > 1:
             names = ", ".join(p.path for p in motions)
-            problems.append(
+            problems.append(_at(
+                model, motions[-1],
                 f"connection set {where}: joint flange {coords[0].path} is driven by "
                 f"{len(motions)} prescribed motions ({names}){through}; a joint follows one "
                 f"motion: remove all but one" if coords else
                 f"connection set {where} rigidly ties prescribed motion {motions[0].path} to "
                 f"{', '.join(p.path for p in motions[1:])}{through}: one rigid group cannot "
-                f"follow two prescribed motions")
+                f"follow two prescribed motions"))
         elif motions and held:
-            problems.append(f"connection set {where} rigidly ties prescribed motion "
-                            f"{motions[0].path} to {', '.join(p.path for p in held)}"
-                            f"{through}: a flange held in place cannot follow a motion")
+            problems.append(_at(model, motions[0], f"connection set {where} rigidly ties "
+                                f"prescribed motion {motions[0].path} to "
+                                f"{', '.join(p.path for p in held)}{through}: a flange held "
+                                f"in place cannot follow a motion"))
         elif len(held) > 1 and values is not None:
             spots = {p.path: (topo.set_of[p], _fixed_position(p, values)) for p in held}
             if len(set(spots.values())) > 1:
-                problems.append(f"connection set {where} holds fixed flanges at different "
-                                f"positions: "
-                                + str({k: v[1] for k, v in spots.items()}) + through)
+                problems.append(_at(model, held[-1], f"connection set {where} holds fixed "
+                                    f"flanges at different positions: "
+                                    + str({k: v[1] for k, v in spots.items()}) + through))
         cycles = nx.cycle_basis(nx.Graph(sub)) if sub.number_of_edges() else []
         parallel = [sorted(sub.get_edge_data(u, v)) for u, v in {(u, v) for u, v, _ in
                                                                  sub.edges(keys=True)}
@@ -436,12 +462,13 @@ def _oned(model, topo, values, problems):
             names = parallel[0] if parallel else sorted({
                 sub.get_edge_data(u, v)[next(iter(sub.get_edge_data(u, v)))]["component"].name
                 for cyc in cycles[:1] for u, v in zip(cyc, cyc[1:] + cyc[:1])})
-            problems.append(f"rigid 1-D elements {', '.join(names)} form a closed loop "
-                            f"(they tie flanges together twice): remove one")
+            problems.append(Problem(f"rigid 1-D elements {', '.join(names)} form a closed "
+                                    f"loop (they tie flanges together twice): remove one",
+                                    **model.fields(model.components[names[-1]])))
         for p in coords:
             if p.component.name not in tree_joints:
-                problems.append(f"{p.path}: joint {p.component.name!r} has no coordinates "
-                                f"here, so its flange cannot be used")
+                problems.append(_at(model, p, f"{p.path}: joint {p.component.name!r} has no "
+                                    f"coordinates here, so its flange cannot be used"))
         inertias = [d["component"] for _, _, d in sub.edges(data=True)
                     if d["component"].has_inertia]
         kind = ("joint" if coords else "prescribed" if motions else
@@ -449,13 +476,17 @@ def _oned(model, topo, values, problems):
                 "world" if len(ports) <= 1 else "massless")
         if kind == "free" and values is not None and all(
                 e.bound(values[e.name]).inertia() == 0 for e in inertias):
-            problems.append(f"connection set {where}: the inertia of "
-                            f"{', '.join(e.name for e in inertias)} is zero and nothing "
-                            f"holds the flange, so its motion is not determined")
+            problems.append(Problem(f"connection set {where}: the inertia of "
+                                    f"{', '.join(e.name for e in inertias)} is zero and "
+                                    f"nothing holds the flange, so its motion is not "
+                                    f"determined", **model.fields(inertias[0], "J" if "J" in
+                                                                  inertias[0].params else
+                                                                  None)))
         if kind == "massless" and not any(p.component.role == "compliant" for p in ports):
-            problems.append(f"connection set {where} has no defined {domain} position: it "
-                            f"has no inertia, spring or damper, so the flows on it cannot "
-                            f"balance; wire it to a joint flange, a Fixed or an inertia")
+            problems.append(_at(model, ports[0], f"connection set {where} has no defined "
+                                f"{domain} position: it has no inertia, spring or damper, so "
+                                f"the flows on it cannot balance; wire it to a joint flange, "
+                                f"a Fixed or an inertia"))
         # a free group's coordinate is its first inertia's position (the state named after it)
         root = (topo.set_of[definers[0]] if definers else
                 topo.set_of[inertias[0].port_ref("flange_a")] if kind == "free" else
@@ -475,15 +506,16 @@ def _motions(model, topo, problems):
     for comp in model.components.values():
         if comp.role != "prescribed":
             continue
-        key = type(comp).reference.name
+        key = comp.reference_param
         wired = topo.set_of[comp.port_ref("u")] in topo.signal_source
         given = comp.reference is not None
         if wired and given:
-            problems.append(f"{model.place(comp, key)}: {comp.name}.u is wired too; the "
-                            f"reference comes from one of them: remove {key} or the wire")
+            problems.append(model.problem(f"{comp.name}.u is wired too; the reference comes "
+                                          f"from one of them: remove {key} or the wire", comp,
+                                          key, hint=f"remove {key} or the wire to u"))
         elif not wired and not given:
-            problems.append(f"{model.place(comp, key)}: no reference: give {key} (an "
-                            f"expression in time t) or wire a signal to {comp.name}.u")
+            problems.append(model.problem(f"no reference: give {key} (an expression in time "
+                                          f"t) or wire a signal to {comp.name}.u", comp, key))
         support = comp.port_ref("support")
         group = group_of.get(topo.set_of[support])
         own = group_of.get(topo.set_of[comp.port_ref("flange")])
@@ -493,11 +525,12 @@ def _motions(model, topo, problems):
                 own is not group:
             own.base = topo.set_of[support]        # it moves relative to a free housing
             continue
-        problems.append(f"{model.place(comp)}: {support.path} is wired to a flange that "
-                        f"moves ({group.kind}); the reaction of a prescribed motion rests "
-                        f"on a free rotor (an inertia) or in the world: wire the support "
-                        f"to an inertia of its own, a joint's support or a Fixed, or leave "
-                        f"it unwired")
+        problems.append(model.problem(f"{support.path} is wired to a flange that moves "
+                                      f"({group.kind}); the reaction of a prescribed motion "
+                                      f"rests on a free rotor (an inertia) or in the world: "
+                                      f"wire the support to an inertia of its own, a joint's "
+                                      f"support or a Fixed, or leave it unwired", comp,
+                                      port="support"))
 
 
 def _junction_masses(model, topo, values, problems):
@@ -506,39 +539,15 @@ def _junction_masses(model, topo, values, problems):
     junctions = set(topo.junctions)
     for comp in topo.forces:
         if values[comp.name].get("mass", 0.0) and junctions & set(_frame_sets(topo, comp)):
-            problems.append(f"{model.place(comp, 'mass')}: {comp.name} ends at a massless "
-                            f"junction (a frame with no body), where a point mass on the line "
-                            f"is not supported; put a body at the junction instead")
+            problems.append(model.problem(f"{comp.name} ends at a massless junction (a frame "
+                                          f"with no body), where a point mass on the line is "
+                                          f"not supported; put a body at the junction "
+                                          f"instead", comp, "mass"))
 
 
-def _inertias(model, bodies, values, problems):
-    """A body's inertia about its centre of mass must be symmetric and positive
-    semi-definite: nothing else is possible for any use. Principal moments that break the
-    triangle inequality (no rigid body has them) are an idealisation MSL's own examples use
-    for parts that turn about one axis only (ActuatedDrive's diag(2, 0, 0), RobotR3's
-    diag(0.001, 1.16, 0.001)): warned once per body, and simulated; a mass matrix they make
-    singular is refused later, naming the joints. A tensor with a zero principal moment (a
-    planar link given only its moment about the joint axis) is an idealisation too common to
-    warn about."""
-    for body in bodies:
-        if "inertia" not in body.params:
-            continue        # computed from a shape: physical by construction
-        inertia = np.asarray(values[body.name]["inertia"], dtype=float)
-        where = model.place(body, "inertia")
-        scale = max(np.max(np.abs(inertia)), 1e-300)
-        if np.max(np.abs(inertia - inertia.T)) > 1e-9 * scale:
-            problems.append(f"{where}: must be symmetric, got {inertia.tolist()}")
-            continue
-        moments = np.linalg.eigvalsh(inertia)
-        listed = ", ".join(f"{m:.6g}" for m in moments)
-        if moments[0] < -1e-9 * scale:
-            problems.append(f"{where}: must be positive semi-definite; its principal moments "
-                            f"are {listed}")
-        elif moments[0] > 1e-12 * scale and moments[0] + moments[1] < moments[2] - 1e-9 * scale:
-            warnings.warn(f"{where}: its principal moments {listed} break the triangle "
-                          f"inequality (the largest exceeds the sum of the other two): no "
-                          f"rigid body has them; simulated as an idealisation",
-                          IdealisedInertiaWarning, stacklevel=2)
+def _at(model, ref, text):
+    """A Problem whose message ``text`` names its place itself, about port ``ref``."""
+    return Problem(text, **model.fields(ref.component, port=ref.name))
 
 
 def _domain(ports):
@@ -546,7 +555,7 @@ def _domain(ports):
     return next((p.domain for p in ports if p.component.role != "probe"), ports[0].domain)
 
 
-def _signals(topo, problems):
+def _signals(model, topo, problems):
     """Each signal connection set has one output and any number of inputs."""
     for index, ports in enumerate(topo.sets):
         physical = [p for p in ports if p.component.role != "probe"]
@@ -555,11 +564,13 @@ def _signals(topo, problems):
         outs = [p for p in physical if p.domain == "signal_out"]
         ins = [p for p in physical if p.domain == "signal_in"]
         if len(outs) > 1:
-            problems.append(f"signal outputs {', '.join(p.path for p in outs)} are wired "
-                            f"together: a signal has exactly one source")
+            problems.append(_at(model, outs[-1], f"signal outputs "
+                                f"{', '.join(p.path for p in outs)} are wired together: a "
+                                f"signal has exactly one source"))
         elif ins and not outs and len(physical) > 1:
-            problems.append(f"signal inputs {', '.join(p.path for p in ins)} are wired to "
-                            f"each other but to no output")
+            problems.append(_at(model, ins[-1], f"signal inputs "
+                                f"{', '.join(p.path for p in ins)} are wired to each other "
+                                f"but to no output"))
         if outs:
             topo.signal_source[index] = outs[0]
 

@@ -212,3 +212,32 @@ def test_sensitivities_refuse_a_run_with_events_rather_than_carry_a_law_past_the
     # before the bump no event is met, and the road's height changes nothing yet
     sens = kn.sensitivity(quarter_car(), ["h"], t_end=0.4, n_points=5, outputs=["body.s"])
     assert np.all(sens.S == 0)
+
+
+def test_sensitivities_before_a_relation_switches_see_the_branch_it_holds():
+    # F while t < 1: over 0.5 s the mass is pushed (s = F t^2 / (2 m), m = 2 kg), and the
+    # sensitivity ds/dF = t^2 / 4 is the pushed branch's, not the other one's (0)
+    model = free_mass("if_else(t < 1, F, 0)", {"F": 3.0})
+    sens = kn.sensitivity(model, ["F"], t_end=0.5, n_points=6, outputs=["mass.s"])
+    np.testing.assert_allclose(sens["mass.s", "F"], sens.t ** 2 / 4, rtol=1e-6, atol=1e-12)
+
+
+@pytest.mark.parametrize("road", ["expression", "table", "pulse", "pulse_blocks"])
+def test_a_sweep_member_with_events_gets_simulates_answer(references, road):
+    # each member through the plan's run, its events and all: the reference, and the very
+    # numbers of kn.simulate, in threads (batch 1 and 4) and serially; the road is linear
+    # in h, so the member of 2 h (the expression's bump twice as high) moves twice as far
+    model = quarter_car(road)
+    ref = references[road]
+    one = kn.simulate(model, t_end=T_END)
+    scale = 2.0 if road == "expression" else 1.0
+    for batch, workers in ((1, 2), (4, 2), (None, 1)):
+        ds = kn.sweep(model, {"h": [0.05, 0.1]}, t_end=T_END, batch=batch, workers=workers,
+                      progress=False)
+        assert list(ds.status.values) == ["ok", "ok"]
+        for h, factor in ((0.05, 1.0), (0.1, scale)):
+            for name, column in (("wheel.s", -4), ("body.s", -2)):
+                member = ds[name].sel(h=h).values
+                assert np.max(np.abs(member - factor * ref[:, column])) < 1e-6, (name, h)
+        np.testing.assert_allclose(ds["body.s"].sel(h=0.05).values, one["body.s"],
+                                   rtol=1e-6, atol=1e-12)
