@@ -8,7 +8,7 @@ Layers, each importing only those before it: ``errors``, ``util``, ``expr``, ``u
 topology, files) -> ``equations`` (the System) -> ``solver`` (the integration plan, driver,
 methods, JIT cache, Results; ``kinetwork.simulation``, its old name, is a deprecated alias)
 -> the faces: ``plot``, ``schema``, ``symbolic``, ``animation``, ``diagram``, ``analysis``,
-``studio``, ``cli``. The four methods of a lower layer that hand work up (``Model.compile``,
+``studio``, ``fmu``, ``cli``. The four methods of a lower layer that hand work up (``Model.compile``,
 ``Model._repr_svg_``, ``Results.plot``, ``Results.animate``) name the function they call in
 one table, ``kinetwork.upcalls``; nothing is installed at import time.
 
@@ -56,6 +56,7 @@ _LAZY = {
     "sweep": ("analysis.sweep", "sweep"),
     "sample": ("analysis.sweep", "sample"),
     "normal": ("analysis.sweep", "normal"),
+    "export_fmu": ("fmu.build", "export_fmu"),
     "uniform": ("analysis.sweep", "uniform"),
 }
 

@@ -474,6 +474,8 @@ VISUALS = {
     "multibody.BodyBox": lambda s, c, v: s.msl_body(c, v, "box"),
     "multibody.BodyCylinder": lambda s, c, v: s.msl_body(c, v, "cylinder"),
     "multibody.BodySphere": Scene.sphere_body,
+    "multibody.PointMass": lambda s, c, v: s.sphere_body(c, {"diameter": v.get("sphereDiameter"),
+                                                             "color": v.get("color")}),
     "multibody.SpringDamper": Scene.line_force,
     "multibody.Spring": Scene.line_force,
     "multibody.Damper": Scene.line_force,

@@ -7,7 +7,13 @@ and rotor (``rotor.py``) are declared in modules of their own and are part of it
 (``kn.multibody.RigidBody``).
 """
 
-from ..spatial import (cardan_quat, eye3, quat_rate, quat_rotation, rotation, unit, vec3,
+import math
+
+import numpy as np
+
+from ..errors import ModelError
+from ..expr import casadi_functions, parse
+from ..spatial import (cardan_quat, eye3, mat3, quat_rate, quat_rotation, rotation, unit, vec3,
                        zero3)
 from .base import COORDINATES, RATES, Component, Param, Port, library_attribute
 from .frames import PartialRigidTransform
@@ -15,8 +21,43 @@ from .frames import PartialRigidTransform
 MB = "multibody"
 
 
-#: gravity fields a Ground may have (MSL's World.gravityType, less NoGravity: a uniform zero)
-GRAVITY_TYPES = ("uniform", "point")
+#: gravity fields a Ground may have (MSL's World.gravityType, less NoGravity: a uniform zero;
+#: "expression" is MSL's redeclared gravityAcceleration function)
+GRAVITY_TYPES = ("uniform", "point", "expression")
+#: names a gravity field's expressions read for the world point (besides t and parameters)
+FIELD_NAMES = ("x", "y", "z")
+
+
+class FieldParam(Param):
+    """Three expressions of the world point (x, y, z), time t and the model's parameters:
+    parsed and checked for form here, their names where the model is compiled."""
+
+    def __init__(self, doc=""):
+        super().__init__(None, optional=True, shape=(3,), unit="m/s^2", kind="expression",
+                         doc=doc)
+
+    def normalize(self, value, where):
+        if value is None:
+            return None
+        if isinstance(value, np.ndarray):
+            value = value.tolist()
+        if not isinstance(value, (list, tuple)) or len(value) != 3:
+            raise ModelError(f"{where}: must be 3 expressions in x, y, z (the world point), "
+                             f"t and the model's parameters, got {value!r}")
+        out = []
+        for i, v in enumerate(value):
+            if isinstance(v, (int, float)) and not isinstance(v, bool):
+                out.append(float(v))
+                continue
+            if not isinstance(v, str) or not v.strip():
+                raise ModelError(f"{where}[{i}]: must be a number or an expression, got "
+                                 f"{v!r}")
+            try:
+                parse(v)
+            except ModelError as exc:
+                raise ModelError(f"{where}[{i}]: {exc}") from None
+            out.append(v)
+        return out
 
 
 class Ground(Component, library=MB):
@@ -24,18 +65,24 @@ class Ground(Component, library=MB):
 
     The field is uniform (``gravity``), or that of a point mass at the world origin
     (``gravity_type`` "point", MSL's World with gravityType PointGravity): -mue/|r|^2 along r
-    at the world point r, acting on every body at its centre of mass (so a body feels a
-    torque about its frame only through its centre-of-mass offset, as in MSL; no
+    at the world point r, or any field the user writes (``gravity_type`` "expression", MSL's
+    redeclared world.gravityAcceleration: ``field``, three expressions in the world point x,
+    y, z, the time t and the model's parameters, such as MSL's WGS84 normal gravity in
+    UserDefinedGravityField). A field acts on every body at its centre of mass (so a body
+    feels a torque about its frame only through its centre-of-mass offset, as in MSL; no
     gravity-gradient torque).
 
     Parameters
     ----------
     gravity : m/s^2, 3 values, default [0, -9.81, 0]
         Uniform gravity acceleration, in the world frame (not used by a point field).
-    gravity_type : "uniform" or "point", default "uniform"
+    gravity_type : "uniform", "point" or "expression", default "uniform"
         Kind of gravity field.
     mue : m^3/s^2, >= 0, default 3.986004418e14 (the Earth's)
         Field constant of the point field, G times the central mass (MSL's mu).
+    field : m/s^2, 3 expressions, default None
+        The gravity acceleration at the world point (x, y, z), in the world frame, for
+        ``gravity_type`` "expression": e.g. ["0", "-9.81*(1 - 2*y/6.371e6)", "0"].
     """
     role = "world"
     frame = Port("frame", "World frame", optional=True)
@@ -46,6 +93,11 @@ class Ground(Component, library=MB):
                              "the world origin, field constant mue)")
     mue = Param(3.986004418e14, unit="m^3/s^2", min=0.0,
                 doc="Field constant of the point gravity field (G times the central mass)")
+    field = FieldParam(doc="Gravity acceleration at the world point (x, y, z), in the world "
+                           "frame: 3 expressions in x, y, z, t and the model's parameters "
+                           "(gravity_type 'expression')")
+    #: the model's parameters and t, as the compiler binds them (names a field may read)
+    _environment = {}
 
     def uniform_gravity(self):
         """The gravity vector of a uniform field, or None for a point field."""
@@ -56,7 +108,32 @@ class Ground(Component, library=MB):
         import casadi as ca
         if self.gravity_type == "uniform":
             return vec3(self.gravity)
-        return -self.mue * r / ca.norm_2(r) ** 3
+        if self.gravity_type == "point":
+            return -self.mue * r / ca.norm_2(r) ** 3
+        env = {**self._environment, **dict(zip(FIELD_NAMES, ca.vertsplit(r)))}
+        out = []
+        for i, v in enumerate(self.field):
+            if isinstance(v, float):
+                out.append(ca.SX(v))
+                continue
+            expr = parse(v)
+            unknown = sorted(expr.names - set(env))
+            if unknown:
+                raise ModelError(f"{self.name}.field[{i}]: unknown name {unknown[0]!r}: a "
+                                 f"gravity field reads x, y, z (the world point), t and the "
+                                 f"model's parameters")
+            out.append(ca.SX(expr.evaluate(env, casadi_functions())))
+        return ca.vertcat(*out)
+
+    def check_values(self, values, place):
+        expression = values.get("gravity_type") == "expression"
+        if expression and values.get("field") is None:
+            return [f"{place('field')}: gravity_type 'expression' needs the field, three "
+                    f"expressions in x, y, z"]
+        if not expression and values.get("field") is not None:
+            return [f"{place('field')}: a field is used with gravity_type 'expression' "
+                    f"only (here {values.get('gravity_type')!r})"]
+        return []
 
 
 class FixedTranslation(PartialRigidTransform, library=MB):
@@ -316,13 +393,19 @@ class FreeMotion(PartialJoint, library=MB):
     given are conditions on the start: the joints of its loop without a q0 (qd0) are solved
     so that frame_b starts where r0 and angles0 put it, moving as v0 and w0 say
     (``equations/loopstart.py``); what they cannot reach is refused.
+
+    A FreeMotion whose frame_b carries nothing but PointMasses (MSL's PointMass alone on a
+    FreeMotion) moves them without turning: no body it carries has rotational inertia, so its
+    orientation is not a state. Its coordinates are then r only, its speeds v, frame_b keeps
+    the orientation angles0 gives (MSL's unit rotation by default) and w0, if given, must be
+    zero (``graph/topology.py`` finds it).
     """
-    dof = 6
     nq = 7
+    #: True while frame_b carries only point masses (set with each model's topology)
+    _translation_only = False
     regular = False
     constant_subspace = False
     cut_preference = 0        # cutting it removes nothing: the first choice
-    units = ("m", "m", "m", "", "", "", "")
     r0 = Param(None, optional=True, shape=(3,), unit="m",
                doc="Initial position, in frame_a (None: 0, or free in a loop)")
     v0 = Param(None, optional=True, shape=(3,), unit="m/s",
@@ -333,23 +416,49 @@ class FreeMotion(PartialJoint, library=MB):
     w0 = Param(None, optional=True, shape=(3,), unit="rad/s",
                doc="Initial angular velocity, resolved in frame_b (None: 0, or free in a loop)")
 
+    @property
+    def dof(self):
+        return 3 if self._translation_only else 6
+
+    def n_coordinates(self):
+        return 3 if self._translation_only else 7
+
+    @property
+    def units(self):
+        return ("m",) * 3 + (() if self._translation_only else ("",) * 4)
+
+    def speed_units(self):
+        return ["m/s"] * 3 + ([] if self._translation_only else ["rad/s"] * 3)
+
     def coordinate_labels(self):
-        return [f"r[{i}]" for i in range(3)] + [f"quat[{i}]" for i in range(4)]
+        return [f"r[{i}]" for i in range(3)] + \
+            ([] if self._translation_only else [f"quat[{i}]" for i in range(4)])
 
     def speed_labels(self):
-        return [f"v[{i}]" for i in range(3)] + [f"w[{i}]" for i in range(3)]
+        return [f"v[{i}]" for i in range(3)] + \
+            ([] if self._translation_only else [f"w[{i}]" for i in range(3)])
+
+    def _held(self):
+        """frame_b's orientation where it does not turn: angles0's (else none)."""
+        return quat_rotation(cardan_quat([0.0] * 3 if self.angles0 is None else self.angles0))
 
     def transform(self, q):
+        if self._translation_only:
+            return self._held(), q[0:3]
         return quat_rotation(q[3:7]), q[0:3]
 
     def subspace(self, q):
         # spatial velocity of frame_b in its own axes: [w; R^T v]
         import casadi as ca
+        if self._translation_only:
+            return ca.vertcat(ca.SX.zeros(3, 3), ca.SX(self._held().T))
         Rt = quat_rotation(q[3:7]).T
         return ca.blockcat([[ca.SX.zeros(3, 3), ca.SX.eye(3)], [Rt, ca.SX.zeros(3, 3)]])
 
     def rate(self, q, u):
         import casadi as ca
+        if self._translation_only:
+            return u
         return ca.vertcat(u[0:3], quat_rate(q[3:7], u[3:6]))
 
     def closure(self, rel_R, rel_p, q):
@@ -361,6 +470,8 @@ class FreeMotion(PartialJoint, library=MB):
 
         def given(v):
             return [0.0] * 3 if v is None else list(v)
+        if self._translation_only:
+            return given(self.r0), given(self.v0)
         return ([*given(self.r0), *ca.vertsplit(cardan_quat(given(self.angles0)))],
                 [*given(self.v0), *given(self.w0)])
 
@@ -386,6 +497,9 @@ class FreeMotion(PartialJoint, library=MB):
 from .bodies import (BodyBox, BodyCylinder, BodyShape, BodySphere,  # noqa: E402,F401
                      RigidBody)
 from .loopjoints import JointRRR, SphericalSpherical, UniversalSpherical  # noqa: E402,F401
+from .pointmass import PointMass  # noqa: E402,F401
+from .assemblies import (JointRRP, JointSSP, JointSSR, JointUPS, JointUSP,  # noqa: E402,F401
+                         JointUSR)
 from .forces import (Damper, Force, ForceAndTorque, LineForceWithTwoMasses,  # noqa: E402,F401
                      Spring, SpringDamper, Torque, WorldForce, WorldTorque)
 from .rotor import Rotor1D  # noqa: E402,F401

@@ -199,6 +199,21 @@ class PartialFlowSensor(PartialRigid):
         return _unit(self.domain, "flow") if port == "y" else None
 
 
+class PartialPowerSensor(PartialRigid):
+    """MSL's PowerSensor and MultiSensor: rigid and massless, wired in series; at flange_a it
+    reads the flow into it, its speed and their product, the power flowing from flange_a to
+    flange_b, each on the output port ``outputs`` names for it."""
+    quantity = "flow"
+    #: output port -> what it carries: "flow", "speed" or "power"
+    outputs = {}
+
+    def signal_unit(self, port):
+        what = self.outputs.get(port)
+        if what == "power":
+            return "W"
+        return None if what is None else _unit(self.domain, 3 if what == "flow" else 1)
+
+
 class PartialMotion(Component):
     """Prescribes the motion of its flange: ``reference`` (or the signal at ``u``, when wired)
     is the ``derivative``-th time derivative of the flange's position (0: the position, 1: the

@@ -2,8 +2,8 @@
 
 from .base import Param, Port, library_attribute
 from .oned import (PartialDamper, PartialFixed, PartialFlowSensor, PartialInertia,
-                   PartialMotion, PartialRigid, PartialSensor, PartialSource, PartialSpring,
-                   PartialSpringDamper)
+                   PartialMotion, PartialPowerSensor, PartialRigid, PartialSensor,
+                   PartialSource, PartialSpring, PartialSpringDamper)
 
 LIB = "rotational"
 
@@ -84,6 +84,25 @@ class AccSensor(PartialSensor, library=LIB):
 class TorqueSensor(PartialFlowSensor, library=LIB):
     """The torque through the sensor (into flange_a) as a signal; wire it in series."""
     domain = LIB
+
+
+class PowerSensor(PartialPowerSensor, library=LIB):
+    """The power flowing from flange_a to flange_b, flange_a.tau * der(flange_a.phi), as the
+    signal ``power`` (MSL's Rotational.Sensors.PowerSensor); wire it in series."""
+    domain = LIB
+    power = Port("signal_out", "Power from flange_a to flange_b [W]", optional=True)
+    outputs = {"power": "power"}
+
+
+class MultiSensor(PartialPowerSensor, library=LIB):
+    """The torque into flange_a (``tau``), the flanges' speed (``w``) and the power flowing
+    from flange_a to flange_b, tau * w (``power``), as MSL's Rotational.Sensors.MultiSensor;
+    wire it in series."""
+    domain = LIB
+    power = Port("signal_out", "Power from flange_a to flange_b [W]", optional=True)
+    w = Port("signal_out", "Speed of the flanges [rad/s]", optional=True)
+    tau = Port("signal_out", "Torque into flange_a [N*m]", optional=True)
+    outputs = {"power": "power", "w": "speed", "tau": "flow"}
 
 
 class Position(PartialMotion, library=LIB):

@@ -1,9 +1,9 @@
 """1-D translational library: position s [m] and force f [N] on flanges."""
 
-from .base import Param, library_attribute
+from .base import Param, Port, library_attribute
 from .oned import (PartialDamper, PartialFixed, PartialFlowSensor, PartialInertia,
-                   PartialMotion, PartialSensor, PartialSource, PartialSpring,
-                   PartialSpringDamper)
+                   PartialMotion, PartialPowerSensor, PartialRigid, PartialSensor,
+                   PartialSource, PartialSpring, PartialSpringDamper)
 
 LIB = "translational"
 
@@ -43,6 +43,17 @@ class Fixed(PartialFixed, library=LIB):
     """Flange fixed at a position in the world."""
     domain = LIB
     s0 = Param(0.0, unit="m", doc="Fixed position")
+
+
+class Rod(PartialRigid, library=LIB):
+    """A rigid massless rod of length L between flange_a and flange_b, MSL's
+    Translational.Components.Rod: flange_b.s = flange_a.s + L, and the force it takes at one
+    flange it passes whole to the other."""
+    domain = LIB
+    L = Param(0.0, unit="m", doc="Length, from flange_a to flange_b (flange_b.s - flange_a.s)")
+
+    def length(self):
+        return self.L
 
 
 class Mass(PartialInertia, library=LIB):
@@ -86,6 +97,25 @@ class AccSensor(PartialSensor, library=LIB):
 class ForceSensor(PartialFlowSensor, library=LIB):
     """The force through the sensor (into flange_a) as a signal; wire it in series."""
     domain = LIB
+
+
+class PowerSensor(PartialPowerSensor, library=LIB):
+    """The power flowing from flange_a to flange_b, flange_a.f * der(flange_a.s), as the
+    signal ``power`` (MSL's Translational.Sensors.PowerSensor); wire it in series."""
+    domain = LIB
+    power = Port("signal_out", "Power from flange_a to flange_b [W]", optional=True)
+    outputs = {"power": "power"}
+
+
+class MultiSensor(PartialPowerSensor, library=LIB):
+    """The force into flange_a (``f``), the flanges' velocity (``v``) and the power flowing
+    from flange_a to flange_b, f * v (``power``), as MSL's Translational.Sensors.MultiSensor;
+    wire it in series."""
+    domain = LIB
+    power = Port("signal_out", "Power from flange_a to flange_b [W]", optional=True)
+    f = Port("signal_out", "Force into flange_a [N]", optional=True)
+    v = Port("signal_out", "Velocity of the flanges [m/s]", optional=True)
+    outputs = {"power": "power", "f": "flow", "v": "speed"}
 
 
 class Position(PartialMotion, library=LIB):

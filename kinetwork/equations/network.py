@@ -105,8 +105,12 @@ class Network:
 
 
 def build(model, topo, bound, q, u, udot, qindex, uindex, t, inverse=None, p=None,
-          p_values=None, reads=None):
+          p_values=None, reads=None, derived=None):
     """The Network of a validated model, in the symbols of the Assembly.
+
+    ``derived``: the flanges whose position an assembly gives (its axis, the angle or
+    distance that closes its loop), PortRef -> (position, speed, acceleration) in (q, u,
+    udot); the generalized force on such a flange reaches the speeds by virtual work.
 
     ``inverse(a, armature, Q)`` is the tree's inverse dynamics (for InverseDynamics blocks):
     the generalized forces for speeds' rates ``a`` with the given armature, less ``Q``.
@@ -116,6 +120,7 @@ def build(model, topo, bound, q, u, udot, qindex, uindex, t, inverse=None, p=Non
     builder = _Builder(model, topo, bound, q, u, udot, qindex, uindex, t, inverse, p,
                        p_values)
     builder.reads = reads or {}
+    builder.derived = derived or {}
     return builder.run()
 
 
@@ -284,6 +289,8 @@ class _Builder:
             self._motion(group, group.definer, placeholders)
         elif kind == "free":
             self._free(group)
+        elif kind == "assembly":
+            self.coord[group.index] = tuple(ca.SX(v) for v in self.derived[group.definer])
         elif kind == "massless":
             theta, w = ca.SX.sym(f"g{group.index}_pos"), ca.SX.sym(f"g{group.index}_vel")
             a = ca.SX.sym(f"g{group.index}_acc")
@@ -359,6 +366,14 @@ class _Builder:
 
     def _output(self, comp):
         """Evaluate a block's or a sensor's output into its signal set."""
+        if getattr(type(comp), "outputs", None):
+            # a power or multi sensor: the flow into flange_a, its speed, their product
+            ref = comp.port_ref("flange_a")
+            read = {"flow": self.net.flow[ref], "speed": self.net.vel[ref]}
+            read["power"] = read["flow"] * read["speed"]
+            for pname, what in comp.outputs.items():
+                self.net.signal[self.topo.set_of[comp.port_ref(pname)]] = ca.SX(read[what])
+            return
         s = self.topo.set_of[comp.port_ref("y")]
         b = self.bound[comp.name]
         if comp.role == "block":
@@ -582,6 +597,13 @@ class _Builder:
             u = self._speed(group)
             self.net.armature[u] += inertia
             self._passive[u] += self._generalized(group, ("compliant",))
+        elif group.kind == "assembly":
+            self._passive += self._virtual(group, self._generalized(group, ("compliant",)))
+
+    def _virtual(self, group, gen):
+        """The generalized forces on the speeds of a force ``gen`` on an assembly's axis:
+        (d(speed of the axis)/du)^T gen, by virtual work."""
+        return ca.jtimes(self.coord[group.index][1], self.u, ca.SX(gen), True)
 
     def _speed(self, group):
         joint = group.definer.component
@@ -594,6 +616,8 @@ class _Builder:
         theta, w, a = self.coord[group.index]
         if group.kind == "joint":
             self.net.Q[self._speed(group)] += gen
+        elif group.kind == "assembly":
+            self.net.Q += self._virtual(group, gen)
         elif group.kind == "free" and group.index in self.circuit.coupled:
             # a rotor a circuit's constraint holds: its acceleration came with the circuit's
             # solution, in the generalized force of all but the circuit's EMFs

@@ -93,6 +93,15 @@ class System:
             "dependent_jacobian", [ca.vertcat(eq.x, eq.z), asm.p],
             [ca.densify(ca.substitute(jd, asm.q, ca.densify(coords)))])
         self.dependent_names = eq.dependent_names or []
+        checks = asm.placed.checks if asm.placed is not None else []
+        #: what stays positive away from the singular positions of assemblies that close
+        #: their loops in closed form, of the full state (None: no assembly)
+        self.f_assembly_checks = None if not checks else ca.Function(
+            "assembly_checks", [asm.t, ca.vertcat(eq.x, eq.z), asm.p],
+            [ca.densify(ca.substitute(ca.vertcat(*[c for c, _, _ in checks]), asm.q,
+                                      ca.densify(coords)))])
+        #: (assembly, what is singular) of each check
+        self.assembly_check_names = [(name, what) for _, name, what in checks]
         if self.formulation in ("tree", "hybrid") and self.speed_names and \
                 not self.n_algebraic:
             self._check_mass_matrix()
@@ -196,6 +205,24 @@ class System:
         if self.eq.residual is None:
             return np.zeros(len(X))
         return pointwise(self._f_residual, X, p)[0].ravel()
+
+    def assembly_singular(self, times, X, p, margin=0.0):
+        """(row, messages): the first row of full states X (at ``times``) at which an
+        assembly that closes its loop in closed form is at (or past, or within ``margin``
+        of) a singular position, and what is singular there; (None, []) where none is."""
+        if self.f_assembly_checks is None or not len(X):
+            return None, []
+        X = np.atleast_2d(np.asarray(X, dtype=float))
+        values = np.asarray(mapped(self.f_assembly_checks, len(X))(
+            np.atleast_1d(times)[None, :], X.T, p)).T
+        with np.errstate(invalid="ignore"):
+            bad = ~(values > margin)
+        rows = np.nonzero(bad.any(axis=1))[0]
+        if not len(rows):
+            return None, []
+        return int(rows[0]), [f"{name} {'is at' if not margin else 'nears'} a singular "
+                              f"position of its loop: {what}" for (name, what), b in
+                              zip(self.assembly_check_names, bad[rows[0]]) if b]
 
     @functools.cached_property
     def _f_residual(self):

@@ -87,6 +87,22 @@ class Topology:
     signal_source: dict = field(default_factory=dict)   # signal set -> its output PortRef
     #: what was accepted with a warning (each warned of too), as Problems: the studio's
     warnings: list = field(default_factory=list)
+    #: assemblies that close their loop in closed form (MSL's Joints.Assemblies), as Cuts
+    #: with no closure rows, and what they place, in the order it can be placed: a Cut places
+    #: its inner frames from its two ends, an Edge a rigid part hanging from a placed frame
+    placements: list = field(default_factory=list)
+    #: frame set -> (assembly, port) of the inner frames assemblies place
+    placed_by: dict = field(default_factory=dict)
+
+    @property
+    def assemblies(self):
+        """The Cuts of the assemblies that close their loops in closed form."""
+        return [c for c in self.placements if isinstance(c, Cut)]
+
+    @property
+    def inner(self):
+        """The frame sets assemblies place: their inner frames and what hangs from them."""
+        return set(self.placed_by) | {e.child for e in self.placements if isinstance(e, Edge)}
 
     @property
     def dof(self):
@@ -243,6 +259,9 @@ def _tree(model, topo, roles, problems):
     frames.add_node(topo.root)
     # joints and rigid parts are the edges, in model order (ties go to the part added first)
     joints = [c for c in model.components.values() if c.role in ("joint", "part")]
+    # an assembly that closes its loop in closed form is no edge of the tree: both of its
+    # ends are placed by the rest, and it places its inner frames from them
+    analytic = [c for c in joints if getattr(type(c), "analytic", False)]
     for rank, comp in enumerate(joints):
         a, b = topo.set_of[comp.port_ref("frame_a")], topo.set_of[comp.port_ref("frame_b")]
         if a == b:
@@ -251,19 +270,27 @@ def _tree(model, topo, roles, problems):
             continue
         # ties go to the part added first: the last joint of a loop closes it (is cut)
         tie = 0.5 * (len(joints) - rank) / len(joints)
-        frames.add_edge(a, b, key=comp.name, component=comp, weight=_keep_weight(comp) + tie)
+        if comp not in analytic:
+            frames.add_edge(a, b, key=comp.name, component=comp,
+                            weight=_keep_weight(comp) + tie)
+        frames.add_nodes_from([a, b])
     for comp in [*roles.get("body", []), *roles.get("frame_force", [])]:
         for pname in comp.ports:
             frames.add_node(topo.set_of[comp.port_ref(pname)])
 
+    for comp in joints:
+        for pname in getattr(type(comp), "placed_frames", ()):
+            frames.add_node(topo.set_of[comp.port_ref(pname)])
     reached = nx.node_connected_component(frames, topo.root)
-    topo.junctions = _junctions(model, topo, roles.get("frame_force", []), frames, reached,
-                                problems)
-    placed = reached | set(topo.junctions)
+    inner = _place_assemblies(model, topo, frames, analytic, reached, problems)
+    topo.junctions = _junctions(model, topo, roles.get("frame_force", []), frames,
+                                reached | inner, problems)
+    placed = reached | inner | set(topo.junctions)
     for comp in [*joints, *roles.get("body", []), *roles.get("frame_force", [])]:
-        # frames a cut joint places from where its ends are (a rod's frame_ia): for probes
+        # frames a cut joint places from where its ends are (a rod's frame_ia): for probes,
+        # unless it carries loads there (an assembly)
         by_cut = getattr(type(comp), "placed_frames", ())
-        for pname in by_cut:
+        for pname in by_cut if not getattr(type(comp), "carries_loads", False) else ():
             stray = [p.path for p in topo.sets[topo.set_of[comp.port_ref(pname)]]
                      if p.component is not comp and p.component.role != "probe"]
             if stray:
@@ -274,7 +301,7 @@ def _tree(model, topo, roles, problems):
             if comp.ports[pname].domain == "frame" and pname not in by_cut and \
                     _dangling(topo, comp, pname) and \
                     len(topo.sets[topo.set_of[comp.port_ref(pname)]]) > 1 and \
-                    topo.set_of[comp.port_ref(pname)] not in reached:
+                    topo.set_of[comp.port_ref(pname)] not in reached | inner:
                 problems.append(model.problem(f"{comp.name}.{pname} is not wired, so it has "
                                               f"no pose for a probe to measure", comp,
                                               port=pname))
@@ -323,10 +350,121 @@ def _tree(model, topo, roles, problems):
     massive = [c for c in model.components.values()
                if c.role == "body" or (c.role in ("joint", "part") and c.has_mass)]
     topo.bodies = [(b, topo.set_of[b.port_ref("frame_a")]) for b in massive
-                   if topo.set_of[b.port_ref("frame_a")] in reached]
+                   if topo.set_of[b.port_ref("frame_a")] in reached | inner]
+    for cut in topo.assemblies:
+        # its loop: the tree's path between its ends (one placed by another assembly has
+        # none: that assembly's loop and this one share it)
+        path = nx.shortest_path(tree, cut.set_a, cut.set_b) if cut.set_a in tree and \
+            cut.set_b in tree else []
+        cut.loop = [tree.edges[x, y]["component"].name for x, y in zip(path, path[1:])] \
+            + [cut.component.name]
+        topo.loops.append(cut.loop)
     topo.forces = [f for f in roles.get("frame_force", [])
                    if all(topo.set_of[f.port_ref(pn)] in placed for pn, port in f.ports.items()
                           if port.domain == "frame" and not _dangling(topo, f, pn))]
+    _point_masses_alone(model, topo, roles, problems)
+
+
+#: what may act on a point mass alone on a FreeMotion: forces at its origin, never a torque
+_FORCES_AT_A_POINT = ("multibody.Spring", "multibody.Damper", "multibody.SpringDamper",
+                      "multibody.LineForceWithTwoMasses", "multibody.WorldForce")
+
+
+def _point_masses_alone(model, topo, roles, problems):
+    """Mark the FreeMotions of the tree whose frame_b carries only PointMasses (and forces at
+    their origin): nothing they move has rotational inertia or takes a torque, so they move
+    without turning and their orientation is no state (MSL's PointMass on a FreeMotion)."""
+    for comp in roles.get("joint", []):
+        if comp.type_name == "multibody.FreeMotion":
+            object.__setattr__(comp, "_translation_only", False)
+    parents = {e.parent for e in topo.tree}
+    ends = {s for c in topo.cuts for s in (c.set_a, c.set_b)} | set(topo.inner)
+    for edge in topo.tree:
+        comp = edge.component
+        if comp.type_name != "multibody.FreeMotion":
+            continue
+        carried = [b for b, s in topo.bodies if s == edge.child]
+        forces = [f for f in roles.get("frame_force", [])
+                  if any(topo.set_of[f.port_ref(pn)] == edge.child for pn, port in
+                         f.ports.items() if port.domain == "frame")]
+        if edge.reversed or edge.child in parents | ends or not carried or \
+                any(b.type_name != "multibody.PointMass" for b in carried) or \
+                any(f.type_name not in _FORCES_AT_A_POINT for f in forces):
+            continue
+        object.__setattr__(comp, "_translation_only", True)
+        w0 = comp._values.get("w0")
+        if w0 is not None and any(not isinstance(v, (int, float)) or v != 0 for v in w0):
+            problems.append(f"{model.place(comp, 'w0')}: {comp.name} carries only point "
+                            f"masses, which do not turn (no rotational inertia): its "
+                            f"orientation is held at angles0, so w0 must be zero or None")
+
+
+def _place_assemblies(model, topo, frames, analytic, reached, problems):
+    """Place the assemblies whose two ends are placed (by the tree, or as the inner frames
+    of another assembly: MSL's PlanarLoops chains them), their inner frames and the rigid
+    parts hanging from those, in an order where each is placed after what it hangs from
+    (``topo.placements``). What hangs from an inner frame moves with it: a joint with degrees
+    of freedom there, or a second path from there to the rest, is refused. Returns the
+    frame sets placed so."""
+    known, inner = set(reached), set()
+    pending = list(analytic)
+    while pending:
+        ready = [c for c in pending if all(topo.set_of[c.port_ref(p)] in known
+                                          for p in ("frame_a", "frame_b"))]
+        if not ready:
+            break
+        for comp in ready:
+            pending.remove(comp)
+            a, b = (topo.set_of[comp.port_ref(p)] for p in ("frame_a", "frame_b"))
+            if a == b:
+                continue                 # refused with the other parts tying a to b
+            topo.placements.append(Cut(comp, a, b, [comp.name]))
+            for pname in comp.placed_frames:
+                s = topo.set_of[comp.port_ref(pname)]
+                if s in known:
+                    problems.append(f"{model.place(comp)}: {comp.name}.{pname} is placed by "
+                                    f"the assembly, but it is wired to a frame the rest of "
+                                    f"the model places too (a loop through an assembly's "
+                                    f"inner frame): wire a body, rigid parts or forces to it, "
+                                    f"or build that loop from joints")
+                    continue
+                topo.placed_by[s] = (comp, pname)
+                known.add(s)
+                inner.add(s)
+                _hang(model, topo, frames, s, known, inner, problems)
+    for comp in pending:
+        problems.append(f"{model.place(comp)}: {comp.name} closes no kinematic loop: a "
+                        f"{comp.type_name} places its inner frames from where its frame_a and "
+                        f"frame_b are, so the rest of the model must place both (wire each to "
+                        f"the ground through joints or rigid parts)")
+    return inner
+
+
+def _hang(model, topo, frames, root, known, inner, problems):
+    """The rigid parts hanging from inner frame ``root``, breadth first, as Edges of
+    ``topo.placements``."""
+    queue = [root]
+    while queue:
+        node = queue.pop(0)
+        for _, other, data in sorted(frames.edges(node, data=True),
+                                     key=lambda e: e[2]["component"].name):
+            comp = data["component"]
+            if any(isinstance(e, Edge) and e.component is comp for e in topo.placements):
+                continue
+            if comp.dof > 0 or other in known:
+                why = (f"{comp.name} is a joint with degrees of freedom" if comp.dof > 0 else
+                       f"{comp.name} ties it to a frame placed otherwise (a loop through the "
+                       f"assembly's inner frame)")
+                comp_, pname = topo.placed_by[root]
+                problems.append(f"{model.place(comp)}: {why}, hanging from {comp_.name}."
+                                f"{pname}; what an assembly's inner frame carries moves "
+                                f"with it: bodies, rigid parts and forces")
+                continue
+            rev = topo.set_of[comp.port_ref("frame_a")] != node
+            topo.placements.append(Edge(comp, node, other, rev))
+            known.add(other)
+            inner.add(other)
+            queue.append(other)
 
 
 def _frame_sets(topo, comp):
@@ -422,11 +560,18 @@ def _oned(model, topo, values, problems):
         where = "{" + ", ".join(p.path for p in ports) + "}"
         elements = sorted({d["component"].name for _, _, d in sub.edges(data=True)})
         through = f" (through {', '.join(elements)})" if elements else ""
+        derived = [p for p in definers
+                   if p.name in getattr(type(p.component), "derived_ports", ())]
         coords = [p for p in definers if p.name in p.component.coordinate_ports]
         motions = [p for p in definers if p.component.role == "prescribed"]
-        held = [p for p in definers if p not in coords and p not in motions]
-        definers = coords + motions + held        # the joint's flange roots its group
-        if len(coords) > 1 or (coords and held):
+        held = [p for p in definers if p not in coords + motions + derived]
+        definers = derived + coords + motions + held   # the joint's flange roots its group
+        inertias = [d["component"] for _, _, d in sub.edges(data=True)
+                    if d["component"].has_inertia]
+        if derived:
+            _derived_group(model, derived, definers, inertias, ports, where, through,
+                           problems)
+        elif len(coords) > 1 or (coords and held):
             problems.append(_at(model, coords[-1], f"connection set {where} rigidly ties joint "
                             f"flange "
                             f"{coords[0].path} to "
@@ -469,9 +614,8 @@ def _oned(model, topo, values, problems):
             if p.component.name not in tree_joints:
                 problems.append(_at(model, p, f"{p.path}: joint {p.component.name!r} has no "
                                     f"coordinates here, so its flange cannot be used"))
-        inertias = [d["component"] for _, _, d in sub.edges(data=True)
-                    if d["component"].has_inertia]
-        kind = ("joint" if coords else "prescribed" if motions else
+        kind = ("assembly" if derived else "joint" if coords else
+                "prescribed" if motions else
                 "fixed" if definers else "free" if inertias else
                 "world" if len(ports) <= 1 else "massless")
         if kind == "free" and values is not None and all(
@@ -495,6 +639,30 @@ def _oned(model, topo, values, problems):
                                    definers[0] if definers else None, kind,
                                    [d["component"] for _, _, d in sub.edges(data=True)],
                                    motions[0] if coords and motions else None))
+
+
+def _derived_group(model, derived, definers, inertias, ports, where, through, problems):
+    """A rigid group whose position an assembly gives (its axis: the angle or distance of
+    its last joint, a function of where its ends are): it can carry springs, dampers,
+    forces and sensors, whose generalized force reaches the mechanism by virtual work, but
+    nothing may set its position, nor give it inertia or a stuck mode."""
+    flange = derived[0]
+    others = [p for p in definers if p is not flange]
+    modes = sorted({p.component.name for p in ports if getattr(type(p.component), "hybrid",
+                                                                 False)})
+    why = None
+    if others:
+        why = (f"it is tied to {', '.join(p.path for p in others)}{through}, which sets a "
+               f"position too")
+    elif inertias:
+        why = (f"{', '.join(e.name for e in inertias)} would give it inertia; put the mass on "
+               f"a body at the assembly's inner frame instead")
+    elif modes:
+        why = f"{', '.join(modes)} would hold it with friction or a stop"
+    if why:
+        problems.append(f"connection set {where}: the position of {flange.path} follows from "
+                        f"{flange.component.name}'s loop (the angle or distance that closes "
+                        f"it), so {why}; drive or hold a joint of the tree instead")
 
 
 def _motions(model, topo, problems):
@@ -588,6 +756,7 @@ def _rooted(sub, root):
 def _defines(ref):
     comp = ref.component
     return (ref.name in comp.coordinate_ports
+            or ref.name in getattr(type(comp), "derived_ports", ())
             or ref.name in comp.zero_ports
             or comp.role == "fixed"
             or (comp.role == "prescribed" and ref.name == "flange"))

@@ -63,7 +63,9 @@ CHUNK_GROWTH = 16
 MAX_RESTARTS = 3
 #: a restarted run must keep the loops closed to this (m, or rotation-matrix entries)
 RESTART_CLOSURE = 1e-6
-
+#: an assembly whose (dimensionless) measure of a singular position is below this at the last
+#: output of a failed run is named as near its singular position there
+NEAR_SINGULAR_ASSEMBLY = 1e-3
 
 
 _SINK = {}
@@ -227,6 +229,10 @@ def _check_finite_start(system, t, x0, p):
 
 
 def _finite_start(system, t, x0, p):
+    _, singular = system.assembly_singular([t], x0[None, :], p)
+    if singular:
+        raise ModelError([f"at the start (t = {t:g} s): {m}; give other start values or "
+                          f"guesses" for m in singular])
     values = [x0]
     if system.n_states:
         nx = system.n_states
@@ -307,6 +313,7 @@ def _integrate(run, method):
             except Failure as exc:
                 failure = exc.reason
         turn = None
+        new, failure = _assembly_watch(run, X, new, failure)
         if run.system.f_dependent is not None:
             new, failure, turn = parts.watch(X, new, failure)
         X.extend(new)
@@ -344,6 +351,27 @@ def _integrate(run, method):
         stats["restarts"] = [{"t": r["t"], "after": r["after"]} for r in restarts]
     stats.update(parts.done())
     return np.array(X), failure, stats
+
+
+def _assembly_watch(run, X, new, failure):
+    """(rows, failure): the new rows before an assembly that closes its loop in closed form
+    reaches a singular position (its two solutions meet, MSL's assertion), and the failure
+    that stops the run there; for a run that failed, the last row's singular positions
+    appended to its reason."""
+    system = run.system
+    if system.f_assembly_checks is None:
+        return new, failure
+    times = run.grid[len(X):len(X) + len(new)]
+    i, singular = system.assembly_singular(times, new, run.p)
+    if i is not None:
+        return new[:i], f"at t = {times[i]:g} s, " + "; ".join(singular)
+    if failure is not None:
+        last, t = (new[-1], times[-1]) if len(new) else (X[-1], run.grid[len(X) - 1])
+        _, near = system.assembly_singular([t], np.atleast_2d(last), run.p,
+                                           NEAR_SINGULAR_ASSEMBLY)
+        if near:
+            failure += f"; at the last output (t = {t:g} s) " + "; ".join(near)
+    return new, failure
 
 
 def _first_chunk(run, method, intervals):

@@ -37,7 +37,8 @@ from . import estimate
 from . import jit as _jit
 from .capture import last_words
 from .compiled import compiled
-from .driver import DEFAULTS, Run, _auto, _check, _check_finite_start, _integrate, _running
+from .driver import (DEFAULTS, Run, _assembly_watch, _auto, _check, _check_finite_start,
+                     _integrate, _running)
 from .events import Events
 from .methods import METHODS, Casadi, _CasadiRun, choose
 from .results import Results
@@ -197,6 +198,10 @@ class Plan:
                            "cancelled": lambda: run.stop_reason() is not None}
             if not system.n_states:   # everything welded to the ground: nothing to integrate
                 X, failure, key = np.tile(x0, (len(self.grid), 1)), None, "none"
+                # a mechanism that motions move all the way: its assemblies are watched all
+                # the same (a driven crank can pull one past its singular position)
+                X, failure = _assembly_watch(run, X[:1], X[1:], failure)
+                X = np.vstack([x0[None, :], X])
             elif self.key == "auto":
                 X, failure, key = _auto(run, stats)
             else:

@@ -17,9 +17,13 @@ def test_a_sweep_of_component_paths_on_a_model_without_parameters(monkeypatch):
     model = oscillator()
     assert model.parameters == {}
     built = []
-    real = graph_model._compiler
-    monkeypatch.setattr(graph_model, "_compiler",
-                        lambda *a, **k: built.append(1) or real(*a, **k))
+    real = graph_model.upcall
+
+    def counting_upcall(name):
+        build = real(name)
+        return (lambda *a, **k: built.append(1) or build(*a, **k)) if name == "compile" \
+            else build
+    monkeypatch.setattr(graph_model, "upcall", counting_upcall)
     ds = kn.sweep(model, {"spring.c": [1.0, 4.0, 9.0], "mass.m": ["1 kg", "2000 g"]},
                   rtol=1e-9, atol=1e-11, **FAST)
     assert built == [1]                            # one compilation for six members
