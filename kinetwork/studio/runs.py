@@ -24,7 +24,8 @@ from .files import StudioError
 log = logging.getLogger("kinetwork.studio")
 
 #: what a run's ``settings`` may hold: simulate's arguments of the same names
-SETTINGS = ("t_end", "n_points", "method", "rtol", "atol", "step", "max_steps", "time_limit")
+SETTINGS = ("t_end", "n_points", "method", "rtol", "atol", "step", "max_step", "max_steps",
+            "time_limit")
 #: finished runs kept for polling, and runs going at once (each takes a core)
 KEEP, MAX_RUNNING = 8, 4
 #: the most time samples of a run's 3-D animation: a denser run is resampled (the viewer
