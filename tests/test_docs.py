@@ -130,10 +130,23 @@ def _literal(comment):
     """The value a comment starts with (before a ``:`` of prose), or None."""
     for head in (comment, comment.split(":")[0]):
         try:
-            return ast.literal_eval(head.strip())
+            value = ast.literal_eval(head.strip())
         except (ValueError, SyntaxError, TypeError, MemoryError, RecursionError):
             continue
+        # "..." stands for the rest of a list; anywhere else it is prose ({"t": ..., })
+        inner = value[:-1] if isinstance(value, (list, tuple)) and value else value
+        return None if _elided(inner) else value
     return None
+
+
+def _elided(value):
+    if value is Ellipsis:
+        return True
+    if isinstance(value, dict):
+        return any(_elided(v) for v in value.values())
+    if isinstance(value, (list, tuple, set)):
+        return any(_elided(v) for v in value)
+    return False
 
 
 def _shown(value, comment):
@@ -203,7 +216,8 @@ def test_docs_build_without_warnings(tmp_path):
     ("print(['a', 'b', 'c'])  # ['a', 'b', ...]", True),
     ("print(['a', 'x'])  # ['a', 'b']", False),
     ("print(1e-9 * 1.2)  # 1.2e-9", True),
-    ("print(5)  # the number of states", True)])       # prose only: nothing to check
+    ("print(5)  # the number of states", True),
+    ("print({'t': 1})  # {'t': ..., 'reason': ...}", True)])       # elided: prose       # prose only: nothing to check
 def test_a_value_a_snippet_shows_is_checked(code, right):
     scope = {"_shown": _shown}
     if right:

@@ -129,7 +129,7 @@ def test_validate_does_not_change_model(seed_model):
 
 def test_param_overrides_checked(seed_model):
     system = seed_model.compile()
-    with pytest.raises(kn.ModelError, match="unknown model parameter 'cc'.*did you mean 'c'"):
+    with pytest.raises(kn.ModelError, match="'cc' is no model parameter .did you mean 'c'."):
         kn.simulate(system, params={"cc": 1.0})
     with pytest.raises(kn.ModelError, match=r"mass1.mass = -2.0 kg: must be >= 0"):
         kn.simulate(system, params={"m1": -2.0})

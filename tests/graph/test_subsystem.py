@@ -90,9 +90,13 @@ def test_a_number_given_to_a_subsystem_is_a_constant_of_the_instance():
     arm.components["lower"].given.pop("q0")
     link.set_parameter("q0", -0.3)
     assert arm.compile().x0[1] == pytest.approx(-0.3)
-    with pytest.raises(kn.ModelError, match=r"'upper.q0' is a value of subsystem 'upper', a "
-                                            r"constant of its equations"):
-        kn.simulate(arm, t_end=1, params={"upper.q0": 1.0})
+    # given by path at run time, it is lifted into a parameter of the run (issue 25 item 5):
+    # the same answer as the value set on the instance
+    lifted = kn.simulate(arm, t_end=1, params={"upper.q0": 1.0}, rtol=1e-9, atol=1e-11)
+    arm.set_parameter("upper.q0", 1.0)
+    direct = kn.simulate(arm, t_end=1, rtol=1e-9, atol=1e-11)
+    assert lifted.states[0, 0] == pytest.approx(1.0)
+    assert np.max(np.abs(lifted.states - direct.states)) < 1e-7
     with pytest.raises(kn.ModelError, match=r"a path names a parameter of a subsystem placed "
                                             r"in 'arm'.*subsystems here: upper, lower"):
         arm.set_parameter("spring.c", 1.0)
