@@ -3,9 +3,10 @@
 Wire components into a :class:`Model`, compile it to a :class:`System` of minimal
 coordinates, :func:`simulate` it and read the probes from the :class:`Results`.
 
-Layers, each importing only those before it: ``errors``, ``util``, ``expr``, ``spatial``
-(helpers) -> ``components`` (what a user places) -> ``graph`` (model, topology, files) ->
-``equations`` (the System) -> ``simulation`` (driver, methods, JIT cache, Results) -> the
+Layers, each importing only those before it: ``errors``, ``outputs`` (the output policy),
+``util``, ``expr``, ``units``, ``spatial`` (helpers) -> ``components`` (what a user places) ->
+``graph`` (model, topology, files) -> ``equations`` (the System) -> ``solver`` (driver,
+methods, JIT cache, Results) -> the
 faces: ``plot``, ``schema``, ``symbolic``, ``animation``, ``diagram``, ``analysis``, ``cli``.
 
 ``import kinetwork`` is quick: the names below are imported on first use (PEP 562), so a

@@ -14,11 +14,14 @@ import os
 import signal
 import sys
 import textwrap
+import threading
 import time
 
 import kinetwork as kn
 
 from . import plotworker
+from .outputs import (OutputRefused, StopFlag, Stopped, catching_signals, check_all,
+                      model_files, plot_kind)
 from .util import finite, quote
 
 # The rest of kinetwork (numpy, CasADi, networkx, the model layers) is imported where a
@@ -30,6 +33,9 @@ EXIT_MODEL, EXIT_USAGE, EXIT_SIMULATION = 1, 2, 3
 STOPPING = (signal.SIGINT, signal.SIGTERM)
 #: what ``validate`` prints of long texts and lists: a summary, not the model again
 SHOWN_CHARACTERS, SHOWN_ITEMS = 500, 20
+#: seconds the outputs of a run still get to be written once it was stopped, or once its
+#: time limit has passed (within "about a second" of a stop, with what was reached)
+WRITE_GRACE = 1.0
 
 
 def _parameter(text):
@@ -256,6 +262,11 @@ def build_parser():
     imp.add_argument("--gravity", type=float, nargs=3, metavar=("GX", "GY", "GZ"),
                      default=None, help="gravity of the ground (default 0 0 -9.81)")
     lin, fit = analysis_commands.add_commands(sub)
+    for command in (run, anim, dia, imp):
+        command.add_argument("--force", action="store_true",
+                             help="replace an existing file of another kind (a CSV, an "
+                                  "image, a model) at an output path; never a file the "
+                                  "command reads, nor a device, pipe or folder")
     for command in (run, val, eqs, anim, dia, studio, lin, fit):
         command.add_argument("--library", action="append", default=[], metavar="DIR",
                              help="a folder of subsystem files (TYPE.json), searched after "
@@ -286,19 +297,60 @@ def _main(argv, worker):
                "cache": _cache, "animate": _animate, "diagram": _diagram,
                "studio": _studio, "import": _import, "sweep": _sweep,
                "examples": _examples, "linearize": _linearize, "fit": _fit}[args.command]
+    caught = {"signum": None}
     try:
-        return command(args)
+        # the studio's server answers signals itself
+        with contextlib.nullcontext() if args.command == "studio" else _stopping(caught):
+            return command(args)
+    except OutputRefused as exc:
+        _error(exc)
+        return EXIT_USAGE
     except kn.ModelError as exc:
         _error(exc)
         return EXIT_MODEL
-    except KeyboardInterrupt:
-        _error("interrupted")
-        return 130
+    except KeyboardInterrupt as exc:
+        return _interrupted(getattr(exc, "signum", None) or caught["signum"] or signal.SIGINT)
+    except (SystemError, RuntimeError):
+        # a signal that arrived inside CasADi comes out of it as one of these
+        if caught["signum"] is not None:
+            return _interrupted(caught["signum"])
+        raise
     except BrokenPipeError:
         # the reader went away (kinetwork equations ... | head): stop quietly, and keep
         # Python from complaining again when it flushes stdout at exit
         os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
         return EXIT_MODEL
+
+
+@contextlib.contextmanager
+def _stopping(caught):
+    """While a command runs, SIGINT and SIGTERM stop it as a KeyboardInterrupt that names its
+    signal (``outputs.Stopped``): files being written are left whole and their temporaries
+    removed on the way out, and the command exits 128 + the signal. A run installs its own
+    handlers while it integrates (it keeps its partial results)."""
+    if threading.current_thread() is not threading.main_thread():
+        yield
+        return
+
+    def stop(signum, frame):
+        caught["signum"] = signum
+        raise Stopped(signum)
+    saved = {}
+    for sig in STOPPING:
+        with contextlib.suppress(ValueError, OSError):
+            if signal.getsignal(sig) is not signal.SIG_IGN:
+                saved[sig] = signal.signal(sig, stop)
+    try:
+        yield
+    finally:
+        for sig, handler in saved.items():
+            signal.signal(sig, handler)
+
+
+def _interrupted(signum):
+    """The message and exit code of a command stopped by ``signum``."""
+    _error(f"interrupted by {signal.Signals(signum).name}")
+    return 128 + int(signum)
 
 
 def _linearize(args):
@@ -346,25 +398,43 @@ def _example_name(text):
     return key in examples.names()
 
 
-def _write(path, write, what, quiet=False):
-    """Write one output, making its folder; an OSError becomes a message naming the file."""
+def _write(path, write, quiet=False):
+    """Write one output, making its folder; an OSError becomes a message naming the file.
+    Returns what ``write`` returns."""
     try:
         os.makedirs(os.path.dirname(os.path.abspath(path)), exist_ok=True)
-        write(path)
+        return write(path)
     except OSError as exc:
         raise kn.ModelError(f"cannot write {path}: {exc.strerror or exc}") from None
-    if not quiet:
-        print(f"wrote {what} {path}")
 
 
-def _outputs(args, results, title):
+def _outputs(args, results, title, deadline=None):
+    """Write the CSV and the plots of ``results``; returns why writing stopped early (a
+    signal, the time limit: a ``StopFlag``), or None.
+
+    The time limit covers writing too; after a stop (or with the limit passed) the outputs
+    still get WRITE_GRACE seconds. The CSV stops between blocks of rows, keeping the rows
+    written and a last line saying where; a plot is drawn whole or not at all."""
     quiet = getattr(args, "quiet", False)
-    if args.out:
-        _write(args.out, results.to_csv,
-               f"{len(results.t)} points x {len(results.columns()[0])} columns to", quiet)
-    if args.plot:
-        _write(args.plot, lambda path: _save_plot(args, results, path, title),
-               "probe plots to", quiet)
+    flag = StopFlag(deadline=None if deadline is None else
+                    max(deadline, time.monotonic() + WRITE_GRACE))
+    with catching_signals(flag):
+        if args.out:
+            why = _write(args.out, lambda path: results.to_csv(
+                path, overwrite=args.force, stop=flag), quiet)
+            if not quiet:
+                rows = f"{len(results.t)} points" if why is None else \
+                    f"the first rows ({why}: cut short, said on its last line)"
+                print(f"wrote {rows} x {len(results.column_names())} columns to {args.out}")
+        if args.plot:
+            why = flag()
+            if why is not None:
+                _error(f"--plot {args.plot} not drawn: {why}")
+            else:
+                _write(args.plot, lambda path: _save_plot(args, results, path, title), quiet)
+                if not quiet:
+                    print(f"wrote probe plots to {args.plot}")
+    return flag
 
 
 def _save_plot(args, results, path, title):
@@ -374,11 +444,13 @@ def _save_plot(args, results, path, title):
     from . import quickplot
     names, hide_flat = args.plot_signals, args.hide_flat
     if quickplot.drawable(path, results, names):
-        return quickplot.save_png(results, path, *names, title=title, hide_flat=hide_flat)
+        return quickplot.save_png(results, path, *names, title=title, hide_flat=hide_flat,
+                                  overwrite=args.force)
     from .plot import save_plot
     worker = getattr(args, "plot_worker", None)
     draw = save_plot if worker is None else worker.save     # the same call, elsewhere
-    return draw(results, path, *names, title=title, hide_flat=hide_flat)
+    return draw(results, path, *names, title=title, hide_flat=hide_flat,
+                overwrite=args.force)
 
 
 @contextlib.contextmanager
@@ -403,18 +475,26 @@ def _progress_bar(args, model, t_end):
 
 
 def _run(args):
-    clash = _clashing_paths(args)
-    if clash:
-        _error(clash)
+    started = time.monotonic()          # the time limit counts from here, writing included
+    outputs = [("--out", args.out, "csv"), ("--plot", args.plot, plot_kind(args.plot or ""))]
+    try:                                # by name, before anything is read or run
+        check_all(outputs, [("the model file", args.model)], args.force)
+    except OutputRefused as exc:
+        _error(f"{exc}: nothing was run")
         return EXIT_USAGE
     model = _load(args.model, args.library)
+    try:                                # nor the definition files the model places
+        check_all(outputs, model_files(model), args.force)
+    except OutputRefused as exc:
+        _error(f"{exc}: nothing was run")
+        return EXIT_USAGE
     if args.plot:
         from .plot import check_plot_path
         check_plot_path(args.plot)
     # a subsystem's value by path ("cyl1.phi0") is a constant of its instance: set on the
     # model before it is compiled; model parameters go to the integrator
     from .graph.settings import check_output, check_settings
-    from .solver.driver import DEFAULTS
+    from .solver.driver import DEFAULTS, output_values
 
     params = {}
     for name, value in args.param:
@@ -432,31 +512,45 @@ def _run(args):
     start = time.perf_counter()
     system = model.compile(loops=args.loops)
     compiled = time.perf_counter()
-    n_values = 1 + system.n_states + system.n_algebraic + sum(sig.size for sig in system.signals)
-    problem = check_output(settings["n_points"], n_values)
+    problem = check_output(settings["n_points"], output_values(system),
+                           3 if args.error_estimate else 1)
     if problem:
         raise kn.ModelError(problem)
+    deadline = None if args.time_limit is None else started + args.time_limit
+    # what is left of the limit after loading and building (at least a moment: a run out
+    # of time still starts, and stops at once with its first point)
+    left = None if deadline is None else max(deadline - time.monotonic(), 1e-6)
     try:
         with _progress_bar(args, model, settings["t_end"]) as progress:
             results = kn.simulate(system, t_end=args.t_end, n_points=args.n_points,
                                   method=args.method, rtol=args.rtol, atol=args.atol,
                                   step=args.step, jit=args.jit, params=params,
-                                  max_steps=args.max_steps, time_limit=args.time_limit,
+                                  max_steps=args.max_steps, time_limit=left,
                                   progress=progress, error_estimate=args.error_estimate)
     except kn.SimulationError as exc:
         _error(exc)
         stopped = exc.signal in STOPPING
+        flag = None
         if exc.results is not None and len(exc.results.t):
             what = "interrupted" if stopped else "failed"
             try:
-                _outputs(args, exc.results, f"{model.name} ({what} at t = {exc.t_reached:g} s)")
+                flag = _outputs(args, exc.results,
+                                f"{model.name} ({what} at t = {exc.t_reached:g} s)", deadline)
             except kn.ModelError as write_exc:
                 _error(write_exc)
-        return 128 + int(exc.signal) if stopped else EXIT_SIMULATION
+        signum = exc.signal if stopped else getattr(flag, "signum", None)
+        return 128 + int(signum) if signum else EXIT_SIMULATION
     done = time.perf_counter()
-    if args.quiet:
-        _outputs(args, results, model.name)
-        return 0
+    if not args.quiet:
+        _summary(args, model, system, results, start, compiled, done)
+    flag = _outputs(args, results, model.name, deadline)
+    if flag.signum is not None:
+        return 128 + int(flag.signum)
+    return EXIT_SIMULATION if flag() is not None else 0
+
+
+def _summary(args, model, system, results, start, compiled, done):
+    """What ``run`` prints about a finished run (not with --quiet)."""
     t = results.t
     print(f"{model.name}: {system.n_states} states ({_listing(system.state_names)})")
     if args.param:
@@ -473,31 +567,6 @@ def _run(args):
     if "error_estimate" in stats:
         from .solver.estimate import summary
         print("\n".join(summary(stats["error_estimate"], results.signal_names)))
-    _outputs(args, results, model.name)
-    return 0
-
-
-def _clashing_paths(args):
-    """Why the outputs of a run would overwrite its model or each other, or None."""
-    named = [("the model file", args.model), ("--out", args.out), ("--plot", args.plot)]
-    named = [(what, path) for what, path in named if path]
-    for i, (what_a, a) in enumerate(named):
-        for what_b, b in named[i + 1:]:
-            if _same_file(a, b):
-                return (f"{what_b} {quote(b)} is {what_a} {'itself' if a == b else quote(a)}"
-                        f": choose another path, nothing was run")
-    return None
-
-
-def _same_file(a, b):
-    """Whether two paths name one file: the same after links are resolved, or (existing) the
-    same file by device and inode (a hard link)."""
-    if os.path.realpath(a) == os.path.realpath(b):
-        return True
-    try:
-        return os.path.samefile(a, b)
-    except OSError:                 # one does not exist yet: not the same file
-        return False
 
 
 def _listing(items, limit=SHOWN_ITEMS):

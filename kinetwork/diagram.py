@@ -35,7 +35,7 @@ from .components.base import ANY
 from .errors import ModelError
 from .graph.model import Model
 from .graph.subsystem import Subsystem
-from .util import atomic_write
+from .outputs import check, model_files, write
 
 NAME_PX, TYPE_PX, LABEL_PX = 10.5, 8.0, 7.0      # font sizes
 ROW = 11           # height of one row of side ports
@@ -1136,16 +1136,16 @@ def cli_diagram(args, model):
     path = args.out
     if not str(path).lower().endswith(".svg"):
         raise ModelError(f"-o {path}: a diagram is written as SVG; name a .svg file")
-    if os.path.isdir(path):
-        raise ModelError(f"cannot write {path}: it is a folder")
+    reads = model_files(model)
+    check(path, "svg", what="-o", reads=reads, force=getattr(args, "force", False))
     text = svg(model)
 
-    def write(tmp):
+    def fill(tmp):
         with open(tmp, "w", encoding="utf-8") as fh:
             fh.write(text)
     try:
         os.makedirs(os.path.dirname(os.path.abspath(path)), exist_ok=True)
-        atomic_write(path, write)
+        write(path, fill, "svg", what="-o", reads=reads, force=getattr(args, "force", False))
     except OSError as exc:
         raise ModelError(f"cannot write {path}: {exc.strerror or exc}") from None
     print(f"wrote the diagram of {model.name} ({len(model.components)} components, "

@@ -47,7 +47,9 @@ from .components import multibody as mb
 from .components import rotational, translational
 from .components.probe import Probe
 from .errors import ModelError
+from .graph.io import MAX_FILE_SIZE, dumps
 from .graph.model import Model
+from .outputs import check, write
 
 JOINT_TYPES = ("revolute", "continuous", "prismatic", "fixed", "floating", "planar")
 #: what a probe on each joint records (the 1-D flange for 1-DOF joints, frame_b otherwise)
@@ -107,8 +109,19 @@ def from_urdf(path, probes=False, floating=False, gravity=(0.0, 0.0, -9.81), nam
 def cli_import(args):
     """``kinetwork import ROBOT.urdf -o MODEL.json``: write the model; the exit code."""
     gravity = (0.0, 0.0, -9.81) if args.gravity is None else tuple(args.gravity)
+    force = getattr(args, "force", False)
+    reads = [("the URDF", args.source)]
+    check(args.out, "model", what="-o", reads=reads, force=force)   # before reading it
     model = from_urdf(args.source, probes=args.probes, floating=args.floating, gravity=gravity)
-    model.save(args.out)
+    text = dumps(model, os.path.dirname(os.path.abspath(args.out))).encode("utf-8")
+
+    def fill(tmp):
+        with open(tmp, "wb") as fh:
+            fh.write(text)
+    try:
+        write(args.out, fill, "model", what="-o", reads=reads, force=force)
+    except OSError as exc:
+        raise ModelError(f"cannot write {args.out}: {exc.strerror or exc}") from None
     parts = model.components.values()
     states = sum(c.dof for c in parts if c.role == "joint")
     bodies = sum(1 for c in parts if c.role == "body" and c.mass != 0)
@@ -130,12 +143,17 @@ def _read(source):
     """The <robot> element of the file."""
     try:
         with open(source, "rb") as fh:
-            text = fh.read()
+            # at most one byte past the limit: /dev/zero or an endless pipe is refused by
+            # size, not read until memory runs out
+            text = fh.read(MAX_FILE_SIZE + 1)
     except FileNotFoundError:
         raise ModelError(f"{_q(source)}: no such file") from None
     except OSError as exc:
         raise ModelError(f"{_q(source)}: cannot read: {exc.strerror or exc}") from None
     where = os.path.basename(source)
+    if len(text) > MAX_FILE_SIZE:
+        raise ModelError(f"{where}: larger than {MAX_FILE_SIZE // 2**20} MiB, too large for a "
+                         f"robot description")
     try:
         root = ET.fromstring(text)
     except ET.ParseError as exc:

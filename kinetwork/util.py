@@ -1,10 +1,8 @@
 """Small helpers every layer uses: checked numbers, near-match suggestions, quoting of user
-input in messages, and atomic file writes. The bottom layer: it imports nothing of kinetwork
-but the errors."""
+input in messages, and atomic file writes (through ``kinetwork.outputs``). The bottom layer:
+it imports nothing of kinetwork but the errors and the output policy."""
 
 import math
-import os
-import stat
 import sys
 
 from .errors import ModelError
@@ -52,29 +50,13 @@ def quote(value, limit=QUOTE_LIMIT):
 
 
 def atomic_write(path, write, mode=0o666):
-    """Write a file in one step: ``write(tmp_path)`` fills a temporary file in the same folder,
-    which is flushed to disk and then replaces ``path``. A failure (a full disk, a signal)
-    leaves the old file whole and removes the temporary one.
-
-    A symbolic link is followed, not replaced; the old file's permissions are kept.
-    """
-    import secrets
-    path = os.path.realpath(os.fspath(path))
-    folder, base = os.path.split(path)
-    tmp = os.path.join(folder, f".{base}.{secrets.token_hex(4)}.tmp")
-    try:
-        # 0o666 lets the umask apply, as to any new file (mkstemp would force 0o600)
-        os.close(os.open(tmp, os.O_WRONLY | os.O_CREAT | os.O_EXCL, mode))
-        write(tmp)
-        with open(tmp, "rb+") as fh:
-            os.fsync(fh.fileno())
-        if os.path.exists(path):
-            os.chmod(tmp, stat.S_IMODE(os.stat(path).st_mode))
-        os.replace(tmp, path)
-    except BaseException:
-        if os.path.exists(tmp):
-            os.unlink(tmp)
-        raise
+    """Write a file in one step under the output policy (``kinetwork.outputs.write``, no
+    check of what kind of file is replaced): ``write(tmp_path)`` fills a temporary file in
+    the same folder, which is flushed to disk and then replaces ``path``. A failure (a full
+    disk, a signal) leaves the old file whole and removes the temporary one; a folder or a
+    special file at ``path`` is refused (``OutputRefused``)."""
+    from .outputs import write as policy_write
+    policy_write(path, write, mode=mode)
 
 
 def callable_module(name, function):

@@ -134,7 +134,7 @@ def test_an_output_too_large_for_memory_is_refused_with_the_size_it_would_need(
     assert main(["run", str(seed_file), "--n-points", "100000000"]) == 1
     err = capsys.readouterr().err
     assert "the results (13 values per point: time, states and probe signals) would need " \
-           "9.69 GiB, more than the 2 GiB a run may keep" in err
+           "about 15.6 GiB, more than the 2 GiB a run may keep" in err
     assert time.perf_counter() - start < 60
 
 

@@ -50,10 +50,17 @@ from ..solver.methods import (
     STIFF_RATIO,
     solver_reason,
 )
+from ..graph.settings import MAX_OUTPUT_BYTES
+from ..outputs import check, model_files, write
 from ..util import suggest
 
 #: members per batch at most (the tolerances of a batch are divided by sqrt(B))
 MAX_BATCH = 64
+#: members of one sweep or sample at most, and worker threads: every input does bounded
+#: work (their results must also fit MAX_OUTPUT_BYTES together)
+MAX_MEMBERS, MAX_WORKERS = 1_000_000, 1024
+#: members the command's summary prints a line for
+SUMMARY_MEMBERS = 100
 #: the methods a batch runs in one CasADi integrator; any other runs member by member
 BATCHED = ("auto", "cvodes", "cvodes-adams", "rk", "collocation")
 
@@ -142,14 +149,15 @@ def sweep(model, grid, *, params=None, t_end=None, n_points=None, method=None, r
         raise ModelError("sweep: the grid must be a non-empty dict of parameter name -> "
                          "values")
     names = _names(system, grid, "sweep")
-    axes = []
     for name in names:
         values = grid[name]
         if isinstance(values, (str, bytes)) or not hasattr(values, "__len__") or \
                 not len(values):
             raise ModelError(f"sweep: {name!r}: give a non-empty sequence of values, got "
                              f"{values!r:.60}")
-        axes.append([_real(v, f"sweep: {name}[{i}]") for i, v in enumerate(values)])
+    _check_members(math.prod(len(grid[name]) for name in names), "sweep: the grid")
+    axes = [[_real(v, f"sweep: {name}[{i}]") for i, v in enumerate(grid[name])]
+            for name in names]
     values = np.array(list(itertools.product(*axes)), dtype=float).reshape(-1, len(names))
     layout = {"dims": list(names), "coords": {n: np.array(a) for n, a in zip(names, axes)},
               "shape": tuple(len(a) for a in axes)}
@@ -172,6 +180,7 @@ def sample(model, distributions, n, *, seed=None, params=None, t_end=None, n_poi
     system = _system(model)
     if isinstance(n, bool) or not isinstance(n, (int, np.integer)) or n < 1:
         raise ModelError(f"sample: n must be a positive integer, got {n!r:.40}")
+    _check_members(int(n), "sample: n")
     if not isinstance(distributions, dict) or not distributions:
         raise ModelError("sample: give a non-empty dict of parameter name -> distribution")
     names = _names(system, distributions, "sample")
@@ -199,6 +208,25 @@ def sample(model, distributions, n, *, seed=None, params=None, t_end=None, n_poi
 
 def _system(model):
     return model if isinstance(model, System) else model.compile()
+
+
+def _check_members(n, what):
+    """Refuse more than MAX_MEMBERS members, before any is made."""
+    if n > MAX_MEMBERS:
+        raise ModelError(f"{what}: {n:.3g} members, more than the {MAX_MEMBERS} a sweep may "
+                         f"run; sweep fewer values (or in parts)")
+
+
+def _check_size(job, n):
+    """Refuse a sweep whose results would not fit MAX_OUTPUT_BYTES, before any member runs."""
+    system = job.system
+    per_point = system.n_states + system.n_algebraic + sum(s.size for s in system.signals)
+    need = 8 * n * len(job.grid) * per_point
+    if need > MAX_OUTPUT_BYTES:
+        raise ModelError(f"sweep: {n} members x {len(job.grid)} points x {per_point} values "
+                         f"(states and probe signals) would need {need / 2**30:.3g} GiB, more "
+                         f"than the {MAX_OUTPUT_BYTES / 2**30:g} GiB a run may keep; fewer "
+                         f"members or points (n_points)")
 
 
 def _names(system, given, what):
@@ -580,6 +608,7 @@ def _run(system, names, values, layout, params, t_end, n_points, method, rtol, a
                     n_points=int(settings["n_points"]))
     job = Job(system, names, params, settings, t_start, jit)
     n = len(values)
+    _check_size(job, n)
     if workers is None:
         workers = len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else \
             (os.cpu_count() or 1)
@@ -587,6 +616,8 @@ def _run(system, names, values, layout, params, t_end, n_points, method, rtol, a
         if v is not None and (isinstance(v, bool) or not isinstance(v, (int, np.integer))
                               or v < 1):
             raise ModelError(f"{what}: must be a positive integer, got {v!r:.40}")
+    if workers > MAX_WORKERS:
+        raise ModelError(f"workers: at most {MAX_WORKERS} threads, got {workers}")
     if batch is None:       # a power of two: sweeps of other sizes reuse the compiled batch
         batch = min(MAX_BATCH, 1 << max(0, math.ceil(n / workers) - 1).bit_length())
     outcome = Outcome(job, n)
@@ -789,7 +820,14 @@ def _values(text):
             raise ValueError
         if rest.count(":") == 2:
             start, stop, count = rest.split(":")
+            if not 1 <= int(count) <= MAX_MEMBERS:
+                raise argparse.ArgumentTypeError(
+                    f"{name.strip()!r:.60}: COUNT must be 1 to {MAX_MEMBERS}, got "
+                    f"{count.strip()[:20]}")
             values = np.linspace(float(start), float(stop), int(count)).tolist()
+        elif rest.count(",") >= MAX_MEMBERS:
+            raise argparse.ArgumentTypeError(f"{name.strip()!r:.60}: more than {MAX_MEMBERS} "
+                                             f"values")
         else:
             values = [float(v) for v in rest.split(",")]
         if not values or not all(math.isfinite(v) for v in values):
@@ -831,6 +869,9 @@ def add_command(sub):
                      help="run on Dask: 'local' (a LocalCluster on this machine) or a "
                           "scheduler's address, tcp://host:8786")
     cmd.add_argument("--out", metavar="FILE.nc", help="write the sweep as NetCDF")
+    cmd.add_argument("--force", action="store_true",
+                     help="replace an existing file of another kind at --out (never the "
+                          "model, nor a device, pipe or folder)")
     cmd.add_argument("--progress", action=argparse.BooleanOptionalAction, default=None,
                      help="a progress bar on stderr (default: when stderr is a terminal)")
     cmd.add_argument("--library", action="append", default=[], metavar="DIR",
@@ -844,6 +885,8 @@ def run_command(args, model):
     grid = dict(args.param)
     if len(grid) != len(args.param):
         raise ModelError("--param: a parameter is given twice")
+    if args.out:                        # before any member runs
+        check(args.out, "netcdf", what="--out", reads=model_files(model), force=args.force)
     progress = args.progress if args.progress is not None else sys.stderr.isatty()
     ds = sweep(model, grid, t_end=args.t_end, n_points=args.n_points, method=args.method,
                rtol=args.rtol, atol=args.atol, jit=args.jit, workers=args.workers,
@@ -851,7 +894,7 @@ def run_command(args, model):
     print(summary(ds))
     if args.out:
         try:
-            to_netcdf(ds, args.out)
+            to_netcdf(ds, args.out, overwrite=args.force, reads=model_files(model))
         except OSError as exc:
             raise ModelError(f"cannot write {args.out}: {exc.strerror or exc}") from None
         print(f"wrote {ds.attrs['members']} members to {args.out}")
@@ -865,7 +908,13 @@ def summary(ds):
     probes = [n for n, v in ds.data_vars.items()
               if v.attrs.get("kind") == "probe" and v.dims == tuple(dims) + ("time",)]
     lines = ["  ".join(dims + probes)]
-    for index in np.ndindex(*ds.status.shape):
+    members = int(np.prod(ds.status.shape))
+    for k, index in enumerate(np.ndindex(*ds.status.shape)):
+        if k == SUMMARY_MEMBERS and members > SUMMARY_MEMBERS:
+            failed = sum(1 for v in np.ravel(ds.status.values) if v != "ok")
+            lines.append(f"... ({members} members in all, {failed} not ok; every one is in "
+                         f"the Dataset, and in the NetCDF file of --out)")
+            break
         at = dict(zip(dims, index))
         member = ds.isel(at)
         head = [f"{d}={member[d].item():g}" for d in dims]
@@ -877,9 +926,12 @@ def summary(ds):
     return "\n".join(lines)
 
 
-def to_netcdf(ds, path):
-    """The Dataset as NetCDF (strings as fixed text, so that scipy's writer takes them)."""
+def to_netcdf(ds, path, overwrite=False, reads=()):
+    """The Dataset as NetCDF (strings as fixed text, so that scipy's writer takes them),
+    under the output policy (``kinetwork.outputs``): atomically, never over ``reads`` (the
+    model's files), a special file or a folder, nor over a file that is not NetCDF unless
+    ``overwrite``."""
     out = ds.copy()
     for name in ("status", "reason", "method"):
         out[name] = out[name].astype(str)
-    out.to_netcdf(path)
+    write(path, out.to_netcdf, "netcdf", reads=reads, force=overwrite)

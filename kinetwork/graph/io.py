@@ -69,6 +69,7 @@ def load(path: str | os.PathLike, validate: bool = True,
     text = _read(source)
     folder = os.path.dirname(os.path.abspath(source))
     model = loads(text, source=source, validate=validate, library=library, folder=folder)
+    model.path = os.path.abspath(source)
     if model.exposed:           # a definition: placed elsewhere, it is saved as a reference
         model.origin = (os.path.realpath(source), "file", dumps(model))
     return model

@@ -14,7 +14,8 @@ import numpy as np
 from ..components.base import ANY, Component, PortRef
 from ..util import quote, suggest
 from . import quantities
-from .subsystem import Subsystem, check_placement, check_port_name, flatten, has_subsystems
+from .subsystem import (Subsystem, check_placement, check_port_name, definitions, flatten,
+                        has_subsystems)
 from .writer import save
 from ..errors import ModelError
 from ..expr import CONSTANTS, FUNCTIONS, parse
@@ -90,6 +91,8 @@ class Model:
         #: "file", "folder" or "library", its text as read); a saver writes a reference to
         #: it while it is unchanged
         self.origin = None
+        #: the file ``kn.load`` read this model from (absolute), or None
+        self.path = None
         #: component name -> how messages locate it (files say 'components[3] "mass1"'; a
         #: flat model's inner components (path shown, place in their definition's file))
         self.places = {}
@@ -361,9 +364,27 @@ class Model:
                 self._compiled[key] = system
             return self._compiled[key]
 
-    def save(self, path: str | os.PathLike) -> None:
-        """Write the model as JSON (atomically: a failed save leaves the old file whole)."""
-        save(self, path)
+    def save(self, path: str | os.PathLike, overwrite: bool = False) -> None:
+        """Write the model as JSON (atomically: a failed save leaves the old file whole).
+        A file that is not a model file (a CSV, an image), a definition file this model
+        places, a folder or a special file is refused (``overwrite=True`` replaces the
+        first kind); see ``kinetwork.outputs``."""
+        save(self, path, overwrite=overwrite)
+
+    def files(self) -> list[str]:
+        """The files this model was read from: its own (``kn.load``) and those of the
+        subsystem definitions it places or keeps. What reads them never writes them."""
+        if self._source is not None:                # a flat model: its model's files
+            return self._source.files()
+        found = [self.path] if self.path else []
+        try:
+            placed = definitions(self)
+        except ModelError:                          # a cycle: refused where it matters
+            placed = []
+        for d in [*self.definitions.values(), *placed]:
+            if d.origin is not None:
+                found.append(d.origin[0])
+        return list(dict.fromkeys(found))
 
     def __repr__(self):
         return (f"<Model {self.name!r}: {len(self.components)} components, "

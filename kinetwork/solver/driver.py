@@ -71,6 +71,12 @@ CHUNK_GROWTH = 16
 MAX_RESTARTS = 3
 #: a restarted run must keep the loops closed to this (m, or rotation-matrix entries)
 RESTART_CLOSURE = 1e-6
+#: the probe signals of a long grid are computed in chunks of about this much work (points
+#: times the instructions of one evaluation: 10 ms or so), a stop served between them
+OUTPUT_CHUNK_WORK = 1e7
+#: after a run stopped (a signal, the time limit), the probe signals of what it reached are
+#: still computed for at most this long [s] (unless stopped again), and kept
+OUTPUT_GRACE = 1.0
 
 
 
@@ -112,6 +118,7 @@ class Run:
         self.jit = jit
         self.cancel, self.progress, self.restart = cancel, progress, restart
         self.signal = None              # the signal that stopped the run, if one did
+        self.signals_seen = 0           # how many arrived
         self.instructions = (system.f_rhs or system.f_dae).n_instructions()
         self.said = []                  # what the solvers printed
         self.quiet = False              # nothing to watch: one call over the grid
@@ -246,7 +253,9 @@ def simulate(model: Model | System, t_end: float | None = None, n_points: int | 
              "atol": atol, "step": step}
     settings = {**DEFAULTS, **system.model.simulation,
                 **{k: v for k, v in given.items() if v is not None}}
-    key = _check(system, settings, t_start, max_steps, time_limit)
+    # an error estimate holds three runs' results at once
+    key = _check(system, settings, t_start, max_steps, time_limit,
+                 runs=3 if error_estimate else 1)
     chosen = METHODS[key]
     chosen.check(system)
     p = system.param_vector(params)        # checks the overrides once for the whole run
@@ -275,19 +284,20 @@ def simulate(model: Model | System, t_end: float | None = None, n_points: int | 
         else:
             X, failure, method_stats = _integrate(run, chosen)
             stats.update(method_stats)
+        t = grid[:len(X)]
+        parts = getattr(run, "partitions", None)
+        if parts is not None and parts.events:     # re-partitioned: each part by its equations
+            X, outputs = parts.finish(t, X)
+        else:
+            X, outputs, cut = _probe_outputs(run, t, X)
+            if cut is not None:
+                t = t[:len(X)]
+                failure = f"{failure}; then {cut}" if failure else cut
     if run.said:
         stats["solver_output"] = "".join(run.said)
     if run.events is not None:
         stats["events"] = run.events.log
     stats["jit"] = bool(run.jit) and not stats.get("jit_fallback")
-    t = grid[:len(X)]
-    parts = getattr(run, "partitions", None)
-    if parts is not None and parts.events:     # re-partitioned: each part by its equations
-        X, outputs = parts.finish(t, X)
-    else:
-        X = system.polish(X, p)
-        f_out = compiled(system).outputs(run.jit)
-        outputs = system.outputs_p(t, X, p, f_out) if len(t) else np.zeros((0, 0))
     results = Results(t, X, system.state_names + system.algebraic_names, outputs,
                       system.signals, stats=stats,
                       state_units=system.state_units + system.algebraic_units,
@@ -318,7 +328,7 @@ def simulate(model: Model | System, t_end: float | None = None, n_points: int | 
     return results
 
 
-def _check(system, settings, t_start, max_steps, time_limit):
+def _check(system, settings, t_start, max_steps, time_limit, runs=1):
     """The method's table key, once every setting is checked (one ModelError for all)."""
     if not isinstance(t_start, (int, float)) or isinstance(t_start, bool) or \
             not math.isfinite(t_start):
@@ -328,9 +338,8 @@ def _check(system, settings, t_start, max_steps, time_limit):
         problems.append(f"simulation.t_end: must be > t_start = {t_start}, "
                         f"got {settings['t_end']}")
     if not problems:        # what the results would hold: time, the full state, the probes
-        values = 1 + system.n_states + system.n_algebraic + \
-            sum(sig.size for sig in system.signals)
-        problems += filter(None, [check_output(int(settings["n_points"]), values)])
+        problems += filter(None, [check_output(int(settings["n_points"]),
+                                               output_values(system), runs)])
     for name, value, kind in (("max_steps", max_steps, int), ("time_limit", time_limit, float)):
         if value is not None and (isinstance(value, bool) or not isinstance(value, (int, float))
                                   or not math.isfinite(value) or value <= 0
@@ -350,6 +359,12 @@ def _check(system, settings, t_start, max_steps, time_limit):
             f"{', '.join(k for k, m in METHODS.items() if m.dae)}, or compile the model with "
             f"loops='projected' or loops='baumgarte' (ODEs)")
     return key
+
+
+def output_values(system):
+    """Numbers a run of ``system`` keeps per output point: time, the full state and every
+    probe value (``check_output`` adds what the run needs beside them)."""
+    return 1 + system.n_states + system.n_algebraic + sum(sig.size for sig in system.signals)
 
 
 def _check_finite_start(system, t, x0, p):
@@ -387,18 +402,18 @@ def _auto(run, stats):
 def _integrate(run, method):
     """States on the grid from ``method``, chunk by chunk: (X, failure or None, stats)."""
     grid, n = run.grid, len(run.grid)
-    X = _Rows(run.x0)
+    X = _Rows(run.x0, n)
     parts = Partitions(run)            # the loops' partitions the run goes through
     stats, restarts = {}, []           # stats: of the steppers replaced by restarts
     if method.fixed and run.max_steps and run.steps_per_interval > run.max_steps:
-        return np.array(X), (f"the step budget of {run.max_steps} steps per output interval "
+        return X.array(), (f"the step budget of {run.max_steps} steps per output interval "
                              f"is smaller than the {run.steps_per_interval} steps of "
                              f"{run.step or run.spacing:g} s that the fixed-step method "
                              f"takes"), stats
     try:
         stepper = method.start(run, grid[0], X[0])
     except Failure as failure:
-        return np.array(X), failure.reason, stats
+        return X.array(), failure.reason, stats
     run.quiet = method.interruptible and run.events is None and \
         run.system.f_dependent is None and run.progress is None and run.cancel is None \
         and run.deadline is None
@@ -419,7 +434,9 @@ def _integrate(run, method):
         origin, restarted = restart_at or (grid[k], X[-1]), restart_at is not None
         restart_at = None
         try:
-            if run.events is None:
+            if run.events is None and getattr(stepper, "writes_in_place", False):
+                new = stepper.advance(times, out=X.slot(m))
+            elif run.events is None:
                 new = stepper.advance(times)
             else:
                 new, restart_at = run.events.advance(method, stepper, times, origin, restarted)
@@ -467,12 +484,51 @@ def _integrate(run, method):
             chunk = 1
     if failure is not None and run.system.f_dependent is not None and \
             run.stop_reason() is None and "singular" not in failure:
-        failure += near_singular(run, np.array(X), grid)
+        failure += near_singular(run, X.array(), grid)
     stats = _merge(stats, stepper.stats)
     if restarts:
         stats["restarts"] = [{"t": r["t"], "after": r["after"]} for r in restarts]
     stats.update(parts.done())
-    return np.array(X), failure, stats
+    return X.array(), failure, stats
+
+
+def _probe_outputs(run, t, X):
+    """The full states polished (loops closed to machine precision) and the probe signals,
+    computed in chunks of the grid into arrays allocated once: (X, outputs, why cut or
+    None). Between chunks a stop is served (a signal, ``cancel``, the time limit): what was
+    computed is kept, cut at the last whole chunk. A run already stopped before this phase
+    gets OUTPUT_GRACE seconds for it (the outputs of what it reached), unless stopped again.
+    """
+    system, p, n = run.system, run.p, len(t)
+    f_out = compiled(system).outputs(run.jit)
+    width = system.f_out.size1_out(0)
+    outputs = np.empty((n, width))
+    if not n:
+        return X, outputs, None
+    size = int(min(max(OUTPUT_CHUNK_WORK / max(system.f_out.n_instructions(), 1), 256),
+                   2**16))
+    size = 2 ** int(np.log2(size))          # few sizes: each has its mapped Function
+    started, earlier, seen = time.perf_counter(), run.stop_reason(), run.signals_seen
+
+    def stopped():
+        if earlier is None:
+            return run.stop_reason()
+        if run.signals_seen != seen:
+            return run.stop_reason()
+        if time.perf_counter() - started > OUTPUT_GRACE:
+            return f"{earlier} (the probe signals were computed for {OUTPUT_GRACE:g} s more)"
+        return None
+
+    polished = X if not system.n_algebraic else np.array(X, dtype=float)
+    for k in range(0, n, size):
+        if k and (why := stopped()) is not None:
+            return polished[:k], outputs[:k], \
+                f"{why} while the probe signals were computed (kept up to t = {t[k - 1]:g} s)"
+        rows = slice(k, min(n, k + size))
+        if system.n_algebraic:
+            polished[rows] = system.polish(polished[rows], p)
+        outputs[rows] = system.outputs_p(t[rows], polished[rows], p, f_out)
+    return polished, outputs, None
 
 
 def _first_chunk(run, method, intervals):
@@ -488,41 +544,53 @@ def _first_chunk(run, method, intervals):
 
 
 class _Rows:
-    """The states reached, kept as the blocks the chunks gave (a list of 10^5 rows costs more
-    to build and join than the integration of a small model)."""
+    """The states reached, in one array of the grid's size allocated at the start (a list of
+    10^5 rows costs more to build and join than the integration of a small model, and
+    joining blocks at the end would hold the states twice): a CasADi method writes its
+    outputs straight into the rows reserved for them (``slot``)."""
 
-    def __init__(self, x0):
-        self.blocks = [np.asarray(x0, dtype=float)[None, :]]
+    def __init__(self, x0, n):
+        x0 = np.asarray(x0, dtype=float)
+        self.data = np.empty((max(n, 1), len(x0)))
+        self.data[0] = x0
         self.n = 1
 
     def __len__(self):
         return self.n
 
     def __getitem__(self, i):
-        if i < 0:
-            i += self.n
-        for block in self.blocks:
-            if i < len(block):
-                return block[i]
-            i -= len(block)
-        raise IndexError(i)
+        return self.data[:self.n][i]
+
+    def slot(self, m):
+        """The next ``m`` rows, for a method to write into (then ``extend`` with them)."""
+        return self.data[self.n:self.n + m]
 
     def extend(self, rows):
-        rows = np.asarray(rows, dtype=float).reshape(-1, self.blocks[0].shape[1])
-        if len(rows):
-            self.blocks.append(rows)
-            self.n += len(rows)
+        rows = np.asarray(rows, dtype=float).reshape(-1, self.data.shape[1])
+        m = len(rows)
+        if not m:
+            return
+        if self.n + m > len(self.data):             # a restart's row past the grid: grow
+            self.data = np.concatenate([self.data[:self.n], rows])
+            self.n += m
+            return
+        target = self.data[self.n:self.n + m]
+        if rows.ctypes.data != target.ctypes.data or rows.strides != target.strides:
+            target[...] = rows                      # not written in place by the method
+        self.n += m
 
     def append(self, row):
         self.extend(np.asarray(row)[None, :])
 
     def replace_last(self, row):
-        block = self.blocks[-1].copy()        # the first block may be a view of x0
-        block[-1] = row
-        self.blocks[-1] = block
+        self.data[self.n - 1] = row
+
+    def array(self):
+        """The rows reached (a view, not a copy)."""
+        return self.data[:self.n]
 
     def __array__(self, dtype=None, copy=None):
-        out = np.vstack(self.blocks)
+        out = self.array()
         return out if dtype is None else out.astype(dtype)
 
 
@@ -608,6 +676,7 @@ def _running(run):
 
     def stop(signum, frame):
         run.signal = signum
+        run.signals_seen += 1
         if run.abortable:           # raised in CasADi's check for signals: the call stops
             run.abortable = False
             raise Interrupted

@@ -80,6 +80,8 @@ COMPILE_TIMEOUT = 300.0
 MAX_CACHE_BYTES = 512 * 2**20
 
 _BUILD_PREFIX = "kinetwork-build-"
+#: how kinetwork names a library: see ``_plan``
+_LIBRARY_NAME = re.compile(r"[A-Za-z0-9_]+_[0-9a-f]{20}\.so")
 _POLL = 0.05                                  # s between looks at the compiler and the lock
 _QUIET = ("cancelled", "deadline")            # fallbacks the caller asked for
 _LOCK = threading.RLock()
@@ -201,35 +203,63 @@ def external(f, jacobian=False, stats=None, required=False, deadline=None, cance
 
 
 def cache_info():
-    """What the cache holds: ``folder``, ``entries``, ``bytes`` and ``libraries``, a list of
-    (file name, bytes, mtime), the most recently loaded first."""
+    """What the cache holds of kinetwork's own (libraries with their records, see
+    :func:`recorded`): ``folder``, ``entries``, ``bytes`` and ``libraries``, a list of (file
+    name, bytes, mtime), the most recently loaded first."""
     folder = cache_dir()
-    libraries = []
-    for lib in folder.glob("*.so") if folder.is_dir() else ():
-        with contextlib.suppress(OSError):
-            st = lib.lstat()
-            libraries.append((lib.name, st.st_size, st.st_mtime))
+    libraries = [(lib.name, size, mtime) for lib, size, mtime in recorded(folder)]
     libraries.sort(key=lambda entry: -entry[2])
     return {"folder": str(folder), "entries": len(libraries),
             "bytes": sum(size for _, size, _ in libraries), "libraries": libraries}
 
 
+def recorded(folder):
+    """(path, bytes, mtime) of each library kinetwork built in ``folder``: a regular file
+    named as kinetwork names libraries (``<name>_<20 hex digits>.so``) with its record
+    beside it. Nothing else in the folder is counted, trimmed or cleared."""
+    found = []
+    if not folder.is_dir():
+        return found
+    for lib in folder.glob("*.so"):
+        if not _LIBRARY_NAME.fullmatch(lib.name):
+            continue
+        with contextlib.suppress(OSError):
+            st, rec = lib.lstat(), _record(lib).lstat()
+            if stat.S_ISREG(st.st_mode) and stat.S_ISREG(rec.st_mode):
+                found.append((lib, st.st_size, st.st_mtime))
+    return found
+
+
 def clear_cache():
-    """Remove what kinetwork wrote in the cache (libraries, their records and build folders
-    left by killed processes); return the number of files removed. Anything else in the
-    folder is left alone."""
+    """Remove what kinetwork wrote in the cache: the libraries its records name, those
+    records, records left without their library, and build folders left by killed
+    processes; return the number of files removed. Anything else in the folder (a library
+    without a record, any other file) is left alone."""
     folder = cache_dir()
     if not folder.is_dir():
         return 0
     removed = 0
     with _LOCK:
-        for path in [*folder.glob("*.so"), *folder.glob("*.so.sha256")]:
-            if not path.is_dir():
-                removed += _remove(path)
+        for lib, _, _ in recorded(folder):
+            removed += _remove(lib) + _remove(_record(lib))
+        for rec in folder.glob("*.so.sha256"):
+            lib = rec.with_name(rec.name[:-len(".sha256")])
+            if _LIBRARY_NAME.fullmatch(lib.name) and not lib.exists() and _is_record(rec):
+                removed += _remove(rec)
         for old in _stale_builds(folder):
             removed += sum(1 for p in old.rglob("*") if not p.is_dir())
             shutil.rmtree(old, ignore_errors=True)
     return removed
+
+
+def _is_record(path):
+    """Whether ``path`` is a regular file holding what kinetwork writes in a record."""
+    try:
+        if not stat.S_ISREG(path.lstat().st_mode) or path.lstat().st_size != 65:
+            return False
+        return re.fullmatch(rb"[0-9a-f]{64}\n", path.read_bytes()) is not None
+    except OSError:
+        return False
 
 
 # -- the cache folder --------------------------------------------------------------------------
@@ -459,6 +489,11 @@ def _build(cc, name, sources, lib, deadline, cancelled):
                 raise _Unavailable("compiler-silent", f"jit: {pathlib.Path(cc).name} exited "
                                    "without writing a library" + _words(work))
             out.chmod(0o700)                      # private whatever the umask
+            for target in (lib, _record(lib)):    # a FIFO, a folder planted there: left be
+                with contextlib.suppress(FileNotFoundError):
+                    if not stat.S_ISREG(target.lstat().st_mode):
+                        raise _Unavailable("cache-error", f"jit: {target} is not a regular "
+                                           f"file; kinetwork replaces only its own files")
             record = work / "record"
             record.write_bytes(_sha256(out) + b"\n")
             record.chmod(0o600)
@@ -538,15 +573,12 @@ def _stop(deadline, cancelled):
 
 # -- the size bound -------------------------------------------------------------------------------
 def _trim(folder, keep):
-    """Remove the least recently loaded libraries until the cache fits in MAX_CACHE_BYTES
-    (never ``keep``, just built), and build folders left by killed processes."""
-    libraries = []
-    for lib in folder.glob("*.so"):
-        with contextlib.suppress(OSError):
-            st = lib.lstat()
-            libraries.append((st.st_mtime, st.st_size, lib))
+    """Remove the least recently loaded libraries until kinetwork's own (:func:`recorded`)
+    fit in MAX_CACHE_BYTES (never ``keep``, just built), and build folders left by killed
+    processes. Files without a record are neither counted nor removed."""
+    libraries = sorted((mtime, size, lib) for lib, size, mtime in recorded(folder))
     total = sum(size for _, size, _ in libraries)
-    for _, size, lib in sorted(libraries):
+    for _, size, lib in libraries:
         if total <= MAX_CACHE_BYTES:
             break
         if lib != keep:
