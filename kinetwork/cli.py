@@ -35,7 +35,7 @@ STOPPING = (signal.SIGINT, signal.SIGTERM)
 SHOWN_CHARACTERS, SHOWN_ITEMS = 500, 20
 #: seconds the outputs of a run still get to be written once it was stopped, or once its
 #: time limit has passed (within "about a second" of a stop, with what was reached)
-WRITE_GRACE = 1.0
+WRITE_GRACE = 0.5
 
 
 def _parameter(text):
@@ -408,16 +408,22 @@ def _write(path, write, quiet=False):
         raise kn.ModelError(f"cannot write {path}: {exc.strerror or exc}") from None
 
 
-def _outputs(args, results, title, deadline=None):
-    """Write the CSV and the plots of ``results``; returns why writing stopped early (a
-    signal, the time limit: a ``StopFlag``), or None.
+def _outputs(args, results, title, deadline=None, stopped=False):
+    """Write the CSV and the plots of ``results``; returns the ``StopFlag`` that says why
+    writing stopped early (a signal, the time limit), if it did.
 
-    The time limit covers writing too; after a stop (or with the limit passed) the outputs
-    still get WRITE_GRACE seconds. The CSV stops between blocks of rows, keeping the rows
-    written and a last line saying where; a plot is drawn whole or not at all."""
+    The time limit covers writing too; once it has passed, or after the run was ``stopped``
+    (a signal), the outputs get WRITE_GRACE seconds more. The CSV stops between blocks of
+    rows, keeping the rows written and a last line saying where; a plot is drawn whole or
+    not at all."""
     quiet = getattr(args, "quiet", False)
-    flag = StopFlag(deadline=None if deadline is None else
-                    max(deadline, time.monotonic() + WRITE_GRACE))
+    now = time.monotonic()
+    if stopped:
+        flag = StopFlag(deadline=now + WRITE_GRACE,
+                        late=f"the run was stopped, and writing gets {WRITE_GRACE:g} s")
+    else:
+        flag = StopFlag(deadline=None if deadline is None else
+                        max(deadline, now + WRITE_GRACE))
     with catching_signals(flag):
         if args.out:
             why = _write(args.out, lambda path: results.to_csv(
@@ -535,7 +541,8 @@ def _run(args):
             what = "interrupted" if stopped else "failed"
             try:
                 flag = _outputs(args, exc.results,
-                                f"{model.name} ({what} at t = {exc.t_reached:g} s)", deadline)
+                                f"{model.name} ({what} at t = {exc.t_reached:g} s)", deadline,
+                                stopped)
             except kn.ModelError as write_exc:
                 _error(write_exc)
         signum = exc.signal if stopped else getattr(flag, "signum", None)

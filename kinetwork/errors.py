@@ -1,22 +1,35 @@
 """The two exceptions every user-facing refusal or failure goes through."""
 
 
+#: problems a ModelError keeps, and shows in its message: a file of a million broken
+#: components is reported by its first problems and their count, not a million lines
+MAX_PROBLEMS, SHOWN_PROBLEMS = 1000, 100
+
+
 class ModelError(ValueError):
     """Bad input: a model, file or parameter that cannot be accepted.
 
-    ``problems`` lists every diagnostic found (each a string naming its place); the message
-    joins them, so one raise reports all of them at once.
+    ``problems`` lists every diagnostic found (each a string naming its place; the first
+    MAX_PROBLEMS of ``count``); the message joins them (the first SHOWN_PROBLEMS), so one
+    raise reports all of them at once.
     """
 
-    def __init__(self, problems):
+    def __init__(self, problems, count=None):
         if isinstance(problems, str):
             problems = [problems]
-        self.problems = list(problems)
-        if len(self.problems) == 1:
+        problems = list(problems)
+        #: how many problems were found, of which ``problems`` keeps the first MAX_PROBLEMS
+        #: (``count``: of a ModelError raised again with its problems placed)
+        self.count = max(len(problems), count or 0)
+        self.problems = problems[:MAX_PROBLEMS]
+        if self.count == 1:
             message = self.problems[0]
         else:
-            message = f"{len(self.problems)} problems:\n" + "\n".join(
-                f"  - {p}" for p in self.problems)
+            shown = self.problems[:SHOWN_PROBLEMS]
+            message = f"{self.count} problems:\n" + "\n".join(f"  - {p}" for p in shown)
+            if self.count > len(shown):
+                message += (f"\n  ... and {self.count - len(shown)} more (the same kind of "
+                            f"mistake repeated, most likely)")
         super().__init__(message)
 
 

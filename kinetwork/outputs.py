@@ -279,11 +279,11 @@ def check_all(outputs, reads=(), force=False):
 # -- stopping ------------------------------------------------------------------------------------
 class StopFlag:
     """Why a write (or a command's outputs) should stop: a signal caught, the caller's
-    ``cancel()``, or the ``deadline`` (a ``time.monotonic()`` value) passed. Call it: the
-    reason in words, or None."""
+    ``cancel()``, or the ``deadline`` (a ``time.monotonic()`` value) passed (said as
+    ``late``). Call it: the reason in words, or None."""
 
-    def __init__(self, cancel=None, deadline=None):
-        self.cancel, self.deadline = cancel, deadline
+    def __init__(self, cancel=None, deadline=None, late="the time limit was reached"):
+        self.cancel, self.deadline, self.late = cancel, deadline, late
         self.signum = None
         #: whether a signal raises Stopped at once (a write that cannot stop halfway)
         self.raising = True
@@ -294,7 +294,7 @@ class StopFlag:
         if self.cancel is not None and self.cancel():
             return "cancelled"
         if self.deadline is not None and time.monotonic() > self.deadline:
-            return "the time limit was reached"
+            return self.late
         return None
 
 

@@ -21,7 +21,7 @@ from ..util import QUOTE_LIMIT, quote, suggest
 from .initial import check_initial
 from .model import Model, model_name_problem, text_problem
 from .settings import check_setting, check_steps
-from .subsystem import Subsystem
+from .subsystem import MAX_COMPONENTS, MAX_CONNECTIONS, Subsystem
 from .writer import (DEFINITION_KEYS, FORMAT, KEYS, KEYS_V2, VERSION, _kind, _plain, dumps,
                      model_to_dict, save)
 
@@ -160,7 +160,7 @@ def model_from_dict(data, source=None, validate=True, context=None):
             # only its values are checked
             model.numeric_values() if model.exposed else model.validate()
         except ModelError as exc:
-            raise ModelError([_at(source, p) for p in exc.problems]) from None
+            raise ModelError([_at(source, p) for p in exc.problems], exc.count) from None
     return model
 
 
@@ -237,6 +237,10 @@ def _components(model, entries, problems, context):
     if not isinstance(entries, list):
         problems.append(f"components: must be a list, got {_kind(entries)}")
         return {UNNAMED}
+    if len(entries) > MAX_COMPONENTS:           # refused before any is built
+        problems.append(f"components: {len(entries)} entries, more than the "
+                        f"{MAX_COMPONENTS} a model may have")
+        return {UNNAMED}
     broken, seen = set(), {}
     for i, entry in enumerate(entries):
         name = entry.get("name") if isinstance(entry, dict) else None
@@ -287,6 +291,10 @@ def _component(entry, place, problems, context):
 def _connections(model, pairs, broken, problems):
     if not isinstance(pairs, list):
         problems.append(f"connections: must be a list of pairs, got {_kind(pairs)}")
+        return
+    if len(pairs) > MAX_CONNECTIONS:
+        problems.append(f"connections: {len(pairs)} entries, more than the "
+                        f"{MAX_CONNECTIONS} a model may have")
         return
     for i, pair in enumerate(pairs):
         if not isinstance(pair, list) or len(pair) != 2:

@@ -14,8 +14,8 @@ import numpy as np
 from ..components.base import ANY, Component, PortRef
 from ..util import quote, suggest
 from . import quantities
-from .subsystem import (Subsystem, check_placement, check_port_name, definitions, flatten,
-                        has_subsystems)
+from .subsystem import (MAX_COMPONENTS, MAX_CONNECTIONS, Subsystem, check_placement,
+                        check_port_name, definitions, flatten, has_subsystems)
 from .writer import save
 from ..errors import ModelError
 from ..expr import CONSTANTS, FUNCTIONS, parse
@@ -158,6 +158,9 @@ class Model:
             raise ModelError(f"model.add expects a component, got {component!r}")
         if component.name in self.components:
             raise ModelError(f"duplicate component name {component.name!r}")
+        if len(self.components) >= MAX_COMPONENTS:
+            raise ModelError(f"{component.name}: model {self.name!r} has {MAX_COMPONENTS} "
+                             f"components already, the most a model may have")
         if isinstance(component, Subsystem):
             check_placement(self, component)
         self.components[component.name] = component
@@ -203,6 +206,10 @@ class Model:
             self._wired = {frozenset(c) for c in self.connections}
         if frozenset((pa, pb)) in self._wired:
             raise ModelError(f"{pa.path} and {pb.path} are already connected")
+        if len(self.connections) >= MAX_CONNECTIONS:
+            raise ModelError(f"{pa.path} - {pb.path}: model {self.name!r} has "
+                             f"{MAX_CONNECTIONS} connections already, the most a model may "
+                             f"have")
         self.connections.append((pa, pb))
         self._wired.add(frozenset((pa, pb)))
 
@@ -307,17 +314,29 @@ class Model:
             raise ModelError(problems)
         return out
 
-    def content_key(self):
+    def content_key(self, _memo=None):
         """What the equations of the model depend on, as a hashable value: the parameter
         names, every component (the object, its type and given parameters) and the wiring.
-        Parameter *values* are not in it: they stay symbols in a compiled System."""
-        comps = tuple((id(c), name, c.signature()) if isinstance(c, Subsystem) else
+        Parameter *values* are not in it: they stay symbols in a compiled System. A placed
+        definition is in it as a digest of its own key (``fingerprint``), each computed once:
+        definitions that each place two of the next cost their number, not 2^depth."""
+        memo = {} if _memo is None else _memo
+        comps = tuple((id(c), name, c.signature(memo)) if isinstance(c, Subsystem) else
                       (id(c), name, type(c).__qualname__, repr(sorted(c.given.items())))
                       for name, c in self.components.items())
         wiring = tuple((a.path, id(a.component), b.path, id(b.component))
                        for a, b in self.connections)
         exposed = tuple((k, v.path, id(v.component)) for k, v in self.exposed.items())
         return tuple(self.parameters), comps, wiring, exposed
+
+    def fingerprint(self, _memo=None):
+        """A digest of ``content_key`` (a text of 64 hex digits), computed once per model in
+        one walk (``_memo``)."""
+        memo = {} if _memo is None else _memo
+        if id(self) not in memo:
+            import hashlib
+            memo[id(self)] = hashlib.sha256(repr(self.content_key(memo)).encode()).hexdigest()
+        return memo[id(self)]
 
     def validate(self) -> Topology:
         """Check the whole model; return its Topology or raise one ModelError listing all.

@@ -15,7 +15,8 @@ machine, so a run's numbers never depend on how fast the machine is or how loade
 
 Each chunk restarts a multistep method (order and step size begin again from one step of order
 one: +33 % evaluations on a 128-link chain in 8 chunks), so a quiet run (nothing of the above
-to watch, a CasADi method) goes in one call over the whole grid. Signals still stop any run at
+to watch, a CasADi method) goes in one call over the whole grid, up to MAX_CHUNK output
+intervals. Signals still stop any run at
 once: CasADi checks Python's signals at every evaluation of the equations, the driver's handler
 aborts the call there, and the outputs it had reached are kept (CasADi writes them into the
 driver's arrays as it goes). A quiet run and a watched one of the same model may differ at the
@@ -67,6 +68,10 @@ CHUNK_WORK = 1e8
 #: CHUNK_GROWTH-fold (each chunk restarts a multistep method: few chunks for a fast run)
 FIRST_CHUNK_STEPS = 100
 CHUNK_GROWTH = 16
+#: output intervals of one CasADi call at most, quiet runs included: building an integrator
+#: over 6e6 output times took 4 s and stopping it only comes between calls (a signal aborts
+#: a call, not the building), and work counts miss the cost of the outputs themselves
+MAX_CHUNK = 2**16
 #: restarts after a failure, with ``restart=True``, at most
 MAX_RESTARTS = 3
 #: a restarted run must keep the loops closed to this (m, or rotation-matrix entries)
@@ -76,7 +81,7 @@ RESTART_CLOSURE = 1e-6
 OUTPUT_CHUNK_WORK = 1e7
 #: after a run stopped (a signal, the time limit), the probe signals of what it reached are
 #: still computed for at most this long [s] (unless stopped again), and kept
-OUTPUT_GRACE = 1.0
+OUTPUT_GRACE = 0.5
 
 
 
@@ -292,7 +297,7 @@ def simulate(model: Model | System, t_end: float | None = None, n_points: int | 
             X, outputs, cut = _probe_outputs(run, t, X)
             if cut is not None:
                 t = t[:len(X)]
-                failure = f"{failure}; then {cut}" if failure else cut
+                failure = f"{failure}; {cut}" if failure else cut
     if run.said:
         stats["solver_output"] = "".join(run.said)
     if run.events is not None:
@@ -312,7 +317,9 @@ def simulate(model: Model | System, t_end: float | None = None, n_points: int | 
         reached = float(t[-1]) if len(t) else float(t_start)
         results.partial = {"t_reached": reached, "reason": failure}
         said = last_words(stats.get("solver_output", ""))
-        raise SimulationError(f"{key} failed after t = {reached:g} s (of "
+        # stopped when asked (a signal, cancel, the time limit), failed otherwise
+        verb = "stopped at" if run.stop_reason() is not None else "failed after"
+        raise SimulationError(f"{key} {verb} t = {reached:g} s (of "
                               f"{settings['t_end']:g} s): {failure}"
                               + (f" (the solver said: {said})" if said else ""),
                               results=results, t_reached=reached, reason=failure,
@@ -418,6 +425,8 @@ def _integrate(run, method):
         run.system.f_dependent is None and run.progress is None and run.cancel is None \
         and run.deadline is None
     chunk = n - 1 if method.stepper or run.quiet else _first_chunk(run, method, n - 1)
+    if not method.stepper:
+        chunk = min(chunk, MAX_CHUNK)
     if run.events is not None:
         run.events.log = []            # of this method (auto may try another after it)
         chunk = min(chunk, EVENT_CHUNK)
@@ -475,9 +484,10 @@ def _integrate(run, method):
                 continue
             break
         if run.quiet:                   # the rest at once (after a restart's first output)
-            chunk = n - 1 - k
+            chunk = min(n - 1 - k, MAX_CHUNK)
         elif not method.stepper:
-            chunk = _next_chunk(run, m, _work(run, stepper.stats) - work_before, n - 1 - k)
+            chunk = min(_next_chunk(run, m, _work(run, stepper.stats) - work_before,
+                                    n - 1 - k), MAX_CHUNK)
             chunk = chunk if run.events is None else min(chunk, EVENT_CHUNK)
             chunk = parts.limit(chunk)
         elif run.events is not None:
@@ -511,23 +521,22 @@ def _probe_outputs(run, t, X):
     started, earlier, seen = time.perf_counter(), run.stop_reason(), run.signals_seen
 
     def stopped():
-        if earlier is None:
-            return run.stop_reason()
-        if run.signals_seen != seen:
-            return run.stop_reason()
+        if earlier is None or run.signals_seen != seen:
+            why = run.stop_reason()
+            return None if why is None else f"{why} while the probe signals were computed"
         if time.perf_counter() - started > OUTPUT_GRACE:
-            return f"{earlier} (the probe signals were computed for {OUTPUT_GRACE:g} s more)"
+            return f"the probe signals were computed for {OUTPUT_GRACE:g} s after the stop"
         return None
 
     polished = X if not system.n_algebraic else np.array(X, dtype=float)
+    buffers = {}                    # one per chunk size, set to each chunk's arrays
     for k in range(0, n, size):
         if k and (why := stopped()) is not None:
-            return polished[:k], outputs[:k], \
-                f"{why} while the probe signals were computed (kept up to t = {t[k - 1]:g} s)"
+            return polished[:k], outputs[:k], f"{why}: kept up to t = {t[k - 1]:g} s"
         rows = slice(k, min(n, k + size))
         if system.n_algebraic:
             polished[rows] = system.polish(polished[rows], p)
-        outputs[rows] = system.outputs_p(t[rows], polished[rows], p, f_out)
+        system.outputs_into(t[rows], polished[rows], p, outputs[rows], f_out, buffers)
     return polished, outputs, None
 
 

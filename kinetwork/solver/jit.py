@@ -162,7 +162,10 @@ def compile_functions(name, functions, stats=None, deadline=None, cancelled=None
             with contextlib.suppress(OSError):
                 os.utime(lib)                   # recently used: the cache is trimmed LRU
         else:
-            _build(cc, name, generate(), lib, deadline, cancelled)
+            def check():                        # between the steps of writing the C
+                if stop := _stop(deadline, cancelled):
+                    raise stop
+            _build(cc, name, generate(check), lib, deadline, cancelled)
             _trim(folder, keep=lib)
     if stats is not None:
         stats["jit_cached"] = stats.get("jit_cached", True) and hit
@@ -317,26 +320,33 @@ def _plan(name, functions, cc, jacobian=False):
                                           JACOBIAN_O1_STATEMENTS, O1_STATEMENTS)),
                                      ca.__version__]).encode())
 
-    def generate():
+    def generate(check=lambda: None):
         sources = {}
         for f in functions:
-            sources.update(_sources(f.name(), f, optimise=True))
+            check()
+            sources.update(_sources(f.name(), f, optimise=True, check=check))
             if jacobian:
+                check()
                 j = f.jacobian()
                 sources.update(_sources(
-                    j.name(), j, optimise=j.n_instructions() <= JACOBIAN_O1_STATEMENTS))
+                    j.name(), j, optimise=j.n_instructions() <= JACOBIAN_O1_STATEMENTS,
+                    check=check))
         return sources
     return generate, f"{name}_{key.hexdigest()[:20]}.so"
 
 
-def _sources(name, f, optimise):
-    """{file name: (C, compiler flags)} of ``f``, in parts when it is long (``_split``)."""
+def _sources(name, f, optimise, check=lambda: None):
+    """{file name: (C, compiler flags)} of ``f``, in parts when it is long (``_split``);
+    ``check()`` between the steps raises when the caller no longer wants them."""
     gen = ca.CodeGenerator(f"{name}.c", {"with_header": False})
     gen.add(f)
+    check()
     optimise = optimise and f.n_instructions() <= O1_STATEMENTS
     flags = [*(("-O1",) if optimise else ("-O0",)), *(c for c in CFLAGS if c != "-O1")]
     size = PART_STATEMENTS if f.n_instructions() > SPLIT_STATEMENTS else None
-    files = _split(gen.dump(), size) if size else {"main.c": gen.dump()}
+    text = gen.dump()
+    check()
+    files = _split(text, size, check) if size else {"main.c": text}
     return {f"{name}_{k}" if k == "main.c" else k: (text, flags) for k, text in files.items()}
 
 
@@ -350,7 +360,7 @@ _VARIABLE = re.compile(r"\ba\d+\b")
 _PREFIX = re.compile(r"#define CASADI_PREFIX\(ID\) (\w+)_ ## ID")
 
 
-def _split(source, size):
+def _split(source, size, check=lambda: None):
     """The C ``source`` as {file name: text}: itself, or, when it holds a function of more
     than ``size`` statements, a main file and one file per part of that function.
 
@@ -369,6 +379,7 @@ def _split(source, size):
     preamble = source[:config]
     files, out, declarations, pos = {}, [], [], 0
     for head in _HEAD.finditer(source):
+        check()
         end = source.find(_END, head.end())
         lines = source[head.end():end].split("\n") if end > 0 else []
         k = 0
@@ -390,6 +401,7 @@ def _split(source, size):
         slots = {}
         calls = []
         for j, part in enumerate(parts):
+            check()
             loads, written = [], set()
             for m in part:
                 reads = [m.group(3)] if m.group(3) else _VARIABLE.findall(m.group(2))

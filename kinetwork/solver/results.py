@@ -19,7 +19,7 @@ from ..util import suggest
 
 #: rows of a CSV written at a time: between blocks a write can be stopped (SIGINT, SIGTERM,
 #: a cancel) and keep the rows before
-CSV_BLOCK_ROWS = 20_000
+CSV_BLOCK_ROWS = 4096
 
 if TYPE_CHECKING:                     # annotations only
     from ..equations.signals import Signal
