@@ -355,7 +355,11 @@ def _interrupted(signum):
 
 def _linearize(args):
     from .analysis import commands
-    return commands.run_linearize(args, _load(args.model, args.library))
+    try:
+        return commands.run_linearize(args, _load(args.model, args.library))
+    except kn.SimulationError as exc:   # the run to --at-time failed: nothing to linearise
+        _error(exc)
+        return 128 + int(exc.signal) if exc.signal in STOPPING else EXIT_SIMULATION
 
 
 def _fit(args):
@@ -364,7 +368,7 @@ def _fit(args):
         return commands.run_fit(args, _load(args.model, args.library))
     except kn.SimulationError as exc:
         _error(exc)
-        return EXIT_SIMULATION
+        return 128 + int(exc.signal) if exc.signal in STOPPING else EXIT_SIMULATION
 
 
 def _sweep(args):

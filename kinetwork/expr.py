@@ -79,8 +79,8 @@ class Expression:
             # no bitwise operators are accepted, so "^" is free to mean a power
             tree = ast.parse(text.strip().replace("^", "**"), mode="eval")
             if (deep := depth(tree.body)) > MAX_DEPTH:
-                raise ModelError(f"expression {quote(text, 60)}: nested {deep} deep, more "
-                                 f"than the {MAX_DEPTH} levels an expression may have")
+                raise ModelError(f"expression nested too deeply ({deep} levels; an "
+                                 f"expression may have {MAX_DEPTH}): {quote(text, 60)}")
             self.names = set()
             self._check(tree.body)
         except ModelError:
@@ -228,9 +228,9 @@ def rename(text, names):
             return _replacement(names[node.id]) if node.id in names else node
     renamed = Renamer().visit(tree)
     if (deep := depth(renamed)) > MAX_DEPTH:
-        raise ModelError(f"expression {quote(text, 60)} nests {deep} deep once written in the "
-                         f"names of the model it is placed in, more than the {MAX_DEPTH} "
-                         f"levels an expression may have")
+        raise ModelError(f"expression {quote(text, 60)}: nested too deeply once written in "
+                         f"the names of the model it is placed in ({deep} levels; an "
+                         f"expression may have {MAX_DEPTH})")
     out = ast.unparse(renamed)
     if len(out) > _MAX_LENGTH:
         raise ModelError(f"expression {quote(text, 60)} grows to {len(out)} characters once "

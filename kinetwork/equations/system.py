@@ -40,6 +40,7 @@ class System:
         # partition, assembly: the same model with other independent coordinates (a run
         # re-partitions a loop where its partition turns singular), on the same assembly
         self.model = model
+        self._compiled_as = (loops, baumgarte_rate)      # how a pickle compiles it again
         self.topology = topology if topology is not None else model.validate()
         values = model.parameter_values()
         self.asm = asm = assembly if assembly is not None else \
@@ -97,6 +98,20 @@ class System:
     @property
     def signal_names(self) -> list[str]:
         return [sig.name for sig in self.signals]
+
+    def __reduce__(self):
+        """A System pickles as the file text of its model and how it was compiled;
+        unpickling compiles it again (CasADi's expressions do not pickle; the equations are
+        rebuilt from the model, in the receiving process, once)."""
+        from ..graph.io import dumps
+        model = self.model._source or self.model        # a flat model: what it expands
+        try:
+            text = dumps(model)
+        except ModelError as exc:
+            raise TypeError(f"cannot pickle the System of {model.name!r}: its model cannot "
+                            f"be written as a file, which is how a System travels ({exc})") \
+                from None
+        return _system_from_text, (text, *self._compiled_as)
 
     def _check_mass_matrix(self):
         """Refuse a mass matrix that is singular at the initial state (a joint that moves no
@@ -197,6 +212,12 @@ class System:
     # -- parameters -----------------------------------------------------------------------
     def param_vector(self, params: Mapping[str, float] | None = None) -> np.ndarray:
         """Model parameters as the vector p, with ``params`` overrides checked."""
+        missing = [k for k in self.param_names if k not in self.model.parameters]
+        if missing:             # taken out of the model after it was compiled
+            raise ModelError(f"model {self.model.name!r} has no parameter "
+                             f"{', '.join(map(repr, missing[:5]))} any more, which its "
+                             f"compiled System uses: compile the model again "
+                             f"(model.compile()), or put the parameter back")
         values = self.model.parameter_values(params)
         if params:
             self.model.numeric_values(params)     # bounds of everything that depends on them
@@ -449,6 +470,12 @@ def overflow_message(model, what, p, names):
             f"state: a number overflows double precision there (or a division by zero); check "
             f"the parameters" + (f" (largest: {', '.join(f'{k} = {v:g}' for k, v in big)})"
                                  if big else "") + " and the initial values")
+
+
+def _system_from_text(text, loops, baumgarte_rate):
+    """The System a pickle holds (``System.__reduce__``): its model read and compiled."""
+    from ..graph.io import loads
+    return loads(text).compile(loops=loops, baumgarte_rate=baumgarte_rate)
 
 
 @functools.lru_cache(maxsize=64)

@@ -65,6 +65,27 @@ class Results:
             self._values[sig.name] = block.reshape(len(self.t), *sig.shape)
 
     @property
+    def system(self) -> System | None:
+        """The System that made these results (None when not known). Results from a pickle
+        compile it again on first use."""
+        if self._system is None and self._recipe is not None:
+            build, args = self._recipe
+            self._system, self._recipe = build(*args), None
+        return self._system
+
+    @system.setter
+    def system(self, value):
+        self._system, self._recipe = value, None
+
+    def __getstate__(self):
+        """Pickled with the System as its recipe (its model's text, compiled again only if
+        the results' System is asked for): CasADi's expressions do not pickle."""
+        state = dict(self.__dict__)
+        if self._system is not None:
+            state["_system"], state["_recipe"] = None, self._system.__reduce__()
+        return state
+
+    @property
     def method(self) -> str | None:
         """The integration method that produced these results (None if not recorded)."""
         return self.settings.get("method")
