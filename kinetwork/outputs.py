@@ -130,8 +130,13 @@ def sniff(head):
         if "<robot" in text:
             return "urdf"
         return "xml"
-    first = stripped.split("\n", 1)[0].strip().strip('"')
-    if "," in first or first == "t":
+    lines = [ln for ln in stripped.split("\n") if ln.strip()]
+    if len(head) == SNIFF_BYTES and len(lines) > 1:
+        lines = lines[:-1]                      # the last may be cut short
+    first = lines[0].split(",", 1)[0].strip().strip('"') if lines else ""
+    commas = {ln.count(",") for ln in lines}
+    # a table: kinetwork's (time first), or rows of one count of commas
+    if first == "t" or (len(lines) > 1 and len(commas) == 1 and commas != {0}):
         return "csv"
     return "text"
 

@@ -50,6 +50,7 @@ from .errors import ModelError
 from .graph.io import MAX_FILE_SIZE, dumps
 from .graph.model import Model
 from .outputs import check, write
+from .util import read_bounded
 
 JOINT_TYPES = ("revolute", "continuous", "prismatic", "fixed", "floating", "planar")
 #: what a probe on each joint records (the 1-D flange for 1-DOF joints, frame_b otherwise)
@@ -142,10 +143,9 @@ def _q(text, limit=80):
 def _read(source):
     """The <robot> element of the file."""
     try:
-        with open(source, "rb") as fh:
-            # at most one byte past the limit: /dev/zero or an endless pipe is refused by
-            # size, not read until memory runs out
-            text = fh.read(MAX_FILE_SIZE + 1)
+        # at most one byte past the limit: /dev/zero or an endless pipe is refused by size,
+        # not read until memory runs out; a FIFO without a writer does not block
+        text = read_bounded(source, MAX_FILE_SIZE)
     except FileNotFoundError:
         raise ModelError(f"{_q(source)}: no such file") from None
     except OSError as exc:

@@ -3,6 +3,7 @@ input in messages, and atomic file writes (through ``kinetwork.outputs``). The b
 it imports nothing of kinetwork but the errors and the output policy."""
 
 import math
+import os
 import sys
 
 from .errors import ModelError
@@ -47,6 +48,61 @@ def quote(value, limit=QUOTE_LIMIT):
     except Exception:                 # a hostile __repr__: say what it is, not what it says
         text = f"<{type(value).__name__}>"
     return text if len(text) <= limit else text[:limit - 3] + "..."
+
+
+#: seconds a read from a pipe or a device may wait for its next bytes
+READ_IDLE = 10.0
+
+
+def read_bounded(path, limit, special=True, idle=READ_IDLE, inspect=None):
+    """The bytes of the file at ``path``: at most ``limit`` + 1 of them (a caller refuses
+    more), so /dev/zero or an endless pipe costs a bounded read.
+
+    Opening never blocks (a FIFO without a writer reads as empty), and a pipe or a device
+    that sends nothing for ``idle`` seconds is refused. ``special=False`` refuses anything
+    but a regular file (a FIFO, a device, a socket) before reading a byte: what a server
+    that must never block uses. ``inspect(first_bytes)``, if given, sees the first block
+    read (up to 1 MiB) and may refuse the rest by raising.
+
+    Raises
+    ------
+    ModelError
+        A special file refused, or one that went silent.
+    OSError
+        The file cannot be opened or read (a folder: IsADirectoryError).
+    """
+    import errno
+    import select
+    import stat
+    fd = os.open(path, os.O_RDONLY | os.O_NONBLOCK | getattr(os, "O_CLOEXEC", 0))
+    try:
+        st = os.fstat(fd)
+        if stat.S_ISDIR(st.st_mode):
+            raise IsADirectoryError(errno.EISDIR, os.strerror(errno.EISDIR), path)
+        regular = stat.S_ISREG(st.st_mode)
+        if not regular and not special:
+            raise ModelError(f"{quote(os.fspath(path))}: not a regular file (a pipe, a device "
+                             f"or a socket): refused without reading it")
+        if regular:
+            os.set_blocking(fd, True)
+        chunks, size = [], 0
+        while size <= limit:
+            try:
+                chunk = os.read(fd, min(1 << 20, limit + 1 - size))
+            except BlockingIOError:         # a pipe or a device with nothing yet: wait
+                if not select.select([fd], [], [], idle)[0]:
+                    raise ModelError(f"{quote(os.fspath(path))}: nothing came from it for "
+                                     f"{idle:g} s") from None
+                continue
+            if not chunk:
+                break
+            if inspect is not None and not chunks:
+                inspect(chunk)
+            chunks.append(chunk)
+            size += len(chunk)
+        return b"".join(chunks)
+    finally:
+        os.close(fd)
 
 
 def atomic_write(path, write, mode=0o666):

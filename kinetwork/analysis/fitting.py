@@ -15,7 +15,7 @@ import numpy as np
 
 from ..equations.system import System
 from ..errors import ModelError, SimulationError
-from ..util import quote, suggest
+from ..util import quote, read_bounded, suggest
 from .channels import output_channels
 from .sensitivities import DEFAULTS, evaluate, param_index, trajectory
 
@@ -204,12 +204,11 @@ def _text(data):
     its byte-order mark as spreadsheet programs write; binary data, a file past
     MAX_DATA_BYTES or one that cannot be read is refused naming it."""
     where = quote(str(data))
+    def text_only(head):
+        if b"\x00" in head and not head.startswith((b"\xff\xfe", b"\xfe\xff")):
+            raise ModelError(f"data: {where} is binary, not a CSV table")
     try:
-        with open(data, "rb") as fh:
-            head = fh.read(1 << 16)
-            if b"\x00" in head and not head.startswith((b"\xff\xfe", b"\xfe\xff")):
-                raise ModelError(f"data: {where} is binary, not a CSV table")
-            raw = head + fh.read(MAX_DATA_BYTES + 1 - len(head))
+        raw = read_bounded(data, MAX_DATA_BYTES, inspect=text_only)
     except OSError as exc:
         raise ModelError(f"data: cannot read {where}: {exc.strerror or exc}") from None
     if len(raw) > MAX_DATA_BYTES:

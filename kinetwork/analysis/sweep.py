@@ -618,6 +618,9 @@ def _run(system, names, values, layout, params, t_end, n_points, method, rtol, a
             raise ModelError(f"{what}: must be a positive integer, got {v!r:.40}")
     if workers > MAX_WORKERS:
         raise ModelError(f"workers: at most {MAX_WORKERS} threads, got {workers}")
+    if batch is not None and batch > MAX_BATCH:
+        raise ModelError(f"batch: at most {MAX_BATCH} members integrated together (their "
+                         f"tolerances are divided by sqrt(batch)), got {batch}")
     if batch is None:       # a power of two: sweeps of other sizes reuse the compiled batch
         batch = min(MAX_BATCH, 1 << max(0, math.ceil(n / workers) - 1).bit_length())
     outcome = Outcome(job, n)

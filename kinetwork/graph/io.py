@@ -17,7 +17,7 @@ from collections.abc import Iterable
 
 from ..components.base import _NAME, NAME_LIMIT, REGISTRY
 from ..errors import ModelError
-from ..util import QUOTE_LIMIT, quote, suggest
+from ..util import QUOTE_LIMIT, quote, read_bounded, suggest
 from .initial import check_initial
 from .model import Model, model_name_problem, text_problem
 from .settings import check_setting, check_steps
@@ -79,13 +79,12 @@ def _read(source):
     """The text of a model file, refused past MAX_FILE_SIZE or when not UTF-8."""
     too_big = f"{source}: larger than {MAX_FILE_SIZE // 2**20} MiB, too large for a model file"
     try:
-        with open(source, "rb") as fh:
-            info = os.fstat(fh.fileno())
-            if stat.S_ISREG(info.st_mode) and info.st_size > MAX_FILE_SIZE:
-                raise ModelError(f"{too_big} ({info.st_size} bytes)")
-            # at most one byte past the limit: a device or a pipe without end is refused by
-            # size, not read until memory runs out
-            raw = fh.read(MAX_FILE_SIZE + 1)
+        info = os.stat(source)
+        if stat.S_ISREG(info.st_mode) and info.st_size > MAX_FILE_SIZE:
+            raise ModelError(f"{too_big} ({info.st_size} bytes)")
+        # at most one byte past the limit: a device or a pipe without end is refused by
+        # size, not read until memory runs out; a FIFO without a writer does not block
+        raw = read_bounded(source, MAX_FILE_SIZE)
     except OSError as exc:
         raise ModelError(f"{source}: cannot read the file ({exc.strerror or exc})") from exc
     if len(raw) > MAX_FILE_SIZE:

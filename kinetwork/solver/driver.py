@@ -107,7 +107,8 @@ def _close_sink():
 class Run:
     """One call of ``simulate``: the settings every method reads, and the driver's state."""
 
-    def __init__(self, system, p, x0, grid, settings, jit, cancel, progress, restart):
+    def __init__(self, system, p, x0, grid, settings, jit, cancel, progress, restart,
+                 started=None):
         self.system, self.p, self.x0, self.grid = system, p, x0, grid
         self.compiled = compiled(system)
         self.t_start, self.t_end = float(grid[0]), float(grid[-1])
@@ -117,7 +118,7 @@ class Run:
         self.steps_per_interval = max(1, math.ceil(self.spacing / (self.step or self.spacing)
                                                    * (1 - 1e-12)))
         self.max_steps = settings["max_steps"]
-        self.started = time.perf_counter()
+        self.started = time.perf_counter() if started is None else started
         limit = settings["time_limit"]
         self.deadline = self.started + limit if limit else None
         self.jit = jit
@@ -253,6 +254,7 @@ def simulate(model: Model | System, t_end: float | None = None, n_points: int | 
         The integration failed or was stopped; ``err.results`` holds the results up to
         ``err.t_reached``.
     """
+    entered = time.perf_counter()      # the time limit counts building the equations too
     system = model if isinstance(model, System) else model.compile()
     given = {"t_end": t_end, "n_points": n_points, "method": method, "rtol": rtol,
              "atol": atol, "step": step}
@@ -273,7 +275,7 @@ def simulate(model: Model | System, t_end: float | None = None, n_points: int | 
                     rtol=float(settings["rtol"]), atol=float(settings["atol"]))
     stats = {}
     jit_on = _jit.enabled(jit) and system.n_states > 0
-    run = Run(system, p, x0, grid, settings, None, cancel, progress, restart)
+    run = Run(system, p, x0, grid, settings, None, cancel, progress, restart, entered)
     run.repartition = bool(repartition)
     if system.modes is not None:       # modes consistent with the start, before any method
         run.events = Events(run)
