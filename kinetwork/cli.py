@@ -428,10 +428,12 @@ def _outputs(args, results, title, deadline=None, stopped=False):
     else:
         flag = StopFlag(deadline=None if deadline is None else
                         max(deadline, now + WRITE_GRACE))
+    flag.cut = None                     # why an output was cut short or not drawn
     with catching_signals(flag):
         if args.out:
             why = _write(args.out, lambda path: results.to_csv(
                 path, overwrite=args.force, stop=flag), quiet)
+            flag.cut = why
             if not quiet:
                 rows = f"{len(results.t)} points" if why is None else \
                     f"the first rows ({why}: cut short, said on its last line)"
@@ -439,6 +441,7 @@ def _outputs(args, results, title, deadline=None, stopped=False):
         if args.plot:
             why = flag()
             if why is not None:
+                flag.cut = why
                 _error(f"--plot {args.plot} not drawn: {why}")
             else:
                 _write(args.plot, lambda path: _save_plot(args, results, path, title), quiet)
@@ -555,9 +558,12 @@ def _run(args):
     if not args.quiet:
         _summary(args, model, system, results, start, compiled, done)
     flag = _outputs(args, results, model.name, deadline)
+    if flag.cut is not None:            # the run is whole; its outputs were cut short
+        _error(f"{flag.cut} while the outputs were written"
+               + (": the CSV ends with a line saying where" if args.out else ""))
     if flag.signum is not None:
         return 128 + int(flag.signum)
-    return EXIT_SIMULATION if flag() is not None else 0
+    return EXIT_SIMULATION if flag.cut is not None else 0
 
 
 def _summary(args, model, system, results, start, compiled, done):
