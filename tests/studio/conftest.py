@@ -2,8 +2,8 @@
 port, over a copy of the example models) and Debian's Chromium driven by Playwright.
 
 Nothing here is autouse, so the server's own tests (test_server.py) are untouched. The
-fixtures skip, saying why, when Chromium, Playwright, FastAPI/uvicorn or the built front end
-is missing.
+fixtures fail, saying why, when Chromium, Playwright, FastAPI/uvicorn or the built front end
+is missing (``browser_missing`` in tests/conftest.py: skipped only when asked).
 """
 
 import os
@@ -14,6 +14,7 @@ import threading
 import time
 
 import pytest
+from browser import browser_missing
 
 REPO = pathlib.Path(__file__).resolve().parents[2]
 CHROMIUM = "/usr/bin/chromium"
@@ -57,7 +58,7 @@ def studio(tmp_path):
     file of the repository)."""
     why = _why_not()
     if why:
-        pytest.skip(why)
+        browser_missing(why)
     import uvicorn
 
     from kinetwork.studio.server import create_app
@@ -89,7 +90,7 @@ def browser(chromium):
     """Debian's Chromium, headless, shared with the whole run (tests/conftest.py)."""
     why = _why_not()
     if why:
-        pytest.skip(why)
+        browser_missing(why)
     return chromium
 
 

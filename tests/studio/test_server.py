@@ -2,7 +2,6 @@
 files confined to the root, the checks of kn.load placed on their blocks, saves that keep
 files byte for byte, and runs that end as kn.simulate ends (done, failed, cancelled)."""
 
-import importlib.util
 import json
 import os
 import pathlib
@@ -13,12 +12,10 @@ import time
 import types
 import warnings
 
+import httpx
 import numpy as np
 import pytest
-
-pytest.importorskip("fastapi")
-httpx = pytest.importorskip("httpx")
-uvicorn = pytest.importorskip("uvicorn")
+import uvicorn
 with warnings.catch_warnings():
     # starlette asks for httpx2 now and says so on import; httpx still does the job
     warnings.filterwarnings("ignore", message="Using `httpx` with `starlette.testclient`")
@@ -332,19 +329,14 @@ def test_results_carry_the_animation_or_null_without_its_module(client, monkeypa
     answer = wait(client, client.post("/api/run", json={"model": seed(client),
                                                         "settings": settings}).json()["run"])
     animation = answer["results"]["animation"]
-    if importlib.util.find_spec("kinetwork.animation") is not None:
-        assert animation["format"] == "kinetwork.animation" and animation["frames"]
-        assert len(animation["t"]) == 6
-    else:
-        assert animation is None
+    assert animation["format"] == "kinetwork.animation" and animation["frames"]
+    assert len(animation["t"]) == 6
     monkeypatch.setitem(sys.modules, "kinetwork.animation", None)     # not importable
     answer = wait(client, client.post("/api/run", json={"model": seed(client),
                                                         "settings": settings}).json()["run"])
     assert answer["state"] == "done" and answer["results"]["animation"] is None
 
 
-@pytest.mark.skipif(importlib.util.find_spec("kinetwork.animation") is None,
-                    reason="kinetwork.animation is not there yet")
 def test_a_dense_run_is_resampled_for_the_animation(client, monkeypatch):
     monkeypatch.setattr(runs, "MAX_FRAMES", 50)
     answer = wait(client, client.post("/api/run", json={"model": seed(client), "settings": {
