@@ -143,7 +143,9 @@ def build_parser():
     run.add_argument("--max-steps", type=_positive(int), metavar="N",
                      help="step budget per output interval of the variable-step methods")
     run.add_argument("--time-limit", type=_positive(float), metavar="S",
-                     help="wall-clock limit of the integration [s]")
+                     help="wall-clock limit [s] of the run: C compilation, integration, "
+                          "probe signals and writing the outputs (what was reached is "
+                          "written)")
     run.add_argument("--quiet", "-q", action="store_true",
                      help="print nothing but errors (on stderr)")
     run.add_argument("--progress", action=argparse.BooleanOptionalAction, default=None,
@@ -488,7 +490,6 @@ def _progress_bar(args, model, t_end):
 
 
 def _run(args):
-    started = time.monotonic()          # the time limit counts from here, writing included
     outputs = [("--out", args.out, "csv"), ("--plot", args.plot, plot_kind(args.plot or ""))]
     try:                                # by name, before anything is read or run
         check_all(outputs, [("the model file", args.model)], args.force)
@@ -529,16 +530,14 @@ def _run(args):
                            3 if args.error_estimate else 1)
     if problem:
         raise kn.ModelError(problem)
-    deadline = None if args.time_limit is None else started + args.time_limit
-    # what is left of the limit after loading and building (at least a moment: a run out
-    # of time still starts, and stops at once with its first point)
-    left = None if deadline is None else max(deadline - time.monotonic(), 1e-6)
+    # the limit counts from the run (its C compilation included) to the last output written
+    deadline = None if args.time_limit is None else time.monotonic() + args.time_limit
     try:
         with _progress_bar(args, model, settings["t_end"]) as progress:
             results = kn.simulate(system, t_end=args.t_end, n_points=args.n_points,
                                   method=args.method, rtol=args.rtol, atol=args.atol,
                                   step=args.step, jit=args.jit, params=params,
-                                  max_steps=args.max_steps, time_limit=left,
+                                  max_steps=args.max_steps, time_limit=args.time_limit,
                                   progress=progress, error_estimate=args.error_estimate)
     except kn.SimulationError as exc:
         _error(exc)

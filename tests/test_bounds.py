@@ -6,6 +6,7 @@ its place, quickly: CPU time is bounded with a wide margin (never wall time)."""
 import json
 import time
 
+import numpy as np
 import pytest
 from conftest import double_pendulum
 
@@ -202,3 +203,22 @@ def test_videos_are_bounded_in_frames_before_anything_is_drawn(seed_model, tmp_p
     with cpu_bound(), pytest.raises(kn.ModelError, match=says):
         res.animate(**kwargs)
     assert list(tmp_path.iterdir()) == []
+
+
+def test_an_animation_of_a_dense_run_computes_poses_only_where_its_frames_fall(
+        seed_model, monkeypatch):
+    from kinetwork.animation import scene
+    res = kn.simulate(seed_model, t_end=10.0, n_points=100_001)
+    evaluated = []
+    poses = scene._frame_poses
+    monkeypatch.setattr(scene, "_frame_poses",
+                        lambda system, t, *rest: evaluated.append(len(t)) or
+                        poses(system, t, *rest))
+    anim = scene.animation_data(res, fps=30)
+    assert len(anim["t"]) == 301 and evaluated[0] <= 2 * 301   # the neighbours of each frame
+    monkeypatch.setattr(scene, "_between", lambda t, fps: slice(None))
+    every = scene.animation_data(res, fps=30)                 # poses at all 100 001 points
+    assert evaluated[-1] == 100_001
+    for a, b in zip(anim["frames"], every["frames"]):
+        np.testing.assert_allclose(a["position"], b["position"], rtol=0, atol=1e-12)
+        np.testing.assert_allclose(a["quaternion"], b["quaternion"], rtol=0, atol=1e-12)

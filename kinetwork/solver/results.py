@@ -85,6 +85,12 @@ class Results:
             state["_system"], state["_recipe"] = None, self._system.__reduce__()
         return state
 
+    def __copy__(self):
+        """A shallow copy sharing the System (no recipe made: see ``__getstate__``)."""
+        twin = type(self).__new__(type(self))
+        twin.__dict__.update(self.__dict__)
+        return twin
+
     @property
     def method(self) -> str | None:
         """The integration method that produced these results (None if not recorded)."""
