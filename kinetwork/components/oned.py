@@ -151,7 +151,9 @@ class PartialMotion(Component):
     its expression and of the signal blocks feeding it); otherwise it is filtered, with the
     filter's states giving the position, speed and acceleration: Modelica's second-order
     Bessel filter of cut-off ``f_crit`` for a position, first-order for a speed. The
-    reaction, through the optional support, rests in the world.
+    reaction, through the optional support, rests in the world; wired to a free rotor (an
+    inertia), the support takes it and the motion is relative to the rotor (MSL's
+    useSupport).
     """
     role = "prescribed"
     derivative = 0

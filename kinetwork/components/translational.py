@@ -52,9 +52,9 @@ class Mass(PartialInertia, library=LIB):
     domain = LIB
     m = Param(unit="kg", min=0.0, doc="Mass")
     position0 = Param(None, optional=True, unit="m", name="s0",
-                      doc="Initial position when the inertia moves freely (None: 0)")
+                      doc="Initial position (None: from what it is tied to, else 0)")
     speed0 = Param(None, optional=True, unit="m/s", name="v0",
-                   doc="Initial speed when the inertia moves freely (None: 0)")
+                   doc="Initial speed (None: from what it is tied to, else 0)")
 
     def inertia(self):
         return self.m

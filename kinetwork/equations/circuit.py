@@ -21,6 +21,7 @@ import casadi as ca
 import networkx as nx
 
 from ..errors import ModelError
+from .matching import maximum_matching
 
 DOMAIN = "electrical"
 
@@ -172,15 +173,12 @@ class Circuit:
                               for o in bad])
         sparsity = jac.sparsity()
         rows, cols = sparsity.get_triplet()
-        g = nx.Graph()
-        eqs = [("e", k) for k in range(len(equations))]
-        g.add_nodes_from(eqs, bipartite=0)
-        g.add_nodes_from((("z", j) for j in range(len(unknowns))), bipartite=1)
-        g.add_edges_from((("e", i), ("z", j)) for i, j in zip(rows, cols))
-        matching = nx.bipartite.hopcroft_karp_matching(g, top_nodes=eqs)
-        unmatched = [k for k in range(len(equations)) if ("e", k) not in matching]
+        # integer nodes: the same matching, so the same names in a refusal, in every run
+        assigned = maximum_matching(len(equations), len(unknowns), zip(rows, cols))
+        unmatched = [k for k in range(len(equations)) if k not in assigned]
         if unmatched or len(equations) != len(unknowns):
-            lost = [names[j] for j in range(len(unknowns)) if ("z", j) not in matching]
+            matched = set(assigned.values())
+            lost = [names[j] for j in range(len(unknowns)) if j not in matched]
             over = sorted({owners[k] for k in unmatched})
             raise ModelError(
                 f"circuit: the equations of {', '.join(over) or 'the circuit'} leave "
@@ -190,7 +188,6 @@ class Circuit:
                 f"higher index (a capacitor directly across a voltage source or another "
                 f"capacitor loop, an inductor in series with a current source), which "
                 f"kinetwork does not solve; add a resistor to the loop or the cut set")
-        assigned = {k: matching[("e", k)][1] for k in range(len(equations))}
         dep = nx.DiGraph()
         dep.add_nodes_from(range(len(equations)))
         owner_of = {j: k for k, j in assigned.items()}

@@ -36,6 +36,7 @@ import casadi as ca
 import networkx as nx
 
 from ..errors import ModelError
+from . import starts, supports
 from .circuit import Circuit
 from .signals import acceleration_unavailable
 
@@ -71,6 +72,8 @@ class Network:
     hybrid: list = field(default_factory=list)
     #: what structural analysis made of the circuits (``circuit.Circuit.summary``)
     circuit: str = ""
+    #: joint starts the inertias on joint axes give: (``"q"`` or ``"u"``, index, value)
+    claims: list = field(default_factory=list)
 
     def summary(self, topo):
         """A line on what structural analysis made of the 1-D network and the blocks."""
@@ -164,6 +167,8 @@ class _Builder:
         n = u.shape[0]
         self.net = Network({}, {}, {}, {}, ca.SX.zeros(n), ca.SX.zeros(n), ca.SX.zeros(n))
         self.k = {}                  # connection set -> ratio to its group's coordinate
+        self.ride = {}               # ... and the shares of its carriers (``supports.ride``)
+        self.kin = {}                # connection set -> (position, speed, acceleration)
         self.kt = {}                 # ... and of its torques (differs through gear losses)
         self.losses = {}             # gear with a loss -> eta^mode
         self.group_of = {}           # connection set -> group
@@ -179,11 +184,12 @@ class _Builder:
             self._ratios(group)
         for group in self.topo.oned:
             self._coordinate(group)
-        for s, group in self.group_of.items():
-            theta, w, a = self.coord[group.index]
-            k = self.k[s]
+        self.kin = supports.kinematics(self)
+        for s, (pos, vel, acc) in self.kin.items():
             for ref in self.topo.sets[s]:
-                self.net.pos[ref], self.net.vel[ref], self.net.acc[ref] = k * theta, k * w, k * a
+                self.net.pos[ref], self.net.vel[ref], self.net.acc[ref] = pos, vel, acc
+        self.riding = supports.clusters(self)
+        starts.free(self)
         self._block_states()
         # circuits next: their currents are expressions of states and speeds, so EMF
         # torques are known before any balance (``circuit.py``)
@@ -210,11 +216,13 @@ class _Builder:
             self.group_of[s] = group
             if parent is None:
                 self.k[s] = self.kt[s] = ca.SX(1)
+                self.ride[s] = [] if group.base is None else [(ca.SX(1), group.base)]
                 continue
             r = self.bound[element.name].ratio()
             a_here = self.topo.set_of[element.port_ref("flange_a")] == s
-            # position(flange_a) = r * position(flange_b)
+            # position(flange_a) = r * position(flange_b), relative to the gear's support
             self.k[s] = self.k[parent] * r if a_here else self.k[parent] / r
+            self.ride[s] = supports.ride(self, parent, element, a_here, r if a_here else 1 / r)
             # torques pass a gear with efficiency eta as torque_b = -r eta^m torque_a, m = +1
             # while flange_a drives (power from a to b), -1 while flange_b does
             loss = self._loss(element, group)
@@ -282,15 +290,14 @@ class _Builder:
                                     self.k[self.topo.set_of[flange]], x, coord))
 
     def _free(self, group):
-        inertias = [e for e in group.rigid if e.has_inertia]
-        first = self.bound[inertias[0].name]
+        """A coordinate and a speed, the position and speed of the group's first inertia
+        (the group's root), named after it; their starts follow from the inertias' own
+        (``starts.free``, once every position is known)."""
+        first = next(e for e in group.rigid if e.has_inertia)
         pos_unit, vel_unit = _units(group)
-        k = self.k[self.topo.set_of[inertias[0].port_ref("flange_a")]]
-        p0 = 0 if first.position0 is None else first.position0 / k
-        w0 = 0 if first.speed0 is None else first.speed0 / k
         a = ca.SX.sym(f"g{group.index}_acc")
-        w = self._state(f"{first.name}.{_vel(group)}", vel_unit, w0, a)
-        theta = self._state(f"{first.name}.{_pos(group)}", pos_unit, p0, w,
+        w = self._state(f"{first.name}.{_vel(group)}", vel_unit, 0, a)
+        theta = self._state(f"{first.name}.{_pos(group)}", pos_unit, 0, w,
                             at=len(self.net.x) - 1)
         self.coord[group.index] = (theta, w, a)
 
@@ -474,9 +481,12 @@ class _Builder:
                 drive = ca.SX.sym(f"drive_{m.comp.name}")
                 self._drive(m, drive / m.k)
                 m.drive = drive
+        for cluster in self.riding:             # trains riding on a housing, solved together
+            supports.solve(self, cluster)
         # motions of free flanges first: the flow into their source is then known, and so
-        # the reaction on their support, before the fixed groups take it
-        for group in sorted(self.topo.oned, key=lambda g: g.kind != "prescribed"):
+        # the reaction on their support, before the fixed groups take it; a train on a
+        # housing before the housing, which takes its reaction
+        for group in supports.order(self):
             self._balance(group)
             if group.kind == "prescribed":
                 m = next(m for m in self.motions if m.group is group)
@@ -557,7 +567,7 @@ class _Builder:
         theta, w, a = self.coord[group.index]
         if group.kind == "joint":
             self.net.Q[self._speed(group)] += gen
-        elif group.kind == "free":
+        elif group.kind == "free" and not any(group in c for c in self.riding):
             self.pending[a] = gen / self.inertia[group.index]
         elif group.kind == "massless":
             self._massless(group, gen)
@@ -590,10 +600,9 @@ class _Builder:
     def _rigid_flows(self, group):
         """Kirchhoff at every set of the group, leaves first: the flow into a rigid element at
         its far side balances what is beyond; its law gives the near side."""
-        flow, k = self.net.flow, self.k
-        theta, w, a = self.coord[group.index]
+        flow = self.net.flow
         beyond = {s: self._applied(s, ("compliant", "source", "prescribed"))
-                  for s, _, _ in group.sets}
+                  + supports.reactions(self, s) for s, _, _ in group.sets}
         for s, parent, element in reversed(group.sets):
             if parent is None:
                 if group.definer is not None:
@@ -605,11 +614,13 @@ class _Builder:
             flow[far] = -beyond[s]
             b = self.bound[element.name]
             if element.has_inertia:
-                flow[near] = b.inertia() * k[s] * a - flow[far]
+                flow[near] = b.inertia() * self.kin[s][2] - flow[far]
             elif far.name == "flange_a":          # torque_b = -ratio * torque_a
                 flow[near] = -b.ratio() * self.losses.get(element.name, 1) * flow[far]
             else:
                 flow[near] = -flow[far] / (b.ratio() * self.losses.get(element.name, 1))
+            if "support" in element.ports:        # MSL: support.tau = -flange_a.tau - flange_b.tau
+                flow[element.port_ref("support")] = -(flow[far] + flow[near])
             beyond[parent] = beyond[parent] + flow[near]
 
     def _finish(self):
@@ -624,7 +635,9 @@ class _Builder:
             ref, u = joint_ports
             net.axis_flow[u] += net.flow.get(ref, 0)
         self._motion_laws()
+        net.claims = starts.claims(self)
         if not self.pending:
+            starts.resolve(net, self.t)
             return
         sub = self._substitution()
         for d in (net.pos, net.vel, net.acc, net.flow, net.signal):
@@ -636,6 +649,7 @@ class _Builder:
         net.alg_res = [sub(r) for r in net.alg_res]
         for rec in net.prescribed.values():
             rec.pos, rec.vel, rec.acc = sub(rec.pos), sub(rec.vel), sub(rec.acc)
+        starts.resolve(net, self.t)
 
     def _substitution(self):
         """The function putting every placeholder's expression in its place."""

@@ -16,6 +16,7 @@ import numpy as np
 
 from ..errors import ModelError
 from . import junctions
+from .closing import closer
 from .assemble import assemble
 from .initial import InitialEquations
 from .loops import BAUMGARTE_RATE, formulate, newton
@@ -270,29 +271,22 @@ class System:
             ) -> np.ndarray:
         """dx/dt of the ODE at (t, x), as numpy (n_states,).
 
-        With loops (algebraic variables z), z is first solved from the closure by Newton,
-        starting from the last z solved (at first the initial one).
+        With loops (algebraic variables z), z is first solved from the closure: Newton from
+        the last z solved, else followed from the assembled start on its branch
+        (``closing.py``; a state where the loops cannot close is refused naming them).
         """
         x = self._vector(x, self.n_states, "x")
         p = self.param_vector(params)
         if not self.n_algebraic:
             return np.asarray(self.f_rhs(t, x, p)).ravel()
-        if self._z_last is None:
-            self._z_last = self.initial_full_p(p)[1]
-        try:
-            z = np.asarray(self._closure_solver(self._z_last, np.concatenate([x, p])))
-        except RuntimeError:
-            raise ModelError("the loops cannot close at this state x (Newton on the "
-                             "dependent coordinates failed)") from None
-        self._z_last = z.ravel()
+        closing = closer(self)
+        z, ok = None, False
+        if self._z_last is not None:
+            z, _, ok = closing.newton(x, self._z_last, p)
+        if not ok:
+            z = closing.close(x, p, self.initial_full_p(p), where="x")
+        self._z_last = np.asarray(z, dtype=float).ravel()
         return np.asarray(self.f_dae(t, x, z, p)[0]).ravel()
-
-    @functools.cached_property
-    def _closure_solver(self):
-        z, xp = ca.SX.sym("z", self.n_algebraic), ca.SX.sym("xp", self.n_states + self.asm.p.numel())
-        alg = ca.Function("alg", [z, xp], [self.f_dae(0, xp[:self.n_states], z,
-                                                      xp[self.n_states:])[1]])
-        return ca.rootfinder("closure", "newton", alg, {"abstol": 1e-13})
 
     @functools.cached_property
     def _f_mass(self):
