@@ -91,7 +91,8 @@ class PartialFixed(Component):
 
 
 class PartialRigid(Component):
-    """A rigid 1-D element: its two flanges move together, position(a) = ratio * position(b).
+    """A rigid 1-D element: its two flanges move together,
+    position(a) = ratio * (position(b) - length).
 
     Rigid elements join connection sets into rigid groups that share one coordinate
     (``kinetwork.graph.topology``); an inertia adds ``inertia()`` to its group.
@@ -103,6 +104,10 @@ class PartialRigid(Component):
 
     def ratio(self):
         return 1.0
+
+    def length(self):
+        """position(flange_b) - position(flange_a) / ratio: a translational Mass's L."""
+        return 0.0
 
     def inertia(self):
         return 0.0

@@ -154,7 +154,7 @@ def formulate(asm, topo, values, formulation="partition", rate=BAUMGARTE_RATE,
         res = ca.substitute(in_states(net.alg_res), asm.t, ca.SX(0))
         eq.z, eq.alg = ca.vertcat(eq.z, z_sig), ca.vertcat(eq.alg, in_states(net.alg_res))
         eq.algebraic_names = eq.algebraic_names + net.alg_names
-        eq.algebraic_units = eq.algebraic_units + [""] * len(net.alg_names)
+        eq.algebraic_units = eq.algebraic_units + net.alg_units
         known = ca.vertcat(eq.x, z_mech, asm.p)
         solve_z = ca.rootfinder("signal_loops", "newton",
                                 ca.Function("res", [z_sig, known], [res]), {"abstol": 1e-13})

@@ -64,6 +64,7 @@ class Network:
     alg_z: list = field(default_factory=list)          # their outputs, unknowns ...
     alg_res: list = field(default_factory=list)        # ... and their equations z - f(z)
     alg_names: list = field(default_factory=list)
+    alg_units: list = field(default_factory=list)
     block_states: int = 0
     no_acceleration: set = field(default_factory=set)  # sets of massless groups
     #: speed index -> Prescribed, for joints whose coordinate a motion source gives
@@ -72,6 +73,8 @@ class Network:
     hybrid: list = field(default_factory=list)
     #: what structural analysis made of the circuits (``circuit.Circuit.summary``)
     circuit: str = ""
+    #: state name -> why it is no state: index reduction found a constraint that fixes it
+    demoted: dict = field(default_factory=dict)
     #: joint starts the inertias on joint axes give: (``"q"`` or ``"u"``, index, value)
     claims: list = field(default_factory=list)
 
@@ -155,6 +158,7 @@ class _Motion:
     coord: tuple                     # placeholders (or the joint's q, u, udot)
     reference: ca.SX = None
     drive: ca.SX = None              # on a joint: the symbol of the generalized force
+    offset: ca.SX = 0                # the source's flange is at k theta + offset
 
 
 class _Builder:
@@ -167,6 +171,7 @@ class _Builder:
         n = u.shape[0]
         self.net = Network({}, {}, {}, {}, ca.SX.zeros(n), ca.SX.zeros(n), ca.SX.zeros(n))
         self.k = {}                  # connection set -> ratio to its group's coordinate
+        self.c = {}                  # ... and offset: position = k theta + c (a Mass's L)
         self.ride = {}               # ... and the shares of its carriers (``supports.ride``)
         self.kin = {}                # connection set -> (position, speed, acceleration)
         self.kt = {}                 # ... and of its torques (differs through gear losses)
@@ -196,6 +201,7 @@ class _Builder:
         self.circuit = Circuit(self).build()
         self.circuit.fill(self.net)
         self.net.circuit = self.circuit.summary
+        self.net.demoted.update(self.circuit.demoted)
         self._flows("compliant")               # springs and dampers need no signal
         self._passive = ca.SX.zeros(self.u.shape[0])
         for group in self.topo.oned:
@@ -216,12 +222,17 @@ class _Builder:
             self.group_of[s] = group
             if parent is None:
                 self.k[s] = self.kt[s] = ca.SX(1)
+                self.c[s] = ca.SX(0)
                 self.ride[s] = [] if group.base is None else [(ca.SX(1), group.base)]
                 continue
             r = self.bound[element.name].ratio()
+            length = self.bound[element.name].length()
             a_here = self.topo.set_of[element.port_ref("flange_a")] == s
-            # position(flange_a) = r * position(flange_b), relative to the gear's support
+            # position(flange_a) = r * (position(flange_b) - length), relative to the
+            # gear's support
             self.k[s] = self.k[parent] * r if a_here else self.k[parent] / r
+            self.c[s] = r * (self.c[parent] - length) if a_here else \
+                self.c[parent] / r + length
             self.ride[s] = supports.ride(self, parent, element, a_here, r if a_here else 1 / r)
             # torques pass a gear with efficiency eta as torque_b = -r eta^m torque_a, m = +1
             # while flange_a drives (power from a to b), -1 while flange_b does
@@ -286,8 +297,9 @@ class _Builder:
         units = _units(group)
         labels = list(zip((_pos(group), _vel(group)), units))[:comp.n_states]
         x = [self._state(f"{comp.name}.{label}", unit, 0, 0) for label, unit in labels]
-        self.motions.append(_Motion(comp, flange.component, group,
-                                    self.k[self.topo.set_of[flange]], x, coord))
+        at = self.topo.set_of[flange]
+        self.motions.append(_Motion(comp, flange.component, group, self.k[at], x, coord,
+                                    offset=self.c[at]))
 
     def _free(self, group):
         """A coordinate and a speed, the position and speed of the group's first inertia
@@ -295,6 +307,12 @@ class _Builder:
         (``starts.free``, once every position is known)."""
         first = next(e for e in group.rigid if e.has_inertia)
         pos_unit, vel_unit = _units(group)
+        at = self.topo.set_of[first.port_ref("flange_a")]
+        # the coordinate is the first inertia's centre (MSL's Mass.s, between its flanges
+        # L apart), in the units of its flanges divided by their ratio
+        centre = self.c[at] + self.bound[first.name].length() / 2
+        for s, _, _ in group.sets:
+            self.c[s] = self.c[s] - self.k[s] * centre / self.k[at]
         a = ca.SX.sym(f"g{group.index}_acc")
         w = self._state(f"{first.name}.{_vel(group)}", vel_unit, 0, a)
         theta = self._state(f"{first.name}.{_pos(group)}", pos_unit, 0, w,
@@ -382,6 +400,7 @@ class _Builder:
                 self.net.alg_z.append(z[i])
                 self.net.alg_res.append(residual[i])
                 self.net.alg_names.append(f"{c.name}.y")
+                self.net.alg_units.append("")
                 self.net.signal[s] = z[i]
             self.net.loops_kept.append(names)
             return
@@ -533,23 +552,28 @@ class _Builder:
         self.net.hybrid.append(Hybrid(comp, b, b._mode, b._F, refs[b.side_a] if b.side_a in
                                       refs else None, refs[b.side_b], u))
 
-    def _applied(self, s, roles=("compliant", "source")):
+    def _applied(self, s, roles=("compliant", "source"), exclude=()):
         """Flows into the non-rigid elements at a connection set (compliant, sources; with
-        ``prescribed`` in ``roles``, motion sources too)."""
+        ``prescribed`` in ``roles``, motion sources too), but those of ``exclude``."""
         return sum((self.net.flow.get(r, 0) for r in self.topo.sets[s]
-                    if r.component.role in roles), ca.SX(0))
-
-    def _generalized(self, group, roles=("compliant", "source")):
-        return sum((-self.kt[s] * self._applied(s, roles) for s, _, _ in group.sets),
+                    if r.component.role in roles and r.component.name not in exclude),
                    ca.SX(0))
+
+    def _generalized(self, group, roles=("compliant", "source"), exclude=()):
+        return sum((-self.kt[s] * self._applied(s, roles, exclude) for s, _, _ in group.sets),
+                   ca.SX(0))
+
+    def group_inertia(self, group):
+        """sum(J k kt) over the group's inertias: its inertia on its coordinate."""
+        at = self.topo.set_of
+        return sum((self.bound[e.name].inertia() * self.k[at[e.port_ref("flange_a")]] *
+                    self.kt[at[e.port_ref("flange_a")]] for e in group.rigid
+                    if e.has_inertia), ca.SX(0))
 
     def _inertia(self, group):
         """The group's inertia; on a joint, its armature, and the passive generalized force
         (springs and dampers) that an InverseDynamics block compensates."""
-        at = self.topo.set_of
-        inertia = sum((self.bound[e.name].inertia() * self.k[at[e.port_ref("flange_a")]] *
-                       self.kt[at[e.port_ref("flange_a")]] for e in group.rigid
-                       if e.has_inertia), ca.SX(0))
+        inertia = self.group_inertia(group)
         self.inertia[group.index] = inertia
         if group.kind == "joint":
             u = self._speed(group)
@@ -567,6 +591,12 @@ class _Builder:
         theta, w, a = self.coord[group.index]
         if group.kind == "joint":
             self.net.Q[self._speed(group)] += gen
+        elif group.kind == "free" and group.index in self.circuit.coupled:
+            # a rotor a circuit's constraint holds: its acceleration came with the circuit's
+            # solution, in the generalized force of all but the circuit's EMFs
+            coupled = self.circuit.coupled[group.index]
+            self.pending[coupled.rest] = self._generalized(group, exclude=coupled.emfs)
+            self.pending[a] = coupled.acc
         elif group.kind == "free" and not any(group in c for c in self.riding):
             self.pending[a] = gen / self.inertia[group.index]
         elif group.kind == "massless":
@@ -631,6 +661,7 @@ class _Builder:
             if self.model.components[name].role == "source":
                 for placeholder, s in read.values():
                     self.pending[placeholder] = net.signal[s]
+        self._input_rates()
         for joint_ports in self._axis_ports():
             ref, u = joint_ports
             net.axis_flow[u] += net.flow.get(ref, 0)
@@ -650,6 +681,29 @@ class _Builder:
         for rec in net.prescribed.values():
             rec.pos, rec.vel, rec.acc = sub(rec.pos), sub(rec.vel), sub(rec.acc)
         starts.resolve(net, self.t)
+
+    def _input_rates(self):
+        """The time derivative of each signal whose circuit constraint was differentiated (a
+        voltage source's u across a capacitor): through t and the rates of the states it
+        reads (signal blocks); one that follows the mechanism's motion is refused."""
+        if not self.circuit.input_rates:
+            return
+        sub = self._substitution()
+        moving = ca.vertcat(self.q, self.u, self.udot)
+        for du, s in self.circuit.input_rates.items():
+            e = sub(self.net.signal[s])
+            if ca.depends_on(e, moving):
+                names = ", ".join(self.circuit.placeholders_in(du))
+                raise ModelError(f"{names}: a constraint of the circuit differentiates its "
+                                 f"input u, whose signal follows the motion of the mechanism; "
+                                 f"put a resistor or an inductor where the source meets the "
+                                 f"capacitors (or the inductors)")
+            states = [x for x in self.net.x if ca.depends_on(e, x)]
+            rate = ca.jacobian(e, self.t)
+            if states:
+                rate += ca.jtimes(e, ca.vertcat(*states),
+                                  sub(ca.vertcat(*[self.net.rate[self._at(x)] for x in states])))
+            self.pending[du] = rate
 
     def _substitution(self):
         """The function putting every placeholder's expression in its place."""
@@ -709,8 +763,8 @@ class _Builder:
                 joint = m.group.definer.component
                 j = joint.coordinate_ports[m.group.definer.name]
                 self.net.prescribed[self.uindex[joint.name][j]] = Prescribed(
-                    self.qindex[joint.name][j], pos / m.k, vel / m.k, acc / m.k, m.drive,
-                    m.comp.name, joint.name)
+                    self.qindex[joint.name][j], (pos - m.offset) / m.k, vel / m.k, acc / m.k,
+                    m.drive, m.comp.name, joint.name)
             else:
                 self.pending.update(zip(m.coord, (pos, vel, acc)))
 

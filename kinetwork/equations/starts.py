@@ -29,10 +29,17 @@ def _given(group, attr):
 def _solved_for(builder, e, which, symbol, attr):
     """The value of ``symbol`` that puts inertia ``e`` at its given start: the inverse of
     the linear form of its position (or speed)."""
-    expr = builder.kin[builder.topo.set_of[e.port_ref("flange_a")]][which]
+    expr = builder.kin[builder.topo.set_of[e.port_ref("flange_a")]][which] + \
+        _centre(builder.bound[e.name], which)
     k = ca.jacobian(expr, symbol)
     rest = ca.substitute(expr, symbol, ca.SX(0))
     return (getattr(builder.bound[e.name], attr) - rest) / k
+
+
+def _centre(bound, which):
+    """From an inertia's flange_a to where its start is given: a Mass's position is its
+    centre, L/2 beyond flange_a (MSL's Mass.s); a speed is the same at both."""
+    return bound.length() / 2 if which == 0 else 0
 
 
 def free(builder):
@@ -92,7 +99,8 @@ def check(model, topo, asm, bound, p_values):
                 ref = e.port_ref("flange_a")
                 actual = (net.pos if which == 0 else net.vel).get(ref)
                 if actual is not None:
-                    rows.append((e, attr, group, getattr(bound[e.name], attr), actual))
+                    rows.append((e, attr, group, getattr(bound[e.name], attr),
+                                 actual + _centre(bound[e.name], which)))
     if not rows:
         return
     known = ca.vertcat(asm.t, asm.q, asm.u, *net.x)

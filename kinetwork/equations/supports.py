@@ -2,7 +2,8 @@
 
 A gear with its support wired reads its flanges relative to the support: position(a) -
 position(s) = ratio * (position(b) - position(s)). Walking a rigid group from its root, a set
-beyond such a gear sits at k * theta plus a share of the support's position (``ride``), so
+beyond such a gear sits at k * theta + c (c: the lengths of the masses between, MSL's L) plus
+a share of the support's position (``ride``), so
 each set's position is a linear form in its own group's coordinate and in those of the groups
 carrying it (``kinematics``). Groups coupled this way (``kinetwork.graph.supports`` lets free
 trains ride on free rotors or on prescribed motions) have one kinetic energy: their
@@ -40,7 +41,7 @@ def kinematics(builder):
         if s not in memo:
             theta, w, a = builder.coord[builder.group_of[s].index]
             k = builder.k[s]
-            out = [k * theta, k * w, k * a]
+            out = [k * theta + builder.c[s], k * w, k * a]
             for c, carrier in builder.ride[s]:
                 out = [o + c * v for o, v in zip(out, at(carrier))]
             memo[s] = out

@@ -29,7 +29,11 @@ class System:
     Attributes
     ----------
     state_names : list of str
-        Joint coordinates, then their speeds (``"shoulder.q"``, ..., ``"shoulder.qd"``).
+        Joint coordinates, then their speeds (``"shoulder.q"``, ..., ``"shoulder.qd"``),
+        then the 1-D network's, the signal blocks' and the circuits' states.
+    demoted_states : dict
+        States index reduction took out (a capacitor of a capacitor loop: ``"C2.v"``), each
+        with why.
     x0 : numpy.ndarray
         Initial state for the model's parameter values.
     signals : list of Signal
@@ -155,13 +159,20 @@ class System:
                          f"{', '.join(involved)} (give the bodies they carry mass or inertia, "
                          f"or lock the joint)")
 
-    def polish(self, X, p):
+    def polish(self, X, p, t=None):
         """Full states X (n_points, n_states + n_algebraic) with the algebraic variables
         (dependent coordinates) Newton-corrected onto the closure to machine precision: the
-        integrator solves them only to its tolerance."""
+        integrator solves them only to its tolerance. Equations that read time (a diode's
+        circuit driven by a source in t) are polished at the times ``t`` of the rows, and
+        not at all without them."""
         if not self.n_algebraic or not len(X):
             return X
-        Z = np.asarray(mapped(self._f_polish, len(X))(np.asarray(X).T, p)).T
+        timed = ca.depends_on(self.eq.alg, self.asm.t)
+        if timed and t is None:
+            return X
+        times = np.zeros(len(X)) if t is None else np.asarray(t, dtype=float)
+        Z = np.asarray(mapped(self._f_polish, len(X))(np.asarray(X).T, p,
+                                                       times[None, :])).T
         out = np.array(X, dtype=float)
         ok = np.all(np.isfinite(Z), axis=1)
         out[ok, self.n_states:] = Z[ok]
@@ -169,7 +180,7 @@ class System:
 
     @functools.cached_property
     def _f_polish(self):
-        return ca.Function("polish", [ca.vertcat(self._x, self._z), self.asm.p],
+        return ca.Function("polish", [ca.vertcat(self._x, self._z), self.asm.p, self.asm.t],
                            [newton(self.eq.alg, self._z)])
 
     @property
@@ -265,6 +276,14 @@ class System:
     @property
     def n_states(self) -> int:
         return len(self.state_names)
+
+    @property
+    def demoted_states(self) -> dict[str, str]:
+        """States that index reduction took out, by name, with why: a capacitor of a loop
+        of capacitors, an inductor of a cut set of inductors, whose value a differentiated
+        constraint fixes from the states kept (``state_names``) and the sources."""
+        net = self.asm.net
+        return dict(net.demoted) if net is not None else {}
 
     # -- numbers --------------------------------------------------------------------------
     def rhs(self, t: float, x: np.ndarray, params: Mapping[str, float] | None = None

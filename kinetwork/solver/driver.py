@@ -364,9 +364,11 @@ def _check(system, settings, t_start, max_steps, time_limit, runs=1):
     if system.n_algebraic and not METHODS[key].dae:
         raise ModelError(
             f"method {settings['method']!r} integrates ODEs only, and {system.model.name!r} "
-            f"has kinematic loops whose dependent coordinates are algebraic variables; use "
-            f"{', '.join(k for k, m in METHODS.items() if m.dae)}, or compile the model with "
-            f"loops='projected' or loops='baumgarte' (ODEs)")
+            f"has algebraic variables ({', '.join(system.algebraic_names[:3])}"
+            f"{', ...' if system.n_algebraic > 3 else ''}: the dependent coordinates of "
+            f"kinematic loops, or the unknowns of a nonlinear circuit or signal loop); use "
+            f"{', '.join(k for k, m in METHODS.items() if m.dae)}, or, for loops, compile the "
+            f"model with loops='projected' or loops='baumgarte' (ODEs)")
     return key
 
 
@@ -537,7 +539,7 @@ def _probe_outputs(run, t, X):
             return polished[:k], outputs[:k], f"{why}: kept up to t = {t[k - 1]:g} s"
         rows = slice(k, min(n, k + size))
         if system.n_algebraic:
-            polished[rows] = system.polish(polished[rows], p)
+            polished[rows] = system.polish(polished[rows], p, t[rows])
         system.outputs_into(t[rows], polished[rows], p, outputs[rows], f_out, buffers)
     return polished, outputs, None
 
