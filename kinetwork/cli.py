@@ -7,12 +7,45 @@ was computed before the failure is still written), 128 + the signal number when 
 SIGTERM stopped a run (130, 143; what was computed is written all the same).
 """
 
-import argparse
-import collections
-import contextlib
 import os
 import signal
 import sys
+
+
+def _started_as_command():
+    """True in the ``kinetwork`` command's own process (its console script or ``python -m
+    kinetwork``), not when a Python program imports this module."""
+    main_module = sys.modules.get("__main__")
+    spec = getattr(main_module, "__spec__", None)
+    if spec is not None:
+        return spec.name in ("kinetwork.__main__", "kinetwork.cli")
+    name = os.path.basename(getattr(main_module, "__file__", None) or "")
+    return name.removesuffix(".exe").removesuffix("-script.py") == "kinetwork"
+
+
+#: SIGINT or SIGTERM that reached the command while it was starting (importing its modules,
+#: reading its arguments): recorded, never raised there (that would be a raw traceback from
+#: an import, or the signal lost when it was started with them ignored), and answered by
+#: ``main`` as soon as it can: exit 128 + the signal, nothing run
+_EARLY = {"signum": None, "saved": {}}
+
+
+def _record_early(signum, frame):
+    if _EARLY["signum"] is None:
+        _EARLY["signum"] = signum
+
+
+if _started_as_command():
+    for _sig in (signal.SIGINT, signal.SIGTERM):
+        try:
+            _EARLY["saved"][_sig] = signal.signal(_sig, _record_early)
+        except (ValueError, OSError):
+            pass
+
+# imported after the early handlers: a signal while importing is kept, not a traceback
+import argparse
+import collections
+import contextlib
 import textwrap
 import threading
 import time
@@ -20,8 +53,8 @@ import time
 import kinetwork as kn
 
 from . import plotworker
-from .outputs import (OutputRefused, StopFlag, Stopped, catching_signals, check_all,
-                      model_files, plot_kind)
+from .outputs import (OutputRefused, StopFlag, Stopped, catching_signals,
+                      check_all, model_files, plot_kind)
 from .util import finite, quote
 
 # The rest of kinetwork (numpy, CasADi, networkx, the model layers) is imported where a
@@ -300,8 +333,12 @@ def _main(argv, worker):
                "studio": _studio, "import": _import, "sweep": _sweep,
                "examples": _examples, "linearize": _linearize, "fit": _fit}[args.command]
     caught = {"signum": None}
+    if args.command == "studio":      # the studio's server answers signals itself
+        for sig, handler in _EARLY["saved"].items():
+            signal.signal(sig, handler)
+    if _EARLY["signum"] is not None:  # stopped while starting: nothing run
+        return _interrupted(_EARLY["signum"])
     try:
-        # the studio's server answers signals itself
         with contextlib.nullcontext() if args.command == "studio" else _stopping(caught):
             return command(args)
     except OutputRefused as exc:
@@ -329,7 +366,8 @@ def _stopping(caught):
     """While a command runs, SIGINT and SIGTERM stop it as a KeyboardInterrupt that names its
     signal (``outputs.Stopped``): files being written are left whole and their temporaries
     removed on the way out, and the command exits 128 + the signal. A run installs its own
-    handlers while it integrates (it keeps its partial results)."""
+    handlers while it integrates (it keeps its partial results). Signals the command was
+    started with ignored are honoured too."""
     if threading.current_thread() is not threading.main_thread():
         yield
         return
@@ -338,10 +376,11 @@ def _stopping(caught):
         caught["signum"] = signum
         raise Stopped(signum)
     saved = {}
+    # also when started with them ignored, as a script's background job is: the command is
+    # the program, and a signal sent to it asks it to stop (it was swallowed, exit 0)
     for sig in STOPPING:
         with contextlib.suppress(ValueError, OSError):
-            if signal.getsignal(sig) is not signal.SIG_IGN:
-                saved[sig] = signal.signal(sig, stop)
+            saved[sig] = signal.signal(sig, stop)
     try:
         yield
     finally:

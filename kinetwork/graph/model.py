@@ -263,7 +263,9 @@ class Model:
         """Model parameters with ``overrides`` applied and checked; an override may be a
         number with a unit (``{"c": "2 N*m/rad"}``), in SI base units, checked against the
         units of the component parameters that use it."""
-        values = dict(self.parameters)
+        # checked again: ``parameters`` is a plain dict that code may have written to directly
+        values = {key: quantities.to_si(value, f"parameters.{key}")
+                  for key, value in self.parameters.items()}
         for key, value in (overrides or {}).items():
             if key not in values and "." in key:
                 instance, _, name = key.rpartition(".")
