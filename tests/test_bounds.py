@@ -116,6 +116,26 @@ def test_a_small_file_that_expands_without_bound_is_refused_before_expansion():
     assert "top (D0, 33554432 components), top.a (D1, 16777216 components)" in message
 
 
+def chain_file(levels):
+    """A version-2 file whose definitions each place the next, ``levels`` deep."""
+    defs = {f"D{i}": {"components": [{"name": "a", "type": f"D{i + 1}"}]}
+            for i in range(levels)}
+    defs[f"D{levels}"] = {"components": [{"name": "x", "type": "signals.Constant",
+                                          "params": {"k": 1.0}}]}
+    return json.dumps({"format": "kinetwork.model", "version": 2, "name": "deep",
+                       "definitions": defs, "components": [{"name": "top", "type": "D0"}]})
+
+
+def test_definitions_nested_past_the_limit_are_refused_once_not_at_every_level():
+    # 3000 levels were 2971 problems in a 12 KB message, the deepest a RecursionError
+    with pytest.raises(kn.ModelError) as info:
+        kn.loads(chain_file(3000))
+    assert str(info.value) == (f"definitions nested more than {subsystem.DEPTH_LIMIT} deep: "
+                               f"D0 places D1 places D2 places ... places "
+                               f"D{subsystem.DEPTH_LIMIT}")
+    assert len(kn.loads(chain_file(subsystem.DEPTH_LIMIT - 2)).flat().components) == 1
+
+
 @pytest.mark.parametrize("levels", [0, 3, 8])
 def test_the_flat_size_counted_per_definition_is_the_size_of_the_flat_model(levels):
     model = kn.loads(doubling_file(levels), validate=False)
