@@ -89,8 +89,10 @@ def test_subsystem_expressions_that_grow_through_the_levels_are_refused():
         outer.add(kn.Subsystem("s", model, params={"p": "p + p"}))
         outer.expose("y", "s.y")
         model = outer
-    with cpu_bound(), pytest.raises(kn.ModelError, match="characters|nested too deeply"):
+    with cpu_bound(), pytest.raises(kn.ModelError, match="characters|nested too deeply") as info:
         model.flat()
+    # the place where it grows too long, by its path in the flat model and in its file
+    assert str(info.value).startswith("s.s.s.s.s.s.s.s.s.p (s.p): expression 'p + p' grows")
 
 
 # -- subsystems, components, connections, problems ------------------------------------------

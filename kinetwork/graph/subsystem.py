@@ -245,12 +245,15 @@ class _Flat:
         expressions without free names as numbers; one that cannot be evaluated (a division
         by zero, a root of a negative number once the instance's numbers are in) is a
         problem naming its place, and stays as it was."""
+        def place():            # only for a message: a model's every parameter passes here
+            where = m.place(comp, key)
+            return f"{shown}.{key}" + ("" if where == f"{comp.name}.{key}" else f" ({where})")
         try:
             return _map(value, lambda text: _constant(rename(text, scope)))
+        except ModelError as exc:               # grows past a bound once renamed
+            raise ModelError(f"{place()}: {exc}") from None
         except (ZeroDivisionError, ValueError, OverflowError, TypeError) as exc:
-            where = m.place(comp, key)
-            place = f"{shown}.{key}" + ("" if where == f"{comp.name}.{key}" else f" ({where})")
-            self.problems.append(f"{place} = {quote(value, 60)}: cannot be evaluated with "
+            self.problems.append(f"{place()} = {quote(value, 60)}: cannot be evaluated with "
                                  f"this instance's parameters ({exc})")
             return value
 
@@ -273,7 +276,11 @@ class _Flat:
                         f"{', '.join(scope) or 'none'}")
                     inner[key] = "0"
                 else:
-                    inner[key] = f"({rename(value, scope)})"
+                    try:
+                        inner[key] = f"({rename(value, scope)})"
+                    except ModelError as exc:     # grows past a bound: say where
+                        raise ModelError(f"{path}.{key} ({m.place(sub, key)}): {exc}") \
+                            from None
             else:
                 inner[key] = repr(float(value))
         return inner
