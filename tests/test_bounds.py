@@ -169,6 +169,26 @@ def test_a_file_with_too_many_components_is_refused_before_any_is_built(monkeypa
     assert not built
 
 
+@pytest.mark.parametrize("where", ["", "definitions.D."])
+def test_a_large_file_is_counted_before_it_is_read_object_by_object(monkeypatch, where):
+    import kinetwork.graph.io as io
+    monkeypatch.setattr(io, "MAX_CONNECTIONS", 50)
+    read = []
+    monkeypatch.setattr(io._Object, "from_pairs", lambda pairs: read.append(1))
+    pairs = [[f"c{i}.y", f"c{i}.u"] for i in range(51)]
+    data = {"format": "kinetwork.model", "version": 2, "name": "many", "components": [],
+            "connections": [], "notes": "x" * io.COUNT_FIRST}
+    if where:
+        data["definitions"] = {"D": {"components": [], "connections": pairs}}
+    else:
+        data["connections"] = pairs
+    with pytest.raises(kn.ModelError) as info:
+        kn.loads(json.dumps(data))
+    assert str(info.value) == f"{where}connections: 51 entries, more than the 50 a model " \
+                              f"may have"
+    assert not read
+
+
 def test_a_flood_of_problems_is_counted_and_summarised():
     m = kn.Model("probes")
     for i in range(3000):

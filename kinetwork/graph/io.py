@@ -120,17 +120,48 @@ def loads(text: str | bytes, source: str | None = None, validate: bool = True,
                            context=Context.top(folder, library))
 
 
+#: a text longer than this is first read by the JSON parser alone, its lists counted before
+#: the slower reading that remembers repeated keys (1.2 M components in 39 MB: refused in
+#: 0.8 s and 430 MB instead of 9 s and 1 GB)
+COUNT_FIRST = 1 << 20
+
+
 def _parse(text, source):
     """The JSON of a model text (keys given twice remembered), or a ModelError saying where
     it stops being JSON."""
     try:
+        if len(text) > COUNT_FIRST:
+            _count(json.loads(text, parse_int=_int), source)
         return json.loads(text, object_pairs_hook=_Object.from_pairs, parse_int=_int)
+    except ModelError:
+        raise
     except json.JSONDecodeError as exc:
         end = " (the text ends early: truncated?)" if exc.pos >= len(text.rstrip()) else ""
         raise ModelError(_at(source, f"line {exc.lineno} column {exc.colno}: invalid JSON: "
                                      f"{exc.msg}{end}")) from None
     except (ValueError, RecursionError) as exc:
         raise ModelError(_at(source, f"invalid JSON ({exc})")) from None
+
+
+def _count(data, source):
+    """Refuse a model whose lists of components or connections (at the top or in an inline
+    definition) are longer than a model may have, as ``_components`` and ``_connections``
+    would, before the file is read again object by object."""
+    if not isinstance(data, dict):
+        return
+    bodies = [("", data)]
+    definitions = data.get("definitions")
+    if isinstance(definitions, dict):
+        bodies += [(f"definitions.{_cut(name)}.", body) for name, body in definitions.items()
+                   if isinstance(body, dict)]
+    problems = [f"{where}{key}: {len(body[key])} entries, more than the {limit} a model "
+                f"may have"
+                for where, body in bodies
+                for key, limit in (("components", MAX_COMPONENTS),
+                                   ("connections", MAX_CONNECTIONS))
+                if isinstance(body.get(key), list) and len(body[key]) > limit]
+    if problems:
+        raise ModelError([_at(source, p) for p in problems])
 
 
 def model_from_dict(data, source=None, validate=True, context=None):
