@@ -118,7 +118,7 @@ class Plant:
 
     def _reached(self, t, p):
         """The full state a simulation (the model's settings) reaches at time t."""
-        from ..solver.driver import simulate
+        from ..solver.plan import simulate
         if t == 0.0:
             return np.concatenate(self.system.initial_full_p(p))
         if not t >= 0 or t == float("inf"):

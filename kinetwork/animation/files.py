@@ -188,7 +188,8 @@ def cli_animate(args, model):
     the model (its ``simulation`` block, ``--t-end``) and write its animation."""
     from ..errors import SimulationError
     from ..graph.settings import check_settings
-    from ..solver.driver import DEFAULTS, simulate
+    from ..solver.driver import DEFAULTS
+    from ..solver.plan import simulate
     outputs = [("--html", args.html, "html"), ("--gif", args.gif, "gif"),
                ("--mp4", args.mp4, "mp4")]
     outputs = [(flag, path, kind) for flag, path, kind in outputs if path]

@@ -3,18 +3,19 @@ each problem placed on its block, and a layout for a diagram without one.
 
 Nothing here is new judgement: the palette is read from the component declarations, and a
 model is checked by ``kinetwork.graph.io.model_from_dict``, the checker behind ``kn.load``.
+A problem goes to the page as the fields of its ``Problem`` record (``API.md``): nothing here
+reads a message's text.
 """
 
 import collections
 import logging
 import math
 import os
-import re
 
 import numpy as np
 
 from ..components.base import REGISTRY
-from ..errors import ModelError
+from ..errors import ModelError, KinetworkWarning, Problem
 from ..graph.io import Context, model_from_dict
 
 log = logging.getLogger("kinetwork.studio")
@@ -24,11 +25,6 @@ LIBRARY_ORDER = ("multibody", "rotational", "translational", "signals", "electri
 #: a model is compiled to list its states only up to this many flat components: the
 #: symbolic build takes about 50 ms for the seed and grows with the model
 COMPILE_LIMIT = 400
-#: where a problem is: components[i] "name" params.key, connections[i], or comp.port
-_PLACE = re.compile(r'components\[(?P<index>\d+)\](?: "(?P<name>[^"]*)")?'
-                    r'(?: params\.(?P<param>[A-Za-z_][A-Za-z0-9_]*))?'
-                    r'|connections\[(?P<wire>\d+)\]'
-                    r'|(?P<ref>[A-Za-z_][A-Za-z0-9_]*)\.[A-Za-z_][A-Za-z0-9_]*(?=[:\s])')
 GRID_COLUMNS, GRID_DX, GRID_DY = 4, 220, 140
 
 
@@ -57,7 +53,8 @@ def type_info(type_name, cls):
                     "min": plain(spec.min), "max": plain(spec.max), "shape": list(spec.shape),
                     "kind": spec.kind,
                     "choices": None if spec.choices is None else plain(list(spec.choices)),
-                    "doc": spec.doc, "required": spec.required, "time": bool(spec.time)}
+                    "doc": spec.doc, "required": spec.required, "time": bool(spec.time),
+                    "aliases": list(spec.aliases)}
                    for name, spec in cls.params.items()],
     }
 
@@ -93,22 +90,24 @@ def build(data, ctx, validate):
 
 
 def validate(data, ctx):
-    """``{"ok", "problems", "summary"}`` of a model file's top-level object.
+    """``{"ok", "problems", "warnings", "summary"}`` of a model file's top-level object.
 
     The model is checked as ``kn.load`` checks it; then compiled (up to COMPILE_LIMIT flat
     components) to count its degrees of freedom and name its states, so what would refuse
-    to run (a mass matrix singular at the start) is a problem here too.
+    to run (a mass matrix singular at the start) is a problem here too. What the checks warn
+    about (an idealised inertia) is in ``warnings``: problems of severity "warning".
     """
     components = data.get("components")
     summary = {"dof": None, "states": None,
                "components": len(components) if isinstance(components, list) else 0}
+    refused = {"ok": False, "warnings": [], "summary": summary}
     try:
         model = build(data, ctx, validate=True)
     except ModelError as exc:
-        return {"ok": False, "problems": problems_of(exc, data), "summary": summary}
+        return {**refused, "problems": problems_of(exc)}
     summary["components"] = len(model.components)
     if model.exposed:      # a definition: wired where it is placed, nothing to count alone
-        return {"ok": True, "problems": [], "summary": summary}
+        return {"ok": True, "problems": [], "warnings": [], "summary": summary}
     try:
         flat = model.flat()
         topo = flat.validate()
@@ -119,36 +118,35 @@ def validate(data, ctx):
             free = sum(1 for group in topo.oned if group.kind == "free")
             summary["dof"] = int(topo.dof + free)
     except ModelError as exc:
-        return {"ok": False, "problems": problems_of(exc, data), "summary": summary}
-    return {"ok": True, "problems": [], "summary": summary}
+        return {**refused, "problems": problems_of(exc)}
+    return {"ok": True, "problems": [], "warnings": [problem(p) for p in topo.warnings],
+            "summary": summary}
 
 
-def problems_of(exc, data=None):
-    """The problems of a ModelError, each with the component, parameter and connection its
-    place names, so the page can show it on the block or the wire."""
-    names = []
-    if isinstance(data, dict) and isinstance(data.get("components"), list):
-        names = [c.get("name") if isinstance(c, dict) else None for c in data["components"]]
-    return [problem(message, names) for message in exc.problems]
+def problems_of(exc):
+    """The problems of a ModelError as the page reads them (``problem``)."""
+    return [problem(p) for p in exc.problems]
 
 
-def problem(message, names=()):
-    """``{"message", "component", "param", "connection"}`` of one problem's message."""
-    out = {"message": message, "component": None, "param": None, "connection": None}
-    match = _PLACE.match(message)
-    if match is None:
-        return out
-    if match["index"] is not None:
-        i = int(match["index"])
-        name = match["name"]
-        if name is None or name.endswith("..."):      # not quoted, or cut: the file's own
-            name = names[i] if i < len(names) and isinstance(names[i], str) else name
-        out["component"], out["param"] = name, match["param"]
-    elif match["wire"] is not None:
-        out["connection"] = int(match["wire"])
-    elif match["ref"] in names:
-        out["component"] = match["ref"]
+def problem(record):
+    """A ``Problem`` as JSON: ``{"message", "component", "port", "parameter", "path", "hint",
+    "severity"}`` (API.md), and the keys the page read before those fields: ``param`` (the
+    parameter of a component of the file itself) and ``connection`` (the index of the wire
+    ``path`` is on)."""
+    out = Problem.of(record).to_dict()
+    path = out["path"] or ""
+    own = path.startswith("components[")
+    out["param"] = out["parameter"] if own else None
+    out["connection"] = _index(path, "connections[")
     return out
+
+
+def _index(path, head):
+    """The index of a path that starts ``head`` ("connections[2][0]" -> 2), else None."""
+    if not path.startswith(head):
+        return None
+    digits = path[len(head):].partition("]")[0]
+    return int(digits) if digits.isdigit() else None
 
 
 # -- layout ------------------------------------------------------------------------------------

@@ -16,7 +16,8 @@ import threading
 import numpy as np
 
 from ..errors import ModelError, SimulationError
-from ..solver.driver import DEFAULTS, simulate
+from ..solver.driver import DEFAULTS
+from ..solver.plan import simulate
 from .checks import build, plain, problems_of
 from .files import StudioError
 
@@ -84,7 +85,7 @@ class Run:
             self.finish("cancelled" if cancelled else "failed",
                         error=None if cancelled else str(exc), results=partial)
         except ModelError as exc:
-            self.finish("failed", error=str(exc), problems=problems_of(exc, data))
+            self.finish("failed", error=str(exc), problems=problems_of(exc))
         except Exception as exc:       # noqa: BLE001 -- a run never takes the server down
             log.exception("run %s failed unexpectedly", self.id)
             self.finish("failed", error=f"internal error: {type(exc).__name__}: {exc}")
@@ -155,11 +156,14 @@ def check_settings(settings):
 
 
 def results_json(res, model=None):
-    """Results as the page reads them: the time grid and every probe signal, values nested
-    with n_points first, non-finite values null; and the 3-D animation when it can be made."""
+    """Results as the page reads them: the time grid and every probe signal with its
+    descriptor (``Signal``: the probe, the quantity, the port measured, unit and shape: the
+    page groups plots by them, never by splitting names), values nested with n_points first,
+    non-finite values null; and the 3-D animation when it can be made."""
     return {
         "t": finite_list(res.t),
-        "signals": [{"name": name, "unit": sig.unit, "shape": list(sig.shape),
+        "signals": [{"name": name, "probe": sig.probe, "quantity": sig.quantity,
+                     "port": sig.target, "unit": sig.unit, "shape": list(sig.shape),
                      "values": finite_list(res[name])} for name, sig in res.signals.items()],
         "animation": animation(res, model),
         "partial": plain(res.partial),

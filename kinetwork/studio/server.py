@@ -180,7 +180,7 @@ def _routes(api, studio):
         try:
             model = checks.build(data, studio.context(studio.model_path(body)), validate=False)
         except ModelError as exc:
-            raise StudioError(400, "the model cannot be read", checks.problems_of(exc, data))
+            raise StudioError(400, "the model cannot be read", checks.problems_of(exc))
         return StudioJSON({"layout": checks.layout(model)})
 
     @api.post("/run")
@@ -247,7 +247,7 @@ def _save(studio, body):
             written = files.read_text(real, rel)
     except ModelError as exc:
         raise StudioError(400, f"{rel}: not saved: the model cannot be written as a file",
-                          checks.problems_of(exc, data)) from None
+                          checks.problems_of(exc)) from None
     except OSError as exc:
         raise StudioError(400, f"{rel}: not saved: {exc.strerror or exc}") from None
     return {"ok": True, "bytes": len(written.encode("utf-8")), "text": written}

@@ -220,19 +220,25 @@ def _circuit(*parts, wires):
 def test_circuits_that_cannot_be_solved_are_refused_by_name():
     no_ground = _circuit(E.VoltageSource("src", V=1.0), E.Resistor("r", R=1.0),
                          wires=[("src.p", "r.p"), ("r.n", "src.n")])
-    with pytest.raises(kn.ModelError, match="src, r has no electrical.Ground|r, src has no"):
+    with pytest.raises(kn.ModelError, match="src, r has no electrical.Ground|r, src has no") \
+            as caught:
         no_ground.compile()
+    # each refusal's place as data (the studio marks the block from the fields)
+    assert caught.value.problems[0].component == "r"
     parallel = _circuit(E.Ground("g"), E.VoltageSource("a", V=1.0), E.VoltageSource("b", V=2.0),
                         E.Resistor("r", R=1.0),
                         wires=[("a.p", "b.p"), ("a.n", "b.n"), ("g.p", "a.n"), ("r.p", "a.p"),
                                ("r.n", "a.n")])
     with pytest.raises(kn.ModelError, match="equations of a, b, g constrain their unknowns "
-                                            "twice.*structurally singular"):
+                                            "twice.*structurally singular") as caught:
         parallel.compile()
+    assert caught.value.problems[0].component == "a"
     silent = _circuit(E.Ground("g"), E.VoltageSource("src"), E.Resistor("r", R=1.0),
                       wires=[("src.p", "r.p"), ("r.n", "src.n"), ("g.p", "src.n")])
-    with pytest.raises(kn.ModelError, match=r"src.*V: no value"):
+    with pytest.raises(kn.ModelError, match=r"src.*V: no value") as caught:
         silent.compile()
+    assert (caught.value.problems[0].component, caught.value.problems[0].parameter) == \
+        ("src", "V")
     shorted = _circuit(E.Ground("g"), E.VoltageSource("src", V=1.0), E.Resistor("r", R=0.0),
                        wires=[("src.p", "r.p"), ("r.n", "src.n"), ("g.p", "src.n")])
     with pytest.raises(kn.ModelError, match="singular"):
@@ -327,3 +333,23 @@ def test_msl_robot_motor_against_its_circuit_by_nodal_analysis():
     ref = np.array([scipy.linalg.expm(M * t) @ z0 for t in res.t]).T
     assert np.max(abs(res["pi.value"] - ref[0])) < 1e-7
     assert np.max(abs(res["pw.speed"] - ref[2])) < 1e-7
+
+
+def test_probes_on_an_aggregate_name_its_ports_not_its_insides():
+    # a DC motor is a resistor, inductor, EMF and rotor inside: a probe wired to motor.p and
+    # one to motor.flange are titled so in results and plots, never motor.Ra.p
+    import matplotlib
+    matplotlib.use("Agg")
+    m = kn.Model("drive")
+    m.add(E.Ground("gnd"))
+    m.add(E.VoltageSource("src", V=12.0))
+    m.add(E.DCMotor("motor", R=1.0, L=0.01, k=0.1, J=0.01))
+    m.add(kn.Probe("pm", quantities=["voltage"]))
+    m.add(kn.Probe("ps", quantities=["speed"]))
+    for a, b in [("src.p", "motor.p"), ("src.n", "gnd.p"), ("motor.n", "gnd.p"),
+                 ("pm.port", "motor.p"), ("ps.port", "motor.flange")]:
+        m.connect(a, b)
+    res = kn.simulate(m, t_end=0.05, n_points=3, **TOL)
+    assert res.probe_targets == {"pm": "motor.p", "ps": "motor.flange"}
+    titles = [ax.get_title() for ax in kn.plot(res).axes]
+    assert titles == ["pm (motor.p): voltage", "ps (motor.flange): speed"]
