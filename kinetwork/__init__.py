@@ -8,9 +8,10 @@ Layers, each importing only those before it: ``errors``, ``outputs`` (the output
 user places) -> ``graph`` (model, topology, files) -> ``equations`` (the System) -> ``solver``
 (the integration plan, driver, methods, JIT cache, Results; ``kinetwork.simulation``, its old
 name, is a deprecated alias) -> the faces: ``plot``, ``schema``, ``symbolic``, ``animation``,
-``diagram``, ``analysis``, ``studio``, ``cli``. The four methods of a lower layer that hand work
-up (``Model.compile``, ``Model._repr_svg_``, ``Results.plot``, ``Results.animate``) name the
-function they call in one table, ``kinetwork.upcalls``; nothing is installed at import time.
+``diagram``, ``analysis``, ``studio``, ``fmu``, ``cli``. The four methods of a lower layer
+that hand work up (``Model.compile``, ``Model._repr_svg_``, ``Results.plot``,
+``Results.animate``) name the function they call in one table, ``kinetwork.upcalls``;
+nothing is installed at import time.
 
 ``import kinetwork`` is quick: the names below are imported on first use (PEP 562), so a
 script pays for CasADi, networkx and scipy when it builds a model, not when it imports the
@@ -56,6 +57,7 @@ _LAZY = {
     "sweep": ("analysis.sweep", "sweep"),
     "sample": ("analysis.sweep", "sample"),
     "normal": ("analysis.sweep", "normal"),
+    "export_fmu": ("fmu.build", "export_fmu"),
     "uniform": ("analysis.sweep", "uniform"),
 }
 

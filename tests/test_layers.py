@@ -22,7 +22,7 @@ PACKAGE = pathlib.Path(kinetwork.__file__).resolve().parent
 LAYERS = [("errors", "outputs", "util", "expr", "units", "spatial", "upcalls"), ("components",), ("graph",),
           ("equations",), ("solver", "simulation"),
           ("plot", "plotlayout", "plotworker", "quickplot", "schema", "symbolic", "animation",
-           "diagram", "urdf", "examples", "studio", "analysis", "cli", "__main__", "")]
+           "diagram", "urdf", "examples", "studio", "analysis", "fmu", "cli", "__main__", "")]
 RANK = {name: rank for rank, names in enumerate(LAYERS) for name in names}
 
 

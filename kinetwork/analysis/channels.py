@@ -168,6 +168,14 @@ def plant(model, inputs=()):
                  nominal)
 
 
+def driven(flat, inputs):
+    """A twin of the flat model ``flat`` in which each input of ``inputs`` (a signals.Input
+    block's name, or an open signal input "component.port") is the value of a new model
+    parameter: (twin, the names of those parameters, the inputs' operating values). What an
+    analysis and an exported FMU drive a model through."""
+    return _twin(flat, list(inputs))
+
+
 def _twin(flat, inputs):
     """A model sharing ``flat``'s components, each input the value of a new parameter:
     (twin, the names of those parameters, the operating values of the inputs)."""

@@ -1,6 +1,6 @@
 """The ``kinetwork`` subcommands whose work another module does: ``animate`` (animation),
 ``diagram`` (diagram), ``studio`` (studio), ``import`` (urdf), ``sweep``, ``linearize`` and
-``fit`` (analysis). Each is imported when its command runs: the faces load only when asked
+``fit`` (analysis), ``export`` (fmu). Each is imported when its command runs: the faces load only when asked
 for."""
 
 import kinetwork as kn
@@ -13,6 +13,7 @@ def add(sub):
     ``studio``, ``import``, ``sweep``, ``linearize``, ``fit``); {name: handler}."""
     from ..analysis import commands
     from ..analysis.sweep_cli import add_command as add_sweep
+    from ..fmu import command as fmu_command
     parser = sub.add_parser(
         "animate", help="write a 3-D animation of a model's motion",
         description="Simulate MODEL.json and write its motion as a self-contained HTML file "
@@ -65,8 +66,9 @@ def add(sub):
     add_sweep(sub)
     for parser in commands.add_commands(sub):        # linearize, fit
         add_library(parser)
+    add_library(fmu_command.add_command(sub))        # export --fmu
     return {"animate": animate, "diagram": diagram, "studio": studio, "import": import_urdf,
-            "sweep": sweep, "linearize": linearize, "fit": fit}
+            "sweep": sweep, "linearize": linearize, "fit": fit, "export": export}
 
 
 def animate(args):
@@ -87,6 +89,11 @@ def studio(args):
 def import_urdf(args):
     from ..urdf import cli_import
     return cli_import(args)
+
+
+def export(args):
+    from ..fmu import command as fmu_command
+    return fmu_command.run_command(args, load_model(args.model, args.library))
 
 
 def sweep(args):
