@@ -3,14 +3,15 @@
 Wire components into a :class:`Model`, compile it to a :class:`System` of minimal
 coordinates, :func:`simulate` it and read the probes from the :class:`Results`.
 
-Layers, each importing only those before it: ``errors``, ``util``, ``expr``, ``units``,
-``spatial``, ``upcalls`` (helpers) -> ``components`` (what a user places) -> ``graph`` (model,
-topology, files) -> ``equations`` (the System) -> ``solver`` (the integration plan, driver,
-methods, JIT cache, Results; ``kinetwork.simulation``, its old name, is a deprecated alias)
--> the faces: ``plot``, ``schema``, ``symbolic``, ``animation``, ``diagram``, ``analysis``,
-``studio``, ``fmu``, ``cli``. The four methods of a lower layer that hand work up (``Model.compile``,
-``Model._repr_svg_``, ``Results.plot``, ``Results.animate``) name the function they call in
-one table, ``kinetwork.upcalls``; nothing is installed at import time.
+Layers, each importing only those before it: ``errors``, ``outputs`` (the output policy),
+``util``, ``expr``, ``units``, ``spatial``, ``upcalls`` (helpers) -> ``components`` (what a
+user places) -> ``graph`` (model, topology, files) -> ``equations`` (the System) -> ``solver``
+(the integration plan, driver, methods, JIT cache, Results; ``kinetwork.simulation``, its old
+name, is a deprecated alias) -> the faces: ``plot``, ``schema``, ``symbolic``, ``animation``,
+``diagram``, ``analysis``, ``studio``, ``fmu``, ``cli``. The four methods of a lower layer
+that hand work up (``Model.compile``, ``Model._repr_svg_``, ``Results.plot``,
+``Results.animate``) name the function they call in one table, ``kinetwork.upcalls``;
+nothing is installed at import time.
 
 ``import kinetwork`` is quick: the names below are imported on first use (PEP 562), so a
 script pays for CasADi, networkx and scipy when it builds a model, not when it imports the

@@ -96,24 +96,36 @@ class Problem(str):
         return {"message": self.message, **{k: getattr(self, k) for k in FIELDS}}
 
 
+#: problems a ModelError keeps, and shows in its message: a file of a million broken
+#: components is reported by its first problems and their count, not a million lines
+MAX_PROBLEMS, SHOWN_PROBLEMS = 1000, 100
+
+
 class ModelError(ValueError):
     """Bad input: a model, file or parameter that cannot be accepted.
 
     ``problems`` lists every diagnostic found, each a ``Problem`` (a string naming its place,
-    with the place as fields too); the message joins them, so one raise reports all of them
-    at once. ``ModelError("text", component="mass1", parameter="mass")`` gives its one
-    problem fields.
+    with the place as fields too; the first MAX_PROBLEMS of ``count``); the message joins
+    them (the first SHOWN_PROBLEMS), so one raise reports all of them at once.
+    ``ModelError("text", component="mass1", parameter="mass")`` gives its one problem fields.
     """
 
-    def __init__(self, problems, **fields):
+    def __init__(self, problems, count=None, **fields):
         if isinstance(problems, str):
             problems = [problems]
-        self.problems = [Problem.of(p, **fields) for p in problems]
-        if len(self.problems) == 1:
+        problems = list(problems)
+        #: how many problems were found, of which ``problems`` keeps the first MAX_PROBLEMS
+        #: (``count``: of a ModelError raised again with its problems placed)
+        self.count = max(len(problems), count or 0)
+        self.problems = [Problem.of(p, **fields) for p in problems[:MAX_PROBLEMS]]
+        if self.count == 1:
             message = self.problems[0].message
         else:
-            message = f"{len(self.problems)} problems:\n" + "\n".join(
-                f"  - {p.message}" for p in self.problems)
+            shown = self.problems[:SHOWN_PROBLEMS]
+            message = f"{self.count} problems:\n" + "\n".join(f"  - {p.message}" for p in shown)
+            if self.count > len(shown):
+                message += (f"\n  ... and {self.count - len(shown)} more (the same kind of "
+                            f"mistake repeated, most likely)")
         super().__init__(message)
 
 

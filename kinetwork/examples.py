@@ -13,11 +13,11 @@ import functools
 import json
 import os
 import pathlib
-import shutil
 
 from .components import REGISTRY
 from .errors import ModelError
 from .graph.io import examples_folder
+from .outputs import write
 
 SUFFIX = ".json"
 #: folders the listing does not look into
@@ -99,7 +99,8 @@ def copy(name, destination="."):
     try:
         for src, target in zip(files, targets):
             target.parent.mkdir(parents=True, exist_ok=True)
-            shutil.copyfile(src, target)
+            data = src.read_bytes()
+            write(target, lambda tmp, data=data: pathlib.Path(tmp).write_bytes(data), "model")
     except OSError as exc:
         raise ModelError(f"copying example {name!r} to {destination}: "
                          f"{exc.strerror or exc}") from None

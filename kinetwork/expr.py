@@ -17,7 +17,6 @@ without stopping. Over CasADi they are then built from ``copysign`` and logical 
 """
 
 import ast
-import copy
 import functools
 import math
 
@@ -63,6 +62,10 @@ _CONSTRUCTS = {ast.IfExp: "a conditional (x if c else y)", ast.Subscript: "index
                ast.Slice: "a slice"}
 _ALLOWED = "numbers, parameter names, + - * / ** ^, one comparison and functions"
 _MAX_LENGTH = 2000
+#: how deeply an expression may nest (operators, calls, parentheses): every walk over its
+#: tree (checks, renaming into a subsystem's outer names, CasADi) stays far from Python's
+#: recursion limit
+MAX_DEPTH = 50
 
 
 class Expression:
@@ -83,6 +86,9 @@ class Expression:
         try:
             # no bitwise operators are accepted, so "^" is free to mean a power
             tree = ast.parse(text.strip().replace("^", "**"), mode="eval")
+            if (deep := depth(tree.body)) > MAX_DEPTH:
+                raise ModelError(f"expression nested too deeply ({deep} levels; an "
+                                 f"expression may have {MAX_DEPTH}): {quote(text, 60)}")
             self.names = set()
             self._check(tree.body)
         except ModelError:
@@ -204,11 +210,27 @@ def dotted(node):
     return ".".join([node.id, *reversed(parts)])
 
 
+def depth(node):
+    """How deeply the tree under ``node`` nests (a name or a number: 1), found without
+    recursion."""
+    deepest, stack = 0, [(node, 1)]
+    while stack:
+        node, level = stack.pop()
+        deepest = max(deepest, level)
+        stack.extend((child, level + 1) for child in ast.iter_child_nodes(node)
+                     if not isinstance(child, (ast.expr_context, ast.operator, ast.unaryop,
+                                               ast.cmpop)))
+    return deepest
+
+
 def rename(text, names):
     """``text`` with each free name in ``names`` (name -> expression text) replaced by its
     expression, parenthesised as needed: how a subsystem's parameter expressions are written
-    in the names of the model it is placed in."""
-    tree = parse(text)._tree
+    in the names of the model it is placed in. Refused (ModelError) when the result would
+    nest more than MAX_DEPTH deep or be longer than an expression may be: subsystems that
+    feed each other's parameters through many levels grow them without bound."""
+    parse(text)                                  # checked, and refused once if it fails
+    tree = ast.parse(text.strip().replace("^", "**"), mode="eval").body   # a copy to edit
 
     class Renamer(ast.NodeTransformer):
         def visit_Call(self, node):          # a function's name is not a free name
@@ -221,7 +243,17 @@ def rename(text, names):
 
         def visit_Name(self, node):
             return _replacement(names[node.id]) if node.id in names else node
-    return ast.unparse(Renamer().visit(copy.deepcopy(tree)))
+    renamed = Renamer().visit(tree)
+    if (deep := depth(renamed)) > MAX_DEPTH:
+        raise ModelError(f"expression {quote(text, 60)}: nested too deeply once written in "
+                         f"the names of the model it is placed in ({deep} levels; an "
+                         f"expression may have {MAX_DEPTH})")
+    out = ast.unparse(renamed)
+    if len(out) > _MAX_LENGTH:
+        raise ModelError(f"expression {quote(text, 60)} grows to {len(out)} characters once "
+                         f"written in the names of the model it is placed in, more than the "
+                         f"{_MAX_LENGTH} an expression may have")
+    return out
 
 
 def _replacement(text):

@@ -13,9 +13,10 @@ import sys
 import numpy as np
 
 from . import plotlayout as layout
+from .outputs import check, model_files, plot_kind, write
 from .errors import ModelError
 from .plotlayout import unit_label  # noqa: F401 -- kinetwork.plot.unit_label, as before
-from .util import atomic_write, callable_module
+from .util import callable_module
 
 _AXES = "xyz"
 
@@ -305,19 +306,27 @@ def check_plot_path(path):
                          f"{', '.join(sorted(supported))}")
 
 
-def save_plot(results, path, *names, probes=None, title=None, dpi=150, **kwargs):
+def save_plot(results, path, *names, probes=None, title=None, dpi=150, overwrite=False,
+              **kwargs):
     """Plot ``results`` (see :func:`plot_results`) into an image file and close the figure.
 
-    The format follows the file extension (png, pdf, svg, ...).
+    The format follows the file extension (png, pdf, svg, ...). The file is written under
+    the output policy (``kinetwork.outputs``): atomically, never over the model file, a
+    special file or a folder, nor over a file of another kind (a CSV, a model) unless
+    ``overwrite``.
 
     Raises
     ------
     ModelError
-        The extension is not an image format matplotlib writes.
+        The extension is not an image format matplotlib writes, or the policy refuses the
+        path (``OutputRefused``).
     OSError
         The file cannot be written.
     """
     check_plot_path(path)
+    reads = model_files(getattr(results.system, "model", None))
+    kind = plot_kind(path)
+    check(path, kind, reads=reads, force=overwrite)       # before drawing anything
     # a figure pyplot never sees: no backend to start (the quick first answer of
     # ``kinetwork run --plot``), and nothing left open if writing fails
     fig = plot_results(results, *names, probes=probes, title=title, _detached=True, **kwargs)
@@ -326,7 +335,8 @@ def save_plot(results, path, *names, probes=None, title=None, dpi=150, **kwargs)
     # 2160 x 825 plot: 0.13 s and 257 KiB against 0.24 s and 230 KiB)
     options = {"pil_kwargs": {"compress_level": 1}} if fmt == "png" else {}
     # atomically: a full disk or a signal leaves an old image whole
-    atomic_write(path, lambda tmp: fig.savefig(tmp, dpi=dpi, format=fmt, **options))
+    write(path, lambda tmp: fig.savefig(tmp, dpi=dpi, format=fmt, **options), kind,
+          reads=reads, force=overwrite)
 
 
 def warm_up():

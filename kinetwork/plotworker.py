@@ -18,6 +18,7 @@ import pickle
 import select
 import signal
 import sys
+import time
 from dataclasses import dataclass
 
 #: what the child answers when it could not run ``save_plot`` at all
@@ -81,12 +82,14 @@ class PlotWorker:
         os.close(answers_w)
         return cls(pid, jobs_w, answers_r)
 
-    def save(self, results, path, *names, title=None, hide_flat=False):
-        """``save_plot(results, path, *names, title=, hide_flat=)``, drawn in the child; waits
-        for it. Raises what ``save_plot`` raised there; draws here if the child is gone."""
+    def save(self, results, path, *names, title=None, hide_flat=False, overwrite=False):
+        """``save_plot(results, path, *names, title=, hide_flat=, overwrite=)``, drawn in the
+        child; waits for it. Raises what ``save_plot`` raised there; draws here if the child
+        is gone."""
         from .plot import save_plot
         job = pickle.dumps({"results": _portable(results), "path": os.fspath(path),
-                            "names": list(names), "title": title, "hide_flat": hide_flat})
+                            "names": list(names), "title": title, "hide_flat": hide_flat,
+                            "overwrite": overwrite})
         try:
             _write_all(self._jobs, job)
         except OSError:                                # the child died: draw here
@@ -96,16 +99,26 @@ class PlotWorker:
         if status == "error":
             raise error
         if status != "done":
-            save_plot(results, path, *names, title=title, hide_flat=hide_flat)
+            save_plot(results, path, *names, title=title, hide_flat=hide_flat,
+                      overwrite=overwrite)
 
     def close(self):
-        """End the child without a job (a refused model, a usage error) and reap it: it has
-        written nothing yet, and waiting for its imports would delay the command's exit."""
+        """End the child and reap it, if it has not answered: a refused model or a usage
+        error (it has written nothing yet, and waiting for its imports would delay the
+        command's exit), or a command stopped while it draws. SIGTERM first, so that a
+        write under way removes its temporary file (``kinetwork.outputs``); SIGKILL if it
+        is still there a second later."""
         self._close_jobs()
         if self._answers is not None:
             try:
-                os.kill(self.pid, signal.SIGKILL)
-            except ProcessLookupError:                 # pragma: no cover (already gone)
+                os.kill(self.pid, signal.SIGTERM)
+                for _ in range(100):
+                    if os.waitpid(self.pid, os.WNOHANG)[0]:
+                        break
+                    time.sleep(0.01)
+                else:
+                    os.kill(self.pid, signal.SIGKILL)
+            except (ProcessLookupError, ChildProcessError):   # already gone, or reaped
                 pass
             self._answer()
 
@@ -159,7 +172,7 @@ def _serve(jobs, answers):
     job = pickle.loads(data)
     try:
         save_plot(job["results"], job["path"], *job["names"], title=job["title"],
-                  hide_flat=job["hide_flat"])
+                  hide_flat=job["hide_flat"], overwrite=job["overwrite"])
         answer = ("done", None)
     except Exception as exc:        # the parent raises it, as if it had drawn
         answer = ("error", exc)

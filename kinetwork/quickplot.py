@@ -26,8 +26,8 @@ from PIL import Image, ImageDraw, ImageFont
 
 from . import plotlayout as layout
 from .errors import ModelError
+from .outputs import check, model_files, write
 from .plotlayout import EDGE, Axis, padded, time_limits
-from .util import atomic_write
 
 DPI, SCALE = 150, 2                     # the file's resolution; lines drawn this much larger
 PX = DPI / 72.0                         # points -> pixels of the file
@@ -56,13 +56,16 @@ def drawable(path, results, names=()):
     return all(np.ndim(results[name]) <= 2 for name in wanted)
 
 
-def save_png(results, path, *names, title=None, hide_flat=False):
-    """``save_plot(results, path, *names, title=, hide_flat=)`` for a .png that
+def save_png(results, path, *names, title=None, hide_flat=False, overwrite=False):
+    """``save_plot(results, path, *names, title=, hide_flat=, overwrite=)`` for a .png that
     :func:`drawable` accepts. Raises ModelError as save_plot does (nothing to plot, an
-    unknown name, only constant signals with hide_flat)."""
+    unknown name, only constant signals with hide_flat, a path the output policy refuses)."""
+    reads = model_files(getattr(results.system, "model", None))
+    check(path, "png", reads=reads, force=overwrite)      # before drawing anything
     image = render(results, *names, title=title, hide_flat=hide_flat)
     data = png_bytes(image)
-    atomic_write(path, lambda tmp: pathlib.Path(tmp).write_bytes(data))
+    write(path, lambda tmp: pathlib.Path(tmp).write_bytes(data), "png", reads=reads,
+          force=overwrite)
 
 
 def png_bytes(image):

@@ -94,6 +94,7 @@ def to_si(text, unit):
                          f"numbers and * / ^ ( ))")
     if any(float(n) > MAX_POWER for n in re.findall(r"\d+(?:\.\d*)?", written)):
         raise ModelError(f"a power in the unit {written!r} is beyond {MAX_POWER}")
+    check_powers(text)
     ureg = registry()
     try:
         quantity = ureg.Quantity(text.strip())
@@ -124,6 +125,85 @@ def to_si(text, unit):
         return float(value)
     except OverflowError:
         raise ModelError(f"{text!r} is out of range in {unit or 'SI units'}") from None
+
+
+def check_powers(text):
+    """Refuse (ModelError) a quantity whose powers would take unbounded work to compute.
+
+    pint evaluates a unit exactly: ``kg^100^100^100`` is kg to the power 100^(100^100), and
+    ``(km/m)^(100*100*100*100)`` is 1000^(10^8), whose digits alone would not fit in memory.
+    So the expression pint would evaluate (the same preprocessing, tokens and tree) is
+    walked first, bottom-up, without evaluating a unit: an exponent must be a number of at
+    most MAX_POWER in size, the number a power computes at most MAX_DIGITS digits, and the
+    total power of the units (``kg^2*m^3`` is 5) at most MAX_DEGREE."""
+    from pint import pint_eval
+    from pint.util import string_preprocessor
+    try:
+        tree = pint_eval.build_eval_tree(pint_eval.tokenizer(string_preprocessor(text)))
+    except Exception:        # pint says what is wrong when it reads it: nothing to bound
+        return
+    _bounds(tree, text)
+
+
+#: the largest total power of the units in a quantity, and the most digits a number computed
+#: inside it may have (1000^100 is 300 digits): bounded work whatever the text
+MAX_DEGREE, MAX_DIGITS = 1000, 1000
+
+
+def _bounds(node, text):
+    """(number or None, degree) of a node of pint's tree: its value when it is a plain
+    number, and the total power of the units in it (see :func:`check_powers`)."""
+    import tokenize
+    from fractions import Fraction
+    if node.right is None and node.operator is None:          # a token
+        token = node.left
+        if token.type == tokenize.NUMBER:
+            try:
+                return Fraction(token.string), 0
+            except (ValueError, ZeroDivisionError):
+                return None, 0
+        return None, 1
+    if node.right is None:                                    # unary + or -
+        value, degree = _bounds(node.left, text)
+        return (-value if value is not None and node.operator.string == "-" else value), degree
+    (a, da), (b, db) = _bounds(node.left, text), _bounds(node.right, text)
+    op = node.operator.string if node.operator else "*"
+    if op in ("**", "^"):
+        if b is None or db:
+            raise ModelError("an exponent in the unit must be a number")
+        if abs(b) > MAX_POWER:
+            raise ModelError(f"an exponent of {_size(b)} in the unit is beyond {MAX_POWER}")
+        degree = da * abs(b)
+        value = None
+        if a is not None:
+            digits = abs(b) * (len(str(a.numerator)) + len(str(a.denominator)))
+            if digits > MAX_DIGITS:
+                raise ModelError(f"a power in the unit has more than {MAX_DIGITS} digits")
+            value = a ** b if b.denominator == 1 else None
+    elif op in ("*", "/", ""):
+        degree = da + db
+        value = None
+        if a is not None and b is not None:
+            if len(str(a.numerator)) + len(str(b.numerator)) + len(str(a.denominator)) + \
+                    len(str(b.denominator)) > MAX_DIGITS:
+                raise ModelError(f"a number in the unit has more than {MAX_DIGITS} digits")
+            value = a * b if op != "/" else (a / b if b else None)
+    elif op in ("+", "-"):
+        degree = max(da, db)
+        value = a + b if op == "+" and a is not None and b is not None else \
+            a - b if a is not None and b is not None else None
+    else:
+        raise ModelError(f"cannot read the unit in {text[:MAX_LENGTH]!r} (the operator "
+                         f"{op!r:.20})")
+    if degree > MAX_DEGREE:
+        raise ModelError(f"units to a total power of {_size(degree)} in the unit, beyond "
+                         f"{MAX_DEGREE}")
+    return value, degree
+
+
+def _size(number):
+    """A number for a message, however large."""
+    return f"{float(number):g}" if abs(number) < 10**300 else "more than 1e300"
 
 
 def _why(exc):

@@ -1,6 +1,7 @@
 """Small helpers every layer uses: checked numbers, near-match suggestions, quoting of user
-input in messages, atomic file writes, and capturing what the solvers print. The bottom
-layer: it imports nothing of kinetwork but the errors."""
+input in messages, bounded reads, atomic file writes (through ``kinetwork.outputs``), and
+capturing what the solvers print. The bottom layer: it imports nothing of kinetwork but the
+errors and the output policy."""
 
 import contextlib
 import ctypes
@@ -66,30 +67,68 @@ def quote(value, limit=QUOTE_LIMIT):
     return text if len(text) <= limit else text[:limit - 3] + "..."
 
 
-def atomic_write(path, write, mode=0o666):
-    """Write a file in one step: ``write(tmp_path)`` fills a temporary file in the same folder,
-    which is flushed to disk and then replaces ``path``. A failure (a full disk, a signal)
-    leaves the old file whole and removes the temporary one.
+#: seconds a read from a pipe or a device may wait for its next bytes
+READ_IDLE = 10.0
 
-    A symbolic link is followed, not replaced; the old file's permissions are kept.
+
+def read_bounded(path, limit, special=True, idle=READ_IDLE, inspect=None):
+    """The bytes of the file at ``path``: at most ``limit`` + 1 of them (a caller refuses
+    more), so /dev/zero or an endless pipe costs a bounded read.
+
+    Opening never blocks (a FIFO without a writer reads as empty), and a pipe or a device
+    that sends nothing for ``idle`` seconds is refused. ``special=False`` refuses anything
+    but a regular file (a FIFO, a device, a socket) before reading a byte: what a server
+    that must never block uses. ``inspect(first_bytes)``, if given, sees the first block
+    read (up to 1 MiB) and may refuse the rest by raising.
+
+    Raises
+    ------
+    ModelError
+        A special file refused, or one that went silent.
+    OSError
+        The file cannot be opened or read (a folder: IsADirectoryError).
     """
-    import secrets
-    path = os.path.realpath(os.fspath(path))
-    folder, base = os.path.split(path)
-    tmp = os.path.join(folder, f".{base}.{secrets.token_hex(4)}.tmp")
+    import errno
+    import select
+    fd = os.open(path, os.O_RDONLY | os.O_NONBLOCK | getattr(os, "O_CLOEXEC", 0))
     try:
-        # 0o666 lets the umask apply, as to any new file (mkstemp would force 0o600)
-        os.close(os.open(tmp, os.O_WRONLY | os.O_CREAT | os.O_EXCL, mode))
-        write(tmp)
-        with open(tmp, "rb+") as fh:
-            os.fsync(fh.fileno())
-        if os.path.exists(path):
-            os.chmod(tmp, stat.S_IMODE(os.stat(path).st_mode))
-        os.replace(tmp, path)
-    except BaseException:
-        if os.path.exists(tmp):
-            os.unlink(tmp)
-        raise
+        st = os.fstat(fd)
+        if stat.S_ISDIR(st.st_mode):
+            raise IsADirectoryError(errno.EISDIR, os.strerror(errno.EISDIR), path)
+        regular = stat.S_ISREG(st.st_mode)
+        if not regular and not special:
+            raise ModelError(f"{quote(os.fspath(path))}: not a regular file (a pipe, a device "
+                             f"or a socket): refused without reading it")
+        if regular:
+            os.set_blocking(fd, True)
+        chunks, size = [], 0
+        while size <= limit:
+            try:
+                chunk = os.read(fd, min(1 << 20, limit + 1 - size))
+            except BlockingIOError:         # a pipe or a device with nothing yet: wait
+                if not select.select([fd], [], [], idle)[0]:
+                    raise ModelError(f"{quote(os.fspath(path))}: nothing came from it for "
+                                     f"{idle:g} s") from None
+                continue
+            if not chunk:
+                break
+            if inspect is not None and not chunks:
+                inspect(chunk)
+            chunks.append(chunk)
+            size += len(chunk)
+        return b"".join(chunks)
+    finally:
+        os.close(fd)
+
+
+def atomic_write(path, write, mode=0o666):
+    """Write a file in one step under the output policy (``kinetwork.outputs.write``, no
+    check of what kind of file is replaced): ``write(tmp_path)`` fills a temporary file in
+    the same folder, which is flushed to disk and then replaces ``path``. A failure (a full
+    disk, a signal) leaves the old file whole and removes the temporary one; a folder or a
+    special file at ``path`` is refused (``ModelError``)."""
+    from .outputs import write as policy_write
+    policy_write(path, write, mode=mode)
 
 
 def callable_module(name, function):

@@ -385,19 +385,19 @@ def test_command_animates_a_loop(tmp_path):
     assert gif.stat().st_size > 1000
 
 
-@pytest.mark.parametrize("args, message", [
-    ([], "nothing to write"),
-    (["--html", "{tmp}/x.gif"], "must be a .html file"),
-    (["--gif", "{tmp}/x.html"], "must be a .gif file"),
-    (["--gif", "{tmp}"], "is a folder"),
-    (["--html", "{model}"], "is the model file itself"),
-    (["--html", "{tmp}/file.txt/x.html"], "cannot write"),
+@pytest.mark.parametrize("args, message, code", [
+    ([], "nothing to write", 1),
+    (["--html", "{tmp}/x.gif"], "must be a .html file", 1),
+    (["--gif", "{tmp}/x.html"], "must be a .gif file", 1),
+    (["--gif", "{tmp}"], "is a folder", 1),
+    (["--html", "{model}"], "is an input here (the model file", 2),
+    (["--html", "{tmp}/file.txt/x.html"], "cannot write", 1),
 ])
-def test_command_refuses_bad_paths(seed_file, tmp_path, capsys, args, message):
+def test_command_refuses_bad_paths(seed_file, tmp_path, capsys, args, message, code):
     (tmp_path / "file.txt").write_text("not a folder")
     before = seed_file.read_bytes()
     args = [a.format(tmp=tmp_path, model=seed_file) for a in args]
-    assert main(["animate", str(seed_file), *args, "--t-end", "0.1"]) == 1
+    assert main(["animate", str(seed_file), *args, "--t-end", "0.1"]) == code
     assert message in capsys.readouterr().err
     assert seed_file.read_bytes() == before
     assert sorted(os.listdir(tmp_path)) == sorted(["file.txt", seed_file.name])

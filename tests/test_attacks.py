@@ -327,3 +327,34 @@ def test_a_line_force_of_normal_length_is_unchanged(monkeypatch):
     np.testing.assert_allclose(regular.states, plain.states, rtol=0, atol=1e-12)
     np.testing.assert_allclose(regular["probe.force"], plain["probe.force"], rtol=0,
                                atol=1e-12)
+
+
+# -- compiled Systems and their Results in other hands ----------------------------------------
+def test_results_and_systems_pickle_and_run_again_the_same():
+    import pickle
+    system = double_pendulum().compile()
+    run = dict(t_end=1.0, n_points=51, rtol=1e-10, atol=1e-12, jit=False)
+    res = kn.simulate(system, **run)
+    copy = pickle.loads(pickle.dumps(res))
+    np.testing.assert_array_equal(copy.t, res.t)          # copied, not computed again
+    np.testing.assert_array_equal(copy["probe1.angle"], res["probe1.angle"])
+    assert copy.settings == res.settings
+    again = kn.simulate(pickle.loads(pickle.dumps(system)), **run)
+    assert again.state_names == res.state_names
+    np.testing.assert_allclose(again.states, res.states, rtol=0, atol=1e-9)
+    # a result's System, compiled again when it is first asked for, runs the same model
+    np.testing.assert_allclose(kn.simulate(copy.system, **run).states, res.states, rtol=0,
+                               atol=1e-9)
+
+
+@pytest.mark.parametrize("change, says", [
+    (lambda p: p.pop("c"), "has no parameter 'c' any more"),
+    (lambda p: p.update(c="stiff"), "parameters.c: must be a number"),
+    (lambda p: p.update(c=float("inf")), "parameters.c: must be finite"),
+    (lambda p: p.update(c="1 kg^100^100^100"), "beyond 100"),
+])
+def test_a_compiled_system_whose_model_parameters_were_spoilt_says_so(change, says):
+    model = double_pendulum()
+    system = model.compile()
+    change(model.parameters)                       # a plain dict, written past set_parameter
+    refused(lambda: kn.simulate(system, t_end=0.1), says)

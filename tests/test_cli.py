@@ -253,12 +253,15 @@ def test_step_budget_and_time_limit_end_in_exit_3_with_the_partial_csv(blowup_fi
     assert no_traceback(capsys.readouterr())
     _, data = read_csv(out, partial=True)
     assert 0.5 < data[-1, 0] < 1.0
+    # no C compiler in the way; how far 0.2 s of wall time gets depends on the machine and
+    # its load (on a busy one, nowhere): what was reached is written, the reason said
     code = main(["run", str(seed_file_long(tmp_path)), "--time-limit", "0.2", "-q",
-                 "--out", str(out)])
+                 "--no-jit", "--out", str(out)])
     assert code == 3
     assert "time limit" in capsys.readouterr().err
     _, data = read_csv(out, partial=True)
-    assert 0 < data[-1, 0] < 1e5
+    assert 0 <= data[-1, 0] < 1e5 and np.all(np.isfinite(data))
+    assert "time limit" in out.read_text().splitlines()[-1]
 
 
 def seed_file_long(tmp_path):

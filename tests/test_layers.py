@@ -2,8 +2,8 @@
 
 Every module is read with ``ast`` (nothing is imported): each import, at any depth (inside
 functions too), relative or absolute, is resolved to the kinetwork module it names. Layers,
-lowest first (the package docstring's list): the helpers ``errors``, ``util``, ``expr``,
-``units``, ``spatial``, ``upcalls``; ``components``; ``graph``; ``equations``; ``solver``; the faces
+lowest first (the package docstring's list): the helpers ``errors``, ``outputs``, ``util``,
+``expr``, ``units``, ``spatial``, ``upcalls``; ``components``; ``graph``; ``equations``; ``solver``; the faces
 ``plot``, ``schema``, ``symbolic``, ``cli`` (and ``kinetwork/__init__.py``, which gathers
 them all). A module of a sub-package is in its package's layer. A module may import from its
 own layer and those below it; the imports must not form a cycle, within a layer either.
@@ -19,7 +19,7 @@ import pytest
 import kinetwork
 
 PACKAGE = pathlib.Path(kinetwork.__file__).resolve().parent
-LAYERS = [("errors", "util", "expr", "units", "spatial", "upcalls"), ("components",), ("graph",),
+LAYERS = [("errors", "outputs", "util", "expr", "units", "spatial", "upcalls"), ("components",), ("graph",),
           ("equations",), ("solver", "simulation"),
           ("plot", "plotlayout", "plotworker", "quickplot", "schema", "symbolic", "animation",
            "diagram", "urdf", "examples", "studio", "analysis", "fmu", "cli", "__main__", "")]

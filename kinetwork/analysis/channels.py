@@ -121,8 +121,8 @@ class Plant:
         from ..solver.plan import simulate
         if t == 0.0:
             return np.concatenate(self.system.initial_full_p(p))
-        if t < 0:
-            raise ModelError(f"at: a time must be >= 0 (the start), got {t!r}")
+        if not t >= 0 or t == float("inf"):
+            raise ModelError(f"at: a time must be finite and >= 0 (the start), got {t!r}")
         # the model itself runs there: its inputs follow their own values in time
         own = self.source.param_names
         values = dict(zip(self.system.param_names, p.tolist()))

@@ -10,12 +10,11 @@ with ``#`` are comments.
 import csv
 import io
 import math
-import pathlib
 
 import numpy as np
 
 from ..errors import ModelError, SimulationError
-from ..util import quote, suggest
+from ..util import quote, read_bounded, suggest
 from .channels import output_channels
 from .sensitivities import Trajectory, analysis_plan, param_index
 
@@ -197,20 +196,48 @@ def _weights(cols, measured, weights):
                      for c, r in zip(cols, rms)])
 
 
+#: the largest measured CSV read (bytes): /dev/zero or an endless pipe is refused by size
+MAX_DATA_BYTES = 256 * 2**20
+
+
+def _text(data):
+    """The text of the CSV file ``data``: UTF-8 (a byte-order mark allowed), or UTF-16 with
+    its byte-order mark as spreadsheet programs write; binary data, a file past
+    MAX_DATA_BYTES or one that cannot be read is refused naming it."""
+    where = quote(str(data))
+    def text_only(head):
+        if b"\x00" in head and not head.startswith((b"\xff\xfe", b"\xfe\xff")):
+            raise ModelError(f"data: {where} is binary, not a CSV table")
+    try:
+        raw = read_bounded(data, MAX_DATA_BYTES, inspect=text_only)
+    except OSError as exc:
+        raise ModelError(f"data: cannot read {where}: {exc.strerror or exc}") from None
+    if len(raw) > MAX_DATA_BYTES:
+        raise ModelError(f"data: {where} is larger than {MAX_DATA_BYTES // 2**20} MiB")
+    utf16 = raw.startswith((b"\xff\xfe", b"\xfe\xff"))
+    try:
+        return raw.decode("utf-16" if utf16 else "utf-8-sig")
+    except UnicodeDecodeError as exc:
+        raise ModelError(f"data: {where} is not {'UTF-16' if utf16 else 'UTF-8'} text (byte "
+                         f"{exc.start})") from None
+
+
 def _read(data):
     """(t, {column: values}) from a CSV file or a mapping."""
     if isinstance(data, dict):
-        table = {str(k): np.asarray(v, dtype=float).ravel() for k, v in data.items()}
+        try:
+            table = {str(k): np.asarray(v, dtype=float).ravel() for k, v in data.items()}
+        except (TypeError, ValueError) as exc:
+            raise ModelError(f"data: every column must be numbers ({exc})") from None
         where = "data"
     else:
-        path = pathlib.Path(data)
-        try:
-            text = path.read_text()
-        except OSError as exc:
-            raise ModelError(f"data: cannot read {quote(str(data))}: {exc.strerror}") from None
-        where = str(path)
+        where = str(data)
+        text = _text(data)
         lines = [ln for ln in text.splitlines() if ln.strip() and not ln.startswith("#")]
-        rows = list(csv.reader(io.StringIO("\n".join(lines))))
+        try:
+            rows = list(csv.reader(io.StringIO("\n".join(lines))))
+        except csv.Error as exc:
+            raise ModelError(f"{where}: not a CSV table ({exc})") from None
         if len(rows) < 2:
             raise ModelError(f"{where}: expected a header row and data rows")
         header, body = rows[0], rows[1:]

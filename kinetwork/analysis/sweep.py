@@ -12,6 +12,7 @@ members as Dask tasks). The answer is an xarray Dataset (``sweep_results.py``).
 """
 
 import itertools
+import math
 import os
 import signal
 import threading
@@ -30,6 +31,9 @@ from .sweep_results import dataset, param_unit, summary, to_netcdf
 
 #: members prepared (parameters checked, start found) and run at a time in this process
 WINDOW = 4 * MAX_BATCH
+#: members of one sweep or sample at most, and worker threads: every input does bounded
+#: work (their results must also fit MAX_OUTPUT_BYTES together)
+MAX_MEMBERS, MAX_WORKERS = 1_000_000, 1024
 
 __all__ = ["Distribution", "normal", "sample", "summary", "sweep", "to_netcdf", "uniform"]
 
@@ -85,14 +89,17 @@ def sweep(model, grid, *, params=None, outputs=None, workers=None, batch=None,
         raise ModelError("sweep: the grid must be a non-empty dict of parameter name -> "
                          "values")
     names = list(grid)
-    plan = _plan(model, names, params, settings)
-    axes = []
     for name in names:
         values = grid[name]
         if isinstance(values, (str, bytes)) or not hasattr(values, "__len__") or \
                 not len(values):
             raise ModelError(f"sweep: {name!r}: give a non-empty sequence of values, got "
                              f"{values!r:.60}")
+    _check_members(math.prod(len(grid[name]) for name in names), "sweep: the grid")
+    plan = _plan(model, names, params, settings)
+    axes = []
+    for name in names:
+        values = grid[name]
         axes.append([_si(plan, name, v, f"sweep: {name}[{i}]") for i, v in enumerate(values)])
     values = np.array(list(itertools.product(*axes)), dtype=float).reshape(-1, len(names))
     layout = {"dims": names, "coords": {n: np.array(a) for n, a in zip(names, axes)},
@@ -116,6 +123,7 @@ def sample(model, distributions, n, *, seed=None, params=None, outputs=None, wor
     """
     if isinstance(n, bool) or not isinstance(n, (int, np.integer)) or n < 1:
         raise ModelError(f"sample: n must be a positive integer, got {n!r:.40}")
+    _check_members(int(n), "sample: n")
     if not isinstance(distributions, dict) or not distributions:
         raise ModelError("sample: give a non-empty dict of parameter name -> distribution")
     names = list(distributions)
@@ -128,6 +136,13 @@ def sample(model, distributions, n, *, seed=None, params=None, outputs=None, wor
               "units": {name: param_unit(plan, name) for name in names}}
     return _run(plan, names, values, layout, params, outputs, workers, batch, scheduler,
                 progress)
+
+
+def _check_members(n, what):
+    """Refuse more than MAX_MEMBERS members, before any is made."""
+    if n > MAX_MEMBERS:
+        raise ModelError(f"{what}: {n:.3g} members, more than the {MAX_MEMBERS} a sweep may "
+                         f"run; sweep fewer values (or in parts)")
 
 
 def _plan(model, names, params, settings):
@@ -167,6 +182,11 @@ def _run(plan, names, values, layout, params, outputs, workers, batch, scheduler
         if v is not None and (isinstance(v, bool) or not isinstance(v, (int, np.integer))
                               or v < 1):
             raise ModelError(f"{what}: must be a positive integer, got {v!r:.40}")
+    if workers is not None and workers > MAX_WORKERS:
+        raise ModelError(f"workers: at most {MAX_WORKERS} threads, got {workers}")
+    if batch is not None and batch > MAX_BATCH:
+        raise ModelError(f"batch: at most {MAX_BATCH} members integrated together, got "
+                         f"{batch}")
     if scheduler is not None:
         sweep_dask.check_scheduler(scheduler)
     if workers is None:

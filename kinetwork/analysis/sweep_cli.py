@@ -6,7 +6,9 @@ import math
 import numpy as np
 
 from ..errors import ModelError
+from ..outputs import check, model_files
 from ..solver.methods import METHODS
+from .sweep import MAX_MEMBERS
 
 
 def _values(text):
@@ -19,7 +21,14 @@ def _values(text):
             raise ValueError
         if rest.count(":") == 2:
             start, stop, count = rest.split(":")
+            if not 1 <= int(count) <= MAX_MEMBERS:
+                raise argparse.ArgumentTypeError(
+                    f"{name.strip()!r:.60}: COUNT must be 1 to {MAX_MEMBERS}, got "
+                    f"{count.strip()[:20]}")
             values = np.linspace(float(start), float(stop), int(count)).tolist()
+        elif rest.count(",") >= MAX_MEMBERS:
+            raise argparse.ArgumentTypeError(f"{name.strip()!r:.60}: more than {MAX_MEMBERS} "
+                                             f"values")
         else:
             values = [_number_or_quantity(v) for v in rest.split(",")]
         if not values or not all(isinstance(v, str) or math.isfinite(v) for v in values):
@@ -79,6 +88,9 @@ def add_command(sub):
                      help="run on Dask: 'local' (a LocalCluster on this machine) or a "
                           "scheduler's address, tcp://host:8786")
     cmd.add_argument("--out", metavar="FILE.nc", help="write the sweep as NetCDF")
+    cmd.add_argument("--force", action="store_true",
+                     help="replace an existing file of another kind at --out (never the "
+                          "model, nor a device, pipe or folder)")
     cmd.add_argument("--progress", action=argparse.BooleanOptionalAction, default=None,
                      help="a progress bar on stderr (default: when stderr is a terminal)")
     cmd.add_argument("--library", action="append", default=[], metavar="DIR",
@@ -94,6 +106,8 @@ def run_command(args, model):
     grid = dict(args.param)
     if len(grid) != len(args.param):
         raise ModelError("--param: a parameter is given twice")
+    if args.out:                        # before any member runs
+        check(args.out, "netcdf", what="--out", reads=model_files(model), force=args.force)
     progress = args.progress if args.progress is not None else sys.stderr.isatty()
     ds = sweep(model, grid, t_end=args.t_end, n_points=args.n_points, method=args.method,
                rtol=args.rtol, atol=args.atol, max_step=args.max_step, jit=args.jit,
@@ -102,7 +116,7 @@ def run_command(args, model):
     print(summary(ds))
     if args.out:
         try:
-            to_netcdf(ds, args.out)
+            to_netcdf(ds, args.out, overwrite=args.force, reads=model_files(model))
         except OSError as exc:
             raise ModelError(f"cannot write {args.out}: {exc.strerror or exc}") from None
         print(f"wrote {ds.attrs['members']} members to {args.out}")

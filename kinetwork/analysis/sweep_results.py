@@ -10,7 +10,11 @@ how each member ended.
 
 import numpy as np
 
+from ..outputs import write
 from ..solver.results import TIME, signal_coords, signal_dims
+
+#: members the command's summary prints a line for
+SUMMARY_MEMBERS = 100
 
 
 def dataset(plan, layout, members, attrs):
@@ -81,7 +85,13 @@ def summary(ds):
     probes = [n for n, v in ds.data_vars.items()
               if v.attrs.get("kind") == "probe" and v.dims == (*dims, TIME)]
     lines = ["  ".join(dims + probes)]
-    for index in np.ndindex(*ds.status.shape):
+    members = int(np.prod(ds.status.shape))
+    for k, index in enumerate(np.ndindex(*ds.status.shape)):
+        if k == SUMMARY_MEMBERS and members > SUMMARY_MEMBERS:
+            failed = sum(1 for v in np.ravel(ds.status.values) if v != "ok")
+            lines.append(f"... ({members} members in all, {failed} not ok; every one is in "
+                         f"the Dataset, and in the NetCDF file of --out)")
+            break
         member = ds.isel(dict(zip(dims, index)))
         head = [f"{d}={member[d].item():g}" for d in dims]
         if member.status.item() == "ok":
@@ -91,9 +101,12 @@ def summary(ds):
     return "\n".join(lines)
 
 
-def to_netcdf(ds, path):
-    """The Dataset as NetCDF (strings as fixed text, so that scipy's writer takes them)."""
+def to_netcdf(ds, path, overwrite=False, reads=()):
+    """The Dataset as NetCDF (strings as fixed text, so that scipy's writer takes them),
+    under the output policy (``kinetwork.outputs``): atomically, never over ``reads`` (the
+    model's files), a special file or a folder, nor over a file that is not NetCDF unless
+    ``overwrite``."""
     out = ds.copy()
     for name in ("status", "reason", "method"):
         out[name] = out[name].astype(str)
-    out.to_netcdf(path)
+    write(path, out.to_netcdf, "netcdf", reads=reads, force=overwrite)

@@ -9,7 +9,7 @@ import sys
 import numpy as np
 
 from ..errors import ModelError
-from ..util import atomic_write
+from ..outputs import Stopped, check_all, model_files, write
 from . import video
 from .scene import animation_data
 
@@ -17,9 +17,15 @@ PLAYER = os.path.join(os.path.dirname(os.path.dirname(__file__)), "assets", "pla
 #: an HTML page holds at most this many times; a denser run is resampled (the player
 #: interpolates between samples, so nothing is lost to the eye)
 HTML_SAMPLES = 6000
+#: videos: a GIF holds every frame in memory while it is written (1,500 frames of 400 px
+#: are about 0.5 GB), an MP4 streams them to ffmpeg (36,000 are 20 minutes at 30 fps)
+MAX_GIF_FRAMES, MAX_MP4_FRAMES = 1500, 36_000
+#: GIF frame delays are hundredths of a second; browsers hold a frame at least 20 ms
+MAX_GIF_FPS = 50
 
 
-def animate(results, path=None, *, gif=None, mp4=None, fps=None, model=None, height=400):
+def animate(results, path=None, *, gif=None, mp4=None, fps=None, model=None, height=400,
+            overwrite=False):
     """Write the 3-D animation of ``results`` (``res.animate``).
 
     Parameters
@@ -32,12 +38,16 @@ def animate(results, path=None, *, gif=None, mp4=None, fps=None, model=None, hei
         Video files rendered without a browser (MP4 needs ffmpeg: ``pip install
         imageio-ffmpeg``, or one on the PATH).
     fps : float, optional
-        Frames per second: of the videos (default 25) and, when given, of the page (by
-        default the page keeps the results' grid, at most HTML_SAMPLES times).
+        Frames per second: of the videos (default 25; a GIF at most MAX_GIF_FPS) and, when
+        given, of the page (by default the page keeps the results' grid, at most
+        HTML_SAMPLES times).
     model : kinetwork.Model or kinetwork.System, optional
         What made the results, when they do not say.
     height : int
         Height of the videos in pixels; the width follows the scene's shape.
+    overwrite : bool
+        Replace an existing file of another kind (the output policy, ``kinetwork.outputs``:
+        never the model file, a special file or a folder).
 
     Returns
     -------
@@ -48,46 +58,71 @@ def animate(results, path=None, *, gif=None, mp4=None, fps=None, model=None, hei
     ------
     ModelError
         Nothing to write, a file name of the wrong kind or not writable, no ffmpeg for MP4,
-        or no model known.
+        too many frames, or no model known.
     """
-    wanted = [(path, ".html", "the page"), (gif, ".gif", "gif"), (mp4, ".mp4", "mp4")]
-    wanted = [(os.fspath(p), ext, what) for p, ext, what in wanted if p is not None]
+    wanted = [(path, ".html", "the page", "html"), (gif, ".gif", "gif", "gif"),
+              (mp4, ".mp4", "mp4", "mp4")]
+    wanted = [(os.fspath(p), ext, what, kind) for p, ext, what, kind in wanted if p is not None]
     if not wanted:
         raise ModelError("animate: nothing to write: give the path of an HTML page, gif=... "
                          "or mp4=...")
-    for p, ext, what in wanted:
+    source = model if model is not None else results.system
+    reads = model_files(getattr(source, "model", source))
+    for p, ext, what, _ in wanted:
         if os.path.isdir(p):
             raise ModelError(f"animate: {what} {p!r:.200} is a folder")
         if not p.lower().endswith(ext) and not (ext == ".html" and p.lower().endswith(".htm")):
             raise ModelError(f"animate: {what} {p!r:.200} must be a {ext} file")
+    check_all([(what, p, kind) for p, _, what, kind in wanted], reads, overwrite)
+    span = float(results.t[-1] - results.t[0]) if len(results.t) else 0.0
+    check_frames(span, fps, gif is not None, mp4 is not None)
     ffmpeg = video.find_ffmpeg() if mp4 is not None else None
     if mp4 is not None and ffmpeg is None:
         raise ModelError("animate: writing MP4 needs ffmpeg: pip install imageio-ffmpeg (or "
                          "put an ffmpeg on the PATH); a GIF needs nothing more")
+
+    def put(target, fill, kind):
+        try:
+            write(target, fill, kind, reads=reads, force=overwrite)
+        except OSError as exc:
+            raise ModelError(f"cannot write {target}: {exc.strerror or exc}") from None
     anim = None
     if path is not None:
-        anim = animation_data(results, fps=fps, model=model)
-        if len(anim["t"]) > HTML_SAMPLES:
-            span = anim["t"][-1] - anim["t"][0]
-            anim = animation_data(results, fps=(HTML_SAMPLES - 1) / span, model=model)
+        page_fps = fps
+        if span > 0 and (len(results.t) > HTML_SAMPLES if fps is None else
+                         span * fps + 1 > HTML_SAMPLES):
+            page_fps = (HTML_SAMPLES - 1) / span      # the player interpolates between
+        anim = animation_data(results, fps=page_fps, model=model)
         page = html_page(anim)
-        _write(path, lambda tmp: _write_text(tmp, page))
+        put(path, lambda tmp: _write_text(tmp, page), "html")
     if gif is not None or mp4 is not None:
         rate = fps or 25
         clip = animation_data(results, fps=rate, model=model)
         if gif is not None:
-            _write(gif, lambda tmp: video.write_gif(clip, tmp, rate, height))
+            put(gif, lambda tmp: video.write_gif(clip, tmp, rate, height), "gif")
         if mp4 is not None:
-            _write(mp4, lambda tmp: video.write_mp4(clip, tmp, rate, height, ffmpeg))
+            put(mp4, lambda tmp: video.write_mp4(clip, tmp, rate, height, ffmpeg), "mp4")
         anim = anim or clip
     return anim
 
 
-def _write(path, write):
-    try:
-        atomic_write(path, write)
-    except OSError as exc:
-        raise ModelError(f"cannot write {path}: {exc.strerror or exc}") from None
+def check_frames(span, fps, gif, mp4):
+    """Refuse (ModelError) videos of ``span`` seconds at ``fps`` with more frames than they
+    may have, before anything is simulated or drawn; ``gif``, ``mp4``: which are asked."""
+    if fps is not None and not (isinstance(fps, (int, float)) and not isinstance(fps, bool)
+                                and math.isfinite(fps) and fps > 0):
+        raise ModelError(f"animate: fps must be a finite number > 0, got {fps!r:.40}")
+    rate = fps or 25
+    if gif and rate > MAX_GIF_FPS:
+        raise ModelError(f"animate: a GIF plays at most {MAX_GIF_FPS} frames per second (its "
+                         f"frame delay is in hundredths of a second, and browsers hold each "
+                         f"frame at least 20 ms); got fps = {rate:g}")
+    frames = math.floor(span * rate + 1e-9) + 1
+    for asked, limit, what in ((gif, MAX_GIF_FRAMES, "a GIF"), (mp4, MAX_MP4_FRAMES, "an MP4")):
+        if asked and frames > limit:
+            raise ModelError(f"animate: {span:g} s at {rate:g} frames per second is {frames} "
+                             f"frames, more than the {limit} {what} may have; lower --fps "
+                             f"or --t-end (the HTML page has no such limit)")
 
 
 def _write_text(path, text):
@@ -152,16 +187,24 @@ def cli_animate(args, model):
     """``kinetwork animate MODEL --html out.html [--gif out.gif] [--mp4 out.mp4]``: simulate
     the model (its ``simulation`` block, ``--t-end``) and write its animation."""
     from ..errors import SimulationError
+    from ..graph.settings import check_settings
+    from ..solver.driver import DEFAULTS
     from ..solver.plan import simulate
-    outputs = [("--html", args.html), ("--gif", args.gif), ("--mp4", args.mp4)]
-    outputs = [(flag, path) for flag, path in outputs if path]
+    outputs = [("--html", args.html, "html"), ("--gif", args.gif, "gif"),
+               ("--mp4", args.mp4, "mp4")]
+    outputs = [(flag, path, kind) for flag, path, kind in outputs if path]
     if not outputs:
         raise ModelError("animate: nothing to write: give --html FILE.html, --gif FILE.gif "
                          "or --mp4 FILE.mp4")
-    for flag, path in outputs:
-        if os.path.realpath(path) == os.path.realpath(args.model):
-            raise ModelError(f"{flag} {path!r:.200} is the model file itself: choose another "
-                             f"path, nothing was run")
+    force = getattr(args, "force", False)
+    check_all(outputs, model_files(model), force)       # before anything is run
+    settings = {**DEFAULTS, **model.simulation,
+                **({"t_end": args.t_end} if args.t_end is not None else {})}
+    problems = check_settings(settings)
+    if problems:
+        raise ModelError(problems)
+    check_frames(settings["t_end"], args.fps, args.gif is not None, args.mp4 is not None)
+    for flag, path, _ in outputs:
         try:
             os.makedirs(os.path.dirname(os.path.abspath(path)), exist_ok=True)
         except OSError as exc:
@@ -171,13 +214,14 @@ def cli_animate(args, model):
         results = simulate(model, t_end=args.t_end)
     except SimulationError as exc:
         print(f"kinetwork: error: {exc}", file=sys.stderr)
+        if exc.signal is not None:                  # stopped: nothing more is drawn
+            raise Stopped(exc.signal) from None
         if exc.results is None or len(exc.results.t) < 2:
             return 3
         results, code = exc.results, 3
     anim = animate(results, args.html, gif=args.gif, mp4=args.mp4, fps=args.fps,
-                   model=model)
-    for flag, path in outputs:
+                   model=model, overwrite=force)
+    for flag, path, _ in outputs:
         print(f"wrote {flag[2:]} {path} ({os.path.getsize(path)} bytes, "
               f"{len(anim['t'])} frames over {anim['t'][-1] - anim['t'][0]:g} s)")
     return code
-

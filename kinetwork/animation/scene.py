@@ -43,7 +43,12 @@ def animation_data(results, fps=None, model=None):
     params = results.settings.get("params") or None
     values = system.model.numeric_values(params)
     t = np.asarray(results.t, dtype=float)
-    frames, index, positions, rotations = _frame_poses(system, results, params)
+    # resampled: the poses are computed only at the results' times the new grid falls
+    # between (a run of millions of points animated at 30 frames per second)
+    kept = _between(t, fps) if fps is not None else slice(None)
+    t = t[kept]
+    frames, index, positions, rotations = _frame_poses(system, t, results.states[kept],
+                                                       params)
     bodies = {}
     for comp in system.model.components.values():
         k = index.get(system.topology.set_of.get(comp.port_ref("frame_a"))) \
@@ -80,17 +85,30 @@ def animation_data(results, fps=None, model=None):
                      "direction": _direction(up, hi - lo).tolist(), "fov": 35}}
 
 
-def _frame_poses(system, results, params):
-    """(frames, {frame set: index}, positions, rotations) of every frame connection set: one
-    mapped evaluation of ``System.f_frames`` over the grid; positions (n, 3) and rotations
-    (n, 3, 3) per frame."""
-    t, sets = np.asarray(results.t, dtype=float), system.frame_sets
+def _between(t, fps):
+    """The indices of the times ``t`` that the grid of ``fps`` frames per second over them
+    falls between (what ``_resample`` interpolates from), in order."""
+    if not (isinstance(fps, (int, float)) and math.isfinite(fps) and fps > 0) or len(t) < 2:
+        return slice(None)                      # _resample says what is wrong with fps
+    count = int(math.floor((t[-1] - t[0]) * fps + 1e-9)) + 1
+    if count >= len(t):
+        return slice(None)
+    grid = t[0] + np.arange(count) / fps
+    i = np.clip(np.searchsorted(t, grid, side="right") - 1, 0, len(t) - 2)
+    return np.unique(np.concatenate([i, i + 1]))
+
+
+def _frame_poses(system, t, states, params):
+    """(frames, {frame set: index}, positions, rotations) of every frame connection set at
+    the times ``t`` and full ``states``: one mapped evaluation of ``System.f_frames`` over
+    them; positions (n, 3) and rotations (n, 3, 3) per frame."""
+    t, sets = np.asarray(t, dtype=float), system.frame_sets
     if not sets:
         raise ModelError(f"nothing to animate: {system.model.name!r} has no multibody frames")
     if not len(t):
         raise ModelError("nothing to animate: the results hold no time point")
     p = system.param_vector(params)
-    out = pointwise(system.f_frames, t[:, None], results.states, p)[0]
+    out = pointwise(system.f_frames, t[:, None], np.asarray(states), p)[0]
     out = out.reshape(len(t), len(sets), 12).transpose(1, 0, 2)          # set, time, 12
     bad = ~np.all(np.isfinite(out), axis=(0, 2))
     if bad.any():

@@ -38,6 +38,27 @@ def parameter_arg(text):
     return name.strip(), number
 
 
+def add_force(parser):
+    """``--force``: an output may replace an existing file of another kind."""
+    parser.add_argument("--force", action="store_true",
+                        help="replace an existing file of another kind (a CSV, an image, a "
+                             "model) at an output path; never a file the command reads, nor "
+                             "a device, pipe or folder")
+
+
+def interrupted(signum):
+    """The message and exit code of a command stopped by ``signum``."""
+    error(f"interrupted by {signal.Signals(signum).name}")
+    return 128 + int(signum)
+
+
+def simulation_failed(exc):
+    """The exit code of a SimulationError: 128 + the signal that stopped it, else
+    EXIT_SIMULATION (said on stderr)."""
+    error(exc)
+    return 128 + int(exc.signal) if exc.signal in STOPPING else EXIT_SIMULATION
+
+
 def positive(kind):
     """argparse type of a finite number > 0 (``kind`` int or float)."""
     def parse(text):
@@ -105,15 +126,14 @@ def example_name(text):
     return key in examples.names()
 
 
-def write_output(path, write, what, quiet=False):
-    """Write one output, making its folder; an OSError becomes a message naming the file."""
+def write_output(path, write):
+    """Write one output, making its folder; an OSError becomes a message naming the file.
+    Returns what ``write`` returns."""
     try:
         os.makedirs(os.path.dirname(os.path.abspath(path)), exist_ok=True)
-        write(path)
+        return write(path)
     except OSError as exc:
         raise kn.ModelError(f"cannot write {path}: {exc.strerror or exc}") from None
-    if not quiet:
-        print(f"wrote {what} {path}")
 
 
 def listing(items, limit=SHOWN_ITEMS):

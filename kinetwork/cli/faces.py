@@ -5,7 +5,7 @@ for."""
 
 import kinetwork as kn
 
-from .common import EXIT_SIMULATION, add_library, error, load_model, positive
+from .common import add_force, add_library, load_model, positive, simulation_failed
 
 
 def add(sub):
@@ -26,6 +26,7 @@ def add(sub):
     parser.add_argument("--t-end", type=float, metavar="T", help="end time [s]")
     parser.add_argument("--fps", type=positive(int), default=30, metavar="N",
                         help="frames per second of the animation (default 30)")
+    add_force(parser)
     add_library(parser)
     parser = sub.add_parser(
         "diagram", help="draw a model's wiring diagram as SVG",
@@ -34,6 +35,7 @@ def add(sub):
                     "layout where it has none.")
     parser.add_argument("model", metavar="MODEL.json", help="model file")
     parser.add_argument("-o", "--out", metavar="FILE.svg", required=True, help="the SVG file")
+    add_force(parser)
     add_library(parser)
     parser = sub.add_parser(
         "studio", help="open the browser studio",
@@ -60,6 +62,7 @@ def add(sub):
                         help="leave the joints' position limits out (default: hard end stops)")
     parser.add_argument("--gravity", type=float, nargs=3, metavar=("GX", "GY", "GZ"),
                         default=None, help="gravity of the ground (default 0 0 -9.81)")
+    add_force(parser)
     add_sweep(sub)
     for parser in commands.add_commands(sub):        # linearize, fit
         add_library(parser)
@@ -100,7 +103,10 @@ def sweep(args):
 
 def linearize(args):
     from ..analysis import commands
-    return commands.run_linearize(args, load_model(args.model, args.library))
+    try:
+        return commands.run_linearize(args, load_model(args.model, args.library))
+    except kn.SimulationError as exc:   # the run to --at-time failed: nothing to linearise
+        return simulation_failed(exc)
 
 
 def fit(args):
@@ -108,5 +114,4 @@ def fit(args):
     try:
         return commands.run_fit(args, load_model(args.model, args.library))
     except kn.SimulationError as exc:
-        error(exc)
-        return EXIT_SIMULATION
+        return simulation_failed(exc)

@@ -9,9 +9,13 @@ import time
 
 import kinetwork as kn
 
-from ..util import quote
-from .common import (EXIT_SIMULATION, EXIT_USAGE, STOPPING, add_library, error, listing,
-                     load_model, parameter_arg, positive, write_output)
+from ..outputs import OutputRefused, StopFlag, catching_signals, check_all, model_files, plot_kind
+from .common import (EXIT_SIMULATION, EXIT_USAGE, STOPPING, add_force, add_library, error,
+                     listing, load_model, parameter_arg, positive, write_output)
+
+#: seconds the outputs of a run still get to be written once it was stopped, or once its
+#: time limit has passed (within "about a second" of a stop, with what was reached)
+WRITE_GRACE = 0.5
 
 
 def add(sub):
@@ -54,7 +58,9 @@ def add(sub):
     parser.add_argument("--max-steps", type=positive(int), metavar="N",
                         help="step budget per output interval of the variable-step methods")
     parser.add_argument("--time-limit", type=positive(float), metavar="S",
-                        help="wall-clock limit of the integration [s]")
+                        help="wall-clock limit [s] of the run: C compilation, integration, "
+                             "probe signals and writing the outputs (what was reached is "
+                             "written)")
     parser.add_argument("--quiet", "-q", action="store_true",
                         help="print nothing but errors (on stderr)")
     parser.add_argument("--progress", action=argparse.BooleanOptionalAction, default=None,
@@ -67,23 +73,31 @@ def add(sub):
                         help="plot only these probes or signals (probe1, probe2.torque)")
     parser.add_argument("--hide-flat", action="store_true",
                         help="leave constant signals out of the plots (named under the figure)")
+    add_force(parser)
     add_library(parser)
     return {"run": run}
 
 
 def run(args):
-    clash = _clashing_paths(args)
-    if clash:
-        error(clash)
+    outputs = [("--out", args.out, "csv"), ("--plot", args.plot, plot_kind(args.plot or ""))]
+    try:                                # by name, before anything is read or run
+        check_all(outputs, [("the model file", args.model)], args.force)
+    except OutputRefused as exc:
+        error(f"{exc}: nothing was run")
         return EXIT_USAGE
     model = load_model(args.model, args.library)
+    try:                                # nor the definition files the model places
+        check_all(outputs, model_files(model), args.force)
+    except OutputRefused as exc:
+        error(f"{exc}: nothing was run")
+        return EXIT_USAGE
     if args.plot:
         from ..plot import check_plot_path
         check_plot_path(args.plot)
     # a subsystem's value by path ("cyl1.phi0") is a constant of its instance: set on the
     # model before it is compiled; model parameters go to the integrator
     from ..graph.settings import check_output, check_settings
-    from ..solver.driver import DEFAULTS
+    from ..solver.driver import DEFAULTS, output_values
 
     params = {}
     for name, value in args.param:
@@ -102,10 +116,12 @@ def run(args):
     start = time.perf_counter()
     system = model.compile(loops=args.loops)
     compiled = time.perf_counter()
-    n_values = 1 + system.n_states + system.n_algebraic + sum(sig.size for sig in system.signals)
-    problem = check_output(settings["n_points"], n_values)
+    problem = check_output(settings["n_points"], output_values(system),
+                           3 if args.error_estimate else 1)
     if problem:
         raise kn.ModelError(problem)
+    # the limit counts from the run (its C compilation included) to the last output written
+    deadline = None if args.time_limit is None else time.monotonic() + args.time_limit
     try:
         with _progress_bar(args, model, settings["t_end"]) as progress:
             results = kn.simulate(system, t_end=args.t_end, n_points=args.n_points,
@@ -117,17 +133,31 @@ def run(args):
     except kn.SimulationError as exc:
         error(exc)
         stopped = exc.signal in STOPPING
+        flag = None
         if exc.results is not None and len(exc.results.t):
             what = "interrupted" if stopped else "failed"
             try:
-                _outputs(args, exc.results, f"{model.name} ({what} at t = {exc.t_reached:g} s)")
+                flag = _outputs(args, exc.results,
+                                f"{model.name} ({what} at t = {exc.t_reached:g} s)", deadline,
+                                stopped)
             except kn.ModelError as write_exc:
                 error(write_exc)
-        return 128 + int(exc.signal) if stopped else EXIT_SIMULATION
+        signum = exc.signal if stopped else getattr(flag, "signum", None)
+        return 128 + int(signum) if signum else EXIT_SIMULATION
     done = time.perf_counter()
-    if args.quiet:
-        _outputs(args, results, model.name)
-        return 0
+    if not args.quiet:
+        _summary(args, model, system, results, start, compiled, done)
+    flag = _outputs(args, results, model.name, deadline)
+    if flag.cut is not None:            # the run is whole; its outputs were cut short
+        error(f"{flag.cut} while the outputs were written"
+              + (": the CSV ends with a line saying where" if args.out else ""))
+    if flag.signum is not None:
+        return 128 + int(flag.signum)
+    return EXIT_SIMULATION if flag.cut is not None else 0
+
+
+def _summary(args, model, system, results, start, compiled, done):
+    """What ``run`` prints about a finished run (not with --quiet)."""
     t = results.t
     print(f"{model.name}: {system.n_states} states ({listing(system.state_names)})")
     if args.param:
@@ -146,18 +176,44 @@ def run(args):
     if "error_estimate" in stats:
         from ..solver.estimate import summary
         print("\n".join(summary(stats["error_estimate"], results.signal_names)))
-    _outputs(args, results, model.name)
-    return 0
 
 
-def _outputs(args, results, title):
+def _outputs(args, results, title, deadline=None, stopped=False):
+    """Write the CSV and the plots of ``results``; returns the ``StopFlag`` that says why
+    writing stopped early (a signal, the time limit), if it did.
+
+    The time limit covers writing too; once it has passed, or after the run was ``stopped``
+    (a signal), the outputs get WRITE_GRACE seconds more. The CSV stops between blocks of
+    rows, keeping the rows written and a last line saying where; a plot is drawn whole or
+    not at all."""
     quiet = getattr(args, "quiet", False)
-    if args.out:
-        write_output(args.out, results.to_csv,
-               f"{len(results.t)} points x {len(results.columns()[0])} columns to", quiet)
-    if args.plot:
-        write_output(args.plot, lambda path: _save_plot(args, results, path, title),
-               "probe plots to", quiet)
+    now = time.monotonic()
+    if stopped:
+        flag = StopFlag(deadline=now + WRITE_GRACE,
+                        late=f"the run was stopped, and writing gets {WRITE_GRACE:g} s")
+    else:
+        flag = StopFlag(deadline=None if deadline is None else
+                        max(deadline, now + WRITE_GRACE))
+    flag.cut = None                     # why an output was cut short or not drawn
+    with catching_signals(flag):
+        if args.out:
+            why = write_output(args.out, lambda path: results.to_csv(
+                path, overwrite=args.force, stop=flag))
+            flag.cut = why
+            if not quiet:
+                rows = f"{len(results.t)} points" if why is None else \
+                    f"the first rows ({why}: cut short, said on its last line)"
+                print(f"wrote {rows} x {len(results.column_names())} columns to {args.out}")
+        if args.plot:
+            why = flag()
+            if why is not None:
+                flag.cut = why
+                error(f"--plot {args.plot} not drawn: {why}")
+            else:
+                write_output(args.plot, lambda path: _save_plot(args, results, path, title))
+                if not quiet:
+                    print(f"wrote probe plots to {args.plot}")
+    return flag
 
 
 def _save_plot(args, results, path, title):
@@ -167,11 +223,13 @@ def _save_plot(args, results, path, title):
     from .. import quickplot
     names, hide_flat = args.plot_signals, args.hide_flat
     if quickplot.drawable(path, results, names):
-        return quickplot.save_png(results, path, *names, title=title, hide_flat=hide_flat)
+        return quickplot.save_png(results, path, *names, title=title, hide_flat=hide_flat,
+                                  overwrite=args.force)
     from ..plot import save_plot
     worker = getattr(args, "plot_worker", None)
     draw = save_plot if worker is None else worker.save     # the same call, elsewhere
-    return draw(results, path, *names, title=title, hide_flat=hide_flat)
+    return draw(results, path, *names, title=title, hide_flat=hide_flat,
+                overwrite=args.force)
 
 
 @contextlib.contextmanager
@@ -193,26 +251,3 @@ def _progress_bar(args, model, t_end):
     finally:
         bar.close()
         terminal.close()
-
-
-def _clashing_paths(args):
-    """Why the outputs of a run would overwrite its model or each other, or None."""
-    named = [("the model file", args.model), ("--out", args.out), ("--plot", args.plot)]
-    named = [(what, path) for what, path in named if path]
-    for i, (what_a, a) in enumerate(named):
-        for what_b, b in named[i + 1:]:
-            if _same_file(a, b):
-                return (f"{what_b} {quote(b)} is {what_a} {'itself' if a == b else quote(a)}"
-                        f": choose another path, nothing was run")
-    return None
-
-
-def _same_file(a, b):
-    """Whether two paths name one file: the same after links are resolved, or (existing) the
-    same file by device and inode (a hard link)."""
-    if os.path.realpath(a) == os.path.realpath(b):
-        return True
-    try:
-        return os.path.samefile(a, b)
-    except OSError:                 # one does not exist yet: not the same file
-        return False

@@ -3,7 +3,7 @@
 import os
 
 from ..errors import ModelError
-from ..util import atomic_write
+from ..outputs import check, model_files, write
 from .drawing import svg
 
 
@@ -12,16 +12,16 @@ def cli_diagram(args, model):
     path = args.out
     if not str(path).lower().endswith(".svg"):
         raise ModelError(f"-o {path}: a diagram is written as SVG; name a .svg file")
-    if os.path.isdir(path):
-        raise ModelError(f"cannot write {path}: it is a folder")
+    reads, force = model_files(model), getattr(args, "force", False)
+    check(path, "svg", what="-o", reads=reads, force=force)       # before drawing anything
     text = svg(model)
 
-    def write(tmp):
+    def fill(tmp):
         with open(tmp, "w", encoding="utf-8") as fh:
             fh.write(text)
     try:
         os.makedirs(os.path.dirname(os.path.abspath(path)), exist_ok=True)
-        atomic_write(path, write)
+        write(path, fill, "svg", what="-o", reads=reads, force=force)
     except OSError as exc:
         raise ModelError(f"cannot write {path}: {exc.strerror or exc}") from None
     print(f"wrote the diagram of {model.name} ({len(model.components)} components, "

@@ -14,6 +14,7 @@ import os
 import pathlib
 import platform
 import re
+import stat
 import subprocess
 import sys
 import tempfile
@@ -120,6 +121,11 @@ def _target(path):
     if target.exists():
         if target.is_dir():
             raise ModelError(f"{quote(str(target))} is a folder; not replaced")
+        if not stat.S_ISREG(target.stat().st_mode):
+            # a device, a FIFO (opening one to look inside would wait for a writer), a
+            # socket: never replaced (the output policy, ``kinetwork.outputs``)
+            raise ModelError(f"{quote(str(target))} is not a regular file (a device, a FIFO "
+                             f"or a socket); not replaced")
         try:
             with zipfile.ZipFile(target) as z:
                 is_fmu = "modelDescription.xml" in z.namelist()

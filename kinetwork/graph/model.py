@@ -14,7 +14,8 @@ import numpy as np
 from ..components.base import ANY, Component, PortRef
 from ..util import hint, quote, suggest
 from . import quantities
-from .subsystem import Subsystem, check_placement, check_port_name, flatten, has_subsystems
+from .subsystem import (MAX_COMPONENTS, MAX_CONNECTIONS, Subsystem, check_placement,
+                        check_port_name, definitions, flatten, has_subsystems)
 from .writer import save
 from ..errors import ModelError, Problem
 from ..expr import CONSTANTS, FUNCTIONS, parse
@@ -81,6 +82,8 @@ class Model:
         #: "file", "folder" or "library", its text as read); a saver writes a reference to
         #: it while it is unchanged
         self.origin = None
+        #: the file ``kn.load`` read this model from (absolute), or None
+        self.path = None
         #: component name -> how messages locate it (files say 'components[3] "mass1"'; a
         #: flat model's inner components (path shown, place in their definition's file))
         self.places = {}
@@ -150,6 +153,10 @@ class Model:
         if component.name in self.components:
             raise ModelError(f"duplicate component name {component.name!r}",
                              component=component.name)
+        if len(self.components) >= MAX_COMPONENTS:
+            raise ModelError(f"{component.name}: model {self.name!r} has {MAX_COMPONENTS} "
+                             f"components already, the most a model may have",
+                             component=component.name)
         if isinstance(component, Subsystem):
             check_placement(self, component)
         self.components[component.name] = component
@@ -195,6 +202,10 @@ class Model:
             self._wired = {frozenset(c) for c in self.connections}
         if frozenset((pa, pb)) in self._wired:
             raise ModelError(f"{pa.path} and {pb.path} are already connected")
+        if len(self.connections) >= MAX_CONNECTIONS:
+            raise ModelError(f"{pa.path} - {pb.path}: model {self.name!r} has "
+                             f"{MAX_CONNECTIONS} connections already, the most a model may "
+                             f"have")
         self.connections.append((pa, pb))
         self._wired.add(frozenset((pa, pb)))
 
@@ -268,7 +279,9 @@ class Model:
         """Model parameters with ``overrides`` applied and checked; an override may be a
         number with a unit (``{"c": "2 N*m/rad"}``), in SI base units, checked against the
         units of the component parameters that use it."""
-        values = dict(self.parameters)
+        # checked again: ``parameters`` is a plain dict that code may have written to directly
+        values = {key: quantities.to_si(value, f"parameters.{key}")
+                  for key, value in self.parameters.items()}
         for key, value in (overrides or {}).items():
             if key not in values and "." in key:
                 instance, _, name = key.rpartition(".")
@@ -319,17 +332,29 @@ class Model:
             raise ModelError(problems)
         return out
 
-    def content_key(self):
+    def content_key(self, _memo=None):
         """What the equations of the model depend on, as a hashable value: the parameter
         names, every component (the object, its type and given parameters) and the wiring.
-        Parameter *values* are not in it: they stay symbols in a compiled System."""
-        comps = tuple((id(c), name, c.signature()) if isinstance(c, Subsystem) else
+        Parameter *values* are not in it: they stay symbols in a compiled System. A placed
+        definition is in it as a digest of its own key (``fingerprint``), each computed once:
+        definitions that each place two of the next cost their number, not 2^depth."""
+        memo = {} if _memo is None else _memo
+        comps = tuple((id(c), name, c.signature(memo)) if isinstance(c, Subsystem) else
                       (id(c), name, type(c).__qualname__, repr(sorted(c.given.items())))
                       for name, c in self.components.items())
         wiring = tuple((a.path, id(a.component), b.path, id(b.component))
                        for a, b in self.connections)
         exposed = tuple((k, v.path, id(v.component)) for k, v in self.exposed.items())
         return tuple(self.parameters), comps, wiring, exposed
+
+    def fingerprint(self, _memo=None):
+        """A digest of ``content_key`` (a text of 64 hex digits), computed once per model in
+        one walk (``_memo``)."""
+        memo = {} if _memo is None else _memo
+        if id(self) not in memo:
+            import hashlib
+            memo[id(self)] = hashlib.sha256(repr(self.content_key(memo)).encode()).hexdigest()
+        return memo[id(self)]
 
     def validate(self) -> Topology:
         """Check the whole model; return its Topology or raise one ModelError listing all.
@@ -374,9 +399,27 @@ class Model:
                 self._compiled[key] = system
             return self._compiled[key]
 
-    def save(self, path: str | os.PathLike) -> None:
-        """Write the model as JSON (atomically: a failed save leaves the old file whole)."""
-        save(self, path)
+    def save(self, path: str | os.PathLike, overwrite: bool = False) -> None:
+        """Write the model as JSON (atomically: a failed save leaves the old file whole).
+        A file that is not a model file (a CSV, an image), a definition file this model
+        places, a folder or a special file is refused (``overwrite=True`` replaces the
+        first kind); see ``kinetwork.outputs``."""
+        save(self, path, overwrite=overwrite)
+
+    def files(self) -> list[str]:
+        """The files this model was read from: its own (``kn.load``) and those of the
+        subsystem definitions it places or keeps. What reads them never writes them."""
+        if self._source is not None:                # a flat model: its model's files
+            return self._source.files()
+        found = [self.path] if self.path else []
+        try:
+            placed = definitions(self)
+        except ModelError:                          # a cycle: refused where it matters
+            placed = []
+        for d in [*self.definitions.values(), *placed]:
+            if d.origin is not None:
+                found.append(d.origin[0])
+        return list(dict.fromkeys(found))
 
     def _repr_svg_(self):
         """Jupyter shows a model as its wiring diagram (``kinetwork.diagram.svg``)."""

@@ -24,6 +24,12 @@ from ..util import hint, quote, suggest
 
 #: how deep subsystems may nest (a cycle is refused by name long before)
 DEPTH_LIMIT = 64
+#: the most components a model may hold, its subsystems expanded (a 10,000-link chain is
+#: 30,000): checked before anything is expanded, so a file of a few kilobytes whose
+#: definitions each place two of the next cannot grow without bound
+MAX_COMPONENTS = 100_000
+#: the most connections, likewise
+MAX_CONNECTIONS = 4 * MAX_COMPONENTS
 
 
 class Subsystem(Component):
@@ -92,10 +98,11 @@ class Subsystem(Component):
                              port=name if isinstance(name, str) else None)
         return PortRef(self, name)
 
-    def signature(self):
-        """What the equations of this instance depend on: its definition, the values given
-        and the definition's own values (numbers are constants of the instance)."""
-        return (self.definition.content_key(), repr(sorted(self.given.items())),
+    def signature(self, _memo=None):
+        """What the equations of this instance depend on: its definition (the digest of its
+        content), the values given and the definition's own values (numbers are constants
+        of the instance)."""
+        return (self.definition.fingerprint(_memo), repr(sorted(self.given.items())),
                 repr(sorted(self.definition.parameters.items())))
 
     def __repr__(self):
@@ -245,12 +252,16 @@ class _Flat:
         expressions without free names as numbers; one that cannot be evaluated (a division
         by zero, a root of a negative number once the instance's numbers are in) is a
         problem naming its place, and stays as it was."""
+        def place():            # only for a message: a model's every parameter passes here
+            where = m.place(comp, key)
+            return f"{shown}.{key}" + ("" if where == f"{comp.name}.{key}" else f" ({where})")
         try:
             return _map(value, lambda text: _constant(rename(text, scope)))
+        except ModelError as exc:               # grows past a bound once renamed
+            raise ModelError(f"{place()}: {exc}", component=flat, parameter=key,
+                             path=self.flat.paths.get(flat)) from None
         except (ZeroDivisionError, ValueError, OverflowError, TypeError) as exc:
-            where = m.place(comp, key)
-            place = f"{shown}.{key}" + ("" if where == f"{comp.name}.{key}" else f" ({where})")
-            self.problems.append(Problem(f"{place} = {quote(value, 60)}: cannot be evaluated "
+            self.problems.append(Problem(f"{place()} = {quote(value, 60)}: cannot be evaluated "
                                          f"with this instance's parameters ({exc})",
                                          component=flat, parameter=key,
                                          path=self.flat.paths.get(flat)))
@@ -276,7 +287,11 @@ class _Flat:
                         path=m.fields(sub, key)["path"] if m is self.model else None))
                     inner[key] = "0"
                 else:
-                    inner[key] = f"({rename(value, scope)})"
+                    try:
+                        inner[key] = f"({rename(value, scope)})"
+                    except ModelError as exc:     # grows past a bound: say where
+                        raise ModelError(f"{path}.{key} ({m.place(sub, key)}): {exc}") \
+                            from None
             else:
                 inner[key] = repr(float(value))
         return inner
@@ -305,13 +320,78 @@ class _Flat:
         raise ModelError(f"{prefix}{ref.path}: subsystems nested more than {DEPTH_LIMIT} deep")
 
 
+def flat_size(model):
+    """(components, connections) of ``model`` once every subsystem is expanded, counted once
+    per definition (nothing is expanded: a definition placed a million times is counted
+    once); exact however large."""
+    definitions(model)              # a cycle is refused before it is counted
+    return _counter()(model)
+
+
+def _counter():
+    """A function giving (components, connections) of a model flat, remembering each
+    definition's count."""
+    memo = {}
+
+    def count(m):
+        if id(m) not in memo:
+            comps, conns = 0, len(m.connections)
+            for comp in m.components.values():
+                if isinstance(comp, Subsystem):
+                    a, b = count(comp.definition)
+                elif _aggregate(comp):
+                    inner = comp.expand()
+                    a, b = len(inner.components), len(inner.connections)
+                else:
+                    a, b = 1, 0
+                comps, conns = comps + a, conns + b
+            memo[id(m)] = (comps, conns)
+        return memo[id(m)]
+    return count
+
+
+def check_size(model):
+    """Refuse (ModelError) a model whose flat form would have more than MAX_COMPONENTS
+    components or MAX_CONNECTIONS connections, naming the instances, by path, through which
+    it grows; before anything is expanded."""
+    definitions(model)
+    count = _counter()
+    comps, conns = count(model)
+    if comps <= MAX_COMPONENTS and conns <= MAX_CONNECTIONS:
+        return
+    path, names, m = [], [], model
+    while len(path) < DEPTH_LIMIT:       # down the heaviest instance at each level
+        subs = [c for c in m.components.values() if isinstance(c, Subsystem)]
+        if not subs:
+            break
+        heaviest = max(subs, key=lambda c: count(c.definition))
+        names.append(heaviest.name)
+        path.append(f"{'.'.join(names)} ({heaviest.definition.name}, "
+                    f"{_many(count(heaviest.definition)[0])} components)")
+        m = heaviest.definition
+    shown = ", ".join(path[:6]) + (f", ..., {path[-1]}" if len(path) > 6 else "")
+    over = comps > MAX_COMPONENTS
+    what = f"{_many(comps)} components" if over else f"{_many(conns)} connections"
+    limit = f"{MAX_COMPONENTS} components" if over else f"{MAX_CONNECTIONS} connections"
+    raise ModelError(f"model {model.name!r}: {what} once its subsystems are expanded, more "
+                     f"than the {limit} a model may have"
+                     + (f"; it grows through {shown}" if path else "")
+                     + " (nothing was expanded)")
+
+
+def _many(n):
+    """A count for a message: as it is below a trillion, else 1.23e+45."""
+    return str(n) if n < 10**12 else f"{float(n):.3g}" if n < 10**300 else "more than 1e300"
+
+
 def flatten(model):
     """The flat model of ``model`` (``model`` itself when it places no subsystem): components
     and parameters named by path, connections through exposed ports resolved to the inner
-    ports. Refuses cycles, unknown exposed ports and unknown names, naming the path."""
+    ports. Refuses cycles, unknown exposed ports and unknown names, naming the path, and a
+    model too large once expanded (``check_size``), before expanding anything."""
     if not has_subsystems(model):
         return model
-    definitions(model)
+    check_size(model)
     flat = type(model).__new__(type(model))
     flat._init_flat(model)
     walker = _Flat(model, flat)

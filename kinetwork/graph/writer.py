@@ -13,7 +13,8 @@ from typing import TYPE_CHECKING
 
 from ..components.base import _NAME, REGISTRY
 from ..errors import ModelError
-from ..util import atomic_write, finite
+from ..outputs import check, model_files, write
+from ..util import finite
 from .initial import check_initial
 from .settings import check_setting
 from .subsystem import Subsystem
@@ -174,31 +175,37 @@ def dumps(model: Model, folder: str | os.PathLike | None = None) -> str:
     return _render(model_to_dict(model, folder), 0) + "\n"
 
 
-def save(model: Model, path: str | os.PathLike) -> None:
-    """Write ``model`` to ``path`` atomically: a failed save leaves the old file whole.
-
-    The text goes to a temporary file in the same folder, is flushed to disk, then replaces
-    ``path`` in one step; on any failure the temporary file is removed.
+def save(model: Model, path: str | os.PathLike, overwrite: bool = False) -> None:
+    """Write ``model`` to ``path`` under the output policy (``kinetwork.outputs``): atomically
+    (a failed save leaves the old file whole), never over a file the model was read from
+    (a definition file it references), a special file or a folder.
 
     Parameters
     ----------
     model : Model
     path : str or os.PathLike
+    overwrite : bool
+        Replace an existing file that is not a model file (a CSV, an image, other JSON...);
+        a model file is replaced without it.
 
     Raises
     ------
     ModelError
-        The model cannot be written as a file (see :func:`model_to_dict`); nothing is written.
+        The model cannot be written as a file (see :func:`model_to_dict`), or the policy
+        refuses the path (``OutputRefused``); nothing is written.
     OSError
         The file system refused; the old file is unchanged.
     """
+    # its own file is saved over (that is what saving is); its definitions' files are read
+    reads = [item for item in model_files(model) if item[0] != "the model file"]
+    check(path, "model", reads=reads, force=overwrite)
     folder = os.path.dirname(os.path.abspath(os.fspath(path)))
     text = dumps(model, folder).encode("utf-8")   # every refusal before the disk is touched
 
-    def write(tmp):
+    def fill(tmp):
         with open(tmp, "wb") as fh:
             fh.write(text)
-    atomic_write(path, write)
+    write(path, fill, "model", reads=reads, force=overwrite)
 
 
 def _render(value, level):

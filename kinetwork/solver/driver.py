@@ -15,7 +15,8 @@ machine, so a run's numbers never depend on how fast the machine is or how loade
 
 Each chunk restarts a multistep method (order and step size begin again from one step of order
 one: +33 % evaluations on a 128-link chain in 8 chunks), so a quiet run (nothing of the above
-to watch, a CasADi method) goes in one call over the whole grid. Signals still stop any run at
+to watch, a CasADi method) goes in one call over the whole grid, up to MAX_CHUNK output
+intervals. Signals still stop any run at
 once: CasADi checks Python's signals at every evaluation of the equations, the driver's handler
 aborts the call there, and the outputs it had reached are kept (CasADi writes them into the
 driver's arrays as it goes). A quiet run and a watched one of the same model may differ at the
@@ -59,10 +60,20 @@ CHUNK_WORK = 1e8
 #: CHUNK_GROWTH-fold (each chunk restarts a multistep method: few chunks for a fast run)
 FIRST_CHUNK_STEPS = 100
 CHUNK_GROWTH = 16
+#: output intervals of one CasADi call at most, quiet runs included: building an integrator
+#: over 6e6 output times took 4 s and stopping it only comes between calls (a signal aborts
+#: a call, not the building), and work counts miss the cost of the outputs themselves
+MAX_CHUNK = 2**16
 #: restarts after a failure, with ``restart=True``, at most
 MAX_RESTARTS = 3
 #: a restarted run must keep the loops closed to this (m, or rotation-matrix entries)
 RESTART_CLOSURE = 1e-6
+#: the probe signals of a long grid are computed in chunks of about this much work (points
+#: times the instructions of one evaluation: 10 ms or so), a stop served between them
+OUTPUT_CHUNK_WORK = 1e7
+#: after a run stopped (a signal, the time limit), the probe signals of what it reached are
+#: still computed for at most this long [s] (unless stopped again), and kept
+OUTPUT_GRACE = 0.5
 #: an assembly whose (dimensionless) measure of a singular position is below this at the last
 #: output of a failed run is named as near its singular position there
 NEAR_SINGULAR_ASSEMBLY = 1e-3
@@ -90,7 +101,8 @@ def _close_sink():
 class Run:
     """One call of ``simulate``: the settings every method reads, and the driver's state."""
 
-    def __init__(self, system, p, x0, grid, settings, jit, cancel, progress, restart):
+    def __init__(self, system, p, x0, grid, settings, jit, cancel, progress, restart,
+                 started=None):
         self.system, self.p, self.x0, self.grid = system, p, x0, grid
         self.compiled = compiled(system)
         self.t_start, self.t_end = float(grid[0]), float(grid[-1])
@@ -103,12 +115,13 @@ class Run:
         self.steps_per_interval = max(1, math.ceil(self.spacing / (self.step or self.spacing)
                                                    * (1 - 1e-12)))
         self.max_steps = settings["max_steps"]
-        self.started = time.perf_counter()
+        self.started = time.perf_counter() if started is None else started
         limit = settings["time_limit"]
         self.deadline = self.started + limit if limit else None
         self.jit = jit
         self.cancel, self.progress, self.restart = cancel, progress, restart
         self.signal = None              # the signal that stopped the run, if one did
+        self.signals_seen = 0           # how many arrived
         self.instructions = (system.f_rhs or system.f_dae).n_instructions()
         self.said = []                  # what the solvers printed
         self.quiet = False              # nothing to watch: one call over the grid
@@ -172,7 +185,7 @@ class Run:
             raise Failure(reason, states)
 
 
-def _check(system, settings, t_start, max_steps, time_limit):
+def _check(system, settings, t_start, max_steps, time_limit, runs=1):
     """The method's table key, once every setting is checked (one ModelError for all)."""
     if not isinstance(t_start, (int, float)) or isinstance(t_start, bool) or \
             not math.isfinite(t_start):
@@ -182,9 +195,8 @@ def _check(system, settings, t_start, max_steps, time_limit):
         problems.append(f"simulation.t_end: must be > t_start = {t_start}, "
                         f"got {settings['t_end']}")
     if not problems:        # what the results would hold: time, the full state, the probes
-        values = 1 + system.n_states + system.n_algebraic + \
-            sum(sig.size for sig in system.signals)
-        problems += filter(None, [check_output(int(settings["n_points"]), values)])
+        problems += filter(None, [check_output(int(settings["n_points"]),
+                                               output_values(system), runs)])
     for name, value, kind in (("max_steps", max_steps, int), ("time_limit", time_limit, float)):
         if value is not None and (isinstance(value, bool) or not isinstance(value, (int, float))
                                   or not math.isfinite(value) or value <= 0
@@ -217,6 +229,12 @@ def _check(system, settings, t_start, max_steps, time_limit):
             f"{', '.join(k for k, m in METHODS.items() if m.dae)}, or, for loops, compile the "
             f"model with loops='projected' or loops='baumgarte' (ODEs)")
     return key
+
+
+def output_values(system):
+    """Numbers a run of ``system`` keeps per output point: time, the full state and every
+    probe value (``check_output`` adds what the run needs beside them)."""
+    return 1 + system.n_states + system.n_algebraic + sum(sig.size for sig in system.signals)
 
 
 def _check_finite_start(system, t, x0, p):
@@ -258,11 +276,11 @@ def _auto(run, stats):
 def _integrate(run, method):
     """States on the grid from ``method``, chunk by chunk: (X, failure or None, stats)."""
     grid, n = run.grid, len(run.grid)
-    X = _Rows(run.x0)
+    X = _Rows(run.x0, n)
     parts = Partitions(run)            # the loops' partitions the run goes through
     stats, restarts = {}, []           # stats: of the steppers replaced by restarts
     if method.fixed and run.max_steps and run.steps_per_interval > run.max_steps:
-        return np.array(X), (f"the step budget of {run.max_steps} steps per output interval "
+        return X.array(), (f"the step budget of {run.max_steps} steps per output interval "
                              f"is smaller than the {run.steps_per_interval} steps of "
                              f"{run.step or run.spacing:g} s that the fixed-step method "
                              f"takes"), stats
@@ -273,12 +291,14 @@ def _integrate(run, method):
     try:
         stepper = method.start(run, grid[0], X[0])
     except Failure as failure:
-        return np.array(X), failure.reason, stats
+        return X.array(), failure.reason, stats
     # (time events alone: each call goes to the next of them, the method restarts there)
     run.quiet = method.interruptible and (run.events is None or not run.events.located) and \
         run.system.f_dependent is None and run.progress is None and run.cancel is None \
         and run.deadline is None
     chunk = n - 1 if method.stepper or run.quiet else _first_chunk(run, method, n - 1)
+    if not method.stepper:
+        chunk = min(chunk, MAX_CHUNK)
     if run.events is not None and run.events.located:
         chunk = min(chunk, EVENT_CHUNK)
     k, failure = 0, None
@@ -294,7 +314,9 @@ def _integrate(run, method):
         origin, restarted = restart_at or (grid[k], X[-1]), restart_at is not None
         restart_at = None
         try:
-            if run.events is None:
+            if run.events is None and getattr(stepper, "writes_in_place", False):
+                new = stepper.advance(times, out=X.slot(m))
+            elif run.events is None:
                 new = stepper.advance(times)
             else:
                 new, restart_at = run.events.advance(method, stepper, times, origin, restarted)
@@ -334,9 +356,10 @@ def _integrate(run, method):
                 continue
             break
         if run.quiet:                   # the rest at once (after a restart's first output)
-            chunk = n - 1 - k
+            chunk = min(n - 1 - k, MAX_CHUNK)
         elif not method.stepper:
-            chunk = _next_chunk(run, m, _work(run, stepper.stats) - work_before, n - 1 - k)
+            chunk = min(_next_chunk(run, m, _work(run, stepper.stats) - work_before,
+                                    n - 1 - k), MAX_CHUNK)
             if run.events is not None and run.events.located:
                 chunk = run.events.chunk(chunk, restart_at is not None)
             chunk = parts.limit(chunk)
@@ -345,12 +368,49 @@ def _integrate(run, method):
             chunk = run.events.chunk(n - 1 - k, restart_at is not None)
     if failure is not None and run.system.f_dependent is not None and \
             run.stop_reason() is None and "singular" not in failure:
-        failure += near_singular(run, np.array(X), grid)
+        failure += near_singular(run, X.array(), grid)
     stats = _merge(stats, stepper.stats)
     if restarts:
         stats["restarts"] = [{"t": r["t"], "after": r["after"]} for r in restarts]
     stats.update(parts.done())
-    return np.array(X), failure, stats
+    return X.array(), failure, stats
+
+
+def _probe_outputs(run, t, X):
+    """The full states polished (loops closed to machine precision) and the probe signals,
+    computed in chunks of the grid into arrays allocated once: (X, outputs, why cut or
+    None). Between chunks a stop is served (a signal, ``cancel``, the time limit): what was
+    computed is kept, cut at the last whole chunk. A run already stopped before this phase
+    gets OUTPUT_GRACE seconds for it (the outputs of what it reached), unless stopped again.
+    """
+    system, p, n = run.system, run.p, len(t)
+    f_out = compiled(system).outputs(run.jit)
+    width = system.f_out.size1_out(0)
+    outputs = np.empty((n, width))
+    if not n:
+        return X, outputs, None
+    size = int(min(max(OUTPUT_CHUNK_WORK / max(system.f_out.n_instructions(), 1), 256),
+                   2**16))
+    size = 2 ** int(np.log2(size))          # few sizes: each has its mapped Function
+    started, earlier, seen = time.perf_counter(), run.stop_reason(), run.signals_seen
+
+    def stopped():
+        if earlier is None or run.signals_seen != seen:
+            why = run.stop_reason()
+            return None if why is None else f"{why} while the probe signals were computed"
+        if time.perf_counter() - started > OUTPUT_GRACE:
+            return f"the probe signals were computed for {OUTPUT_GRACE:g} s after the stop"
+        return None
+
+    polished = X if not system.n_algebraic else np.array(X, dtype=float)
+    for k in range(0, n, size):
+        if k and (why := stopped()) is not None:
+            return polished[:k], outputs[:k], f"{why}: kept up to t = {t[k - 1]:g} s"
+        rows = slice(k, min(n, k + size))
+        if system.n_algebraic:
+            polished[rows] = system.polish(polished[rows], p, t[rows])
+        system.outputs_into(t[rows], polished[rows], p, outputs[rows], f_out)
+    return polished, outputs, None
 
 
 def _assembly_watch(run, X, new, failure):
@@ -387,41 +447,53 @@ def _first_chunk(run, method, intervals):
 
 
 class _Rows:
-    """The states reached, kept as the blocks the chunks gave (a list of 10^5 rows costs more
-    to build and join than the integration of a small model)."""
+    """The states reached, in one array of the grid's size allocated at the start (a list of
+    10^5 rows costs more to build and join than the integration of a small model, and
+    joining blocks at the end would hold the states twice): a CasADi method writes its
+    outputs straight into the rows reserved for them (``slot``)."""
 
-    def __init__(self, x0):
-        self.blocks = [np.asarray(x0, dtype=float)[None, :]]
+    def __init__(self, x0, n):
+        x0 = np.asarray(x0, dtype=float)
+        self.data = np.empty((max(n, 1), len(x0)))
+        self.data[0] = x0
         self.n = 1
 
     def __len__(self):
         return self.n
 
     def __getitem__(self, i):
-        if i < 0:
-            i += self.n
-        for block in self.blocks:
-            if i < len(block):
-                return block[i]
-            i -= len(block)
-        raise IndexError(i)
+        return self.data[:self.n][i]
+
+    def slot(self, m):
+        """The next ``m`` rows, for a method to write into (then ``extend`` with them)."""
+        return self.data[self.n:self.n + m]
 
     def extend(self, rows):
-        rows = np.asarray(rows, dtype=float).reshape(-1, self.blocks[0].shape[1])
-        if len(rows):
-            self.blocks.append(rows)
-            self.n += len(rows)
+        rows = np.asarray(rows, dtype=float).reshape(-1, self.data.shape[1])
+        m = len(rows)
+        if not m:
+            return
+        if self.n + m > len(self.data):             # a restart's row past the grid: grow
+            self.data = np.concatenate([self.data[:self.n], rows])
+            self.n += m
+            return
+        target = self.data[self.n:self.n + m]
+        if rows.ctypes.data != target.ctypes.data or rows.strides != target.strides:
+            target[...] = rows                      # not written in place by the method
+        self.n += m
 
     def append(self, row):
         self.extend(np.asarray(row)[None, :])
 
     def replace_last(self, row):
-        block = self.blocks[-1].copy()        # the first block may be a view of x0
-        block[-1] = row
-        self.blocks[-1] = block
+        self.data[self.n - 1] = row
+
+    def array(self):
+        """The rows reached (a view, not a copy)."""
+        return self.data[:self.n]
 
     def __array__(self, dtype=None, copy=None):
-        out = np.vstack(self.blocks)
+        out = self.array()
         return out if dtype is None else out.astype(dtype)
 
 
@@ -509,6 +581,7 @@ def _running(run):
 
     def stop(signum, frame):
         run.signal = signum
+        run.signals_seen += 1
         if run.abortable:           # raised in CasADi's check for signals: the call stops
             run.abortable = False
             raise Interrupted

@@ -51,6 +51,7 @@ import functools
 import hashlib
 import os
 import pathlib
+import re
 import shutil
 import stat
 import threading
@@ -89,6 +90,8 @@ COMPILE_TIMEOUT = 300.0
 #: the cache is trimmed to this size after each build, least recently loaded first
 MAX_CACHE_BYTES = 512 * 2**20
 
+#: how kinetwork names a library: see ``_names``
+_LIBRARY_NAME = re.compile(r"[A-Za-z0-9_]+(-quick)?_[0-9a-f]{20}\.so")
 _POLL = 0.05                                  # s between looks at the lock
 _QUIET = ("cancelled", "deadline")            # fallbacks the caller asked for
 _LOCK = threading.RLock()
@@ -175,8 +178,8 @@ def compile_functions(name, functions, stats=None, deadline=None, cancelled=None
             _touch(lib)
         elif _tier(functions) == "optimised":
             lib = optimised
-            build(cc, _generate(functions, jacobian, "optimised"), lib, deadline, cancelled,
-                  COMPILE_TIMEOUT)
+            build(cc, _generated(functions, jacobian, "optimised", deadline, cancelled), lib,
+                  deadline, cancelled, COMPILE_TIMEOUT)
             _trim(folder, keep=lib)
         else:
             tier, lib = "quick", folder / names["quick"]
@@ -184,8 +187,8 @@ def compile_functions(name, functions, stats=None, deadline=None, cancelled=None
             if hit:
                 _touch(lib)
             else:
-                build(cc, _generate(functions, jacobian, "quick"), lib, deadline, cancelled,
-                      COMPILE_TIMEOUT)
+                build(cc, _generated(functions, jacobian, "quick", deadline, cancelled), lib,
+                      deadline, cancelled, COMPILE_TIMEOUT)
                 _trim(folder, keep=lib)
             if level() == "tiered" and str(lib) not in _PENDING:
                 pending = jit_tiers.start(optimised, name, serialised, jacobian)
@@ -256,39 +259,71 @@ def wait(timeout=None):
 
 
 def cache_info():
-    """What the cache holds: ``folder``, ``entries``, ``bytes`` and ``libraries``, a list of
-    (file name, bytes, mtime), the most recently loaded first."""
+    """What the cache holds of kinetwork's own (libraries with their records, see
+    :func:`recorded`): ``folder``, ``entries``, ``bytes`` and ``libraries``, a list of (file
+    name, bytes, mtime), the most recently loaded first."""
     folder = cache_dir()
-    libraries = []
-    for lib in folder.glob("*.so") if folder.is_dir() else ():
-        with contextlib.suppress(OSError):
-            st = lib.lstat()
-            libraries.append((lib.name, st.st_size, st.st_mtime))
+    libraries = [(lib.name, size, mtime) for lib, size, mtime in recorded(folder)]
     libraries.sort(key=lambda entry: -entry[2])
     return {"folder": str(folder), "entries": len(libraries),
             "bytes": sum(size for _, size, _ in libraries), "libraries": libraries}
 
 
+def recorded(folder):
+    """(path, bytes, mtime) of each library kinetwork built in ``folder``: a regular file
+    named as kinetwork names libraries (``<name>[-quick]_<20 hex digits>.so``) with its
+    record beside it. Nothing else in the folder is counted, trimmed or cleared."""
+    found = []
+    if not folder.is_dir():
+        return found
+    for lib in folder.glob("*.so"):
+        if not _LIBRARY_NAME.fullmatch(lib.name):
+            continue
+        with contextlib.suppress(OSError):
+            st, rec = lib.lstat(), _record(lib).lstat()
+            if stat.S_ISREG(st.st_mode) and stat.S_ISREG(rec.st_mode):
+                found.append((lib, st.st_size, st.st_mtime))
+    return found
+
+
 def clear_cache():
-    """Remove what kinetwork wrote in the cache (libraries, their records, the notes of
-    failed background builds, lock files no build holds, and build folders left by killed
-    processes); return the number of files removed. Anything else in the folder is left
-    alone."""
+    """Remove what kinetwork wrote in the cache: the libraries its records name, those
+    records, records left without their library, the notes of failed background builds and
+    lock files no build holds (of libraries named as kinetwork names them), and build
+    folders left by killed processes; return the number of files removed. Anything else in
+    the folder (a library without a record, any other file) is left alone."""
     folder = cache_dir()
     if not folder.is_dir():
         return 0
     removed = 0
     with _LOCK:
-        for path in [*folder.glob("*.so"), *folder.glob("*.so.sha256"),
-                     *folder.glob("*.so.failed")]:
-            if not path.is_dir():
-                removed += _remove(path)
+        for lib, _, _ in recorded(folder):
+            removed += _remove(lib) + _remove(_record(lib))
+        for rec in folder.glob("*.so.sha256"):
+            lib = rec.with_name(rec.name[:-len(".sha256")])
+            if _LIBRARY_NAME.fullmatch(lib.name) and not lib.exists() and _is_record(rec):
+                removed += _remove(rec)
+        for note in folder.glob("*.so.failed"):
+            if _LIBRARY_NAME.fullmatch(note.name[:-len(".failed")]) and \
+                    stat.S_ISREG(note.lstat().st_mode):
+                removed += _remove(note)
         for lock in folder.glob("*.so.lock"):
-            removed += _remove_unheld(lock)
+            if _LIBRARY_NAME.fullmatch(lock.name[:-len(".lock")]):
+                removed += _remove_unheld(lock)
         for old in _stale_builds(folder):
             removed += sum(1 for p in old.rglob("*") if not p.is_dir())
             shutil.rmtree(old, ignore_errors=True)
     return removed
+
+
+def _is_record(path):
+    """Whether ``path`` is a regular file holding what kinetwork writes in a record."""
+    try:
+        if not stat.S_ISREG(path.lstat().st_mode) or path.lstat().st_size != 65:
+            return False
+        return re.fullmatch(rb"[0-9a-f]{64}\n", path.read_bytes()) is not None
+    except OSError:
+        return False
 
 
 # -- the cache folder --------------------------------------------------------------------------
@@ -370,6 +405,18 @@ def _generate(functions, jacobian, tier):
     return sources
 
 
+def _generated(functions, jacobian, tier, deadline, cancelled):
+    """``_generate``, unless the caller no longer wants the library (``deadline`` passed,
+    ``cancelled()``): asked before and after writing the C, which takes seconds for a long
+    model."""
+    if stop := _stop(deadline, cancelled):
+        raise stop
+    sources = _generate(functions, jacobian, tier)
+    if stop := _stop(deadline, cancelled):
+        raise stop
+    return sources
+
+
 def _sources(name, f, tier, swappable):
     part = PART_STATEMENTS if f.n_instructions() > SPLIT_STATEMENTS else None
     files = jit_source.sources(name, f, [*LEVELS[tier], *CFLAGS], part)
@@ -387,15 +434,12 @@ def _touch(lib):
 
 
 def _trim(folder, keep):
-    """Remove the least recently loaded libraries until the cache fits in MAX_CACHE_BYTES
-    (never ``keep``, just built), and build folders left by killed processes."""
-    libraries = []
-    for lib in folder.glob("*.so"):
-        with contextlib.suppress(OSError):
-            st = lib.lstat()
-            libraries.append((st.st_mtime, st.st_size, lib))
+    """Remove the least recently loaded libraries until kinetwork's own (:func:`recorded`)
+    fit in MAX_CACHE_BYTES (never ``keep``, just built), and build folders left by killed
+    processes. Files without a record are neither counted nor removed."""
+    libraries = sorted((mtime, size, lib) for lib, size, mtime in recorded(folder))
     total = sum(size for _, size, _ in libraries)
-    for _, size, lib in sorted(libraries):
+    for _, size, lib in libraries:
         if total <= MAX_CACHE_BYTES:
             break
         if lib != keep:

@@ -99,6 +99,11 @@ def build(cc, sources, lib, deadline=None, cancelled=None, timeout=300.0, librar
                 raise Unavailable("compiler-silent", f"jit: {pathlib.Path(cc).name} exited "
                                   "without writing a library" + _words(work))
             out.chmod(0o700)                      # private whatever the umask
+            for target in (lib, record(lib)):     # a FIFO, a folder planted there: left be
+                with contextlib.suppress(FileNotFoundError):
+                    if not stat.S_ISREG(target.lstat().st_mode):
+                        raise Unavailable("cache-error", f"jit: {target} is not a regular "
+                                          f"file; kinetwork replaces only its own files")
             said = work / "record"
             said.write_bytes(sha256(out) + b"\n")
             said.chmod(0o600)

@@ -160,7 +160,15 @@ class Casadi(Method):
         return _CasadiRun(self, run, t, x)
 
 
+#: an integrator over more output times than this is not kept for the next run: CasADi
+#: holds about 50 bytes per output time in it
+KEPT_GRID = 100_000
+
+
 class _CasadiRun:
+    #: ``advance(times, out=rows)`` writes the states into ``rows`` when it can
+    writes_in_place = True
+
     def __init__(self, method, run, t, x):
         self.method, self.run = method, run
         self.t, self.x = float(t), np.asarray(x, dtype=float)
@@ -189,7 +197,9 @@ class _CasadiRun:
         equal intervals, the same one for every chunk of as many intervals (unless
         ``exact``: times an event is looked for at, which must not be rounded to the grid)."""
         key, build = self.recipe(times, opts, exact)
-        if self.method.plugin == "idas":    # its options hold the state's rate: not reusable
+        # IDAS's options hold the state's rate: not reusable; a grid past KEPT_GRID is too
+        # large to keep
+        if self.method.plugin == "idas" or len(times) > KEPT_GRID:
             return build()
         return self.run.compiled.integrator(key, build)
 
@@ -202,14 +212,17 @@ class _CasadiRun:
         if not exact and \
                 abs(times[-1] - self.t - n * run.spacing) <= 1e-9 * max(1.0, abs(times[-1])):
             grid = ("uniform", n, run.spacing)          # equal intervals: j * spacing
-            taus = lambda: (np.arange(1, n + 1) * run.spacing).tolist()  # noqa: E731
+            # an array, not a list: 8 bytes a time instead of 32 (a grid of millions)
+            taus = lambda: np.arange(1, n + 1) * run.spacing  # noqa: E731
         else:
             grid = tuple((np.asarray(times, dtype=float) - self.t).tolist())
             taus = lambda: list(grid)  # noqa: E731
         key = ("integrator", m.plugin, grid, tuple(sorted(opts.items())), bool(run.jit))
         return key, lambda: ca.integrator("simulate", m.plugin, dae, 0.0, taus(), opts)
 
-    def advance(self, times, exact=False):
+    def advance(self, times, exact=False, out=None):
+        """The states at ``times`` (a row each), written into ``out`` (rows of the driver's
+        array) when given and the model has no algebraic variables."""
         m, run = self.method, self.run
         nx = run.system.n_states
         if exact and len(times) == 1 and m.plugin != "idas":
@@ -235,7 +248,14 @@ class _CasadiRun:
         # converted (50 ms for the 256 x 1001 states of a 128-link chain)
         x0, z0 = np.ascontiguousarray(self.x[:nx]), np.ascontiguousarray(self.x[nx:])
         p = np.append(self.p, self.t)
-        xf, zf = np.full((len(times), nx), np.nan), np.full((len(times), len(self.x) - nx), np.nan)
+        nz = len(self.x) - nx
+        if out is not None and not nz and out.shape == (len(times), nx) and \
+                out.flags.c_contiguous:
+            xf = out
+            xf.fill(np.nan)
+        else:
+            xf = np.full((len(times), nx), np.nan)
+        zf = np.full((len(times), nz), np.nan)
         buffer, evaluate = integ.buffer()
         for name, value in (("x0", x0), ("z0", z0), ("p", p)):
             if value.size:
@@ -249,7 +269,7 @@ class _CasadiRun:
             failed = None
         except (RuntimeError, Interrupted) as exc:
             failed = exc
-        X = np.hstack([xf, zf])
+        X = np.hstack([xf, zf]) if nz else xf
         reached = X[:_finite_rows(X)]
         self._count(buffer, len(reached) if failed is not None else len(times))
         if failed is not None:

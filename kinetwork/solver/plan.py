@@ -22,6 +22,7 @@ So a tolerance means one thing on every path (``tolerance.py``), and a setting a
 from __future__ import annotations
 
 import logging
+import time
 from collections.abc import Callable, Mapping, Sequence
 from typing import TYPE_CHECKING
 
@@ -31,6 +32,7 @@ import numpy as np
 from ..equations.system import System
 from ..errors import ModelError, SimulationError
 from ..graph.lift import is_path, lift
+from ..graph.settings import check_output
 from ..units import to_si
 from ..util import quote, suggest
 from . import estimate
@@ -38,7 +40,7 @@ from . import jit as _jit
 from .capture import last_words
 from .compiled import compiled
 from .driver import (DEFAULTS, Run, _assembly_watch, _auto, _check, _check_finite_start,
-                     _integrate, _running)
+                     _integrate, _probe_outputs, _running, output_values)
 from .events import Events
 from .methods import METHODS, Casadi, _CasadiRun, choose
 from .results import Results
@@ -165,10 +167,11 @@ class Plan:
         return choose(run, keep)
 
     # -- one run ------------------------------------------------------------------------------
-    def new_run(self, p, x0, cancel=None, progress=None):
-        """The driver's Run of p from x0 (its events started: modes consistent there)."""
+    def new_run(self, p, x0, cancel=None, progress=None, started=None):
+        """The driver's Run of p from x0 (its events started: modes consistent there);
+        ``started``, the ``time.perf_counter()`` its time limit counts from (default: now)."""
         run = Run(self.system, p, x0, self.grid, self.settings, None, cancel, progress,
-                  self.restart)
+                  self.restart, started)
         run.repartition = self.repartition
         if self.system.modes is not None or self.system.relations is not None:
             # modes consistent with the start, relations' values there, before any method
@@ -179,18 +182,23 @@ class Plan:
     def run(self, params: Mapping[str, float | str] | None = None, *, p=None,
             cancel: Callable[[], object] | None = None,
             progress: Callable[[float], object] | None = None,
-            error_estimate: bool = False) -> Results:
+            error_estimate: bool = False, started: float | None = None) -> Results:
         """One run: what ``kn.simulate`` returns (see there). ``p`` (the checked parameter
         vector) instead of ``params`` skips their check; ``params`` is then what the results
-        record."""
+        record. ``started``: the ``time.perf_counter()`` the time limit counts from (default:
+        now)."""
+        system, settings = self.system, self.settings
+        if error_estimate:          # an error estimate holds three runs' results at once
+            too_large = check_output(len(self.grid), output_values(system), runs=3)
+            if too_large:
+                raise ModelError(too_large)
         if p is None:
             p = self.vector(params)
         x0 = self.start(p)
-        system, settings = self.system, self.settings
         stats = {}
         if self.lifted is not None:
             stats["lifted"] = self.lifted.note
-        run = self.new_run(p, x0, cancel, progress)
+        run = self.new_run(p, x0, cancel, progress, started)
         with _running(run):
             if self.jit_on:
                 run.jit = {"stats": stats, "required": self.jit is True,
@@ -208,18 +216,24 @@ class Plan:
                 X, failure, method_stats = _integrate(run, METHODS[self.key])
                 stats.update(method_stats)
                 key = self.key
+            # the probe signals, a stop served between their chunks: inside the handlers
+            X, outputs, cut = self.outputs(run, X)
+            if cut is not None:
+                failure = f"{failure}; {cut}" if failure else cut
         if run.said:
             stats["solver_output"] = "".join(run.said)
         if run.events is not None:
             stats["events"] = run.events.log
             stats["time_events"] = run.events.time_events
         stats["jit"] = bool(run.jit) and not stats.get("jit_fallback")
-        results = self.results(run, X, p, stats, key, params)
+        results = self.results(run, X, p, stats, key, params, outputs)
         if failure is not None:
             reached = float(results.t[-1]) if len(results.t) else self.t_start
             results.partial = {"t_reached": reached, "reason": failure}
             said = last_words(stats.get("solver_output", ""))
-            raise SimulationError(f"{key} failed after t = {reached:g} s (of "
+            # stopped when asked (a signal, cancel, the time limit), failed otherwise
+            verb = "stopped at" if run.stop_reason() is not None else "failed after"
+            raise SimulationError(f"{key} {verb} t = {reached:g} s (of "
                                   f"{settings['t_end']:g} s): {failure}"
                                   + (f" (the solver said: {said})" if said else ""),
                                   results=results, t_reached=reached, reason=failure,
@@ -230,18 +244,25 @@ class Plan:
                                                                         cancel=cancel))
         return results
 
-    def results(self, run, X, p, stats, key, params=None):
-        """The Results of states X on the first rows of the grid: the loops' coordinates
-        polished onto their closure, the probe signals computed."""
-        system, settings = self.system, self.settings
+    def outputs(self, run, X):
+        """(X, outputs, why cut or None) of states X on the first rows of the grid: the
+        loops' coordinates polished onto their closure, the probe signals computed, in
+        chunks between which a stop is served (``driver._probe_outputs``: what was computed
+        is kept)."""
         t = self.grid[:len(X)]
         parts = getattr(run, "partitions", None)
         if parts is not None and parts.events:     # re-partitioned: each part by its equations
             X, outputs = parts.finish(t, X)
-        else:
-            X = system.polish(X, p, t)
-            f_out = compiled(system).outputs(run.jit)
-            outputs = system.outputs_p(t, X, p, f_out) if len(t) else np.zeros((0, 0))
+            return X, outputs, None
+        return _probe_outputs(run, t, X)
+
+    def results(self, run, X, p, stats, key, params=None, outputs=None):
+        """The Results of states X on the first rows of the grid (``outputs``: their probe
+        signals, as ``outputs`` gives them with X; computed here when not given)."""
+        system, settings = self.system, self.settings
+        if outputs is None:
+            X, outputs, _ = self.outputs(run, X)
+        t = self.grid[:len(X)]
         return Results(t, X, system.state_names + system.algebraic_names, outputs,
                        system.signals, stats=stats,
                        state_units=system.state_units + system.algebraic_units,
@@ -388,11 +409,13 @@ def simulate(model: Model | System, t_end: float | None = None, n_points: int | 
         The integration failed or was stopped; ``err.results`` holds the results up to
         ``err.t_reached``.
     """
+    entered = time.perf_counter()      # the time limit counts building the equations too
     plan = Plan(model, names=list(params or ()), t_end=t_end, n_points=n_points, method=method,
                 rtol=rtol, atol=atol, step=step, max_step=max_step, t_start=t_start, jit=jit,
                 max_steps=max_steps, time_limit=time_limit, restart=restart,
                 repartition=repartition)
-    return plan.run(params, cancel=cancel, progress=progress, error_estimate=error_estimate)
+    return plan.run(params, cancel=cancel, progress=progress, error_estimate=error_estimate,
+                    started=entered)
 
 
 # -- resolving parameter names ----------------------------------------------------------------

@@ -10,13 +10,17 @@ from __future__ import annotations
 import csv
 import io
 import os
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
 from ..upcalls import upcall
-from ..util import atomic_write, suggest
+from ..util import suggest
+
+#: rows of a CSV written at a time: between blocks a write can be stopped (SIGINT, SIGTERM,
+#: a cancel) and keep the rows before
+CSV_BLOCK_ROWS = 4096
 
 if TYPE_CHECKING:                     # annotations only
     from ..equations.signals import Signal
@@ -84,6 +88,33 @@ class Results:
             self._values[sig.name] = block.reshape(len(self.t), *sig.shape)
 
     @property
+    def system(self) -> System | None:
+        """The System that made these results (None when not known). Results from a pickle
+        compile it again on first use."""
+        if self._system is None and self._recipe is not None:
+            build, args = self._recipe
+            self._system, self._recipe = build(*args), None
+        return self._system
+
+    @system.setter
+    def system(self, value):
+        self._system, self._recipe = value, None
+
+    def __getstate__(self):
+        """Pickled with the System as its recipe (its model's text, compiled again only if
+        the results' System is asked for): CasADi's expressions do not pickle."""
+        state = dict(self.__dict__)
+        if self._system is not None:
+            state["_system"], state["_recipe"] = None, self._system.__reduce__()
+        return state
+
+    def __copy__(self):
+        """A shallow copy sharing the System (no recipe made: see ``__getstate__``)."""
+        twin = type(self).__new__(type(self))
+        twin.__dict__.update(self.__dict__)
+        return twin
+
+    @property
     def method(self) -> str | None:
         """The integration method that produced these results (None if not recorded)."""
         return self.settings.get("method")
@@ -121,30 +152,86 @@ class Results:
 
     def columns(self) -> tuple[list[str], np.ndarray]:
         """(header, 2-D array) of the CSV: t, then every probe signal, vectors expanded."""
-        header, cols = ["t"], [self.t[:, None]]
-        for name, sig in self.signals.items():
-            header += sig.column_names()
-            cols.append(self._values[name].reshape(len(self.t), sig.size))
-        return header, np.hstack(cols)
+        return self.column_names(), self._rows(0, len(self.t))
 
-    def to_csv(self, path: str | os.PathLike) -> None:
-        """Write t and every probe signal as CSV with a header row, atomically (a failed
-        write leaves an old file whole). Partial results end with a comment line
-        ``# partial: ...`` saying where and why the run stopped."""
-        header, data = self.columns()
-        text = io.StringIO(newline="")
-        writer = csv.writer(text)
-        writer.writerow(header)
-        writer.writerows([repr(float(v)) for v in row] for row in data)
+    def column_names(self) -> list[str]:
+        """The CSV's header: t, then every probe signal, vectors expanded."""
+        header = ["t"]
+        for sig in self.signals.values():
+            header += sig.column_names()
+        return header
+
+    def _rows(self, start, stop):
+        """Rows ``start:stop`` of the CSV table (t, then every signal expanded)."""
+        n = stop - start
+        cols = [self.t[start:stop, None]]
+        for name, sig in self.signals.items():
+            cols.append(self._values[name][start:stop].reshape(n, sig.size))
+        return np.hstack(cols)
+
+    def to_csv(self, path: str | os.PathLike, overwrite: bool = False,
+               cancel: Callable[[], object] | None = None, stop: Any = None) -> str | None:
+        """Write t and every probe signal as CSV with a header row, under the output policy
+        (``kinetwork.outputs``): atomically (a failed write leaves an old file whole), never
+        over the model file these results came from, a special file or a folder, nor over
+        a file that is not a CSV table unless ``overwrite``.
+
+        Partial results end with a comment line ``# partial: ...`` saying where and why the
+        run stopped. The rows are written in blocks; when ``cancel()`` turns true, or SIGINT
+        or SIGTERM arrives, between two blocks, the file ends there with such a line saying
+        where the writing stopped (and the signal is raised again once the file is whole:
+        a KeyboardInterrupt). ``stop`` is a command's ``kinetwork.outputs.StopFlag``, in
+        place of ``cancel`` and the signals.
+
+        Returns
+        -------
+        str or None
+            Why the writing stopped before the last row, or None.
+        """
+        from ..outputs import StopFlag, Stopped, catching_signals, model_files, write
+        reads = model_files(self.system.model if self.system is not None else None)
+        flag = stop if stop is not None else StopFlag(cancel=cancel)
+        line = io.StringIO(newline="")
+        csv.writer(line).writerow(self.column_names())     # names such as "R[0,1]" are quoted
+        header = line.getvalue()
+        n = len(self.t)
+
+        def fill(tmp, told):
+            written = 0
+            with open(tmp, "w", newline="", encoding="utf-8") as fh:
+                fh.write(header)
+                while written < n and (written == 0 or told() is None):
+                    block = self._rows(written, min(n, written + CSV_BLOCK_ROWS))
+                    fh.write("".join(",".join(map(repr, row)) + "\n"
+                                     for row in block.tolist()))
+                    written += len(block)
+                why = told() if written < n else None
+                trailer = self._trailer(written, why)
+                if trailer:
+                    fh.write(trailer)
+
+        if stop is not None:
+            return write(path, fill, "csv", reads=reads, force=overwrite,
+                         stop=flag, cooperative=True)
+        with catching_signals(flag):
+            reason = write(path, fill, "csv", reads=reads, force=overwrite,
+                           stop=flag, cooperative=True)
+        if flag.signum is not None:
+            raise Stopped(flag.signum)
+        return reason
+
+    def _trailer(self, written, why):
+        """The comment line ending a CSV of partial results, or of rows cut short by
+        ``why`` after ``written`` rows; "" when neither."""
+        parts = []
+        if why is not None and written < len(self.t):
+            last = self.t[written - 1] if written else self.t[0]
+            parts.append(f"the writing stopped after t = {float(last)!r} s ({why}); the "
+                         f"run reached t = {float(self.t[-1])!r} s")
         if self.partial is not None:
             reason = " ".join(str(self.partial["reason"]).split())
-            text.write(f"# partial: the run stopped at t = {self.partial['t_reached']!r} s: "
-                       f"{reason}\n")
-
-        def write(tmp):
-            with open(tmp, "w", newline="") as fh:
-                fh.write(text.getvalue())
-        atomic_write(path, write)
+            parts.append(f"the run stopped at t = {self.partial['t_reached']!r} s: {reason}")
+        return f"# partial: {'; '.join(parts)}\n" if parts else ""
 
     def to_pandas(self, states: bool = False) -> pandas.DataFrame:
         """A ``pandas.DataFrame`` indexed by time ``t`` [s], one column per CSV column (vectors

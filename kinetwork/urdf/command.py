@@ -1,14 +1,30 @@
 """``kinetwork import ROBOT.urdf -o MODEL.json``."""
 
+import os
+
+from ..errors import ModelError
+from ..graph.io import dumps
+from ..outputs import check, write
 from .load import from_urdf
 
 
 def cli_import(args):
     """``kinetwork import ROBOT.urdf -o MODEL.json``: write the model; the exit code."""
     gravity = (0.0, 0.0, -9.81) if args.gravity is None else tuple(args.gravity)
+    force = getattr(args, "force", False)
+    reads = [("the URDF", args.source)]
+    check(args.out, "model", what="-o", reads=reads, force=force)   # before reading it
     model = from_urdf(args.source, probes=args.probes, floating=args.floating, gravity=gravity,
                       limits=not getattr(args, "no_limits", False))
-    model.save(args.out)
+    text = dumps(model, os.path.dirname(os.path.abspath(args.out))).encode("utf-8")
+
+    def fill(tmp):
+        with open(tmp, "wb") as fh:
+            fh.write(text)
+    try:
+        write(args.out, fill, "model", what="-o", reads=reads, force=force)
+    except OSError as exc:
+        raise ModelError(f"cannot write {args.out}: {exc.strerror or exc}") from None
     parts = model.components.values()
     states = sum(c.dof for c in parts if c.role == "joint")
     bodies = sum(1 for c in parts if c.role == "body" and c.mass != 0)

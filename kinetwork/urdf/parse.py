@@ -10,6 +10,8 @@ import xml.etree.ElementTree as ET
 import numpy as np
 
 from ..errors import ModelError
+from ..graph.io import MAX_FILE_SIZE
+from ..util import read_bounded
 from .rotations import rpy_matrix
 
 JOINT_TYPES = ("revolute", "continuous", "prismatic", "fixed", "floating", "planar")
@@ -26,13 +28,17 @@ def _q(text, limit=80):
 def read(source):
     """The <robot> element of the file."""
     try:
-        with open(source, "rb") as fh:
-            text = fh.read()
+        # at most one byte past the limit: /dev/zero or an endless pipe is refused by size,
+        # not read until memory runs out; a FIFO without a writer does not block
+        text = read_bounded(source, MAX_FILE_SIZE)
     except FileNotFoundError:
         raise ModelError(f"{_q(source)}: no such file") from None
     except OSError as exc:
         raise ModelError(f"{_q(source)}: cannot read: {exc.strerror or exc}") from None
     where = os.path.basename(source)
+    if len(text) > MAX_FILE_SIZE:
+        raise ModelError(f"{where}: larger than {MAX_FILE_SIZE // 2**20} MiB, too large for a "
+                         f"robot description")
     try:
         root = ET.fromstring(text)
     except ET.ParseError as exc:

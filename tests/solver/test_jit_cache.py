@@ -4,6 +4,7 @@ means CasADi's virtual machine (one warning per reason), never a crash or a hang
 
 import os
 import shutil
+import stat
 import subprocess
 import sys
 import threading
@@ -277,3 +278,51 @@ def test_cache_info_and_clear_cache(cache):
     assert jit.clear_cache() == 5                 # two libraries, two records, one stale file
     assert sorted(p.name for p in cache.iterdir()) == ["kinetwork-build-now", "notes.txt"]
     assert jit.cache_info()["entries"] == 0 and jit.clear_cache() == 0
+
+
+def foreign(cache, name, size):
+    """A library kinetwork did not build: no record beside it (a name like kinetwork's, or
+    any other)."""
+    path = cache / name
+    with open(path, "wb") as fh:
+        fh.truncate(size)                               # sparse: large, costs no disk
+    return path
+
+
+def test_the_size_bound_counts_and_removes_only_recorded_libraries(cache, monkeypatch):
+    first = jit.compile_functions("a", [tiny("a")])
+    size = first.stat().st_size
+    strangers = [foreign(cache, "rhs_0123456789abcdef0123.so", 600 * 2**20),
+                 foreign(cache, "libmine.so", 600 * 2**20)]
+    monkeypatch.setattr(jit, "MAX_CACHE_BYTES", size * 5 // 2)
+    second = jit.compile_functions("b", [tiny("b")])     # two of ours fit: none removed
+    assert all(p.exists() for p in [first, second, *strangers])
+    os.utime(first, (1e9, 1e9))
+    third = jit.compile_functions("c", [tiny("c")])      # three do not: the oldest of ours
+    assert not first.exists() and second.exists() and third.exists()
+    assert all(p.exists() and p.stat().st_size == 600 * 2**20 for p in strangers)
+    assert jit.cache_info()["entries"] == 2
+
+
+def test_clear_leaves_what_no_record_names(cache):
+    lib = jit.compile_functions("a", [tiny("a")])
+    strangers = [foreign(cache, "rhs_0123456789abcdef0123.so", 10),
+                 foreign(cache, "libmine.so", 10)]
+    orphan = cache / "gone_0123456789abcdef0123.so.sha256"      # its library removed by hand
+    orphan.write_text("0" * 64 + "\n")
+    look_alike = cache / "mine_0123456789abcdef0123.so.sha256"   # not a record's content
+    look_alike.write_text("my own notes\n")
+    assert jit.clear_cache() == 3                       # the library, its record, the orphan
+    assert not lib.exists() and not orphan.exists()
+    assert sorted(p.name for p in cache.iterdir()) == sorted(
+        [look_alike.name, *(p.name for p in strangers)])
+
+
+def test_a_special_file_at_a_library_name_is_left_alone(cache):
+    f = tiny("planted_fifo")
+    cache.mkdir(mode=0o700)
+    os.mkfifo(library_path(cache, f))
+    with pytest.warns(JitFallbackWarning, match="not a regular file"):
+        g = jit.external(f)
+    check(g)
+    assert stat.S_ISFIFO(os.lstat(library_path(cache, f)).st_mode)

@@ -86,14 +86,14 @@ def test_a_partial_run_ends_its_csv_with_a_comment(tmp_path):
 
 def test_a_failed_write_keeps_the_old_file(tmp_path, monkeypatch):
     path = tmp_path / "out.csv"
-    path.write_text("old contents\n")
+    path.write_text("t,old\n0.0,1.0\n")            # the last run's table
 
     def full_disk(*args):
         raise OSError(28, "No space left on device")
     monkeypatch.setattr(os, "replace", full_disk)
     with pytest.raises(OSError, match="No space left"):
         results().to_csv(path)
-    assert path.read_text() == "old contents\n"
+    assert path.read_text() == "t,old\n0.0,1.0\n"
     assert os.listdir(tmp_path) == ["out.csv"]           # no temporary file left behind
 
 
