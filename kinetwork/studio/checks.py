@@ -29,6 +29,8 @@ _PLACE = re.compile(r'components\[(?P<index>\d+)\](?: "(?P<name>[^"]*)")?'
                     r'(?: params\.(?P<param>[A-Za-z_][A-Za-z0-9_]*))?'
                     r'|connections\[(?P<wire>\d+)\]'
                     r'|(?P<ref>[A-Za-z_][A-Za-z0-9_]*)\.[A-Za-z_][A-Za-z0-9_]*(?=[:\s])')
+#: the definition a problem is in: "definitions.Axis. ..." (after the file's name, if any)
+_SCOPE = re.compile(r'(?:[^\s:]+\.json: )?definitions\.(?P<name>[A-Za-z_][A-Za-z0-9_]*)\.')
 GRID_COLUMNS, GRID_DX, GRID_DY = 4, 220, 140
 
 
@@ -133,22 +135,51 @@ def problems_of(exc, data=None):
 
 
 def problem(message, names=()):
-    """``{"message", "component", "param", "connection"}`` of one problem's message."""
-    out = {"message": message, "component": None, "param": None, "connection": None}
-    match = _PLACE.match(message)
+    """A problem as the page reads it (API.md): ``{"message", "component", "port",
+    "parameter", "path", "hint", "severity", "reason"}`` (``reason``: what is wrong, without
+    the place, for the page to say it in the user's words), and the older keys ``param``
+    and ``connection``."""
+    message = str(message)
+    out = {"message": message, "component": None, "port": None, "parameter": None,
+           "path": None, "hint": None, "severity": "error", "reason": None,
+           "param": None, "connection": None}
+    # a problem inside an inline definition: placed in it ("definitions.Axis." first)
+    scope = _SCOPE.match(message)
+    text, prefix = (message[scope.end():], f"definitions.{scope['name']}.") if scope \
+        else (message, "")
+    if scope:
+        names = ()
+    match = _PLACE.match(text)
     if match is None:
         return out
+    rest = text[match.end():]
     if match["index"] is not None:
         i = int(match["index"])
         name = match["name"]
         if name is None or name.endswith("..."):      # not quoted, or cut: the file's own
             name = names[i] if i < len(names) and isinstance(names[i], str) else name
         out["component"], out["param"] = name, match["param"]
+        out["parameter"] = match["param"]
+        out["path"] = prefix + f"components[{i}]" + \
+            (f".params.{match['param']}" if match["param"] else "")
     elif match["wire"] is not None:
-        out["connection"] = int(match["wire"])
+        out["connection"] = None if scope else int(match["wire"])
+        out["path"] = prefix + f"connections[{match['wire']}]"
     elif match["ref"] in names:
         out["component"] = match["ref"]
+        out["port"] = text[len(match["ref"]) + 1:match.end()]
+    out["reason"] = _reason(rest)
     return out
+
+
+def _reason(rest):
+    """What is wrong, from the text after a place: ``" = -1 kg: must be >= 0"`` is
+    ``"must be >= 0 (got -1 kg)"``."""
+    rest = rest.strip()
+    if rest.startswith("= ") and ": " in rest:
+        value, _, what = rest[2:].partition(": ")
+        return f"{what} (got {value})"
+    return rest.lstrip(":").strip() or None
 
 
 # -- layout ------------------------------------------------------------------------------------
