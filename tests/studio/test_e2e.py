@@ -519,7 +519,7 @@ def test_runs_overlay_cancel_and_the_3d_view_follows_the_plot_cursor(page, studi
     page.click(tid("run"))
     page.wait_for_function("() => window.__kinetwork.runState && "
                            "window.__kinetwork.runState.state === 'running' && "
-                           "window.__kinetwork.runState.id")
+                           "window.__kinetwork.runState.progress > 0")    # integrating
     page.click(tid("cancel"))
     page.wait_for_function("() => window.__kinetwork.runState.state === 'cancelled'",
                            timeout=RUN_TIMEOUT)
