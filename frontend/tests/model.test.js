@@ -7,11 +7,9 @@ import {
   connectProblem,
   editInScope,
   emptyModel,
-  formatValue,
   freshName,
   moveComponents,
   nameStem,
-  parseValue,
   pasteComponents,
   placeComponents,
   removeComponents,
@@ -22,6 +20,7 @@ import {
   shapeProblem,
   signalSourceProblem,
 } from "../src/studio/model.js";
+import { formatValue, parseValue } from "../src/studio/values.js";
 import seed from "../../models/double_pendulum.json" with { type: "json" };
 
 const port = (path, domain) => ({ path, domain });

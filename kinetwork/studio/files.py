@@ -258,15 +258,16 @@ def _ours(path):
     return isinstance(data, dict) and data.get("format") == RECOVERY_FORMAT
 
 
-def write_recovery(root, rel, model, base):
-    """Keep ``model`` (the page's document, finished or not) as the recovery of ``rel``."""
+def write_recovery(root, rel, model, base, session=None):
+    """Keep ``model`` (the page's document, finished or not) as the recovery of ``rel``;
+    ``session`` names the page that wrote it (a page does not offer its own work back)."""
     path = recovery_path(root, rel)
     if not os.path.isdir(os.path.dirname(path)):
         raise StudioError(400, f"{rel}: its folder does not exist")
     if not _ours(path):
         raise StudioError(409, f"{os.path.basename(path)}: a file of that name is there and "
                                f"is not the studio's; no recovery kept")
-    record = {"format": RECOVERY_FORMAT, "path": rel, "base": base,
+    record = {"format": RECOVERY_FORMAT, "path": rel, "base": base, "session": session,
               "saved": datetime.datetime.now(datetime.timezone.utc).isoformat(
                   timespec="seconds"), "model": model}
     data = json.dumps(record, allow_nan=False).encode("utf-8")
@@ -295,7 +296,7 @@ def read_recovery(root, rel):
             not isinstance(data.get("model"), dict):
         return None
     return {"path": rel, "base": data.get("base"), "saved": data.get("saved"),
-            "model": data["model"]}
+            "session": data.get("session"), "model": data["model"]}
 
 
 def discard_recovery(root, rel):

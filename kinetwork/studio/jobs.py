@@ -42,7 +42,7 @@ PHASES = ("starting", "checking", "compiling", "integrating", "writing results")
 #: reached), while writing the results it finished (kept: bounded by the size of results)
 CANCEL_GRACE = {"starting": 0.5, "checking": 0.5, "compiling": 0.5, "integrating": 5.0,
                 "writing results": 60.0}
-KILL_GRACE = 0.3
+KILL_GRACE = 0.2
 
 _context = None
 _context_lock = threading.Lock()
@@ -120,17 +120,17 @@ class _Popen(_popen_base()):
 
 
 def warm_up():
-    """Start the forkserver now, in the background, so the first check does not wait for it."""
+    """Start the forkserver now, in the background, so the first check does not wait for
+    its imports."""
     def start():
+        if context().get_start_method() != "forkserver":
+            return
         try:
-            Child(_nothing, ()).answer(60)
+            from multiprocessing import forkserver
+            forkserver.ensure_running()
         except Exception:     # noqa: BLE001 -- a failed warm-up shows again on the first call
             log.debug("the studio's forkserver did not start", exc_info=True)
     threading.Thread(target=start, name="kinetwork-studio-warm-up", daemon=True).start()
-
-
-def _nothing(channel):
-    return None
 
 
 class Channel:

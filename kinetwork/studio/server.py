@@ -241,10 +241,13 @@ def _routes(api, studio):
 
     @api.post("/autosave")
     async def autosave(body: dict = Depends(_body)):
-        _keys(body, "autosave", required=("model",), optional=("path", "base"))
+        _keys(body, "autosave", required=("model",), optional=("path", "base", "session"))
         rel = _rel_or_none(studio, body.get("path"))
-        base = _base(body)
-        await run_in_threadpool(files.write_recovery, studio.root, rel, _model(body), base)
+        base, session = _base(body), body.get("session")
+        if session is not None and (not isinstance(session, str) or len(session) > 100):
+            raise StudioError(400, "session: a string naming the page's session, or null")
+        await run_in_threadpool(files.write_recovery, studio.root, rel, _model(body), base,
+                                session)
         return StudioJSON({"ok": True})
 
     @api.get("/recovery")

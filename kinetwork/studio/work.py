@@ -86,7 +86,7 @@ def run(data, settings, folder, library, channel):
                              "it in a model to run it")
         sim = {**DEFAULTS, **model.simulation, **settings}
         n_points, t_end = sim.get("n_points"), sim.get("t_end")
-        _check_size(n_points, 1, 1)
+        _check_size(n_points, 1, 1, beyond=True)
         phase = "compiling"
         channel.enter(phase)
         system = model.compile()
@@ -123,12 +123,18 @@ def _final(state, error=None, problems=(), results=None, phase=None):
                           "results": results})
 
 
-def _check_size(n_points, columns, members):
-    """Refuse, before the work, results too large for the page."""
+def _check_size(n_points, columns, members, beyond=False):
+    """Refuse, before the work, results too large for the page: ``columns`` per point and
+    member (the time and the probes' values, once compiled). ``beyond``: before the model is
+    compiled, refuse only what no model could fit (a point has a time at least)."""
     if not isinstance(n_points, (int, float)) or isinstance(n_points, bool) or \
             not math.isfinite(n_points) or n_points < 2:
         return                        # simulate says what is wrong with it
     values = int(n_points) * columns * members
+    if beyond and values > MAX_VALUES:
+        raise ModelError(f"simulation.n_points: {int(n_points):,} points are more than the "
+                         f"studio plots ({MAX_VALUES:,} numbers, the time included); run it "
+                         f"from the command line (kinetwork run MODEL --out results.csv)")
     if values > MAX_VALUES:
         most = max(2, MAX_VALUES // (columns * members))
         what = f"{members} members x " if members > 1 else ""
@@ -153,7 +159,7 @@ def sweep(data, spec, folder, library, channel):
                              "it in a model to sweep it")
         kind, names, members = _sweep_spec(spec)
         sim = {**DEFAULTS, **model.simulation}
-        _check_size(sim.get("n_points"), 1, members)
+        _check_size(sim.get("n_points"), 1, members, beyond=True)
         channel.enter("compiling")
         system = model.compile()
         _check_size(sim.get("n_points"), 1 + sum(sig.size for sig in system.signals), members)

@@ -87,6 +87,24 @@ function Breadcrumbs() {
   );
 }
 
+/** Unsaved work of an earlier session, offered back above the diagram (not in its way). */
+function RecoveryBar() {
+  const offer = useStudio((s) => s.offer);
+  // always there (a row of the centre's grid), empty when there is nothing to offer
+  if (!offer) return <div className="kn-offer-slot" />;
+  return (
+    <div className="kn-offer-slot kn-offer" data-testid="recovery" role="alert">
+      <span>{offer.message}</span>
+      <button className="kn-btn kn-primary" data-testid="choice-recover" onClick={offer.recover}>
+        Recover them
+      </button>
+      <button className="kn-btn" data-testid="choice-discard" onClick={offer.discard}>
+        Discard them
+      </button>
+    </div>
+  );
+}
+
 function Toasts() {
   const toasts = useStudio((s) => s.toasts);
   const dismiss = useStudio((s) => s.dismiss);
@@ -162,6 +180,7 @@ export default function App() {
       <div className="kn-main">
         <Palette palette={palette} definitions={definitions} onAdd={edit.placeAtCentre} />
         <div className="kn-center">
+          <RecoveryBar />
           <Breadcrumbs />
           <Canvas nodes={diagram.nodes} edges={diagram.edges} placed={placed} edit={edit} />
           <div className="kn-results">

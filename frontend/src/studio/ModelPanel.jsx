@@ -1,7 +1,8 @@
 // The panel of the model (or of the definition opened): its name, description, parameters,
 // exposed ports, and the simulation settings.
 import { useState } from "react";
-import { IDENT, formatValue, parseValue } from "./model.js";
+import { IDENT } from "./model.js";
+import { formatValue, parseValue } from "./values.js";
 import { useStudio } from "./store.js";
 import { Field } from "./Field.jsx";
 

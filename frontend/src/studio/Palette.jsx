@@ -3,7 +3,8 @@
 // (or the last clicked) is described below the list: doc, ports, parameters with units.
 import { useMemo, useState } from "react";
 import { TypeIcon, LIBRARY_COLORS } from "./icons.jsx";
-import { DOMAIN_COLORS, formatValue } from "./model.js";
+import { DOMAIN_COLORS } from "./model.js";
+import { formatValue } from "./values.js";
 import { DRAG_MIME } from "./Canvas.jsx";
 import { search } from "./search.js";
 

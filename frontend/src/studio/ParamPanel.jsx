@@ -1,7 +1,8 @@
 // The right-hand panel: the selected component's parameters (value or expression, with
 // unit, bounds, default and doc), or, with nothing selected, the model (or definition): its
 // name, parameters and simulation settings.
-import { formatValue, parseValue, typeInfo } from "./model.js";
+import { typeInfo } from "./model.js";
+import { formatValue, parseValue } from "./values.js";
 import { useStudio } from "./store.js";
 import ModelPanel from "./ModelPanel.jsx";
 import { Field } from "./Field.jsx";

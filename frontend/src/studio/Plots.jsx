@@ -81,7 +81,7 @@ function buildData(names, runs) {
         const label = names.length > 1 ? `${shortName(name)}${labels[k] ? ` ${labels[k]}` : ""}` : labels[k] || quantityOf(name);
         const older = src.r > 0;
         series.push({
-          label: `${label} · ${src.label}`,
+          label: sources.length > 1 ? `${label} · ${src.label}` : label,
           stroke: older ? `${c}66` : c,
           width: older ? 1 : 1.6,
           dash: older ? [5, 4] : undefined,

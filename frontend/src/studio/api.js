@@ -53,7 +53,7 @@ export const api = {
   validate: (model, path) => call("POST", "api/validate", { model, path: path || null }),
   /** ``base``: the version of the file the model was based on (null: a new file). */
   save: (path, model, text, base) => call("POST", "api/save", { path, model, text, base: base ?? null }),
-  autosave: (path, model, base) => call("POST", "api/autosave", { path: path || null, model, base: base ?? null }),
+  autosave: (path, model, base, session) => call("POST", "api/autosave", { path: path || null, model, base: base ?? null, session }),
   recovery: (path) => call("GET", path ? `api/recovery?path=${q(path)}` : "api/recovery"),
   discardRecovery: (path) => call("POST", "api/recovery/discard", { path: path || null }),
   run: (model, settings, path) => call("POST", "api/run", { model, settings, path: path || null }),

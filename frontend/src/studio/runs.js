@@ -1,6 +1,6 @@
 // Names of runs in the plots: "run 3 · c = 5" says what differs from the run before it;
 // a sweep's members are named by the values they were given.
-import { formatValue } from "./model.js";
+import { formatValue } from "./values.js";
 
 const MAX_DIFFERENCES = 3;
 

@@ -61,6 +61,8 @@ export const useStudio = create((set, get) => ({
   /** @type {{id: number, message: string, kind: string}[]} */
   toasts: [],
   dialog: null,
+  /** unsaved work kept from an earlier session, offered back: {path, message, recover, discard} */
+  offer: null,
   busy: null,
   /** the pointer's last place over the diagram (layout units), for paste */
   pointer: null,
@@ -117,10 +119,11 @@ export const useStudio = create((set, get) => ({
     const id = ++toastId;
     // the same message again replaces the one shown (a repeated refusal is one toast)
     set((s) => ({ toasts: [...s.toasts.filter((t) => t.message !== message).slice(-3), { id, message, kind }] }));
-    setTimeout(() => get().dismiss(id), kind === "error" ? 8000 : 4000);
+    setTimeout(() => get().dismiss(id), kind === "error" ? 8000 : 6000);
   },
   dismiss: (id) => set((s) => ({ toasts: s.toasts.filter((t) => t.id !== id) })),
   setDialog: (dialog) => set({ dialog }),
+  setOffer: (offer) => set({ offer }),
   setBusy: (busy) => set({ busy }),
 }));
 

@@ -1,6 +1,7 @@
 // "Make subsystem": selected components of a scope become a new definition, placed once
 // where they were, with a port exposed for each of their ports wired across the selection.
-import { clone, identifiers, freshName, IDENT } from "./model.js";
+import { clone, freshName, IDENT } from "./model.js";
+import { identifiers } from "./values.js";
 
 /**
  * @param {any} body the scope's body (components, connections, layout, parameters)

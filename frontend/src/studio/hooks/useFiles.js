@@ -13,6 +13,8 @@ import { positions } from "./useDefinitions.js";
 
 /** Seconds after the last edit before the model is autosaved. */
 export const AUTOSAVE_MS = 1500;
+/** This page's session: a recovery it wrote itself is not offered back to it. */
+export const SESSION = `${Date.now().toString(36)}-${Math.random().toString(36).slice(2, 10)}`;
 
 /**
  * A choice asked in a dialog: resolves with the id of the button pressed (null: dismissed).
@@ -95,7 +97,11 @@ async function mayDiscard(action) {
     ],
     testid: "confirm-discard",
   });
-  if (choice === "discard") return true;
+  if (choice === "discard") {
+    // dropped on purpose: its recovery goes too
+    api.discardRecovery(s.file.path).catch(() => {});
+    return true;
+  }
   if (choice === "save") return saveCurrent();
   return false;
 }
@@ -125,7 +131,8 @@ async function offerRecovery(path) {
   } catch {
     return;
   }
-  if (!rec || !rec.model || shapeProblem(rec.model)) return;
+  // a recovery of this page's own work is not "unsaved work from before"
+  if (!rec || !rec.model || shapeProblem(rec.model) || rec.session === SESSION) return;
   const s = studio();
   if (path && JSON.stringify(rec.model) === JSON.stringify(s.hist.present)) {
     api.discardRecovery(path).catch(() => {});
@@ -133,22 +140,21 @@ async function offerRecovery(path) {
   }
   const when = rec.saved ? new Date(rec.saved).toLocaleString() : "an earlier session";
   const changed = path && rec.base && rec.base !== s.file.version;
-  const choice = await ask({
-    title: "Recover unsaved work?",
-    message: `The studio kept unsaved changes to ${path || `"${rec.model.name || "untitled"}" (never saved)`} from ${when}.` +
-      (changed ? " The file has changed on disk since: recovering and saving will ask before overwriting it." : ""),
-    choices: [
-      { id: "recover", label: "Recover them", primary: true },
-      { id: "discard", label: "Discard them" },
-    ],
-    testid: "recovery",
+  // offered beside the work, not in its way: the page stays usable until it is answered
+  s.setOffer({
+    path,
+    message: `Unsaved changes to ${path || `"${rec.model.name || "untitled"}" (never saved)`} were kept from ${when}.` +
+      (changed ? " The file has changed on disk since: saving will ask before overwriting it." : ""),
+    recover: () => {
+      studio().setOffer(null);
+      studio().update(() => rec.model);
+      studio().fit();
+    },
+    discard: () => {
+      studio().setOffer(null);
+      api.discardRecovery(path).catch(() => {});
+    },
   });
-  if (choice === "recover") {
-    studio().update(() => rec.model);
-    studio().fit();
-  } else if (choice === "discard") {
-    api.discardRecovery(path).catch(() => {});
-  }
 }
 
 /** Open a file (``{path}``) or an example (``{example}``), asking first about unsaved work. */
@@ -164,6 +170,7 @@ export async function openModel(src, { ask: asking = true } = {}) {
       return false;
     }
     forgetJobs();
+    s.setOffer(null);
     s.load(r.model, { path: r.path || null, text: r.text, version: r.version || null, baseline: JSON.stringify(r.model), example: src.example || null });
     s.setDialog(null);
     setUrl(r.path || null);
@@ -208,7 +215,10 @@ export async function saveTo(path, base) {
       /* keep what was sent */
     }
     const shown = unchanged ? doc : saved;
+    const before = s.file.path;
     studio().saved(shown, { path, text: r.text, version: r.version || null, baseline: JSON.stringify(shown), example: null });
+    // the work is in the file now: the recovery of where it was before goes too
+    if (before !== path) api.discardRecovery(before).catch(() => {});
     setUrl(path);
     const problems = (r.problems || []).length;
     s.toast(`saved ${path} (${r.bytes} bytes)${problems ? `, with ${problems} problem${problems > 1 ? "s" : ""} still to fix before it runs` : ""}`, "info");
@@ -238,7 +248,10 @@ async function resolveConflict(path, conflict, message) {
     ],
     testid: "conflict",
   });
-  if (choice === "reload") return openModel({ path }, { ask: false });
+  if (choice === "reload") {
+    api.discardRecovery(path).catch(() => {});
+    return openModel({ path }, { ask: false });
+  }
   if (choice === "overwrite") return saveTo(path, conflict.version);
   if (choice === "saveas") return saveAs();
   return false;
@@ -287,7 +300,7 @@ export function useFiles(openPath, example) {
   useEffect(() => {
     if (!ready || !dirty || file.example) return undefined;
     const id = setTimeout(() => {
-      api.autosave(file.path, doc, file.version).catch(() => {
+      api.autosave(file.path, doc, file.version, SESSION).catch(() => {
         /* a failed autosave is retried on the next edit; the page keeps the model */
       });
     }, AUTOSAVE_MS);
