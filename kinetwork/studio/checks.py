@@ -24,6 +24,8 @@ LIBRARY_ORDER = ("multibody", "rotational", "translational", "signals", "electri
 #: a model is compiled to list its states only up to this many flat components: the
 #: symbolic build takes about 50 ms for the seed and grows with the model
 COMPILE_LIMIT = 400
+#: problems sent to the page at most (a model of a million broken parts lists the first)
+MAX_PROBLEMS = 200
 #: where a problem is: components[i] "name" params.key, connections[i], or comp.port
 _PLACE = re.compile(r'components\[(?P<index>\d+)\](?: "(?P<name>[^"]*)")?'
                     r'(?: params\.(?P<param>[A-Za-z_][A-Za-z0-9_]*))?'
@@ -95,34 +97,52 @@ def build(data, ctx, validate):
 
 
 def validate(data, ctx):
-    """``{"ok", "problems", "summary"}`` of a model file's top-level object.
+    """``{"ok", "problems", "summary"}`` of a model file's top-level object: :func:`check`,
+    then :func:`summarize` when the check passes."""
+    answer = check(data, ctx)
+    if answer.pop("compile"):
+        more = summarize(data, ctx)
+        if more.get("problems"):
+            return {"ok": False, "problems": more["problems"], "summary": answer["summary"]}
+        answer["summary"].update(more["summary"])
+    return answer
 
-    The model is checked as ``kn.load`` checks it; then compiled (up to COMPILE_LIMIT flat
-    components) to count its degrees of freedom and name its states, so what would refuse
-    to run (a mass matrix singular at the start) is a problem here too.
-    """
+
+def check(data, ctx):
+    """The checks of ``kn.load`` on a model file's top-level object: ``{"ok", "problems",
+    "summary": {"dof", "states", "components"}, "compile"}``, ``compile`` saying whether
+    :func:`summarize` has more to tell (a sound model that is not a definition)."""
     components = data.get("components")
     summary = {"dof": None, "states": None,
                "components": len(components) if isinstance(components, list) else 0}
     try:
         model = build(data, ctx, validate=True)
     except ModelError as exc:
-        return {"ok": False, "problems": problems_of(exc, data), "summary": summary}
+        return {"ok": False, "problems": problems_of(exc, data), "summary": summary,
+                "compile": False}
     summary["components"] = len(model.components)
-    if model.exposed:      # a definition: wired where it is placed, nothing to count alone
-        return {"ok": True, "problems": [], "summary": summary}
+    # a definition is wired where it is placed: nothing to count alone
+    return {"ok": True, "problems": [], "summary": summary, "compile": not model.exposed}
+
+
+def summarize(data, ctx):
+    """What compiling a sound model tells (up to COMPILE_LIMIT flat components): its degrees
+    of freedom and states, ``{"summary": {"dof", "states"}}``, or ``{"problems": [...]}``
+    for what would refuse to run (a mass matrix singular at the start)."""
+    out = {"dof": None, "states": None}
     try:
+        model = build(data, ctx, validate=True)
         flat = model.flat()
         topo = flat.validate()
         if len(flat.components) <= COMPILE_LIMIT:
             system = model.compile()
-            summary["dof"], summary["states"] = int(system.dof), list(system.state_names)
+            out["dof"], out["states"] = int(system.dof), list(system.state_names)
         elif not topo.loops:
             free = sum(1 for group in topo.oned if group.kind == "free")
-            summary["dof"] = int(topo.dof + free)
+            out["dof"] = int(topo.dof + free)
     except ModelError as exc:
-        return {"ok": False, "problems": problems_of(exc, data), "summary": summary}
-    return {"ok": True, "problems": [], "summary": summary}
+        return {"problems": problems_of(exc, data)}
+    return {"summary": out}
 
 
 def problems_of(exc, data=None):
@@ -131,7 +151,11 @@ def problems_of(exc, data=None):
     names = []
     if isinstance(data, dict) and isinstance(data.get("components"), list):
         names = [c.get("name") if isinstance(c, dict) else None for c in data["components"]]
-    return [problem(message, names) for message in exc.problems]
+    listed = [problem(message, names) for message in exc.problems[:MAX_PROBLEMS]]
+    if len(exc.problems) > MAX_PROBLEMS:
+        listed.append(problem(f"... and {len(exc.problems) - MAX_PROBLEMS:,} more problems "
+                              f"(the first {MAX_PROBLEMS} are listed)"))
+    return listed
 
 
 def problem(message, names=()):

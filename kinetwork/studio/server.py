@@ -39,9 +39,10 @@ STATIC = pathlib.Path(__file__).resolve().parent / "static"
 TOKEN_HEADER = "X-Kinetwork-Token"
 #: the largest request body: a model file's limit, and room for its JSON around it
 MAX_BODY = 2 * MAX_FILE_SIZE
-#: seconds a check (validate, layout, the text of a save) may take before it is stopped,
-#: and a linearisation (it may simulate up to its time)
-CHECK_LIMIT, LINEARIZE_LIMIT = 10.0, 120.0
+#: seconds a check (validate, layout, the text of a save) may take before it is stopped; the
+#: compilation validate does to count states (a model that checks: its answer waits for it,
+#: or goes without the counts); and a linearisation (it may simulate up to its time)
+CHECK_LIMIT, SUMMARY_LIMIT, LINEARIZE_LIMIT = 15.0, 30.0, 120.0
 #: checks in child processes at once; more wait their turn (up to their time limit)
 MAX_CHECKS = 4
 
@@ -226,12 +227,24 @@ def _routes(api, studio):
         data = _model(body)
         folder = studio.folder(studio.model_path(body))
         try:
-            answer = await studio.call(work.validate, data, folder, studio.library)
+            answer = await studio.call(work.check, data, folder, studio.library)
         except StudioError as exc:
             if exc.status != 503:
                 raise
-            answer = {"ok": False, "summary": None,
-                      "problems": [checks.problem(exc.message)]}
+            return StudioJSON({"ok": False, "summary": None,
+                               "problems": [checks.problem(exc.message)]})
+        if answer.pop("compile"):
+            try:
+                more = await studio.call(work.summarize, data, folder, studio.library,
+                                         limit=SUMMARY_LIMIT, what="counting the states")
+            except StudioError as exc:      # too long to count: the check's answer stands
+                if exc.status != 503:
+                    raise
+                more = {"summary": {}}
+            if more.get("problems"):
+                answer.update(ok=False, problems=more["problems"])
+            else:
+                answer["summary"].update(more["summary"])
         return StudioJSON(answer)
 
     @api.post("/save")

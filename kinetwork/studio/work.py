@@ -32,10 +32,16 @@ def _ctx(folder, library):
     return checks.context(folder, library)
 
 
-def validate(data, folder, library, channel):
-    """``checks.validate`` of the model: ``{"ok", "problems", "summary"}``."""
+def check(data, folder, library, channel):
+    """``checks.check`` of the model: ``{"ok", "problems", "summary", "compile"}``."""
     channel.enter("checking")
-    return checks.validate(data, _ctx(folder, library))
+    return checks.check(data, _ctx(folder, library))
+
+
+def summarize(data, folder, library, channel):
+    """``checks.summarize`` of the model: its degrees of freedom and states, or problems."""
+    channel.enter("compiling")
+    return checks.summarize(data, _ctx(folder, library))
 
 
 def layout(data, folder, library, channel):

@@ -2,9 +2,23 @@
 waits on the page's state (the test build's window.__kinetwork), never on time."""
 
 import json
+import os
+import pathlib
+import tempfile
 import time
 
 RUN_TIMEOUT = 240_000          # ms: EngineV6 compiles for ~30 s on a busy 2-core machine
+#: where the screenshots go: a folder of the test run, unless KINETWORK_SCREENSHOTS names
+#: one (`KINETWORK_SCREENSHOTS=docs/images pytest tests/studio` refreshes the docs'); a test
+#: run never rewrites files of the repository
+IMAGES = pathlib.Path(os.environ.get("KINETWORK_SCREENSHOTS")
+                      or pathlib.Path(tempfile.gettempdir()) / "kinetwork-screenshots")
+
+
+def screenshot(page, name):
+    """The page as it is now, as ``IMAGES/name``."""
+    IMAGES.mkdir(parents=True, exist_ok=True)
+    page.screenshot(path=str(IMAGES / name))
 
 
 def tid(name):

@@ -8,25 +8,17 @@ the studio's extras are missing.
 """
 
 import json
-import os
 import pathlib
-import tempfile
-import time
 
 import numpy as np
 
 import kinetwork as kn
-from tests.studio.helpers import (RUN_TIMEOUT, K, center, deselect, open_file, open_studio,
+from tests.studio.helpers import (IMAGES, RUN_TIMEOUT, K, center, deselect, open_file, open_studio,
                                   place, run, select, set_field, tid, wait_validated, wire)
 
 REPO = pathlib.Path(__file__).resolve().parents[2]
 SEED = "models/double_pendulum.json"
 MODEL_FILES = sorted(p.relative_to(REPO).as_posix() for p in (REPO / "models").rglob("*.json"))
-#: where the screenshots go: a folder of the test run, unless KINETWORK_SCREENSHOTS names
-#: one (`KINETWORK_SCREENSHOTS=docs/images pytest tests/studio/test_e2e.py` refreshes the
-#: README's); a test run never rewrites files of the repository
-IMAGES = pathlib.Path(os.environ.get("KINETWORK_SCREENSHOTS")
-                      or pathlib.Path(tempfile.gettempdir()) / "kinetwork-screenshots")
 
 
 def seed_results():

@@ -8,8 +8,8 @@ import json
 import numpy as np
 
 import kinetwork as kn
-from tests.studio.helpers import (RUN_TIMEOUT, K, deselect, open_studio, place, run, set_field,
-                                  tid, wire)
+from tests.studio.helpers import (RUN_TIMEOUT, K, deselect, open_studio, place, run,
+                                  screenshot, set_field, tid, wire)
 
 SEED = "models/double_pendulum.json"
 
@@ -56,6 +56,7 @@ def test_a_grid_sweep_from_the_page_plots_its_members_as_kn_sweep_gives_them(pag
     assert K(page, "K.plottedSeries.angle") == 12
     legend = page.locator(f'{tid("plot-angle")} .u-legend').inner_text()
     assert "c = 1, d = 0.2" in legend and "c = 4, d = 1" in legend
+    screenshot(page, "studio-sweep.png")
     assert not page.errors, page.errors
 
 
@@ -117,6 +118,7 @@ def test_linearize_at_the_cursor_gives_kn_linearizes_poles_and_a_bode_plot(page,
     page.wait_for_selector(tid("bode-mag"))
     page.wait_for_selector(f'{tid("bode-phase")} canvas')
     assert "motor.u" in page.locator(tid("bode")).inner_text()
+    screenshot(page, "studio-linearize.png")
     assert not page.errors, page.errors
 
 

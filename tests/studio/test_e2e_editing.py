@@ -7,8 +7,8 @@ double-click, the run counter per model, overlaid runs named."""
 import json
 
 import kinetwork as kn
-from tests.studio.helpers import (K, center, deselect, open_file, open_studio, place, run, select,
-                                  set_field, tid, wait_validated, wire)
+from tests.studio.helpers import (K, center, deselect, open_file, open_studio, place, run,
+                                  screenshot, select, set_field, tid, wait_validated, wire)
 
 SEED = "models/double_pendulum.json"
 
@@ -46,6 +46,7 @@ def test_ctrl_a_selects_every_block_and_delete_removes_them(page, studio):
 def test_the_right_click_menu_renames_duplicates_rotates_deletes_and_opens(page, studio):
     open_studio(page, studio, open=SEED)
     right_click(page, tid("node-mass2"))
+    screenshot(page, "studio-menu.png")
     items = [el.get_attribute("data-testid") for el in
              page.locator('[data-testid^="menu-"]').all()]
     assert items == ["menu-rename", "menu-duplicate", "menu-rotate", "menu-make-subsystem",

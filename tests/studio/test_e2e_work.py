@@ -7,8 +7,8 @@ changed on disk since it was opened is not overwritten without asking."""
 import json
 
 import kinetwork as kn
-from tests.studio.helpers import (K, deselect, leave, open_file, open_studio, select, set_field,
-                                  tid)
+from tests.studio.helpers import (K, deselect, leave, open_file, open_studio, screenshot, select,
+                                  set_field, tid)
 
 SEED = "models/double_pendulum.json"
 
@@ -261,6 +261,7 @@ def test_a_conflicting_save_is_refused_and_offers_reload_overwrite_or_save_as(pa
     dialog.wait_for()
     text = dialog.inner_text()
     assert "changed on disk" in text
+    screenshot(page, "studio-conflict.png")
     for choice in ("reload", "overwrite", "saveas", "cancel"):
         assert page.locator(tid(f"choice-{choice}")).count() == 1
     assert (studio.root / SEED).read_bytes() == theirs       # nothing overwritten

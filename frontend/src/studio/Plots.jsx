@@ -38,13 +38,16 @@ function fmt(v) {
   return v.toFixed(4);
 }
 
-function shortName(name) {
-  // "probe1.angle" -> "probe1"; "upper.p1.angle" -> "upper.p1"
+/** The probe a signal is of ("probe1", "upper.p1"): its descriptor's, sent by the server. */
+function probeOf(sig, name) {
+  if (sig && sig.probe) return sig.probe;
   const i = name.lastIndexOf(".");
   return i < 0 ? name : name.slice(0, i);
 }
 
-export function quantityOf(name) {
+/** The quantity a signal records ("angle"): its descriptor's, sent by the server. */
+export function quantityOf(sig, name) {
+  if (sig && sig.quantity) return sig.quantity;
   const i = name.lastIndexOf(".");
   return i < 0 ? name : name.slice(i + 1);
 }
@@ -78,7 +81,7 @@ function buildData(names, runs) {
       if (sig && !unit) unit = sig.unit || "";
       cols.forEach((col, k) => {
         const c = COLORS[color++ % COLORS.length];
-        const label = names.length > 1 ? `${shortName(name)}${labels[k] ? ` ${labels[k]}` : ""}` : labels[k] || quantityOf(name);
+        const label = names.length > 1 ? `${probeOf(sig, name)}${labels[k] ? ` ${labels[k]}` : ""}` : labels[k] || quantityOf(sig, name);
         const older = src.r > 0;
         series.push({
           label: sources.length > 1 ? `${label} · ${src.label}` : label,
@@ -239,20 +242,22 @@ export default function Plots({ runs, bus, running, progress, status }) {
     return () => ro.disconnect();
   }, []);
   const latest = runs[0];
-  const names = useMemo(() => (latest ? sourcesOf(latest)[0].results.signals.map((s) => s.name) : []), [latest]);
+  const signals = useMemo(() => (latest ? sourcesOf(latest)[0].results.signals : []), [latest]);
+  const names = useMemo(() => signals.map((s) => s.name), [signals]);
   // panels: one per quantity (every probe's angle together, as the seed paper plots them),
   // or one per signal
   const panels = useMemo(() => {
     const shown = names.filter((n) => !hidden.has(n));
     if (!byQuantity) return shown.map((n) => ({ title: n, names: [n] }));
     const groups = new Map();
+    const byName = new Map(signals.map((s) => [s.name, s]));
     for (const n of shown) {
-      const q = quantityOf(n);
+      const q = quantityOf(byName.get(n), n);
       if (!groups.has(q)) groups.set(q, []);
       groups.get(q).push(n);
     }
     return [...groups].map(([q, ns]) => ({ title: q, names: ns }));
-  }, [names, hidden, byQuantity]);
+  }, [signals, names, hidden, byQuantity]);
   const cols = width > 1000 ? 3 : width > 500 ? 2 : 1;
   const panelWidth = Math.floor((width - 12 * cols) / cols) - 8;
   // the panels fill the height they have (a title and a legend around each plot)
