@@ -29,8 +29,10 @@ demo: $(VENV)/.core
 
 # the front end first: its packages from the lockfile, ESLint (with React's rules of hooks)
 # and the type check, then its unit tests (Vitest); then two pytest workers (pytest-xdist),
-# each taking whole test files so module fixtures are built once
+# each taking whole test files so module fixtures are built once; the browser tests need
+# Debian's Chromium, installed here where it is missing (as root)
 test: $(VENV)/.installed
+	@.ci/chromium
 	cd frontend && npm ci --no-audit --no-fund && npm run lint && npm test
 	$(PY) -m pytest -q -n 2 --dist loadfile
 

@@ -33,7 +33,6 @@ URDF libraries on PyPI check no more (a negative mass or a joint to a missing li
 them) and bring mesh stacks this module does not need.
 """
 
-import functools
 import json
 import math
 import os
@@ -509,17 +508,6 @@ Z_TO_X = np.array([[0.0, 0.0, -1.0], [0.0, 1.0, 0.0], [1.0, 0.0, 0.0]])
 LOOKS_ANGLE = 1e-9
 
 
-@functools.cache
-def shapes_on_bodies():
-    """Whether RigidBody draws shapes (``shape``, ``shape_size``, ``color``): without them,
-    a visual is kept as data only."""
-    try:
-        mb.RigidBody("look", mass=0.0, shape="box", shape_size=[1.0, 1.0, 1.0], color="#000000")
-    except (ModelError, TypeError):
-        return False
-    return True
-
-
 def _look(model, names, base, visual, at, materials, link):
     """The visual as data ({"link", "frame", "kind", "xyz", "rpy", "color", "component"},
     and URDF's "size", "length" and "radius", or "filename" and "scale"); a box, cylinder or
@@ -540,8 +528,6 @@ def _look(model, names, base, visual, at, materials, link):
     else:
         data["radius"] = size[0]
         shape_size = [2 * size[0]] * 3
-    if not shapes_on_bodies():
-        return data
     turned = axis_angle(R)[1] > LOOKS_ANGLE
     frame = (_fixed(model, names, f"{base}_visual_origin", visual["xyz"], R, at) if turned
              else at)

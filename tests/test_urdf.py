@@ -256,8 +256,6 @@ def test_visuals():
     assert [(m["filename"], m["scale"]) for m in meshes] == [
         ("package://industrial_arm/meshes/base_link.stl", [0.001, 0.001, 0.001]),
         ("meshes/link_1.dae", [1.0, 1.0, 1.0])]
-    if not urdf.shapes_on_bodies():
-        return
     box = model.components[visuals[1]["component"]]
     assert (box.mass, box.shape, box.shape_size, box.color, box.r_cm) == (
         0.0, "box", [1.0, 0.05, 0.05], "#ff6b00", [0.5, 0.0, 0.0])
@@ -282,8 +280,6 @@ def probe_values(system, x):
 def test_visuals_sit_where_urdf_puts_them(robot):
     """Each shape's centre and axes (a cylinder's length along the RigidBody's x) against
     the link frames of Pinocchio's model composed with the visual's origin."""
-    if not urdf.shapes_on_bodies():
-        pytest.skip("RigidBody has no shape, shape_size, color parameters in this tree")
     pair = Pair(robot)
     looks = [v for v in pair.model.layout["ground"]["urdf"]["visuals"] if v["component"]]
     for v in looks:

@@ -77,7 +77,7 @@ def test_random_trees_match_pinocchios_derivatives_of_its_forward_dynamics(seed)
     """A and B of a random spatial tree (revolute and prismatic joints on skew axes, some
     reversed) against Pinocchio's analytical derivatives of the articulated-body algorithm
     (computeABADerivatives: d qdd / d q, d qdd / d qd and M^-1), another engine."""
-    pin = pytest.importorskip("pinocchio")
+    import pinocchio as pin
     from equations.test_pinocchio import build_pinocchio
     links, gravity = random_mechanism(seed, 4, reversed_fraction=0.3, tree=True)
     model = build_kinetwork(links, gravity)

@@ -10,13 +10,12 @@ import pickle
 import numpy as np
 import pytest
 import scipy.stats
+import xarray as xr
 from scenes import double_pendulum
 from scenes.reference import seed_reference
 
 import kinetwork as kn
 from kinetwork.analysis.sweep import Job, run_batch
-
-xr = pytest.importorskip("xarray")
 
 FAST = {"t_end": 1.5, "n_points": 151, "jit": False, "progress": False}
 
@@ -177,7 +176,7 @@ def test_a_job_travels_as_the_model_text():
 
 
 def test_dask_cluster_gives_the_local_numbers():
-    distributed = pytest.importorskip("distributed")
+    import distributed
     model = double_pendulum()
     grid = {"c": [0.5, 2.0, 4.0]}
     local = kn.sweep(model, grid, batch=2, workers=1, t_end=0.5, n_points=51, jit=False,
@@ -232,7 +231,7 @@ def test_a_swept_initial_angle_starts_each_member_there():
 
 
 def test_a_lost_dask_task_marks_its_members_and_keeps_the_others(monkeypatch):
-    distributed = pytest.importorskip("distributed")
+    import distributed
     module = __import__("sys").modules["kinetwork.analysis.sweep"]
     real = module.run_batch
 

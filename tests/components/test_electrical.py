@@ -8,6 +8,8 @@ import pytest
 import scipy.integrate
 import scipy.linalg
 
+from close import assert_same_numbers
+
 import kinetwork as kn
 
 E = kn.electrical
@@ -239,7 +241,7 @@ def test_a_circuit_saves_and_loads(tmp_path):
     again = kn.load(tmp_path / "rl.json")
     r1 = kn.simulate(m, t_end=0.2, n_points=3, jit=False)
     r2 = kn.simulate(again, t_end=0.2, n_points=3, jit=False)
-    assert np.array_equal(r1["pl.current"], r2["pl.current"])
+    assert_same_numbers(r1["pl.current"], r2["pl.current"])
 
 
 def test_inverting_amplifier_of_an_ideal_op_amp():

@@ -13,6 +13,7 @@ import pytest
 
 import kinetwork as kn
 import scenes
+from close import assert_same_json_file
 from scenes import reference_loops as ref
 
 ROOT = pathlib.Path(__file__).resolve().parents[2]
@@ -316,7 +317,7 @@ FILES = {"fourbar1": "Fourbar1", "fourbar2": "UniversalSpherical"}
 @pytest.mark.parametrize("name", FILES)
 def test_the_msl_fourbar_files_are_the_builders(name, tmp_path):
     msl_fourbar(FILES[name]).save(tmp_path / "built.json")
-    assert (tmp_path / "built.json").read_bytes() == (ROOT / "models" / f"{name}.json").read_bytes()
+    assert_same_json_file(tmp_path / "built.json", ROOT / "models" / f"{name}.json")
 
 
 @pytest.fixture(scope="module")

@@ -8,6 +8,7 @@ import os
 import jsonschema
 import numpy as np
 import pytest
+from close import assert_same_numbers
 
 import kinetwork as kn
 from kinetwork.cli import main
@@ -50,7 +51,7 @@ def test_a_model_of_subsystems_is_saved_as_version_2_and_reads_back(tmp_path):
     assert kn.dumps(back) == kn.dumps(arm)
     a = kn.simulate(arm, t_end=1, n_points=11)
     b = kn.simulate(back, t_end=1, n_points=11)
-    assert np.array_equal(a.states, b.states)
+    assert_same_numbers(a.states, b.states)
     validator = jsonschema.Draft202012Validator(kn.schema())
     assert list(validator.iter_errors(data)) == []
 

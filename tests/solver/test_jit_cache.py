@@ -26,7 +26,6 @@ __attribute__((constructor)) static void planted(void) {
 }
 """
 
-pytestmark = pytest.mark.skipif(jit.compiler() is None, reason="no C compiler")
 
 
 def tiny(name="f", op=ca.sin):
@@ -185,6 +184,11 @@ def test_a_compiler_that_fails_missing_or_writes_nothing_falls_back(cache, tmp_p
     assert not list(cache.glob("*"))                    # no build folder left behind
 
 
+#: [s] of wall time within which a stopped build has returned: the fake compilers sleep 60 s,
+#: so any bound well below that tells a stop from a wait, however loaded the machine
+STOPPED = 20.0
+
+
 def test_a_hanging_compiler_is_stopped(cache, tmp_path, monkeypatch):
     monkeypatch.setenv("CC", str(script(tmp_path, "slowcc", "echo thinking >&2; sleep 60")))
     # the run's deadline or its cancellation: a quiet fallback, even when C was required
@@ -192,14 +196,14 @@ def test_a_hanging_compiler_is_stopped(cache, tmp_path, monkeypatch):
                     {"cancelled": lambda t=time.perf_counter() + 1.0: time.perf_counter() > t}]:
         start, stats = time.perf_counter(), {}
         check(jit.external(tiny(), stats=stats, required=True, **options))
-        assert time.perf_counter() - start < 3.0
+        assert time.perf_counter() - start < STOPPED
         assert "deadline" in stats["jit_fallback"] or "cancelled" in stats["jit_fallback"]
     # no deadline: COMPILE_TIMEOUT, said with the compiler's words
     monkeypatch.setattr(jit, "COMPILE_TIMEOUT", 1.0)
     start = time.perf_counter()
     with pytest.warns(JitFallbackWarning, match="slowcc was stopped after 1 s: thinking"):
         check(jit.external(tiny()))
-    assert time.perf_counter() - start < 3.0
+    assert time.perf_counter() - start < STOPPED
     assert not list(cache.glob("*"))
 
 
@@ -213,7 +217,7 @@ def test_an_interrupted_build_leaves_no_build_folder(cache, tmp_path, monkeypatc
         return False
     with pytest.raises(KeyboardInterrupt):
         jit.external(tiny(), cancelled=interrupt)
-    assert time.perf_counter() - start < 3.0
+    assert time.perf_counter() - start < STOPPED
     assert cache.is_dir() and not list(cache.glob("*"))
 
 

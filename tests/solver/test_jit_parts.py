@@ -9,7 +9,6 @@ from scenes import build_kinetwork, random_mechanism
 
 from kinetwork.solver import jit
 
-pytestmark = pytest.mark.skipif(jit.compiler() is None, reason="no C compiler")
 
 
 @pytest.fixture

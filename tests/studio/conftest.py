@@ -7,7 +7,8 @@ which the studio's shipped build does not have): ``vite build --mode e2e`` into 
 the test session, from ``frontend/`` (``npm ci`` first when its packages are not installed).
 
 Nothing here is autouse, so the server's own tests (test_server.py) are untouched. The
-fixtures skip, saying why, when Chromium, Playwright, FastAPI/uvicorn or Node is missing.
+fixtures fail, saying why, when Chromium, Playwright, FastAPI/uvicorn or Node is missing
+(``browser_missing`` in tests/browser.py: skipped only when asked).
 """
 
 import fcntl
@@ -20,6 +21,7 @@ import threading
 import time
 
 import pytest
+from browser import browser_missing
 
 REPO = pathlib.Path(__file__).resolve().parents[2]
 FRONTEND = REPO / "frontend"
@@ -62,7 +64,7 @@ def test_page(tmp_path_factory):
     """The studio's page built with its test hook, in a folder of this test session."""
     why = _why_not()
     if why:
-        pytest.skip(why)
+        browser_missing(why)
     npm_installed()
     out = tmp_path_factory.mktemp("studio-e2e-build")
     done = subprocess.run([str(FRONTEND / "node_modules" / ".bin" / "vite"), "build",
@@ -120,7 +122,7 @@ def browser(chromium):
     """Debian's Chromium, headless, shared with the whole run (tests/conftest.py)."""
     why = _why_not()
     if why:
-        pytest.skip(why)
+        browser_missing(why)
     return chromium
 
 

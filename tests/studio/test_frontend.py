@@ -12,6 +12,7 @@ import subprocess
 
 import pytest
 
+from browser import browser_missing
 from tests.studio.conftest import FRONTEND, REPO, npm_installed
 
 STATIC = REPO / "kinetwork" / "studio" / "static"
@@ -26,7 +27,8 @@ def files_of(folder):
 @pytest.fixture(scope="module")
 def vite():
     if shutil.which("npm") is None or shutil.which("node") is None:
-        pytest.skip("Node and npm are needed to build the front end (apt-get install nodejs npm)")
+        browser_missing("Node and npm are needed to build the front end (apt-get install "
+                        "nodejs npm)")
     npm_installed()
     return str(FRONTEND / "node_modules" / ".bin" / "vite")
 

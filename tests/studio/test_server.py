@@ -12,12 +12,10 @@ import time
 import types
 import warnings
 
+import httpx
 import numpy as np
 import pytest
-
-pytest.importorskip("fastapi")
-httpx = pytest.importorskip("httpx")
-uvicorn = pytest.importorskip("uvicorn")
+import uvicorn
 with warnings.catch_warnings():
     # starlette asks for httpx2 now and says so on import; httpx still does the job
     warnings.filterwarnings("ignore", message="Using `httpx` with `starlette.testclient`")

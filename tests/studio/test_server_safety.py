@@ -17,15 +17,13 @@ import sys
 import threading
 import time
 
+import httpx
 import pytest
+import uvicorn
 
-pytest.importorskip("fastapi")
-httpx = pytest.importorskip("httpx")
-uvicorn = pytest.importorskip("uvicorn")
-
-import kinetwork as kn  # noqa: E402
-from kinetwork.studio import files, launch  # noqa: E402
-from kinetwork.studio.server import TOKEN_HEADER, create_app  # noqa: E402
+import kinetwork as kn
+from kinetwork.studio import files, launch
+from kinetwork.studio.server import TOKEN_HEADER, create_app
 
 MODELS = pathlib.Path(__file__).resolve().parents[2] / "models"
 TOKEN = "safety-token-0123456789"
