@@ -16,6 +16,7 @@ import logging
 import os
 import pathlib
 import secrets
+import time
 
 from fastapi import APIRouter, Depends, FastAPI, Request
 from fastapi.exceptions import RequestValidationError
@@ -45,6 +46,8 @@ MAX_BODY = 2 * MAX_FILE_SIZE
 CHECK_LIMIT, SUMMARY_LIMIT, LINEARIZE_LIMIT = 15.0, 30.0, 120.0
 #: checks in child processes at once; more wait their turn (up to their time limit)
 MAX_CHECKS = 4
+#: the longest a poll of a run waits for it to end
+MAX_WAIT = 2.0
 
 
 class StudioJSON(JSONResponse):
@@ -294,8 +297,9 @@ def _routes(api, studio):
         return StudioJSON({"run": started.id})
 
     @api.get("/run/{run_id}")
-    def poll(run_id: str):
-        return Response(studio.runs.get(run_id, "run").body(), media_type="application/json")
+    async def poll(run_id: str, wait: float = 0.0):
+        return Response(await _waited(studio.runs.get(run_id, "run"), wait),
+                        media_type="application/json")
 
     @api.post("/run/{run_id}/cancel")
     def cancel(run_id: str):
@@ -314,8 +318,8 @@ def _routes(api, studio):
         return StudioJSON({"sweep": started.id})
 
     @api.get("/sweep/{sweep_id}")
-    def poll_sweep(sweep_id: str):
-        return Response(studio.runs.get(sweep_id, "sweep").body(),
+    async def poll_sweep(sweep_id: str, wait: float = 0.0):
+        return Response(await _waited(studio.runs.get(sweep_id, "sweep"), wait),
                         media_type="application/json")
 
     @api.post("/sweep/{sweep_id}/cancel")
@@ -333,6 +337,17 @@ def _routes(api, studio):
                                             studio.folder(studio.model_path(body)),
                                             studio.library, limit=LINEARIZE_LIMIT,
                                             what="linearising the model"))
+
+
+async def _waited(job, wait):
+    """A job's answer, once it has ended or ``wait`` seconds (at most MAX_WAIT) have passed:
+    a page polling with a wait hears of the end at once."""
+    if not (0.0 <= wait <= MAX_WAIT):
+        raise StudioError(400, f"wait: seconds from 0 to {MAX_WAIT:g}, got {wait!r:.40}")
+    end = time.monotonic() + wait
+    while job.state == "running" and job.cancel_at is None and time.monotonic() < end:
+        await asyncio.sleep(0.01)
+    return job.body()
 
 
 def _rel_or_none(studio, path):

@@ -101,10 +101,16 @@ def run(data, settings, folder, library, channel):
             return _final("cancelled", phase=phase)
         phase = "integrating"
         channel.enter(phase)
-        t0 = 0.0
-        span = t_end - t0 if isinstance(t_end, (int, float)) and t_end > t0 else None
+        span = t_end if isinstance(t_end, (int, float)) and t_end > 0 else None
+
+        def progress(t):
+            channel.report(t / span)
+            if t >= span * (1 - 1e-12):
+                # integrated to the end: the probes' outputs follow, results that a cancel
+                # now would lose; they are finished and kept (jobs: no SIGINT in this phase)
+                channel.enter("writing results")
         results = simulate(system, **settings, cancel=channel.cancelled,
-                           progress=(lambda t: channel.report((t - t0) / span)) if span else None)
+                           progress=progress if span else None)
         phase = "writing results"
         channel.enter(phase)
         return _final("done", results=results_json(results, model), phase=phase)

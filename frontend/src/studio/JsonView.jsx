@@ -4,24 +4,10 @@
 import { useEffect, useRef, useState } from "react";
 import { api } from "./api.js";
 import { shapeProblem } from "./model.js";
+import { parseJson } from "./values.js";
 import { placeOf } from "./problems.js";
 import { studio, useStudio } from "./store.js";
 import { DEBOUNCE_MS } from "./hooks/useValidation.js";
-
-/** The JSON error of ``text`` with its line and column, or null; and the parsed value. */
-export function parseJson(text) {
-  try {
-    return { value: JSON.parse(text), error: null };
-  } catch (e) {
-    const msg = String(e.message || e);
-    const at = /position (\d+)/.exec(msg);
-    if (!at) return { value: null, error: msg };
-    const upto = text.slice(0, Number(at[1]));
-    const line = upto.split("\n").length;
-    const col = upto.length - upto.lastIndexOf("\n");
-    return { value: null, error: `line ${line}, column ${col}: ${msg.replace(/\s*\(line \d+ column \d+\)/, "")}` };
-  }
-}
 
 export default function JsonView() {
   const doc = useStudio((s) => s.hist.present);

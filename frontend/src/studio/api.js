@@ -57,9 +57,10 @@ export const api = {
   recovery: (path) => call("GET", path ? `api/recovery?path=${q(path)}` : "api/recovery"),
   discardRecovery: (path) => call("POST", "api/recovery/discard", { path: path || null }),
   run: (model, settings, path) => call("POST", "api/run", { model, settings, path: path || null }),
-  runStatus: (id) => call("GET", `api/run/${q(id)}`),
+  /** A run's state; ``wait``: seconds to wait for its end before answering. */
+  runStatus: (id, wait = 0) => call("GET", `api/run/${q(id)}?wait=${wait}`),
   sweep: (model, sweep, path) => call("POST", "api/sweep", { model, sweep, path: path || null }),
-  sweepStatus: (id) => call("GET", `api/sweep/${q(id)}`),
+  sweepStatus: (id, wait = 0) => call("GET", `api/sweep/${q(id)}?wait=${wait}`),
   /** Cancel run or sweep ``id`` (``kind`` "run" or "sweep"). */
   cancel: (kind, id) => call("POST", `api/${kind === "sweep" ? "sweep" : "run"}/${q(id)}/cancel`),
   linearize: (model, spec, path) => call("POST", "api/linearize", { model, ...spec, path: path || null }),

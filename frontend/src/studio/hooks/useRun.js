@@ -9,7 +9,9 @@ import { runLabel } from "../runs.js";
 
 /** Runs overlaid in the plots besides the latest. */
 export const OVERLAY = 3;
-const POLL_MS = 120;
+// each poll waits on the server for the run's end (the page hears of it at once), at most
+// this long, so that the progress shown moves on meanwhile
+const POLL_WAIT_S = 0.25;
 const POLL_CANCELLING_MS = 40;
 
 let timer = null;
@@ -36,7 +38,8 @@ function follow(id, kind, meta, started) {
   const tick = async () => {
     let st;
     try {
-      st = kind === "sweep" ? await api.sweepStatus(id) : await api.runStatus(id);
+      const wait = studio().run && studio().run.state === "cancelling" ? 0 : POLL_WAIT_S;
+      st = kind === "sweep" ? await api.sweepStatus(id, wait) : await api.runStatus(id, wait);
     } catch (e) {
       if (mine !== generation) return;
       useStudio.setState({ run: { id, kind, state: "failed", progress: 0, error: e.message, problems: e.problems } });
@@ -48,13 +51,13 @@ function follow(id, kind, meta, started) {
     if (st.state === "running") {
       const cancelling = now && now.state === "cancelling";
       useStudio.setState({ run: { id, kind, state: cancelling ? "cancelling" : "running", progress: st.progress || 0, phase: st.phase || null } });
-      timer = setTimeout(tick, cancelling ? POLL_CANCELLING_MS : POLL_MS);
+      timer = setTimeout(tick, cancelling ? POLL_CANCELLING_MS : 0);
       return;
     }
     timer = null;
     finish(id, kind, st, meta, started);
   };
-  timer = setTimeout(tick, 40);
+  timer = setTimeout(tick, 0);
 }
 
 function finish(id, kind, st, meta, started) {
