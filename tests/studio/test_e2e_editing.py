@@ -209,7 +209,9 @@ def test_a_problem_is_said_in_the_users_words_inside_its_block(page, studio):
     message.wait_for()
     assert message.inner_text().startswith("mass: must be >= 0")
     problems = page.locator(tid("problems")).inner_text()
-    assert "mass1.mass: must be >= 0" in problems and "components[" not in problems
+    assert "mass1.mass\nmust be >= 0" in problems and "components[" not in problems
+    field = page.locator(".kn-param.bad .kn-param-problem").inner_text()
+    assert field.startswith("mass1.mass: must be >= 0")
     # inside the block: it covers no other block
     block = page.locator(tid("node-mass1")).bounding_box()
     msg = message.bounding_box()

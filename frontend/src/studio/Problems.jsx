@@ -24,7 +24,7 @@ export default function Problems({ places, ok, onGo }) {
                 {p.scope ? `${p.scope} › ` : ""}
                 {whereOf(p) || "model"}
               </span>
-              <span className="kn-problem-msg">{p.text}</span>
+              <span className="kn-problem-msg">{p.reason || p.text}</span>
               {p.hint ? <span className="kn-problem-hint">{p.hint}</span> : null}
             </div>
           ))

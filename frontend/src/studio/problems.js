@@ -11,6 +11,7 @@
  * @property {number | null} connection
  * @property {string} message      the server's whole text
  * @property {string} text         the same in the user's words: "mass1.mass: must be >= 0"
+ * @property {string | null} reason what is wrong, without the place (when the server says)
  * @property {string | null} hint
  * @property {string} severity     "error" or "warning"
  * @property {boolean} [run]       reported by a run rather than by validation
@@ -54,6 +55,7 @@ export function placeOf(problem) {
     message: String(p.message ?? ""),
     hint: typeof p.hint === "string" ? p.hint : null,
     severity: p.severity === "warning" ? "warning" : "error",
+    reason: typeof p.reason === "string" && p.reason ? p.reason : null,
   };
   return { ...place, text: userText(p, place) };
 }
@@ -82,7 +84,7 @@ export function userText(problem, place) {
 
 /** The short text a block shows of its first problem: "mass: must be >= 0". */
 export function blockText(place) {
-  const reason = place.text.startsWith(`${whereOf(place)}: `) ? place.text.slice(whereOf(place).length + 2) : place.text;
   const sub = place.parameter || place.port;
-  return sub && reason !== place.text ? `${sub}: ${reason}` : reason;
+  if (!place.reason) return place.text;
+  return sub ? `${sub}: ${place.reason}` : place.reason;
 }
