@@ -31,7 +31,7 @@ log = logging.getLogger("kinetwork.studio")
 #: what the forkserver imports once, so that each child starts with it loaded; the last one
 #: runs a small model there (``warm``), so that each child starts warm too
 PRELOAD = ["kinetwork", "kinetwork.graph.io", "kinetwork.equations", "kinetwork.solver.driver",
-           "kinetwork.studio.work", "kinetwork.studio.warm"]
+           "kinetwork.studio.jobs", "kinetwork.studio.work", "kinetwork.studio.warm"]
 #: environment variables a child takes from the server at each call (the forkserver's were
 #: fixed when it started): kinetwork's own settings
 ENV_PREFIX = "KINETWORK_"
