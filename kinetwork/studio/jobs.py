@@ -261,14 +261,19 @@ class Child:
         return True
 
     def kill(self):
-        """End the child and its process group now: SIGTERM, then SIGKILL."""
+        """End the child and its process group now: SIGTERM, then SIGKILL (where there are
+        process groups; elsewhere the process alone)."""
         pid = self.process.pid
         if pid is None or not self.process.is_alive():
+            return
+        if not hasattr(os, "killpg"):
+            self.process.kill()
+            self.process.join(1.0)
             return
         for sig, wait in ((signal.SIGTERM, KILL_GRACE), (signal.SIGKILL, 1.0)):
             try:
                 os.killpg(pid, sig)
-            except (ProcessLookupError, PermissionError, OSError):
+            except OSError:
                 try:
                     os.kill(pid, sig)
                 except OSError:
@@ -281,10 +286,8 @@ class Child:
 def _child_main(fn, args, conn, progress, phase, cancel, env):
     """The child: its own process group, the server's KINETWORK_ settings, the call, the
     answer down the pipe."""
-    try:
+    with contextlib.suppress(OSError, AttributeError):
         os.setpgid(0, 0)       # a kill takes the C compiler it may start along
-    except OSError:
-        pass
     for key in [k for k in os.environ if k.startswith(ENV_PREFIX) and k not in env]:
         del os.environ[key]
     os.environ.update(env)
