@@ -16,7 +16,7 @@ package. The first use also installs the faces on the core classes (``Model.comp
 
 import importlib
 
-from .errors import IdealisedInertiaWarning, ModelError, SimulationError
+from .errors import AssemblyBranchWarning, IdealisedInertiaWarning, ModelError, SimulationError
 
 __version__ = "0.1.0"
 
@@ -54,7 +54,7 @@ _LAZY = {
     "uniform": ("analysis.sweep", "uniform"),
 }
 
-__all__ = ["IdealisedInertiaWarning", "ModelError", "SimulationError", *_LAZY]
+__all__ = ["AssemblyBranchWarning", "IdealisedInertiaWarning", "ModelError", "SimulationError", *_LAZY]
 
 #: modules that install themselves on the core classes when imported
 _FACES = ("equations", "plot")

@@ -536,6 +536,11 @@ def _validate(args):
         f"\n  ... ({len(topo.cuts)} in all)" if len(topo.cuts) > SHOWN_ITEMS else "")
     if args.compile:
         lines += _compiled_summary(model.compile(loops=args.loops), topo, loops)
+    elif any(port.domain == "electrical" for c in model.components.values()
+             for port in c.ports.values()):
+        # a circuit's states are chosen by its structure (index reduction): compiled to say
+        # which, as validation of a circuit is about which energy stores are independent
+        lines += _compiled_summary(model.compile(loops=args.loops), topo, loops)
     else:
         # the joints' degrees of freedom and the free 1-D groups' are exact without the
         # equations; loops take away as many as their independent closure equations
@@ -618,6 +623,8 @@ def _compiled_summary(system, topo, loops):
         *([textwrap.fill(f"why these states: {system.formulation_note}", 88,
                          subsequent_indent="  ")] if system.formulation_note else []),
         *([textwrap.fill(network, 88, subsequent_indent="  ")] if network else []),
+        *[textwrap.fill(f"demoted by index reduction: {name} ({why})", 88,
+                        subsequent_indent="  ") for name, why in system.demoted_states.items()],
         f"equations: {size['states']} states, {size['algebraic']} algebraic variables, "
         f"{len(system.signal_names)} probe signals ({n_values} values); right-hand side "
         f"{size['operations']} operations per evaluation ("

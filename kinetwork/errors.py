@@ -38,3 +38,10 @@ class IdealisedInertiaWarning(UserWarning):
     inequality), accepted as an idealisation: MSL's examples give parts that only turn about
     one axis inertias such as diag(2, 0, 0). The model simulates; a mass matrix made singular
     by it is still refused, naming the joints."""
+
+
+class AssemblyBranchWarning(UserWarning):
+    """A kinematic loop assembled at the start on another branch than its guesses lie on
+    (the pistons of MSL's EngineV6 below the crankshaft, with the default guesses): the
+    model simulates that assembly; the warning names the loop, its joints and where they
+    start, so that guesses (q0_guess) can pick the one meant."""

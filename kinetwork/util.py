@@ -1,13 +1,23 @@
 """Small helpers every layer uses: checked numbers, near-match suggestions, quoting of user
-input in messages, and atomic file writes. The bottom layer: it imports nothing of kinetwork
-but the errors."""
+input in messages, atomic file writes, and capturing what the solvers print. The bottom
+layer: it imports nothing of kinetwork but the errors."""
 
+import contextlib
+import ctypes
+import functools
+import io
 import math
 import os
+import re
 import stat
 import sys
+import tempfile
+import threading
 
 from .errors import ModelError
+
+#: a CasADi warning line: its message, without the time stamp and the C++ source place
+_WARNING = re.compile(r'^CasADi - [^W]*WARNING\("(.*)"\)\s*(\[.*\])?$')
 
 #: user input quoted in a message is cut to this many characters
 QUOTE_LIMIT = 200
@@ -89,3 +99,86 @@ def callable_module(name, function):
         __doc__ = function.__doc__
 
     sys.modules[name].__class__ = CallableModule
+
+
+#: the solvers print through file descriptors 1 and 2, which belong to the whole process:
+#: one integration section at a time captures them
+SOLVER_LOCK = threading.RLock()
+
+
+@contextlib.contextmanager
+def solver_output(sink):
+    """What the integrators print (SUNDIALS' failure chatter, CasADi's warnings) captured
+    instead of reaching the user's terminal: CasADi writes through Python's sys.stdout and
+    sys.stderr, plain C code to file descriptors 1 and 2; both are caught, in the file
+    ``sink`` (emptied first). The text is in the yielded dict's "text" afterwards. Callers
+    hold ``SOLVER_LOCK``."""
+    box = {"text": ""}
+    fd = sink.fileno()
+    if os.fstat(fd).st_size:            # (a seek and a truncate cost 25 us: only when needed)
+        sink.seek(0)
+        sink.truncate()
+    python_level = io.StringIO()
+    for stream in (sys.stdout, sys.stderr):
+        with contextlib.suppress(Exception):
+            stream.flush()
+    try:
+        saved = [os.dup(1), os.dup(2)]
+    except OSError:                            # no file descriptors to redirect
+        saved = None
+    streams = sys.stdout, sys.stderr           # (contextlib's redirections cost 30 us)
+    sys.stdout = sys.stderr = python_level
+    try:
+        if saved:
+            os.dup2(fd, 1)
+            os.dup2(fd, 2)
+        yield box
+    finally:
+        sys.stdout, sys.stderr = streams
+        caught = b""
+        if saved:
+            _libc().fflush(None)
+            os.dup2(saved[0], 1)
+            os.dup2(saved[1], 2)
+            for saved_fd in saved:
+                os.close(saved_fd)
+            if os.fstat(fd).st_size:
+                sink.seek(0)
+                caught = sink.read()
+        box["text"] = python_level.getvalue() + caught.decode("utf-8", "replace")
+
+
+@functools.lru_cache(maxsize=1)
+def _libc():
+    return ctypes.CDLL(None)
+
+
+def last_words(text):
+    """The solver's own last line (what it said when it failed), shortened."""
+    lines = [ln.strip() for ln in text.splitlines() if ln.strip()]
+    if not lines:
+        return ""
+    line = lines[-1]
+    return line if len(line) <= 200 else line[:197] + "..."
+
+
+@contextlib.contextmanager
+def quiet():
+    """What CasADi and the C code under it print while the block runs, captured (never on
+    the user's terminal): the yielded dict's "text" holds it afterwards, for a summary in
+    the error or warning that follows."""
+    with SOLVER_LOCK, tempfile.TemporaryFile() as sink, solver_output(sink) as box:
+        yield box
+
+
+def summary(text, limit=3):
+    """A short account of captured solver output: how many lines, and the distinct ones
+    first (up to ``limit``), for a message."""
+    lines = [ln.strip() for ln in text.splitlines() if ln.strip()]
+    if not lines:
+        return ""
+    # CasADi's lines differ in their time stamps and source places only
+    distinct = list(dict.fromkeys(_WARNING.sub(r"\1", ln) for ln in lines))
+    shown = "; ".join(ln if len(ln) <= 160 else ln[:157] + "..." for ln in distinct[:limit])
+    more = f" (and {len(distinct) - limit} more kinds)" if len(distinct) > limit else ""
+    return f"the solver said {len(lines)} line{'s' * (len(lines) != 1)}: {shown}{more}"

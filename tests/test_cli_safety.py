@@ -190,8 +190,12 @@ def test_a_run_stopped_by_a_signal_writes_its_partial_results(tmp_path, signum, 
     try:
         # the progress bar's first output: the equations are built, the run has begun
         assert os.read(child.stderr.fileno(), 1)
-        time.sleep(1.5)
-        before = cpu_seconds(child.pid)
+        started, patience = cpu_seconds(child.pid), time.monotonic() + 120
+        # a second and a half of the command's CPU (not of wall time: a loaded machine gives
+        # it less): rows enough to be written when it stops
+        while ((before := cpu_seconds(child.pid)) < 1.5 + started and child.poll() is None
+               and time.monotonic() < patience):
+            time.sleep(0.05)
         child.send_signal(signum)
         _, err = child.communicate(timeout=120)
         took = children_cpu_seconds() - waited - before

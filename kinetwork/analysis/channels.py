@@ -18,6 +18,7 @@ import numpy as np
 
 from ..components.base import PortRef
 from ..components.signals import Input
+from ..equations.closing import closer
 from ..equations.system import System
 from ..errors import ModelError
 from ..graph.model import Model, evaluate
@@ -84,28 +85,36 @@ class Plant:
                     raise ModelError(f"at: {quote(key)} is not a state{suggest(key, names)}; "
                                      f"states are {', '.join(s.state_names)}")
                 X[names.index(key)] = float(value)
-            return 0.0, self._closed(X, p)
+            given_z = any(k in s.algebraic_names for k in at)
+            return 0.0, self._closed(X, p, given_z)
         X = np.asarray(at, dtype=float).ravel()
+        given_z = X.shape == (s.n_states + s.n_algebraic,)
         if X.shape == (s.n_states,):
             X = np.concatenate([X, x0[s.n_states:]])
         if X.shape != (s.n_states + s.n_algebraic,):
             raise ModelError(f"at: expected a time, a dict of states or {s.n_states} state "
                              f"values ({', '.join(s.state_names)}), got shape {np.shape(at)}")
-        return 0.0, self._closed(X, p)
+        return 0.0, self._closed(X, p, given_z)
 
-    def _closed(self, X, p):
-        """X with its algebraic variables Newton-solved onto the loop closure."""
+    def _closed(self, X, p, given_z=True):
+        """X with its algebraic variables (the dependent coordinates of loops) closing the
+        loops at its independent states, on the branch the model starts on: Newton from the
+        given ones when ``given_z`` (the caller chose the branch) and they converge there,
+        else followed from the assembled start (``equations/closing.py``)."""
         s = self.system
         if not np.all(np.isfinite(X)):
             raise ModelError("at: the state must be finite")
         if not s.n_algebraic:
             return X
-        out = s.polish(X[None, :], p)[0]
-        if s.constraint_residual_p(out[None, :], p)[0] > 1e-8:
-            raise ModelError(f"at: the loops of {s.model.name!r} cannot close at this state "
-                             f"(the independent coordinates {', '.join(s.state_names)} place "
-                             f"the mechanism where it cannot be assembled)")
-        return out
+        n = s.n_states
+        c = closer(s)
+        x = X[:n]
+        if given_z:
+            z, _, ok = c.newton(x, X[n:], p)
+            if ok:
+                return np.concatenate([x, z])
+        x0, z0 = s.initial_full_p(p)
+        return np.concatenate([x, c.close(x, p, (x0, z0))])
 
     def _reached(self, t, p):
         """The full state a simulation (the model's settings) reaches at time t."""

@@ -7,12 +7,19 @@ rates from ``rates``. ``kinetwork.equations.circuit`` gathers them with Kirchhof
 at every connection set, and solves the circuit by structural analysis (the connection sets
 are the alias elimination of the potentials; a block-lower-triangular sort of the rest).
 What a component is handed, ``e``, reads ``e.v("p")``, ``e.i("p")``, ``e.x`` (its states),
-``e.t``, ``e.u`` (the signal at u, or None when unwired) and, for an EMF, ``e.w`` (the speed of
-its flange relative to its support).
+``e.t``, ``e.u`` (the signal at u, or None when unwired), ``e.parameters`` (the model's
+parameters as symbols), ``e.place(key)`` (where a parameter is, for messages) and, for an EMF,
+``e.w`` (the speed of its flange relative to its support). A law may be nonlinear (a diode):
+the circuit's solver then leaves the unknowns it reads nonlinearly to IDAS.
 """
 
+import casadi as ca
+
+from ..errors import ModelError
+from ..expr import casadi_functions, parse
 from .base import Component, Param, Port, PortRef
 from .loopjoints import Expansion
+from .signals import ExpressionParam
 
 LIB = "electrical"
 
@@ -25,6 +32,9 @@ class PartialTwoPin(Component):
     n_states = 0
     state_labels = ()
     state_units = ()
+    #: the parameters giving the states' starts: one given makes its state preferred where
+    #: a constraint leaves a choice (index reduction)
+    start_params = ()
 
     def laws(self, e):
         """The two residuals: the current through (i_p + i_n = 0) and the component's law."""
@@ -41,11 +51,57 @@ class PartialTwoPin(Component):
 
 
 class Resistor(PartialTwoPin, library=LIB):
-    """Ideal linear resistor: v = R i."""
-    R = Param(unit="Ohm", min=0.0, doc="Resistance")
+    """Ideal linear resistor: v = R i (R positive, zero or negative, as MSL's)."""
+    R = Param(unit="Ohm", doc="Resistance")
 
     def law(self, v, i, e):
         return v - self.R * i
+
+
+class Conductor(PartialTwoPin, library=LIB):
+    """Ideal linear conductor: i = G v (G positive, zero or negative), MSL's
+    Analog.Basic.Conductor."""
+    G = Param(unit="S", doc="Conductance")
+
+    def law(self, v, i, e):
+        return i - self.G * v
+
+
+class NonlinearResistor(PartialTwoPin, library=LIB):
+    """A resistor whose current from p to n is an expression of its voltage v = v_p - v_n
+    (and of t and the model's parameters): MSL's Chua resistor is
+    ``i="if_else(v < -Ve, Gb*(v + Ve) - Ga*Ve, if_else(v > Ve, Gb*(v - Ve) + Ga*Ve, Ga*v))"``.
+    A nonlinear law makes the circuit a DAE that IDAS solves."""
+    i = ExpressionParam(doc="Current from p to n, in the voltage v, t and the model's "
+                            "parameters", unit="A")
+
+    def law(self, v, i, e):
+        if not isinstance(self.i, str):
+            return i - self.i
+        expr = parse(self.i)
+        env = {**e.parameters, "t": e.t, "v": v}
+        unknown = sorted(expr.names - set(env))
+        if unknown:
+            raise ModelError(f"{e.place('i')}: unknown name {unknown[0]!r} in {self.i!r}; "
+                             f"names are v (the voltage), t and the model's parameters "
+                             f"{', '.join(e.parameters) or '(none)'}")
+        return i - ca.SX(expr.evaluate(env, casadi_functions()))
+
+
+class Diode(PartialTwoPin, library=LIB):
+    """Simple diode with a parallel ohmic resistance, MSL's Analog.Semiconductors.Diode
+    (without its heat port): i = Ids (exlin(v/Vt, Maxexp) - 1) + v/R, the exponential
+    continued linearly beyond the exponent Maxexp so that it cannot overflow."""
+    Ids = Param(1e-6, unit="A", min=0.0, doc="Saturation current")
+    Vt = Param(0.04, unit="V", positive=True, doc="Voltage equivalent of temperature (kT/qn)")
+    Maxexp = Param(15.0, unit="1", positive=True,
+                   doc="Max. exponent for linear continuation")
+    R = Param(1e8, unit="Ohm", positive=True, doc="Parallel ohmic resistance")
+
+    def law(self, v, i, e):
+        x = v / self.Vt
+        exlin = ca.exp(ca.fmin(x, self.Maxexp)) * (1 + ca.fmax(x - self.Maxexp, 0))
+        return i - (self.Ids * (exlin - 1) + v / self.R)
 
 
 class Inductor(PartialTwoPin, library=LIB):
@@ -55,6 +111,7 @@ class Inductor(PartialTwoPin, library=LIB):
     n_states = 1
     state_labels = ("i",)
     state_units = ("A",)
+    start_params = ("i0",)
 
     def law(self, v, i, e):
         return i - e.x[0]
@@ -73,6 +130,7 @@ class Capacitor(PartialTwoPin, library=LIB):
     n_states = 1
     state_labels = ("v",)
     state_units = ("V",)
+    start_params = ("v0",)
 
     def law(self, v, i, e):
         return v - e.x[0]
@@ -198,6 +256,27 @@ class IdealOpAmp(Component, library=LIB):
 
     def laws(self, e):
         return [e.v("p1") - e.v("n1"), e.i("p1"), e.i("n1"), e.i("p2") + e.i("n2")]
+
+    def rates(self, e):
+        return []
+
+    def initial(self):
+        return []
+
+
+class IdealOpAmp3Pin(Component, library=LIB):
+    """Ideal operational amplifier with three pins (MSL's Analog.Ideal.IdealOpAmp3Pin): no
+    voltage across and no current into the inputs in_p, in_n (a nullator); the output out
+    takes any voltage and current (a norator to ground)."""
+    role = "electrical"
+    in_p = Port("electrical", "Positive input pin")
+    in_n = Port("electrical", "Negative input pin")
+    out = Port("electrical", "Output pin")
+    n_states = 0
+    state_labels = state_units = ()
+
+    def laws(self, e):
+        return [e.v("in_p") - e.v("in_n"), e.i("in_p"), e.i("in_n")]
 
     def rates(self, e):
         return []

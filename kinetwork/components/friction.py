@@ -143,14 +143,53 @@ class PartialBearingFriction(PartialTwoFlanges):
 
 
 class PartialNormalForceFriction(PartialFriction):
-    """Friction pressed by a normal force fn_max * f_normalized (the signal at u, or the
-    parameter), as MSL's Brake and Clutch: f_kinetic = mu * cgeo * fn."""
+    """Friction pressed by a normal force fn = fn_max * f_normalized (the signal at u, or the
+    parameter), as MSL's Brake and Clutch: f_kinetic = mu * cgeo * fn, and free (mode 2,
+    MSL's Free: no Coulomb friction, nothing held) while fn <= 0. Engaged, each mode also
+    ends where fn falls to 0; free ends where fn rises above ``FREE_EDGE * (1 + fn_max)``
+    (an indicator at zero would never be seen crossing), and the element then slides the way
+    its relative speed goes, or at rest sticks if it can (MSL: from Free to Forward,
+    Backward or Stuck)."""
+    FREE = 2
+    modes = {**PartialFriction.modes, FREE: "free"}
     u = Port("signal_in", "Normalized normal force f_normalized, 0..1 (instead of the "
                           "parameter)", optional=True)
 
+    def normal_force(self, u):
+        return self.fn_max * (self.f_normalized if u is None else u)
+
     def kinetic(self, u):
-        fn = self.fn_max * (self.f_normalized if u is None else u)
-        return self.mu * self.cgeo * ca.fmax(fn, 0)
+        return self.mu * self.cgeo * ca.fmax(self.normal_force(u), 0)
+
+    def held(self, mode):
+        return ca.if_else(mode == 0, 1, 0)
+
+    def law(self, rel, w_rel, mode, u):
+        return ca.if_else(mode == self.FREE, 0, mode) * self.kinetic(u) + self.d * w_rel
+
+    def values(self, t, u):
+        return self.peak * self.kinetic(u), self.normal_force(u)
+
+    def indicator(self, mode, rel, w_rel, force, values, power=None):
+        engaged = ca.fmin(super().indicator(mode, rel, w_rel, force, values), values[1])
+        edge = EDGE * (1 + ca.fabs(self.fn_max))
+        return ca.if_else(mode == self.FREE, edge - values[1], engaged)
+
+    def disengaged(self, values):
+        """Free at a state whose numbers (static limit, normal force) are ``values``."""
+        return values[1] <= EDGE
+
+    def first_mode(self, ev):
+        if self.disengaged(ev.values):
+            return self.FREE, None, None
+        return super().first_mode(ev)
+
+    def next_mode(self, ev):
+        if ev.mode == self.FREE:                  # pressed again: engage
+            return PartialFriction.first_mode(self, ev)
+        if ev.values[1] <= 0:                     # the normal force is gone
+            return self.FREE, None, None
+        return super().next_mode(ev)
 
 
 class PartialElastoGap(PartialHybrid):

@@ -131,10 +131,13 @@ class JointRRR(Component, library=MB):
     rod 1 runs ``r_rod1`` (in frame_ia) to the middle revolute, whose far side frame_im is
     fixed to rod 2; frame_ib is fixed to rod 2 at the third revolute, ``r_rod2`` (in frame_ib)
     from the middle one, and frame_b is that revolute's far side. ``axis`` and ``support``
-    are the third revolute's flanges. Compiled, it is that chain, its third revolute the cut
-    joint of the loop (so it must close one): the same motion as three Revolutes, with bodies
-    on frame_ia, frame_im and frame_ib as on any frame. Its coordinates are
-    ``<name>.rev1.q``, ``<name>.rev2.q`` and ``<name>.rev3.q``.
+    (MSL's ``bearing``, also wirable by that name) are the third revolute's flanges. As in
+    MSL, the third revolute turns from frame_b to frame_ib: its angle is frame_ib's rotation
+    relative to frame_b about the axis, and a torque on ``axis`` drives that angle. Compiled,
+    it is that chain, its third revolute the cut joint of the loop (so it must close one):
+    the same motion as three Revolutes, with bodies on frame_ia, frame_im and frame_ib as on
+    any frame. Its coordinates are ``<name>.rev1.q``, ``<name>.rev2.q`` and
+    ``<name>.rev3.q``.
     """
     role = "aggregate"
     frame_a = Port("frame", "Outer side of the first revolute")
@@ -144,8 +147,10 @@ class JointRRR(Component, library=MB):
     frame_im = Port("frame", "Far side of the middle revolute, fixed to rod 2", optional=True)
     frame_ib = Port("frame", "Inner side of the third revolute, fixed to rod 2",
                     optional=True)
-    axis = Port("rotational", "Flange driving the third revolute", optional=True)
+    axis = Port("rotational", "Flange driving the third revolute (angle of frame_ib "
+                              "relative to frame_b)", optional=True)
     support = Port("rotational", "Reaction flange of that drive", optional=True)
+    bearing = Port("rotational", "The support, by MSL's name", optional=True)
     n_a = Param([0.0, 0.0, 1.0], unit="1", shape=(3,), nonzero=True,
                 doc="Axis of the three revolutes, in frame_a")
     r_rod1 = Param([1.0, 0.0, 0.0], unit="m", shape=(3,),
@@ -156,14 +161,17 @@ class JointRRR(Component, library=MB):
                      doc="Start of the search for the three angles (picks the assembly)")
 
     def expand(self):
-        """The chain rev1 - rod1 - rev2 - rod2 - rev3 (cut), and its ports as this one's."""
+        """The chain rev1 - rod1 - rev2 - rod2 - rev3 (cut), and its ports as this one's.
+        rev3 sits between frame_ib and frame_b about -n_a: turning frame_b by q about -n_a
+        is turning frame_ib by q about n_a relative to frame_b, MSL's angle (its axis is
+        n_a in frame_b too, the loop being planar)."""
         g = self.q0_guess
         revolute, rod = REGISTRY[f"{MB}.Revolute"], REGISTRY[f"{MB}.FixedTranslation"]
         parts = [revolute("rev1", axis=self.n_a, q0_guess=g[0]),
                  rod("rod1", r=self.r_rod1),
                  revolute("rev2", axis=self.n_a, q0_guess=g[1]),
                  rod("rod2", r=_negated(self.r_rod2)),
-                 revolute("rev3", axis=self.n_a, q0_guess=g[2], cut=True)]
+                 revolute("rev3", axis=_negated(self.n_a), q0_guess=g[2], cut=True)]
         comps = {c.name: c for c in parts}
 
         def port(path):
@@ -173,6 +181,7 @@ class JointRRR(Component, library=MB):
                  ("rev2.frame_b", "rod2.frame_a"), ("rod2.frame_b", "rev3.frame_a")]
         exposed = {"frame_a": "rev1.frame_a", "frame_ia": "rev1.frame_b",
                    "frame_im": "rev2.frame_b", "frame_ib": "rev3.frame_a",
-                   "frame_b": "rev3.frame_b", "axis": "rev3.axis", "support": "rev3.support"}
+                   "frame_b": "rev3.frame_b", "axis": "rev3.axis", "support": "rev3.support",
+                   "bearing": "rev3.support"}
         return Expansion(self.name, comps, [(port(a), port(b)) for a, b in chain],
                          {k: port(v) for k, v in exposed.items()})

@@ -334,6 +334,13 @@ class FreeMotion(PartialJoint, library=MB):
     angular velocity w of frame_b relative to frame_a, resolved in frame_b (as Modelica's
     FreeMotion). The quaternion has no singular orientation, so tumbling runs of any length
     are fine.
+
+    Its start values (r0, v0, angles0, w0) default to None: at rest at frame_a for a free
+    body. A FreeMotion that closes a kinematic loop (MSL's DoublePendulumInitTip: from the
+    world to a pendulum's tip) constrains nothing while the model runs, but the start values
+    given are conditions on the start: the joints of its loop without a q0 (qd0) are solved
+    so that frame_b starts where r0 and angles0 put it, moving as v0 and w0 say
+    (``equations/loopstart.py``); what they cannot reach is refused.
     """
     dof = 6
     nq = 7
@@ -341,12 +348,15 @@ class FreeMotion(PartialJoint, library=MB):
     constant_subspace = False
     cut_preference = 0        # cutting it removes nothing: the first choice
     units = ("m", "m", "m", "", "", "", "")
-    r0 = Param([0.0, 0.0, 0.0], shape=(3,), unit="m", doc="Initial position, in frame_a")
-    v0 = Param([0.0, 0.0, 0.0], shape=(3,), unit="m/s", doc="Initial velocity, in frame_a")
-    angles0 = Param([0.0, 0.0, 0.0], shape=(3,), unit="rad",
-                    doc="Initial orientation: body-fixed x-y-z (Cardan) angles")
-    w0 = Param([0.0, 0.0, 0.0], shape=(3,), unit="rad/s",
-               doc="Initial angular velocity, resolved in frame_b")
+    r0 = Param(None, optional=True, shape=(3,), unit="m",
+               doc="Initial position, in frame_a (None: 0, or free in a loop)")
+    v0 = Param(None, optional=True, shape=(3,), unit="m/s",
+               doc="Initial velocity, in frame_a (None: 0, or free in a loop)")
+    angles0 = Param(None, optional=True, shape=(3,), unit="rad",
+                    doc="Initial orientation: body-fixed x-y-z (Cardan) angles (None: 0, or "
+                        "free in a loop)")
+    w0 = Param(None, optional=True, shape=(3,), unit="rad/s",
+               doc="Initial angular velocity, resolved in frame_b (None: 0, or free in a loop)")
 
     def coordinate_labels(self):
         return [f"r[{i}]" for i in range(3)] + [f"quat[{i}]" for i in range(4)]
@@ -369,7 +379,27 @@ class FreeMotion(PartialJoint, library=MB):
         return ca.SX(0, 1)                         # cut: it constrains nothing
 
     def initial(self):
-        return [*self.r0, *ca.vertsplit(cardan_quat(self.angles0))], [*self.v0, *self.w0]
+        def given(v):
+            return [0.0] * 3 if v is None else list(v)
+        return ([*given(self.r0), *ca.vertsplit(cardan_quat(given(self.angles0)))],
+                [*given(self.v0), *given(self.w0)])
+
+    def start_conditions(self, rel_R, rel_p, rel_v, rel_w):
+        """As a loop's cut joint: the rows of its given start values, each zero when frame_b
+        starts where they say (at ``rel_R``, ``rel_p`` in frame_a, moving at ``rel_v`` in
+        frame_a and ``rel_w`` in frame_b): (position rows, speed rows), each a list of (SX,
+        the parameter it comes from)."""
+        position, speed = [], []
+        if self.r0 is not None:
+            position.append((rel_p - vec3(self.r0), "r0"))
+        if self.angles0 is not None:
+            R0 = quat_rotation(cardan_quat(self.angles0))
+            position.append((ca.vec(R0.T @ rel_R - ca.SX.eye(3)), "angles0"))
+        if self.v0 is not None:
+            speed.append((rel_v - vec3(self.v0), "v0"))
+        if self.w0 is not None:
+            speed.append((rel_w - vec3(self.w0), "w0"))
+        return position, speed
 
 
 #: MSL's world.defaultWidthFraction: a shape's default width (or diameter) is its length / 20

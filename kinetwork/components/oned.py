@@ -91,7 +91,8 @@ class PartialFixed(Component):
 
 
 class PartialRigid(Component):
-    """A rigid 1-D element: its two flanges move together, position(a) = ratio * position(b).
+    """A rigid 1-D element: its two flanges move together,
+    position(a) = ratio * (position(b) - length).
 
     Rigid elements join connection sets into rigid groups that share one coordinate
     (``kinetwork.graph.topology``); an inertia adds ``inertia()`` to its group.
@@ -103,6 +104,10 @@ class PartialRigid(Component):
 
     def ratio(self):
         return 1.0
+
+    def length(self):
+        """position(flange_b) - position(flange_a) / ratio: a translational Mass's L."""
+        return 0.0
 
     def inertia(self):
         return 0.0
@@ -151,7 +156,9 @@ class PartialMotion(Component):
     its expression and of the signal blocks feeding it); otherwise it is filtered, with the
     filter's states giving the position, speed and acceleration: Modelica's second-order
     Bessel filter of cut-off ``f_crit`` for a position, first-order for a speed. The
-    reaction, through the optional support, rests in the world.
+    reaction, through the optional support, rests in the world; wired to a free rotor (an
+    inertia), the support takes it and the motion is relative to the rotor (MSL's
+    useSupport).
     """
     role = "prescribed"
     derivative = 0

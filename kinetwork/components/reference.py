@@ -123,6 +123,8 @@ def param_line(info):
                                  else choices))
     elif info["kind"] == "names":
         parts.append("list of " + (", ".join(info["choices"]) if info["choices"] else "names"))
+    elif info["kind"] == "expression" and unit:
+        parts.append(f"expression in {unit}")
     else:
         parts.append({"bool": "true or false", "name": "component name",
                       "color": "colour '#rrggbb'", "table": "rows [x, y]",

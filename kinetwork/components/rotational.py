@@ -48,13 +48,16 @@ class Fixed(PartialFixed, library=LIB):
 class Inertia(PartialInertia, library=LIB):
     """A rigid rotor between flange_a and flange_b. Rigidly coupled to a joint axis
     (directly or through gears) it adds to the joint's inertia and costs no state; free, it has
-    its own angle and speed."""
+    its own angle and speed. Its phi0 and w0 are always used: they start a free rotor (and
+    what is geared to it), or the joint it is rigidly on (MSL's Engine1a puts the engine's
+    start speed on the load inertia); where something else decides its start (the joint's
+    own q0, a motion, a Fixed, another inertia) they must agree, or the model is refused."""
     domain = LIB
     J = Param(unit="kg*m^2", min=0.0, doc="Moment of inertia")
     position0 = Param(None, optional=True, unit="rad", name="phi0",
-                      doc="Initial angle when the inertia moves freely (None: 0)")
+                      doc="Initial angle (None: from what it is tied to, else 0)")
     speed0 = Param(None, optional=True, unit="rad/s", name="w0",
-                   doc="Initial speed when the inertia moves freely (None: 0)")
+                   doc="Initial speed (None: from what it is tied to, else 0)")
 
     def inertia(self):
         return self.J
@@ -117,10 +120,14 @@ class Accelerate(PartialMotion, library=LIB):
 
 
 class IdealGear(PartialRigid, library=LIB):
-    """A gear: flange_a turns ``ratio`` times as far as flange_b (Modelica's convention), and
-    flange_b's torque is ``ratio`` times flange_a's, times the efficiency eta when flange_a
-    drives, divided by it when flange_b does (the driving side found by events); the reaction
-    rests in the world (or on the support, when wired)."""
+    """A gear: flange_a turns ``ratio`` times as far as flange_b relative to the support
+    (Modelica's convention, flange_a.phi - support.phi = ratio * (flange_b.phi -
+    support.phi)), and flange_b's torque is ``ratio`` times flange_a's, times the efficiency
+    eta when flange_a drives, divided by it when flange_b does (the driving side found by
+    events). The support takes the reaction -(tau_a + tau_b) (MSL's useSupport): unwired or
+    on a Fixed it stands still; on a housing inertia (MSL's ElasticBearing) the housing
+    turns with it, the gear train riding on it (a train that is free, on a housing that is
+    free or moved by a motion; eta = 1)."""
     domain = LIB
     lossy = True
     support = Port("1d", "Reaction flange (unwired: the world)", optional=True)

@@ -17,7 +17,7 @@ class BearingFriction(PartialBearingFriction, library="rotational"):
 class Brake(PartialTwoFlanges, PartialNormalForceFriction, library="rotational"):
     """Brake with stiction (MSL's Rotational.Components.Brake, constant mu): friction torque
     mu * cgeo * fn_max * f_normalized between the flange (flange_a and flange_b, rigidly
-    joined) and its support."""
+    joined) and its support; free (mode 2) while the normal force is <= 0."""
     domain = "rotational"
     mu = Param(unit="1", min=0.0, doc="Coefficient of kinetic friction")
     peak = Param(1.0, unit="1", min=1.0, doc="Static over kinetic friction coefficient")
@@ -30,7 +30,8 @@ class Brake(PartialTwoFlanges, PartialNormalForceFriction, library="rotational")
 
 class Clutch(PartialNormalForceFriction, library="rotational"):
     """Clutch with stiction (MSL's Rotational.Components.Clutch, constant mu): friction torque
-    mu * cgeo * fn_max * f_normalized between flange_a and flange_b."""
+    mu * cgeo * fn_max * f_normalized between flange_a and flange_b; free (mode 2, no
+    Coulomb torque, nothing held) while the normal force is <= 0, as MSL's."""
     domain = "rotational"
     flange_a = Port(ONED, "Flange a")
     flange_b = Port(ONED, "Flange b")

@@ -303,8 +303,8 @@ class ExpressionParam(Param):
     compiled (the block's inputs as well as model parameters and t): parsed and checked for
     form here, its names checked by the block that evaluates it."""
 
-    def __init__(self, default=REQUIRED, *, doc=""):
-        super().__init__(default, kind="expression", doc=doc)
+    def __init__(self, default=REQUIRED, *, doc="", unit=""):
+        super().__init__(default, kind="expression", doc=doc, unit=unit)
 
     def normalize(self, value, where):
         if isinstance(value, (int, float)) and not isinstance(value, bool):

@@ -46,18 +46,24 @@ class Fixed(PartialFixed, library=LIB):
 
 
 class Mass(PartialInertia, library=LIB):
-    """A rigid sliding mass between flange_a and flange_b. Rigidly coupled to a joint axis
-    (directly or through gears) it adds to the joint's inertia and costs no state; free, it has
-    its own position and speed."""
+    """A rigid sliding mass of length L between flange_a and flange_b, MSL's Mass: its
+    position s is its centre, flange_a at s - L/2 and flange_b at s + L/2. Rigidly coupled to
+    a joint axis (directly or through gears) it adds to the joint's inertia and costs no
+    state; free, it has its own position s and speed v."""
     domain = LIB
     m = Param(unit="kg", min=0.0, doc="Mass")
+    L = Param(0.0, unit="m", doc="Length, from flange_a to flange_b (flange_b.s - flange_a.s)")
     position0 = Param(None, optional=True, unit="m", name="s0",
-                      doc="Initial position when the inertia moves freely (None: 0)")
+                      doc="Initial position of the centre (None: from what it is tied to, "
+                          "else 0)")
     speed0 = Param(None, optional=True, unit="m/s", name="v0",
-                   doc="Initial speed when the inertia moves freely (None: 0)")
+                   doc="Initial speed (None: from what it is tied to, else 0)")
 
     def inertia(self):
         return self.m
+
+    def length(self):
+        return self.L
 
 
 class PositionSensor(PartialSensor, library=LIB):

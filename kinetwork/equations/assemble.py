@@ -15,7 +15,8 @@ import numpy as np
 from ..errors import ModelError
 from ..expr import casadi_functions, parse
 from ..spatial import vee
-from . import applied, junctions, network
+from . import applied, junctions, loopstart, network
+from . import starts as inertia_starts
 from .newton_euler import Body, aba, crba, motion_subspace, rnea, spatial_inertia
 from .signals import probe_signals
 
@@ -70,6 +71,8 @@ class Assembly:
     applied: object = None
     #: massless junctions of line forces (junctions.Junctions), None without any
     junctions: object = None
+    #: the rows a loop's cut joint's start values add to the start (loopstart.StartRows)
+    start_rows: object = None
 
     def mass_matrix(self):
         M = crba(self.bodies, self.u.shape[0], self.armature)
@@ -232,6 +235,11 @@ def assemble(model, topo, values):
         given += [v is not None for v in q0]
         u_start += [0 if v is None else v for v in u0]
         u_given += [v is not None for v in u0]
+    # an inertia rigidly on a joint axis gives the joint's start, unless the joint does
+    for kind, i, value in net.claims:
+        vals, flags = (starts, given) if kind == "q" else (u_start, u_given)
+        if not flags[i]:
+            vals[i], flags[i] = value, True
     if net.prescribed:
         starts, u_start = _prescribed_starts(model, net, t, q, u, starts, u_start, given,
                                              u_given, p, [values[k] for k in names])
@@ -248,11 +256,13 @@ def assemble(model, topo, values):
     asm.cuts = [(cut, _closure(asm, cut, bound[cut.component.name], qindex))
                 for cut in topo.cuts]
     _place_cut_frames(asm, topo, bound)
+    asm.start_rows = loopstart.rows(asm, topo, bound)
     asm.prescribed = dict(sorted(net.prescribed.items()))
     asm.lam = ca.vertcat(ca.SX.sym("lambda", sum(r.shape[0] for _, r in asm.cuts)),
                          *[m.drive for m in asm.prescribed.values()])
     asm.qindex, asm.uindex, asm.Q_drive = qindex, uindex, net.axis_flow
     asm.signals = probe_signals(asm, topo, net, bound, model)
+    inertia_starts.check(model, topo, asm, bound, [values[k] for k in names])
     return asm
 
 

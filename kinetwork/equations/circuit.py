@@ -1,28 +1,43 @@
 """Electrical circuits (``kinetwork.components.electrical``), solved by structural analysis.
 
 The unknowns are one potential per connection set of pins (the connection sets are the
-alias elimination: every pin wired together shares one symbol) and one current per pin.
-The equations are Kirchhoff's current law at every set and each component's laws, one per
-pin, linear in the unknowns, with the components' states (inductor currents, capacitor
-voltages), the speeds of EMF flanges, time and signal inputs as knowns. Matching equations to
-unknowns (networkx's Hopcroft-Karp) finds a circuit that is structurally singular (no
-ground, two voltage sources in parallel) or of higher index (a capacitor across a voltage
-source, an inductor in series with a current source), refused with its components named;
-the strongly connected components of the matched dependency graph (Tarjan), in topological
-order, are the block-lower-triangular form: each block is solved symbolically in turn, a
-scalar block by one division, a loop of resistors as one small linear system.
+alias elimination: every pin wired together shares one symbol), one current per pin and
+the derivatives of the components' states (inductor currents, capacitor voltages). The
+equations are Kirchhoff's current law at every set, each component's laws (one per pin)
+and its states' rate equations (C v' = i, L i' = v); the speeds of EMF flanges, time and
+the signals at the sources' u inputs are knowns.
 
-Every current and potential so becomes an expression of the states, the mechanism's speeds,
-t and placeholders for the signals at the sources' u inputs (their values are substituted
-when the network has them all: ``Circuit.inputs``).
+A circuit whose laws fix a relation among its states (a capacitor across a voltage source,
+a loop of capacitors, inductors in series, an inductor in series with a current source) is
+of higher index: ``structure.reduce_index`` finds the equations to differentiate
+(Pantelides), CasADi differentiates them, and the dummy derivatives pick the states those
+constraints fix, which become algebraic (solved from the other states and the sources), as
+a Modelica tool does. Where the choice is free, a state whose start the user gave (``v0``,
+``i0``) stays a state, then the one placed first. A structurally singular circuit (no
+ground, two voltage sources in parallel, an open current source) is refused naming the
+components whose laws over-determine it, sorted.
+
+The index-1 system left is solved block by block (``blocks.solve_blocks``): a linear
+block symbolically, a nonlinear one (a diode and its resistor) torn, its tearing unknowns
+left to IDAS as algebraic variables. Every current and potential so becomes an expression
+of the states, the mechanism's speeds, t and placeholders for the signals at the sources'
+u inputs (and their time derivatives, where a constraint was differentiated): the network
+substitutes those once it has them (``Circuit.inputs``, ``Circuit.input_rates``).
 """
 
 import casadi as ca
 import networkx as nx
+import numpy as np
 
 from ..errors import ModelError
+from .circuit_dae import Candidate, Dae, couple
+from .blocks import solve_blocks
+from .structure import Singular, reduce_index
 
 DOMAIN = "electrical"
+#: a given start further than this (relative to 1 + |value|) from the value a constraint
+#: fixes is refused
+START_TOL = 1e-9
 
 
 class _Pins:
@@ -31,12 +46,16 @@ class _Pins:
     def __init__(self, circuit, comp, x, u, w):
         self._c, self._comp, self.x, self.u, self.w = circuit, comp, x, u, w
         self.t = circuit.b.t
+        self.parameters = circuit.parameters
 
     def v(self, pin):
         return self._c.potential[self._c.topo.set_of[self._comp.port_ref(pin)]]
 
     def i(self, pin):
         return self._c.current[self._comp.port_ref(pin)]
+
+    def place(self, key):
+        return self._c.model.place(self._comp, key)
 
 
 class Circuit:
@@ -48,9 +67,18 @@ class Circuit:
                       if any(port.domain == DOMAIN for port in c.ports.values())]
         self.potential, self.current = {}, {}      # set -> SX, PortRef -> SX
         self.inputs = {}                           # placeholder -> signal set of its u
+        self.input_rates = {}                      # placeholder of du/dt -> signal set
         self.sources = {}                          # component name -> its placeholder
+        self.source_rates = {}                     # component name -> placeholder of du/dt
+        self.speeds = {}                           # EMF name -> (symbol of w, of dw/dt)
+        #: free group index -> ``circuit_dae.Coupled``: rotors a constraint couples in
+        self.coupled = {}
         self.views = {}
+        self.parameters = ({name: b.p[i] for i, name in enumerate(self.model.parameters)}
+                           if b.p is not None else {})
         self.summary = ""
+        #: state name -> why it is no state (its value fixed by a differentiated constraint)
+        self.demoted = {}
 
     # -- building ---------------------------------------------------------------------------
     def build(self):
@@ -60,53 +88,105 @@ class Circuit:
         sets = sorted({self.topo.set_of[c.port_ref(pn)] for c in self.comps
                        for pn, port in c.ports.items() if port.domain == DOMAIN})
         self._check_grounds(sets)
-        unknowns, names = [], []
+        dae = self._equations(sets)
+        try:
+            reduced = self._reduce(dae)
+            moving = self._moving(reduced.equations, derivative=True)
+        except Singular as exc:
+            # with the speeds as knowns, EMFs tied to each other look like voltage sources
+            # in parallel: with the rotors' balances they may not be
+            moving = self._moving([dae.equations[e] for e in exc.equations])
+            if not moving:
+                raise self._refusal(exc, dae) from None
+        if moving:
+            # a constraint reaches the speed of rotors (or masses) the EMFs turn: their
+            # balances join the system, their speeds among its candidate states
+            dae = couple(self, dae, moving)
+            try:
+                reduced = self._reduce(dae)
+            except Singular as exc:
+                raise self._refusal(exc, dae) from None
+        try:
+            solved = solve_blocks(reduced.equations, reduced.unknowns, self._regular,
+                                  self._sample)
+        except Singular as exc:
+            raise self._refusal(exc, dae, reduced) from None
+        self._apply(dae, reduced, solved, sets)
+        return self
+
+    def _equations(self, sets):
+        """The circuit's DAE: Kirchhoff's current law at every set, the components' laws
+        and their states' rate equations, in the unknown potentials and pin currents."""
+        dae = Dae()
         for s in sets:
             self.potential[s] = ca.SX.sym(f"v{s}")
-            unknowns.append(self.potential[s])
-            names.append(f"the potential at {{{self._where(s)}}}")
+            dae.unknowns.append(self.potential[s])
+            dae.names.append(f"the potential at {{{self._where(s)}}}")
         for c in self.comps:
             for pn, port in c.ports.items():
                 if port.domain == DOMAIN:
                     ref = c.port_ref(pn)
                     self.current[ref] = ca.SX.sym(f"i_{c.name}_{pn}")
-                    unknowns.append(self.current[ref])
-                    names.append(f"the current into {ref.path}")
-        equations, owners = [], []
-        for s in sets:                            # Kirchhoff's current law
-            equations.append(sum((self.current[r] for r in self.topo.sets[s]
-                                  if r in self.current), ca.SX(0)))
-            owners.append(f"the currents at {{{self._where(s)}}}")
-        for c in self.comps:
-            view = self._view(c)
-            for eq in self.b.bound[c.name].laws(view):
-                equations.append(ca.SX(eq))
-                owners.append(self.model.place(c))
-        solved = self._solve(equations, owners, unknowns, names)
-        values = ca.vertcat(*[solved[k] for k in range(len(unknowns))])
-        z = ca.vertcat(*unknowns)
-
-        def sub(e):
-            return ca.substitute(ca.SX(e), z, values)
+                    dae.unknowns.append(self.current[ref])
+                    dae.names.append(f"the current into {ref.path}")
         for s in sets:
-            self.potential[s] = sub(self.potential[s])
-        for ref in self.current:
-            self.current[ref] = sub(self.current[ref])
+            dae.add(sum((self.current[r] for r in self.topo.sets[s] if r in self.current),
+                        ca.SX(0)), None)
+        for c in self.comps:
+            view = self._view(c, dae.knowns)
+            for eq in self.b.bound[c.name].laws(view):
+                dae.add(ca.SX(eq), c)
         for c in self.comps:
             view = self.views[c.name]
-            for x, rate in zip(view.x, self.b.bound[c.name].rates(view)):
-                self.b.net.rate[self.b._at(x)] = sub(rate)
-        return self
+            bound = self.b.bound[c.name]
+            for k, (x, rate) in enumerate(zip(view.x, bound.rates(view))):
+                key = _start_key(c, k)
+                dae.candidate(Candidate(x, self.b.net.names[self.b._at(x)], c, key,
+                                        bound.initial()[k]), rate, c)
+        return dae
 
-    def _view(self, comp):
+    def _reduce(self, dae):
+        return reduce_index(dae.equations, dae.unknowns, [c.x for c in dae.candidates],
+                            [c.dx for c in dae.candidates], dae.knowns, self.b.t,
+                            # a start given keeps a state, then a rotor's speed (the
+                            # mechanism's), then the first placed
+                            [(c.key in c.comp.given, c.group is not None, -k)
+                             for k, c in enumerate(dae.candidates)],
+                            self._sample, self.b.p if self.b.p is not None else ca.SX(0, 1))
+
+    def _moving(self, equations, derivative=False):
+        """EMFs whose speed (with ``derivative``, the speed's derivative) ``equations``
+        read, where their flange or support moves: the circuit may constrain the
+        mechanism."""
+        if not self.speeds or not equations:
+            return []
+        eqs = ca.vertcat(*equations)
+        net = self.b.net
+        out = []
+        for name, (w, dw) in self.speeds.items():
+            c = self.model.components[name]
+            vel = ca.SX(net.vel[c.port_ref("flange")] - net.vel[c.port_ref("support")])
+            if ca.depends_on(eqs, dw if derivative else w) and not vel.is_zero():
+                out.append(c)
+        return out
+
+    def _view(self, comp, knowns):
         b = self.b
         bound = b.bound[comp.name]
         x = [b._state(f"{comp.name}.{label}", unit, start, 0) for label, unit, start in
              zip(bound.state_labels, bound.state_units, bound.initial())]
         u = self.sources.get(comp.name)
+        if u is not None:
+            du = self.source_rates[comp.name] = ca.SX.sym(f"du_{comp.name}")
+            self.input_rates[du] = self.inputs[u]
+            knowns.append((u, du))
         w = None
         if getattr(type(comp), "converter", False):
-            w = (b.net.vel[comp.port_ref("flange")] - b.net.vel[comp.port_ref("support")])
+            # a symbol for the speed, its derivative the flange's relative acceleration:
+            # both put in once the circuit is solved (``_apply``)
+            w, dw = self.speeds[comp.name] = (ca.SX.sym(f"w_{comp.name}"),
+                                               ca.SX.sym(f"dw_{comp.name}"))
+            knowns.append((w, dw))
         view = _Pins(self, comp, x, u, w)
         self.views[comp.name] = view
         return view
@@ -145,7 +225,7 @@ class Circuit:
         grounded = {self.topo.set_of[c.port_ref("p")] for c in self.comps
                     if c.type_name == "electrical.Ground"}
         problems = []
-        for part in nx.connected_components(g):
+        for part in sorted(nx.connected_components(g), key=min):
             if not part & grounded:
                 names = sorted({r.component.name for s in part for r in self.topo.sets[s]
                                 if r.component.role != "probe"})
@@ -158,86 +238,217 @@ class Circuit:
     def _where(self, s):
         return ", ".join(r.path for r in self.topo.sets[s] if r.component.role != "probe")
 
-    # -- structural analysis ----------------------------------------------------------------
-    def _solve(self, equations, owners, unknowns, names):
-        """Index of unknown -> its expression in the knowns: matching, then the blocks of
-        the block-lower-triangular form, in order."""
-        z = ca.vertcat(*unknowns)
-        r = ca.vertcat(*equations)
-        jac = ca.jacobian(r, z)
-        if ca.depends_on(jac, z):
-            bad = sorted({owners[k] for k in range(len(equations))
-                          if ca.depends_on(ca.jacobian(r[k], z), z)})
-            raise ModelError([f"{o}: its law is not linear in the currents and potentials"
-                              for o in bad])
-        sparsity = jac.sparsity()
-        rows, cols = sparsity.get_triplet()
-        g = nx.Graph()
-        eqs = [("e", k) for k in range(len(equations))]
-        g.add_nodes_from(eqs, bipartite=0)
-        g.add_nodes_from((("z", j) for j in range(len(unknowns))), bipartite=1)
-        g.add_edges_from((("e", i), ("z", j)) for i, j in zip(rows, cols))
-        matching = nx.bipartite.hopcroft_karp_matching(g, top_nodes=eqs)
-        unmatched = [k for k in range(len(equations)) if ("e", k) not in matching]
-        if unmatched or len(equations) != len(unknowns):
-            lost = [names[j] for j in range(len(unknowns)) if ("z", j) not in matching]
-            over = sorted({owners[k] for k in unmatched})
-            raise ModelError(
-                f"circuit: the equations of {', '.join(over) or 'the circuit'} leave "
-                f"{', '.join(lost) or 'nothing'} undetermined and constrain the rest twice: "
-                f"the circuit is structurally singular (two voltage sources in parallel, a "
-                f"current source in series with another, an open current source) or of "
-                f"higher index (a capacitor directly across a voltage source or another "
-                f"capacitor loop, an inductor in series with a current source), which "
-                f"kinetwork does not solve; add a resistor to the loop or the cut set")
-        assigned = {k: matching[("e", k)][1] for k in range(len(equations))}
-        dep = nx.DiGraph()
-        dep.add_nodes_from(range(len(equations)))
-        owner_of = {j: k for k, j in assigned.items()}
-        for i, j in zip(rows, cols):
-            if assigned[i] != j:
-                dep.add_edge(owner_of[j], i)      # equation i needs what owner_of[j] gives
-        dag = nx.condensation(dep)
-        sizes = sorted((len(dag.nodes[c]["members"]) for c in dag), reverse=True)
-        loops = [n for n in sizes if n > 1]
-        states = sum(len(v.x) for v in self.views.values())
-        self.summary = (f"circuits: {len(unknowns) - len(self.current)} node potentials and "
-                        f"{len(self.current)} pin currents in {len(sizes)} blocks solved "
-                        f"symbolically" + (f" (linear loops of {', '.join(map(str, loops))})"
-                                           if loops else "") + f", {states} states")
-        solved = {}
-        known_z, known_v = [], []
-        for c in nx.topological_sort(dag):
-            block = sorted(dag.nodes[c]["members"])
-            zs = [assigned[k] for k in block]
-            res = ca.vertcat(*[r[k] for k in block])
-            if known_z:
-                res = ca.substitute(res, ca.vertcat(*known_z), ca.vertcat(*known_v))
-            zb = ca.vertcat(*[unknowns[j] for j in zs])
-            a = ca.jacobian(res, zb)
-            rest = ca.substitute(res, zb, ca.SX.zeros(len(zs)))
-            self._regular(a, [owners[k] for k in block])
-            values = -rest / a if len(zs) == 1 else -ca.solve(a, rest)
-            for n, j in enumerate(zs):
-                solved[j] = values[n]
-                known_z.append(unknowns[j])
-                known_v.append(values[n])
-        return solved
-
-    def _regular(self, a, owners):
-        """Refuse a block whose matrix is singular at the parameters' values (a loop of
-        zero resistances)."""
+    # -- numbers at the parameters' values --------------------------------------------------
+    def _at_values(self, expr):
         b = self.b
-        det = ca.det(a)
         if b.p is not None and b.p.numel():
-            det = ca.substitute(det, b.p, ca.DM(b.p_values))
-        if not det.is_constant():
-            return                  # a coefficient varies in time: CVODES will say
-        det = float(det)
-        if abs(det) < 1e-300 or det != det:
-            raise ModelError(f"circuit: the equations of {', '.join(sorted(set(owners)))} "
-                             f"are singular at the parameters' values (det = {det:g}): a "
-                             f"loop of zero resistances or of sources")
+            expr = ca.substitute(expr, b.p, ca.DM(b.p_values))
+        return expr
+
+    def _sample(self, expr):
+        """A Jacobian at the parameters' values and generic values of every other symbol
+        (the same in every run): where the dummy derivatives' ranks are taken."""
+        expr = self._at_values(ca.SX(expr))
+        syms = ca.symvar(expr)
+        if syms:
+            rng = np.random.default_rng(20260527)
+            expr = ca.substitute(expr, ca.vertcat(*syms),
+                                 ca.DM(rng.uniform(0.5, 1.5, len(syms))))
+        return np.array(ca.evalf(expr), dtype=float).reshape(expr.shape)
+
+    def _regular(self, a):
+        """Whether a block's matrix is regular at the parameters' values (a loop of zero
+        resistances is not): its rank, numerically (a symbolic determinant costs
+        exponential time in the block's size); one whose entries vary in time is taken as
+        regular (IDAS or CVODES will say where it is not)."""
+        a = self._at_values(ca.SX(a))
+        if not a.is_constant():
+            return True
+        m = np.array(ca.evalf(a), dtype=float).reshape(a.shape)
+        if not np.all(np.isfinite(m)):
+            return False
+        return m[0, 0] != 0 if m.shape == (1, 1) else np.linalg.matrix_rank(m) == m.shape[0]
+
+    # -- the solution -----------------------------------------------------------------------
+    def _apply(self, dae, reduced, solved, sets):
+        """Put the solution in place: potentials, currents, the kept states' rates (a
+        coupled rotor's acceleration), the demoted states' values (their states dropped),
+        the algebraic variables."""
+        b = self.b
+        value = dict(zip((z.element_hash() for z in reduced.unknowns), solved.values))
+        z = ca.vertcat(*dae.unknowns)
+        vz = ca.vertcat(*[value[u.element_hash()] for u in dae.unknowns])
+        demoted = [dae.candidates[i] for i in reduced.demoted]
+        dx = ca.vertcat(*[d.x for d in demoted])
+        vd = ca.vertcat(*[value[d.x.element_hash()] for d in demoted])
+        known = self._knowns()
+
+        def sub(e):
+            e = ca.substitute(ca.SX(e), z, vz)
+            if demoted:
+                e = ca.substitute(e, dx, vd)
+            return known(e)
+        for s in sets:
+            self.potential[s] = sub(self.potential[s])
+        for ref in self.current:
+            self.current[ref] = sub(self.current[ref])
+        for cand in dae.candidates:
+            rate = sub(value[cand.dx.element_hash()])
+            if cand.group is not None:
+                self.coupled[cand.group.index].acc = rate
+            elif cand not in demoted:
+                b.net.rate[b._at(cand.x)] = rate
+        kept = [dae.candidates[i] for i in reduced.states]
+        self._check_starts(dae, reduced, kept, demoted, [sub(v) for v in ca.vertsplit(vd)])
+        for cand, v in zip(demoted, ca.vertsplit(vd)):
+            if cand.group is not None:       # a rotor's speed: the network substitutes it
+                b.pending[cand.x] = sub(v)
+            self._drop(cand.x)
+        if solved.kept:
+            net = b.net
+            owners = sorted({o.name for o in dae.owners if o is not None and any(
+                ca.depends_on(r, k) for r in solved.residuals for k in solved.kept)})
+            net.alg_z += solved.kept
+            net.alg_res += [sub(r) for r in solved.residuals]
+            net.alg_names += [self._label(k, dae.unknowns) for k in solved.kept]
+            net.alg_units += ["V" if k.name().startswith("v") else "A"
+                              for k in solved.kept]
+            net.loops_kept.append(owners)
+        # the rates of the sources' signals are needed only where a constraint was
+        # differentiated through a source (the network finds them: ``_input_rates``)
+        used = ca.vertcat(*self.potential.values(), *self.current.values(),
+                          *b.net.rate, *b.net.alg_res,
+                          *[c.acc for c in self.coupled.values()])
+        self.input_rates = {du: s for du, s in self.input_rates.items()
+                            if ca.depends_on(used, du)}
+        self.summary = self._summary(dae, reduced, solved)
+
+    def _knowns(self):
+        """The function putting the EMF speeds in, and their derivatives where a
+        differentiated constraint reads them: zero on a flange that cannot turn (on one that
+        turns freely, the rotor was coupled into the system: ``circuit_dae.couple``)."""
+        net = self.b.net
+
+        def known(e):
+            for name, (w, dw) in self.speeds.items():
+                c = self.model.components[name]
+                f, s = c.port_ref("flange"), c.port_ref("support")
+                if ca.depends_on(e, dw):
+                    e = ca.substitute(e, dw, ca.SX(net.acc[f] - net.acc[s]))
+                if ca.depends_on(e, w):
+                    e = ca.substitute(e, w, ca.SX(net.vel[f] - net.vel[s]))
+            return e
+        return known
+
+    def _check_starts(self, dae, reduced, kept, demoted, values):
+        """Record why each demoted state is no state, and check a start the user gave it
+        against the constraint (at t = 0 and the parameters' values): one that disagrees,
+        or that depends on signals the network has not built yet, is refused."""
+        problems = []
+        xs = ca.vertcat(*[c.x for c in kept])
+        starts = ca.vertcat(*[self._at_values(ca.SX(c.start)) for c in kept])
+        for cand, v in zip(demoted, values):
+            self.demoted[cand.name] = self._why(dae, reduced, cand, v, kept)
+            if cand.key not in cand.comp.given:
+                continue
+            at0 = self._at_values(ca.substitute(v, self.b.t, ca.SX(0)))
+            if kept:
+                at0 = self._at_values(ca.substitute(at0, xs, starts))
+            given = float(self._at_values(ca.SX(cand.start)))
+            where = self.model.place(cand.comp, cand.key)
+            why = self.demoted[cand.name]
+            if not at0.is_constant():
+                problems.append(f"{where}: {cand.name} is no state ({why}); its start follows "
+                                f"from signals, so it cannot be given: remove {cand.key}")
+                continue
+            fixed = float(at0)
+            if abs(fixed - given) > START_TOL * (1 + abs(fixed)):
+                problems.append(f"{where} = {given:g}: {cand.name} is no state ({why}), and "
+                                f"the constraint gives {fixed:g} at the start: remove "
+                                f"{cand.key} or make it agree")
+        if problems:
+            raise ModelError(problems)
+
+    def _why(self, dae, reduced, cand, value, kept):
+        """What fixes a demoted state: the kept states and the sources its value follows
+        from, and the components of the constraint (the laws differentiated in the step
+        that found it, with the components of those states), grounds left out."""
+        symbols = {x.element_hash() for x in ca.symvar(value)}
+        reads = [c for c in kept if c.x.element_hash() in symbols]
+        group = {c.comp.name for c in reads} | {cand.comp.name}
+        for eqs in reduced.constraints:
+            if any(ca.depends_on(dae.equations[e], cand.x) for e in eqs):
+                group |= {dae.owners[e].name for e in eqs if dae.owners[e] is not None}
+        group = [name for name in self.model.components if name in group
+                 and self.model.components[name].type_name != "electrical.Ground"]
+        driven = [name for name in group if getattr(
+            type(self.model.components[name]), "reference_key", None)]
+        follows = ", ".join([c.name for c in reads] + [f"the source {n}" for n in driven])
+        return f"follows from {follows or 'the sources'} through the constraint of " \
+               f"{', '.join(group)}"
+
+    def _drop(self, x):
+        """Take the state ``x`` out of the network: a constraint gives its value."""
+        net = self.b.net
+        at = self.b._at(x)
+        for seq in (net.x, net.rate, net.start, net.names, net.units):
+            del seq[at]
+
+    def _label(self, z, unknowns):
+        """A short name of an unknown kept as an algebraic variable: ``D1.p.v`` for the
+        potential at a set holding pin D1.p, ``D1.p.i`` for a pin's current."""
+        for s, v in zip(sorted(self.potential), unknowns):
+            if v.element_hash() == z.element_hash():
+                first = next(r for r in self.topo.sets[s] if r.component.role != "probe")
+                return f"{first.path}.v"
+        for ref, v in zip(self.current, unknowns[len(self.potential):]):
+            if v.element_hash() == z.element_hash():
+                return f"{ref.path}.i"
+        return z.name()
+
+    def _summary(self, dae, reduced, solved):
+        loops = [n for n in solved.sizes if n > 1]
+        out = (f"circuits: {len(self.potential)} node potentials and {len(self.current)} "
+               f"pin currents in {len(solved.sizes)} blocks"
+               + ("" if solved.kept else " solved symbolically")
+               + (f" (linear loops of {', '.join(map(str, loops))})" if loops else "")
+               + f", {len(reduced.states)} states")
+        if self.coupled:
+            out += ("; with the rotors (masses) the EMFs turn: "
+                    + ", ".join(c.candidate.name for c in self.coupled.values()))
+        if reduced.demoted:
+            out += (f"; index reduction (Pantelides, dummy derivatives): "
+                    f"{len(reduced.constraints)} constraints differentiated, "
+                    f"{', '.join(self.demoted)} demoted to algebraic")
+        if solved.kept:
+            out += (f"; {solved.nonlinear} nonlinear blocks, {len(solved.kept)} algebraic "
+                    f"variables")
+        return out
+
+    def _refusal(self, exc, dae, reduced=None):
+        """The ModelError of a circuit that cannot be solved: the components whose laws
+        over-determine it and the unknowns left undetermined, each sorted."""
+        eqs = exc.equations if reduced is None else sorted({reduced.origin[e]
+                                                            for e in exc.equations})
+        comps = sorted({dae.owners[e].name for e in eqs if dae.owners[e] is not None})
+        kcl = any(dae.owners[e] is None for e in eqs)
+        lost = [dae.described(v if reduced is None else reduced.base[v][0])
+                for v in exc.unknowns]
+        what = (", ".join(comps) or "the circuit") + (
+            " and Kirchhoff's current law" if kcl and comps else "")
+        if exc.reason:
+            reason = exc.reason
+            if "rest_g" in reason:
+                reason = ("it needs the derivative of the forces on a rotor the circuit "
+                          "constrains (a constraint of the mechanism's accelerations)")
+            return ModelError(f"circuit: the equations of {what} cannot be solved: {reason}"
+                              + (f"; undetermined: {', '.join(lost)}" if lost else ""))
+        return ModelError(
+            f"circuit: the equations of {what} constrain their unknowns twice and leave "
+            f"{', '.join(lost) or 'nothing'} undetermined: the circuit is structurally "
+            f"singular (two voltage sources in parallel, a loop of voltage sources, a current "
+            f"source in series with another, an open current source, an ideal op-amp with "
+            f"no feedback)")
 
     # -- what the network reads -------------------------------------------------------------
     def output(self, comp):
@@ -256,8 +467,10 @@ class Circuit:
         return self.current[comp.port_ref("p")]
 
     def placeholders_in(self, expr):
-        """Names of the sources whose signal input ``expr`` depends on."""
-        return [name for name, ph in self.sources.items() if ca.depends_on(ca.SX(expr), ph)]
+        """Names of the sources whose signal input (or its rate) ``expr`` depends on."""
+        expr = ca.SX(expr)
+        return [name for name, ph in self.sources.items()
+                if ca.depends_on(expr, ph) or ca.depends_on(expr, self.source_rates[name])]
 
     def fill(self, net):
         """Pins' potentials and currents into the network's ``pos`` and ``flow`` (what
@@ -265,3 +478,9 @@ class Circuit:
         for ref, i in self.current.items():
             net.pos[ref] = self.potential[self.topo.set_of[ref]]
             net.flow[ref] = i
+
+
+def _start_key(comp, k):
+    """The parameter giving the start of ``comp``'s state k (``v0``, ``i0``), or None."""
+    keys = getattr(type(comp), "start_params", ())
+    return keys[k] if k < len(keys) else None

@@ -14,11 +14,12 @@ equations it could not satisfy.
 import json
 
 import casadi as ca
-import networkx as nx
 import numpy as np
 
 from ..errors import ModelError
-from ..util import suggest
+from ..util import quiet, suggest, summary
+from .matching import maximum_matching
+from .modes import operating_modes
 
 #: a residual above this (scaled by 1 + |d|) after Newton is no solution
 RESIDUAL_TOL = 1e-8
@@ -64,6 +65,7 @@ class _Problem:
                              "differential equations; this one has algebraic variables "
                              f"({', '.join(system.algebraic_names)}: kinematic or algebraic "
                              f"loops): give their start instead")
+        self.system = system
         states, params = list(system.state_names), list(system.param_names)
         steady = spec.get("steady", False)
         problems = []
@@ -132,38 +134,73 @@ class _Problem:
     def _undetermined(self, r, w):
         """Refuse unknowns that a maximum matching of the Jacobian's pattern leaves out."""
         rows, cols = ca.jacobian(r, w).sparsity().get_triplet()
-        g = nx.Graph()
-        eqs = [("r", k) for k in range(len(self.equations))]
-        g.add_nodes_from(eqs)
-        g.add_nodes_from(("w", j) for j in range(len(self.unknowns)))
-        g.add_edges_from((("r", i), ("w", j)) for i, j in zip(rows, cols))
-        matching = nx.bipartite.hopcroft_karp_matching(g, top_nodes=eqs)
-        lost = [self.unknowns[j] for j in range(len(self.unknowns)) if ("w", j) not in matching]
+        matching = maximum_matching(len(self.equations), len(self.unknowns), zip(rows, cols))
+        matched = set(matching.values())
+        lost = [self.unknowns[j] for j in range(len(self.unknowns)) if j not in matched]
         if lost:
             idle = [self.equations[k] for k in range(len(self.equations))
-                    if ("r", k) not in matching]
+                    if k not in matching]
             raise ModelError(f"initial: the equations do not determine {', '.join(lost)} "
                              f"(structurally singular: no equation left reads them; "
                              f"{', '.join(idle)} is one too many): fix those states, or "
                              f"solve something these equations depend on")
 
     def solve(self, x0, p):
+        """(x0, p) with the unknowns solved; the modes of friction and stops as the run
+        starts them, before and after (a stuck friction that cannot hold is refused: its
+        start would not keep the derivatives asked)."""
+        x0 = self._modes(x0, p, check=False)
+        x0, p = self._newton(x0, p)
+        moved = self._modes(x0, p, check=True)
+        if not np.array_equal(moved, x0):       # the start found changed a mode: again
+            x0, p = self._newton(moved, p)
+            x0 = self._modes(x0, p, check=True)
+        known = np.concatenate([x0, p])
+        w = np.concatenate([x0[self.x_unknown], p[self.p_unknown]])
+        left = np.asarray(self.residual(w, known), dtype=float).ravel()
+        if not np.all(np.abs(left) <= RESIDUAL_TOL * (1 + np.abs(self.d))):
+            raise ModelError(f"initial: the start solved for does not keep "
+                             f"{', '.join(self.equations)} once its modes are those the run "
+                             f"starts with (residual " + ", ".join(
+                                 f"{e}: {v:.3g}" for e, v in zip(self.equations, left))
+                             + "): give a start nearer one where they hold")
+        return x0, p
+
+    def _modes(self, x0, p, check):
+        """x0 with the modes of friction and stops that its numbers give (``operating_modes``);
+        with ``check``, a stuck friction beyond its static limit is refused."""
+        system = self.system
+        if system.modes is None:
+            return x0
+        try:
+            return operating_modes(system, 0.0, x0, p, check=check)
+        except ModelError as exc:
+            shown = ", ".join(f"{system.state_names[i]} = {x0[i]:.6g}"
+                              for i in self.x_unknown)
+            raise ModelError(f"initial: the start solved for ({shown or 'as given'}) keeps "
+                             f"{', '.join(self.equations)} only with a friction stuck where "
+                             f"it cannot hold: {exc}") from None
+
+    def _newton(self, x0, p):
         known = np.concatenate([x0, p])
         guess = np.concatenate([x0[self.x_unknown], p[self.p_unknown]])
-        try:
-            w = np.asarray(self.newton(guess, known), dtype=float).ravel()
-        except RuntimeError:
-            w = None
+        with quiet() as said:
+            try:
+                w = np.asarray(self.newton(guess, known), dtype=float).ravel()
+            except RuntimeError:
+                w = None
         if w is not None:
             left = np.asarray(self.residual(w, known), dtype=float).ravel()
         if w is None or not np.all(np.abs(left) <= RESIDUAL_TOL * (1 + np.abs(self.d))):
             where = "" if w is None else " (residual " + ", ".join(
                 f"{e}: {v:.3g}" for e, v in zip(self.equations, left)) + ")"
+            chatter = summary(said["text"])
             raise ModelError(f"initial: the model cannot satisfy {', '.join(self.equations)} "
                              f"with {', '.join(self.unknowns)} as unknowns: Newton from the "
                              f"given start and parameter values found no solution{where}; "
                              f"the equations may have none (a spring constant that does not "
-                             f"act at the start), or start nearer one")
+                             f"act at the start), or start nearer one"
+                             + (f" ({chatter})" if chatter else ""))
         x0, p = x0.copy(), p.copy()
         nx_ = len(self.x_unknown)
         x0[self.x_unknown] = w[:nx_]

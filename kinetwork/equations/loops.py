@@ -59,6 +59,8 @@ import casadi as ca
 import numpy as np
 
 from ..errors import ModelError
+from ..util import quiet, summary
+from . import loopstart
 from .newton_euler import aba, rnea
 
 def _qr(*args, **kwargs):
@@ -152,7 +154,7 @@ def formulate(asm, topo, values, formulation="partition", rate=BAUMGARTE_RATE,
         res = ca.substitute(in_states(net.alg_res), asm.t, ca.SX(0))
         eq.z, eq.alg = ca.vertcat(eq.z, z_sig), ca.vertcat(eq.alg, in_states(net.alg_res))
         eq.algebraic_names = eq.algebraic_names + net.alg_names
-        eq.algebraic_units = eq.algebraic_units + [""] * len(net.alg_names)
+        eq.algebraic_units = eq.algebraic_units + net.alg_units
         known = ca.vertcat(eq.x, z_mech, asm.p)
         solve_z = ca.rootfinder("signal_loops", "newton",
                                 ca.Function("res", [z_sig, known], [res]), {"abstol": 1e-13})
@@ -162,13 +164,17 @@ def formulate(asm, topo, values, formulation="partition", rate=BAUMGARTE_RATE,
         x0 = np.concatenate([x0, np.asarray(start(p), dtype=float).ravel()])
         if solve_z is None:
             return x0, z0
-        try:
-            zs = solve_z(np.zeros(len(net.alg_z)), np.concatenate([x0, z0, p]))
-        except RuntimeError:
+        with quiet() as said:
+            try:
+                zs = solve_z(np.zeros(len(net.alg_z)), np.concatenate([x0, z0, p]))
+            except RuntimeError:
+                zs = None
+        if zs is None:
+            chatter = summary(said["text"])
             raise ModelError("the nonlinear algebraic loop(s) through "
                              + "; ".join(", ".join(n) for n in net.loops_kept)
                              + " have no solution at the initial state (Newton from 0 "
-                               "failed)") from None
+                               "failed" + (f"; {chatter}" if chatter else "") + ")")
         return x0, np.concatenate([z0, np.asarray(zs, dtype=float).ravel()])
     eq.initial = initial
     return eq
@@ -302,11 +308,20 @@ class _Loops:
                 f"quaternions cannot follow the closure; let one of them be the cut joint "
                 f"(mark it cut=True), or replace it by a Universal joint (a coupler between "
                 f"two ball joints spins freely about its own axis)")
-        self.free = [i for i in sorted(loop_coords)
+        # the start values of a cut joint (a FreeMotion's r0) are rows of the start's
+        # assembly too, after the closures (``loopstart.py``)
+        start = asm.start_rows
+        phi_start = self.phi if start is None else ca.vertcat(self.phi, start.position)
+        start_coords = set(np.nonzero(np.asarray(
+            ca.DM(ca.jacobian(phi_start, q).sparsity(), 1)).any(axis=0))[0])
+        self.free = [i for i in sorted(loop_coords | start_coords)
                      if asm.regular[i] and not asm.given[i]]
-        self.f_phi = ca.Function("closure", [q, asm.p], [self.phi])
+        self.f_phi = ca.Function("closure", [q, asm.p], [phi_start])
         self.f_jac = ca.Function("closure_jacobian", [q, asm.p],
-                                 [ca.jacobian(self.phi, q)[:, self.free]])
+                                 [ca.jacobian(phi_start, q)[:, self.free]])
+        self.f_speed = None if start is None or not start.speed.numel() else ca.Function(
+            "start_speeds", [q, u, asm.p], [ca.densify(start.speed),
+                                            ca.densify(ca.jacobian(start.speed, u))])
         self.f_start = asm.start_function()
         self.f_J = ca.Function("J", [q, asm.p], [ca.densify(self.J)])
         self.loop_coords = loop_coords
@@ -315,6 +330,7 @@ class _Loops:
             return
         q0 = self.close(p_nom)
         self.rows, self.dep = self._partition(np.asarray(self.f_J(q0, p_nom)), loop_coords)
+        loopstart.branch(self, q0, p_nom)
 
     # -- consistent initial configuration ---------------------------------------------------
     def close(self, p):
@@ -333,6 +349,11 @@ class _Loops:
         if not self._closed(r):
             q, r = self._search(start, p, q, r)
         worst = np.max(np.abs(r), initial=0.0)
+        n_closure = self.phi.shape[0]
+        if np.isfinite(worst) and worst > CLOSED and \
+                np.max(np.abs(r[:n_closure]), initial=0.0) <= CLOSED:
+            raise loopstart.unmet(self.asm.start_rows.position_labels, r[n_closure:],
+                                  "configuration")
         if not np.isfinite(worst) or worst > CLOSED:
             by_loop = {}
             for i, v in zip(self.owner, np.abs(r)):
@@ -655,7 +676,8 @@ class _Loops:
             def initial(p):
                 qc = self.close(p)
                 _, u0 = start(p)
-                un = np.asarray(f_u(qc, np.asarray(u0, dtype=float).ravel()[ind], p))
+                u0 = loopstart.speeds(self, qc, np.asarray(u0, dtype=float).ravel(), p)
+                un = np.asarray(f_u(qc, u0[ind], p))
                 return np.concatenate([qc[all_q], un.ravel()[all_u]]), np.zeros(0)
             note = (f"kinematic loops, Baumgarte formulation: all {len(all_q)} coordinates "
                     f"and {len(all_u)} speeds are states ({len(ind)} degrees of freedom; "
@@ -685,6 +707,7 @@ class _Loops:
                     f"fixed by the loop closure (it is a dependent coordinate); give the "
                     f"initial speed of an independent coordinate "
                     f"({', '.join(unames[k] for k in ind)}) instead")
+            u0 = loopstart.speeds(self, qc, u0, p)
             if projected:
                 return np.concatenate([qc[keep_q], qc[dep_q], u0[ind]]), np.zeros(0)
             return np.concatenate([qc[keep_q], u0[ind]]), qc[dep_q]

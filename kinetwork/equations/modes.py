@@ -147,7 +147,9 @@ def operating_modes(system, t, X, p, check=True):
     table = np.asarray(modes.f_values(t, x, p)).reshape(len(modes.comps), -1)
     for i, comp in enumerate(modes.comps):
         k = modes.mode_index[i]
-        if getattr(type(comp), "at_rest_modes", None):
+        if getattr(type(comp), "disengaged", None) and comp.disengaged(table[i, 4:6]):
+            x[k] = comp.FREE                 # a clutch or brake with no normal force
+        elif getattr(type(comp), "at_rest_modes", None):
             w = table[i, 2]
             x[k] = 0 if abs(w) <= AT_REST else np.sign(w)
         elif getattr(type(comp), "state_mode", False) and table[i, 0] < 0:

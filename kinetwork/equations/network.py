@@ -36,6 +36,7 @@ import casadi as ca
 import networkx as nx
 
 from ..errors import ModelError
+from . import starts, supports
 from .circuit import Circuit
 from .signals import acceleration_unavailable
 
@@ -63,6 +64,7 @@ class Network:
     alg_z: list = field(default_factory=list)          # their outputs, unknowns ...
     alg_res: list = field(default_factory=list)        # ... and their equations z - f(z)
     alg_names: list = field(default_factory=list)
+    alg_units: list = field(default_factory=list)
     block_states: int = 0
     no_acceleration: set = field(default_factory=set)  # sets of massless groups
     #: speed index -> Prescribed, for joints whose coordinate a motion source gives
@@ -71,6 +73,10 @@ class Network:
     hybrid: list = field(default_factory=list)
     #: what structural analysis made of the circuits (``circuit.Circuit.summary``)
     circuit: str = ""
+    #: state name -> why it is no state: index reduction found a constraint that fixes it
+    demoted: dict = field(default_factory=dict)
+    #: joint starts the inertias on joint axes give: (``"q"`` or ``"u"``, index, value)
+    claims: list = field(default_factory=list)
 
     def summary(self, topo):
         """A line on what structural analysis made of the 1-D network and the blocks."""
@@ -152,6 +158,7 @@ class _Motion:
     coord: tuple                     # placeholders (or the joint's q, u, udot)
     reference: ca.SX = None
     drive: ca.SX = None              # on a joint: the symbol of the generalized force
+    offset: ca.SX = 0                # the source's flange is at k theta + offset
 
 
 class _Builder:
@@ -164,6 +171,9 @@ class _Builder:
         n = u.shape[0]
         self.net = Network({}, {}, {}, {}, ca.SX.zeros(n), ca.SX.zeros(n), ca.SX.zeros(n))
         self.k = {}                  # connection set -> ratio to its group's coordinate
+        self.c = {}                  # ... and offset: position = k theta + c (a Mass's L)
+        self.ride = {}               # ... and the shares of its carriers (``supports.ride``)
+        self.kin = {}                # connection set -> (position, speed, acceleration)
         self.kt = {}                 # ... and of its torques (differs through gear losses)
         self.losses = {}             # gear with a loss -> eta^mode
         self.group_of = {}           # connection set -> group
@@ -179,17 +189,19 @@ class _Builder:
             self._ratios(group)
         for group in self.topo.oned:
             self._coordinate(group)
-        for s, group in self.group_of.items():
-            theta, w, a = self.coord[group.index]
-            k = self.k[s]
+        self.kin = supports.kinematics(self)
+        for s, (pos, vel, acc) in self.kin.items():
             for ref in self.topo.sets[s]:
-                self.net.pos[ref], self.net.vel[ref], self.net.acc[ref] = k * theta, k * w, k * a
+                self.net.pos[ref], self.net.vel[ref], self.net.acc[ref] = pos, vel, acc
+        self.riding = supports.clusters(self)
+        starts.free(self)
         self._block_states()
         # circuits next: their currents are expressions of states and speeds, so EMF
         # torques are known before any balance (``circuit.py``)
         self.circuit = Circuit(self).build()
         self.circuit.fill(self.net)
         self.net.circuit = self.circuit.summary
+        self.net.demoted.update(self.circuit.demoted)
         self._flows("compliant")               # springs and dampers need no signal
         self._passive = ca.SX.zeros(self.u.shape[0])
         for group in self.topo.oned:
@@ -210,11 +222,18 @@ class _Builder:
             self.group_of[s] = group
             if parent is None:
                 self.k[s] = self.kt[s] = ca.SX(1)
+                self.c[s] = ca.SX(0)
+                self.ride[s] = [] if group.base is None else [(ca.SX(1), group.base)]
                 continue
             r = self.bound[element.name].ratio()
+            length = self.bound[element.name].length()
             a_here = self.topo.set_of[element.port_ref("flange_a")] == s
-            # position(flange_a) = r * position(flange_b)
+            # position(flange_a) = r * (position(flange_b) - length), relative to the
+            # gear's support
             self.k[s] = self.k[parent] * r if a_here else self.k[parent] / r
+            self.c[s] = r * (self.c[parent] - length) if a_here else \
+                self.c[parent] / r + length
+            self.ride[s] = supports.ride(self, parent, element, a_here, r if a_here else 1 / r)
             # torques pass a gear with efficiency eta as torque_b = -r eta^m torque_a, m = +1
             # while flange_a drives (power from a to b), -1 while flange_b does
             loss = self._loss(element, group)
@@ -278,19 +297,25 @@ class _Builder:
         units = _units(group)
         labels = list(zip((_pos(group), _vel(group)), units))[:comp.n_states]
         x = [self._state(f"{comp.name}.{label}", unit, 0, 0) for label, unit in labels]
-        self.motions.append(_Motion(comp, flange.component, group,
-                                    self.k[self.topo.set_of[flange]], x, coord))
+        at = self.topo.set_of[flange]
+        self.motions.append(_Motion(comp, flange.component, group, self.k[at], x, coord,
+                                    offset=self.c[at]))
 
     def _free(self, group):
-        inertias = [e for e in group.rigid if e.has_inertia]
-        first = self.bound[inertias[0].name]
+        """A coordinate and a speed, the position and speed of the group's first inertia
+        (the group's root), named after it; their starts follow from the inertias' own
+        (``starts.free``, once every position is known)."""
+        first = next(e for e in group.rigid if e.has_inertia)
         pos_unit, vel_unit = _units(group)
-        k = self.k[self.topo.set_of[inertias[0].port_ref("flange_a")]]
-        p0 = 0 if first.position0 is None else first.position0 / k
-        w0 = 0 if first.speed0 is None else first.speed0 / k
+        at = self.topo.set_of[first.port_ref("flange_a")]
+        # the coordinate is the first inertia's centre (MSL's Mass.s, between its flanges
+        # L apart), in the units of its flanges divided by their ratio
+        centre = self.c[at] + self.bound[first.name].length() / 2
+        for s, _, _ in group.sets:
+            self.c[s] = self.c[s] - self.k[s] * centre / self.k[at]
         a = ca.SX.sym(f"g{group.index}_acc")
-        w = self._state(f"{first.name}.{_vel(group)}", vel_unit, w0, a)
-        theta = self._state(f"{first.name}.{_pos(group)}", pos_unit, p0, w,
+        w = self._state(f"{first.name}.{_vel(group)}", vel_unit, 0, a)
+        theta = self._state(f"{first.name}.{_pos(group)}", pos_unit, 0, w,
                             at=len(self.net.x) - 1)
         self.coord[group.index] = (theta, w, a)
 
@@ -375,6 +400,7 @@ class _Builder:
                 self.net.alg_z.append(z[i])
                 self.net.alg_res.append(residual[i])
                 self.net.alg_names.append(f"{c.name}.y")
+                self.net.alg_units.append("")
                 self.net.signal[s] = z[i]
             self.net.loops_kept.append(names)
             return
@@ -474,9 +500,12 @@ class _Builder:
                 drive = ca.SX.sym(f"drive_{m.comp.name}")
                 self._drive(m, drive / m.k)
                 m.drive = drive
+        for cluster in self.riding:             # trains riding on a housing, solved together
+            supports.solve(self, cluster)
         # motions of free flanges first: the flow into their source is then known, and so
-        # the reaction on their support, before the fixed groups take it
-        for group in sorted(self.topo.oned, key=lambda g: g.kind != "prescribed"):
+        # the reaction on their support, before the fixed groups take it; a train on a
+        # housing before the housing, which takes its reaction
+        for group in supports.order(self):
             self._balance(group)
             if group.kind == "prescribed":
                 m = next(m for m in self.motions if m.group is group)
@@ -523,23 +552,28 @@ class _Builder:
         self.net.hybrid.append(Hybrid(comp, b, b._mode, b._F, refs[b.side_a] if b.side_a in
                                       refs else None, refs[b.side_b], u))
 
-    def _applied(self, s, roles=("compliant", "source")):
+    def _applied(self, s, roles=("compliant", "source"), exclude=()):
         """Flows into the non-rigid elements at a connection set (compliant, sources; with
-        ``prescribed`` in ``roles``, motion sources too)."""
+        ``prescribed`` in ``roles``, motion sources too), but those of ``exclude``."""
         return sum((self.net.flow.get(r, 0) for r in self.topo.sets[s]
-                    if r.component.role in roles), ca.SX(0))
-
-    def _generalized(self, group, roles=("compliant", "source")):
-        return sum((-self.kt[s] * self._applied(s, roles) for s, _, _ in group.sets),
+                    if r.component.role in roles and r.component.name not in exclude),
                    ca.SX(0))
+
+    def _generalized(self, group, roles=("compliant", "source"), exclude=()):
+        return sum((-self.kt[s] * self._applied(s, roles, exclude) for s, _, _ in group.sets),
+                   ca.SX(0))
+
+    def group_inertia(self, group):
+        """sum(J k kt) over the group's inertias: its inertia on its coordinate."""
+        at = self.topo.set_of
+        return sum((self.bound[e.name].inertia() * self.k[at[e.port_ref("flange_a")]] *
+                    self.kt[at[e.port_ref("flange_a")]] for e in group.rigid
+                    if e.has_inertia), ca.SX(0))
 
     def _inertia(self, group):
         """The group's inertia; on a joint, its armature, and the passive generalized force
         (springs and dampers) that an InverseDynamics block compensates."""
-        at = self.topo.set_of
-        inertia = sum((self.bound[e.name].inertia() * self.k[at[e.port_ref("flange_a")]] *
-                       self.kt[at[e.port_ref("flange_a")]] for e in group.rigid
-                       if e.has_inertia), ca.SX(0))
+        inertia = self.group_inertia(group)
         self.inertia[group.index] = inertia
         if group.kind == "joint":
             u = self._speed(group)
@@ -557,7 +591,13 @@ class _Builder:
         theta, w, a = self.coord[group.index]
         if group.kind == "joint":
             self.net.Q[self._speed(group)] += gen
-        elif group.kind == "free":
+        elif group.kind == "free" and group.index in self.circuit.coupled:
+            # a rotor a circuit's constraint holds: its acceleration came with the circuit's
+            # solution, in the generalized force of all but the circuit's EMFs
+            coupled = self.circuit.coupled[group.index]
+            self.pending[coupled.rest] = self._generalized(group, exclude=coupled.emfs)
+            self.pending[a] = coupled.acc
+        elif group.kind == "free" and not any(group in c for c in self.riding):
             self.pending[a] = gen / self.inertia[group.index]
         elif group.kind == "massless":
             self._massless(group, gen)
@@ -590,10 +630,9 @@ class _Builder:
     def _rigid_flows(self, group):
         """Kirchhoff at every set of the group, leaves first: the flow into a rigid element at
         its far side balances what is beyond; its law gives the near side."""
-        flow, k = self.net.flow, self.k
-        theta, w, a = self.coord[group.index]
+        flow = self.net.flow
         beyond = {s: self._applied(s, ("compliant", "source", "prescribed"))
-                  for s, _, _ in group.sets}
+                  + supports.reactions(self, s) for s, _, _ in group.sets}
         for s, parent, element in reversed(group.sets):
             if parent is None:
                 if group.definer is not None:
@@ -605,11 +644,13 @@ class _Builder:
             flow[far] = -beyond[s]
             b = self.bound[element.name]
             if element.has_inertia:
-                flow[near] = b.inertia() * k[s] * a - flow[far]
+                flow[near] = b.inertia() * self.kin[s][2] - flow[far]
             elif far.name == "flange_a":          # torque_b = -ratio * torque_a
                 flow[near] = -b.ratio() * self.losses.get(element.name, 1) * flow[far]
             else:
                 flow[near] = -flow[far] / (b.ratio() * self.losses.get(element.name, 1))
+            if "support" in element.ports:        # MSL: support.tau = -flange_a.tau - flange_b.tau
+                flow[element.port_ref("support")] = -(flow[far] + flow[near])
             beyond[parent] = beyond[parent] + flow[near]
 
     def _finish(self):
@@ -620,11 +661,14 @@ class _Builder:
             if self.model.components[name].role == "source":
                 for placeholder, s in read.values():
                     self.pending[placeholder] = net.signal[s]
+        self._input_rates()
         for joint_ports in self._axis_ports():
             ref, u = joint_ports
             net.axis_flow[u] += net.flow.get(ref, 0)
         self._motion_laws()
+        net.claims = starts.claims(self)
         if not self.pending:
+            starts.resolve(net, self.t)
             return
         sub = self._substitution()
         for d in (net.pos, net.vel, net.acc, net.flow, net.signal):
@@ -636,6 +680,30 @@ class _Builder:
         net.alg_res = [sub(r) for r in net.alg_res]
         for rec in net.prescribed.values():
             rec.pos, rec.vel, rec.acc = sub(rec.pos), sub(rec.vel), sub(rec.acc)
+        starts.resolve(net, self.t)
+
+    def _input_rates(self):
+        """The time derivative of each signal whose circuit constraint was differentiated (a
+        voltage source's u across a capacitor): through t and the rates of the states it
+        reads (signal blocks); one that follows the mechanism's motion is refused."""
+        if not self.circuit.input_rates:
+            return
+        sub = self._substitution()
+        moving = ca.vertcat(self.q, self.u, self.udot)
+        for du, s in self.circuit.input_rates.items():
+            e = sub(self.net.signal[s])
+            if ca.depends_on(e, moving):
+                names = ", ".join(self.circuit.placeholders_in(du))
+                raise ModelError(f"{names}: a constraint of the circuit differentiates its "
+                                 f"input u, whose signal follows the motion of the mechanism; "
+                                 f"put a resistor or an inductor where the source meets the "
+                                 f"capacitors (or the inductors)")
+            states = [x for x in self.net.x if ca.depends_on(e, x)]
+            rate = ca.jacobian(e, self.t)
+            if states:
+                rate += ca.jtimes(e, ca.vertcat(*states),
+                                  sub(ca.vertcat(*[self.net.rate[self._at(x)] for x in states])))
+            self.pending[du] = rate
 
     def _substitution(self):
         """The function putting every placeholder's expression in its place."""
@@ -695,8 +763,8 @@ class _Builder:
                 joint = m.group.definer.component
                 j = joint.coordinate_ports[m.group.definer.name]
                 self.net.prescribed[self.uindex[joint.name][j]] = Prescribed(
-                    self.qindex[joint.name][j], pos / m.k, vel / m.k, acc / m.k, m.drive,
-                    m.comp.name, joint.name)
+                    self.qindex[joint.name][j], (pos - m.offset) / m.k, vel / m.k, acc / m.k,
+                    m.drive, m.comp.name, joint.name)
             else:
                 self.pending.update(zip(m.coord, (pos, vel, acc)))
 

@@ -16,6 +16,7 @@ import numpy as np
 
 from ..errors import ModelError
 from . import junctions
+from .closing import closer
 from .assemble import assemble
 from .initial import InitialEquations
 from .loops import BAUMGARTE_RATE, formulate, newton
@@ -28,7 +29,11 @@ class System:
     Attributes
     ----------
     state_names : list of str
-        Joint coordinates, then their speeds (``"shoulder.q"``, ..., ``"shoulder.qd"``).
+        Joint coordinates, then their speeds (``"shoulder.q"``, ..., ``"shoulder.qd"``),
+        then the 1-D network's, the signal blocks' and the circuits' states.
+    demoted_states : dict
+        States index reduction took out (a capacitor of a capacitor loop: ``"C2.v"``), each
+        with why.
     x0 : numpy.ndarray
         Initial state for the model's parameter values.
     signals : list of Signal
@@ -138,13 +143,20 @@ class System:
                          f"{', '.join(involved)} (give the bodies they carry mass or inertia, "
                          f"or lock the joint)")
 
-    def polish(self, X, p):
+    def polish(self, X, p, t=None):
         """Full states X (n_points, n_states + n_algebraic) with the algebraic variables
         (dependent coordinates) Newton-corrected onto the closure to machine precision: the
-        integrator solves them only to its tolerance."""
+        integrator solves them only to its tolerance. Equations that read time (a diode's
+        circuit driven by a source in t) are polished at the times ``t`` of the rows, and
+        not at all without them."""
         if not self.n_algebraic or not len(X):
             return X
-        Z = np.asarray(mapped(self._f_polish, len(X))(np.asarray(X).T, p)).T
+        timed = ca.depends_on(self.eq.alg, self.asm.t)
+        if timed and t is None:
+            return X
+        times = np.zeros(len(X)) if t is None else np.asarray(t, dtype=float)
+        Z = np.asarray(mapped(self._f_polish, len(X))(np.asarray(X).T, p,
+                                                       times[None, :])).T
         out = np.array(X, dtype=float)
         ok = np.all(np.isfinite(Z), axis=1)
         out[ok, self.n_states:] = Z[ok]
@@ -152,7 +164,7 @@ class System:
 
     @functools.cached_property
     def _f_polish(self):
-        return ca.Function("polish", [ca.vertcat(self._x, self._z), self.asm.p],
+        return ca.Function("polish", [ca.vertcat(self._x, self._z), self.asm.p, self.asm.t],
                            [newton(self.eq.alg, self._z)])
 
     @property
@@ -243,34 +255,35 @@ class System:
     def n_states(self) -> int:
         return len(self.state_names)
 
+    @property
+    def demoted_states(self) -> dict[str, str]:
+        """States that index reduction took out, by name, with why: a capacitor of a loop
+        of capacitors, an inductor of a cut set of inductors, whose value a differentiated
+        constraint fixes from the states kept (``state_names``) and the sources."""
+        net = self.asm.net
+        return dict(net.demoted) if net is not None else {}
+
     # -- numbers --------------------------------------------------------------------------
     def rhs(self, t: float, x: np.ndarray, params: Mapping[str, float] | None = None
             ) -> np.ndarray:
         """dx/dt of the ODE at (t, x), as numpy (n_states,).
 
-        With loops (algebraic variables z), z is first solved from the closure by Newton,
-        starting from the last z solved (at first the initial one).
+        With loops (algebraic variables z), z is first solved from the closure: Newton from
+        the last z solved, else followed from the assembled start on its branch
+        (``closing.py``; a state where the loops cannot close is refused naming them).
         """
         x = self._vector(x, self.n_states, "x")
         p = self.param_vector(params)
         if not self.n_algebraic:
             return np.asarray(self.f_rhs(t, x, p)).ravel()
-        if self._z_last is None:
-            self._z_last = self.initial_full_p(p)[1]
-        try:
-            z = np.asarray(self._closure_solver(self._z_last, np.concatenate([x, p])))
-        except RuntimeError:
-            raise ModelError("the loops cannot close at this state x (Newton on the "
-                             "dependent coordinates failed)") from None
-        self._z_last = z.ravel()
+        closing = closer(self)
+        z, ok = None, False
+        if self._z_last is not None:
+            z, _, ok = closing.newton(x, self._z_last, p)
+        if not ok:
+            z = closing.close(x, p, self.initial_full_p(p), where="x")
+        self._z_last = np.asarray(z, dtype=float).ravel()
         return np.asarray(self.f_dae(t, x, z, p)[0]).ravel()
-
-    @functools.cached_property
-    def _closure_solver(self):
-        z, xp = ca.SX.sym("z", self.n_algebraic), ca.SX.sym("xp", self.n_states + self.asm.p.numel())
-        alg = ca.Function("alg", [z, xp], [self.f_dae(0, xp[:self.n_states], z,
-                                                      xp[self.n_states:])[1]])
-        return ca.rootfinder("closure", "newton", alg, {"abstol": 1e-13})
 
     @functools.cached_property
     def _f_mass(self):

@@ -16,6 +16,7 @@ import numpy as np
 
 from ..components.probe import QUANTITIES
 from ..errors import IdealisedInertiaWarning, ModelError
+from . import supports
 
 ONED_DOMAINS = ("rotational", "translational")
 SIGNAL_DOMAINS = ("signal_in", "signal_out")
@@ -59,6 +60,12 @@ class OneDGroup:
     kind: str = "massless"
     rigid: list = field(default_factory=list)
     motion: object = None
+    #: gears of the group whose support is wired (MSL's useSupport): element name -> the
+    #: connection set of its support (``kinetwork.graph.supports``)
+    supports: dict = field(default_factory=dict)
+    #: for a prescribed motion whose support is on a free rotor: the support's set, which the
+    #: motion's flange moves relative to
+    base: int = None
 
 
 @dataclass
@@ -149,8 +156,10 @@ def analyze(model):
     if world is not None:
         _tree(model, topo, roles, problems)
     _oned(model, topo, values, problems)
+    supports.check(model, topo, values, problems)
     _signals(topo, problems)
     _motions(model, topo, problems)
+    supports.rings(topo, problems)
     if values is not None and topo.junctions:
         _junction_masses(model, topo, values, problems)
     if values is not None:
@@ -447,8 +456,11 @@ def _oned(model, topo, values, problems):
             problems.append(f"connection set {where} has no defined {domain} position: it "
                             f"has no inertia, spring or damper, so the flows on it cannot "
                             f"balance; wire it to a joint flange, a Fixed or an inertia")
-        topo.oned.append(OneDGroup(len(topo.oned), domain, _rooted(sub, members, definers,
-                                                                    topo), ports,
+        # a free group's coordinate is its first inertia's position (the state named after it)
+        root = (topo.set_of[definers[0]] if definers else
+                topo.set_of[inertias[0].port_ref("flange_a")] if kind == "free" else
+                min(members))
+        topo.oned.append(OneDGroup(len(topo.oned), domain, _rooted(sub, root), ports,
                                    definers[0] if definers else None, kind,
                                    [d["component"] for _, _, d in sub.edges(data=True)],
                                    motions[0] if coords and motions else None))
@@ -457,7 +469,8 @@ def _oned(model, topo, values, problems):
 def _motions(model, topo, problems):
     """A motion source takes its reference from its parameter or from its input u, not
     both; its reaction rests in the world (unwired support, a joint's support or a Fixed:
-    nothing there moves)."""
+    nothing there moves) or, for a motion that is no joint's, on a free rotor: then the
+    motion is relative to it, as MSL's with useSupport."""
     group_of = {s: g for g in topo.oned for s, _, _ in g.sets}
     for comp in model.components.values():
         if comp.role != "prescribed":
@@ -473,11 +486,18 @@ def _motions(model, topo, problems):
                             f"expression in time t) or wire a signal to {comp.name}.u")
         support = comp.port_ref("support")
         group = group_of.get(topo.set_of[support])
-        if group is not None and group.kind not in ("fixed", "world"):
-            problems.append(f"{model.place(comp)}: {support.path} is wired to a flange that "
-                            f"moves ({group.kind}); the reaction of a prescribed motion rests "
-                            f"in the world: leave the support unwired, or wire it to a "
-                            f"joint's support or a Fixed")
+        own = group_of.get(topo.set_of[comp.port_ref("flange")])
+        if group is None or group.kind in ("fixed", "world"):
+            continue
+        if group.kind == "free" and own is not None and own.kind == "prescribed" and \
+                own is not group:
+            own.base = topo.set_of[support]        # it moves relative to a free housing
+            continue
+        problems.append(f"{model.place(comp)}: {support.path} is wired to a flange that "
+                        f"moves ({group.kind}); the reaction of a prescribed motion rests "
+                        f"on a free rotor (an inertia) or in the world: wire the support "
+                        f"to an inertia of its own, a joint's support or a Fixed, or leave "
+                        f"it unwired")
 
 
 def _junction_masses(model, topo, values, problems):
@@ -544,10 +564,9 @@ def _signals(topo, problems):
             topo.signal_source[index] = outs[0]
 
 
-def _rooted(sub, members, definers, topo):
-    """The group's sets, the definer's first, each with (parent set, rigid element) of the
+def _rooted(sub, root):
+    """The group's sets, ``root`` first, each with (parent set, rigid element) of the
     breadth-first tree over the rigid elements."""
-    root = topo.set_of[definers[0]] if definers else min(members)
     order = [(root, None, None)]
     for parent, child in nx.bfs_edges(nx.Graph(sub), root):
         data = next(iter(sub.get_edge_data(parent, child).values()))

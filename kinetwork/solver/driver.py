@@ -285,7 +285,7 @@ def simulate(model: Model | System, t_end: float | None = None, n_points: int | 
     if parts is not None and parts.events:     # re-partitioned: each part by its equations
         X, outputs = parts.finish(t, X)
     else:
-        X = system.polish(X, p)
+        X = system.polish(X, p, t)
         f_out = compiled(system).outputs(run.jit)
         outputs = system.outputs_p(t, X, p, f_out) if len(t) else np.zeros((0, 0))
     results = Results(t, X, system.state_names + system.algebraic_names, outputs,
@@ -346,9 +346,11 @@ def _check(system, settings, t_start, max_steps, time_limit):
     if system.n_algebraic and not METHODS[key].dae:
         raise ModelError(
             f"method {settings['method']!r} integrates ODEs only, and {system.model.name!r} "
-            f"has kinematic loops whose dependent coordinates are algebraic variables; use "
-            f"{', '.join(k for k, m in METHODS.items() if m.dae)}, or compile the model with "
-            f"loops='projected' or loops='baumgarte' (ODEs)")
+            f"has algebraic variables ({', '.join(system.algebraic_names[:3])}"
+            f"{', ...' if system.n_algebraic > 3 else ''}: the dependent coordinates of "
+            f"kinematic loops, or the unknowns of a nonlinear circuit or signal loop); use "
+            f"{', '.join(k for k, m in METHODS.items() if m.dae)}, or, for loops, compile the "
+            f"model with loops='projected' or loops='baumgarte' (ODEs)")
     return key
 
 

@@ -305,8 +305,10 @@ class Events:
         contradict it."""
         comps, index = self.modes.comps, self.modes.mode_index
         table = self.values(t, x)
+        # a free clutch (no normal force) takes no part: its mode is none of these
         rest = [i for i, comp in enumerate(comps) if getattr(type(comp), "at_rest_modes", None)
-                and abs(table[i, 2]) <= self.run.atol]
+                and abs(table[i, 2]) <= self.run.atol
+                and int(round(x[index[i]])) in comps[i].at_rest_modes]
         if not rest:
             return x
         start = tuple(int(round(x[index[i]])) for i in rest)

@@ -33,7 +33,8 @@ def test_rl_circuit_step_and_sine_match_closed_forms():
     res = kn.simulate(m, t_end=1.0, n_points=21, **TOL, params={"R": 4.0})
     assert res.state_names == ["l.i"]
     # what `kinetwork validate --compile` says of it: 3 nodes, 7 pins, every block scalar
-    assert "circuits: 3 node potentials and 7 pin currents in 10 blocks solved symbolically, " \
+    # (10 of the potentials and currents, 1 of the inductor's rate)
+    assert "circuits: 3 node potentials and 7 pin currents in 11 blocks solved symbolically, " \
         "1 states" in m.compile().asm.net.summary(m.validate())
     tau = 0.5 / 4.0
     assert np.max(abs(res["pl.current"] - 3 / 4 * (1 - np.exp(-res.t / tau)))) < 1e-8
@@ -221,10 +222,13 @@ def test_circuits_that_cannot_be_solved_are_refused_by_name():
                          wires=[("src.p", "r.p"), ("r.n", "src.n")])
     with pytest.raises(kn.ModelError, match="src, r has no electrical.Ground|r, src has no"):
         no_ground.compile()
-    across = _circuit(E.Ground("g"), E.VoltageSource("src", V=1.0), E.Capacitor("c", C=1.0),
-                      wires=[("src.p", "c.p"), ("c.n", "src.n"), ("g.p", "src.n")])
-    with pytest.raises(kn.ModelError, match="higher index"):
-        across.compile()
+    parallel = _circuit(E.Ground("g"), E.VoltageSource("a", V=1.0), E.VoltageSource("b", V=2.0),
+                        E.Resistor("r", R=1.0),
+                        wires=[("a.p", "b.p"), ("a.n", "b.n"), ("g.p", "a.n"), ("r.p", "a.p"),
+                               ("r.n", "a.n")])
+    with pytest.raises(kn.ModelError, match="equations of a, b, g constrain their unknowns "
+                                            "twice.*structurally singular"):
+        parallel.compile()
     silent = _circuit(E.Ground("g"), E.VoltageSource("src"), E.Resistor("r", R=1.0),
                       wires=[("src.p", "r.p"), ("r.n", "src.n"), ("g.p", "src.n")])
     with pytest.raises(kn.ModelError, match=r"src.*V: no value"):

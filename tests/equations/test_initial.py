@@ -157,3 +157,63 @@ def test_msl_init_spring_constant_model_file():
     assert solved(model.compile())["c"] == pytest.approx(9.81 * 0.5 / 0.1, rel=1e-12)
     res = kn.simulate(model, t_end=1.0, n_points=11, rtol=1e-10, atol=1e-12, jit=False)
     assert np.max(abs(res["angle.angle"])) < 1e-9
+
+
+def _held_rotor(phi0, w0=None):
+    """A unit rotor on a spring (c = 50) to the ground, held by a BearingFriction of
+    0.5 N*m (peak 1)."""
+    rot = kn.rotational
+    m = kn.Model("held_rotor")
+    m.add(rot.Inertia("J", J=1.0, phi0=phi0, w0=w0))
+    m.add(rot.Spring("spring", c=50.0))
+    m.add(rot.Fixed("ground"))
+    m.add(rot.BearingFriction("bearing", tau_c=0.5))
+    m.connect("spring.flange_a", "ground.flange")
+    m.connect("spring.flange_b", "J.flange_a")
+    m.connect("bearing.flange", "J.flange_b")
+    m.set_initial(derivatives={"J.w": 0}, solve=["J.phi"])
+    return m
+
+
+def test_a_start_the_friction_cannot_hold_is_refused():
+    """At rest at phi = 1 the spring pulls 50 N*m: the bearing (0.5 N*m) cannot hold, so
+    der(J.w) = 0 is no start there (the run would begin at -49.5 rad/s^2)."""
+    with pytest.raises(kn.ModelError, match=r"initial: the start solved for \(J.phi = 1\) "
+                                            r"keeps der\(J.w\) = 0 only with a friction stuck "
+                                            r"where it cannot hold: bearing: at rest there, it "
+                                            r"would have to hold 50 beyond its static limit "
+                                            r"0.5"):
+        _held_rotor(1.0).compile().initial_state()
+
+
+def test_a_start_the_friction_holds_stays_and_a_sliding_one_is_solved_with_its_law():
+    held = _held_rotor(0.005)                    # the spring pulls 0.25 N*m: it holds
+    res = kn.simulate(held, t_end=0.2, n_points=3, rtol=1e-10, atol=1e-12)
+    np.testing.assert_allclose(res["J.phi"], 0.005, atol=1e-12)
+    # sliding forward at 1 rad/s: der(w) = -50 phi - 0.5 = 0 at phi = -0.01
+    sliding = _held_rotor(0.3, w0=1.0).compile()
+    x0 = dict(zip(sliding.state_names, sliding.initial_state()))
+    assert x0["J.phi"] == pytest.approx(-0.01, abs=1e-12)
+    assert sliding.rhs(0.0, sliding.initial_state())[sliding.state_names.index("J.w")] == \
+        pytest.approx(0.0, abs=1e-9)
+
+
+def test_what_the_solver_prints_on_a_failed_start_is_captured_and_summarised(capfd):
+    """A start Newton cannot find (the pendulum's length solved for an acceleration gravity
+    cannot give: NaN on the way) is refused with CasADi's warnings summarised in the error;
+    nothing reaches the terminal."""
+    mb = kn.multibody
+    m = kn.Model("pendulum", parameters={"L": 1.0})
+    m.add(mb.Ground("ground"))
+    m.add(mb.Revolute("j", q0=0.3))
+    m.add(mb.RigidBody("bob", mass=1.0, r_cm=["L", 0, 0]))
+    m.connect("ground.frame", "j.frame_a")
+    m.connect("j.frame_b", "bob.frame_a")
+    m.set_initial(derivatives={"j.qd": 1.0}, solve=["L"])
+    capfd.readouterr()
+    with pytest.raises(kn.ModelError, match=r"initial: the model cannot satisfy der\(j.qd\) = 1 "
+                                            r"with L as unknowns: .*\(the solver said \d+ lines?:"
+                                            r" initial:g failed: NaN detected"):
+        m.compile().initial_state()
+    out, err = capfd.readouterr()
+    assert out == "" and err == ""

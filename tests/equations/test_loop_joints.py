@@ -371,7 +371,7 @@ def rrr_fourbar(theta0=1.0, masses=(1.0, 2.0, 1.5)):
     crank_tip = scenes.loops._rod(m, "crank", "A.frame_b", repr(A), masses[0], A)
     phi, psi = (float(v) for v in ref.fourbar_closure(theta0))
     m.add(mb.JointRRR("rrr", r_rod1=["b", 0, 0], r_rod2=["c", 0, 0],
-                      q0_guess=[phi - theta0, psi - phi, -psi]))
+                      q0_guess=[phi - theta0, psi - phi, psi]))
     m.add(mb.FixedTranslation("base", r=[D, 0, 0]))
     m.add(mb.RigidBody("coupler_mass", mass=masses[1], r_cm=["b/2", 0, 0],
                        inertia=[0, 0, masses[1] * B * B / 12]))
@@ -396,8 +396,9 @@ def test_joint_rrr_is_three_revolutes_with_the_last_one_cut():
     res = kn.simulate(system, t_end=2.0, n_points=201)
     theta = res["crank_probe.angle"]
     phi, psi = ref.fourbar_closure(theta)
-    # the third revolute turns frame_ib (along the rocker) back to the ground: -psi
-    assert np.max(np.abs(wrap(res["rocker_probe.angle"] + psi))) < 1e-9
+    # MSL's third revolute turns from frame_b (on the ground) to frame_ib (along the
+    # rocker): its angle is the rocker's, psi
+    assert np.max(np.abs(wrap(res["rocker_probe.angle"] - psi))) < 1e-9
     C_point = np.stack([D + C * np.cos(psi), C * np.sin(psi)], -1)
     assert np.max(np.abs(res["coupler_point.position"][:, :2] - C_point)) < 1e-9
 
@@ -408,6 +409,23 @@ def test_joint_rrr_moves_as_the_three_revolutes_it_stands_for():
     r = ref.fourbar_simulate(1.0, 0.0, res.t)
     assert np.max(np.abs(res["crank_probe.angle"] - revolutes["crank_probe.angle"])) < 1e-10
     assert np.max(np.abs(res["crank_probe.angle"] - r["theta"])) < 1e-9
+
+
+def test_joint_rrr_axis_is_msls_angle_of_frame_ib_relative_to_frame_b():
+    """A Position on the JointRRR's axis (its reaction on ``bearing``, MSL's name) turns the
+    rocker to the angle it prescribes: MSL's third revolute goes from frame_b (on the
+    ground at D) to frame_ib (along the rocker), so its angle is the rocker's, psi, and the
+    middle joint sits at D + c (cos psi, sin psi)."""
+    m = rrr_fourbar()
+    m.components["A"].q0 = None
+    m.add(kn.rotational.Position("drive", phi_ref="1.6 + 0.2*sin(3*t)"))
+    m.connect("drive.flange", "rrr.axis")
+    m.connect("drive.support", "rrr.bearing")
+    res = kn.simulate(m, t_end=1.0, n_points=21, rtol=1e-10, atol=1e-12)
+    psi = 1.6 + 0.2 * np.sin(3 * res.t)
+    np.testing.assert_allclose(res["rocker_probe.angle"], psi, atol=1e-9)
+    C_point = np.stack([D + C * np.cos(psi), C * np.sin(psi)], -1)
+    np.testing.assert_allclose(res["coupler_point.position"][:, :2], C_point, atol=1e-9)
 
 
 def test_joint_rrr_round_trips_through_a_file(tmp_path):

@@ -323,7 +323,7 @@ REFUSED = [
      lambda m: (m.add(rot.Position("a", phi_ref="t")), m.connect("a.flange", "shoulder.axis"),
                 m.connect("a.support", "elbow.axis")),
      r"a.support is wired to a flange that moves \(joint\); the reaction of a prescribed "
-     r"motion rests in the world"),
+     r"motion rests on a free rotor \(an inertia\) or in the world"),
 ]
 
 

@@ -207,14 +207,16 @@ def gear_type2(w_s=None):
 def axis_type2(motor_def, gear_def, controller_def):
     """Utilities.AxisType2: controller, motor and GearType2."""
     params = {"kp": 10.0, "ks": 1.0, "Ts": 0.01, **MOTOR, "ratio": -105.0, "Rv0": 0.4,
-              "Rv1": 0.13 / 160, "peak": 1.0}
+              "Rv1": 0.13 / 160, "peak": 1.0, "q_start": 0.0}
     m = kn.Model("AxisType2", parameters=params, description=(
         "Modelica.Mechanics.MultiBody.Examples.Systems.RobotR3.Utilities.AxisType2: "
         "controller, motor and GearType2 (no elasticity: the motor's rotor is geared rigidly "
-        "to the joint) wired as MSL's, the axis bus as ports: flange, angle_ref, speed_ref."))
+        "to the joint) wired as MSL's, the axis bus as ports: flange, angle_ref, speed_ref. "
+        "The motor starts at ratio q_start, where the joint it is geared to starts."))
     m.add(kn.Subsystem("controller", controller_def, params={
         "kp": "kp", "ks": "ks", "Ts": "Ts", "ratio": "ratio"}))
-    m.add(kn.Subsystem("motor", motor_def, params={k: k for k in MOTOR}))
+    m.add(kn.Subsystem("motor", motor_def, params={**{k: k for k in MOTOR},
+                                                   "phi0": "ratio*q_start"}))
     m.add(kn.Subsystem("gear", gear_def, params={
         "i": "ratio", "Rv0": "Rv0", "Rv1": "Rv1", "peak": "peak"}))
     _wire(m, [("motor.flange_motor", "gear.flange_a"),
@@ -317,9 +319,7 @@ def full_robot(mechanics_def, axis1_def, axis2_def):
         n = k + 1
         m.add(ptp(f"path_q{n}", "q", axis=n, **path))
         m.add(ptp(f"path_qd{n}", "qd", axis=n, **path))
-        params = {**values, "kp": 5.0, "ks": 0.5, "Ts": 0.05}
-        if k < 3:
-            params["q_start"] = path["q_begin"][k]
+        params = {**values, "kp": 5.0, "ks": 0.5, "Ts": 0.05, "q_start": path["q_begin"][k]}
         m.add(kn.Subsystem(f"axis{n}", axis1_def if k < 3 else axis2_def, params=params))
         m.add(kn.Probe(f"joint{n}", quantities=["angle", "speed"]))
         _wire(m, [(f"path_q{n}.y", f"axis{n}.angle_ref"), (f"path_qd{n}.y", f"axis{n}.speed_ref"),
