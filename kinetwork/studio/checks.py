@@ -158,12 +158,67 @@ def problems_of(exc, data=None):
     return listed
 
 
-def problem(message, names=()):
+def problem(record, names=()):
     """A problem as the page reads it (API.md): ``{"message", "component", "port",
     "parameter", "path", "hint", "severity", "reason"}`` (``reason``: what is wrong, without
     the place, for the page to say it in the user's words), and the older keys ``param``
-    and ``connection``."""
-    message = str(message)
+    and ``connection``.
+
+    A ``kinetwork.Problem`` record is read by its fields; a plain string (a library that
+    does not yet give its problems fields) is placed by :func:`_placed`.
+    """
+    if getattr(record, "severity", None) is None:
+        return _placed(str(record), names)
+    out = {"message": str(record), "reason": None, "param": None, "connection": None}
+    for key in ("component", "port", "parameter", "path", "hint"):
+        value = getattr(record, key, None)
+        out[key] = value if isinstance(value, str) else None
+    out["severity"] = "warning" if record.severity == "warning" else "error"
+    path = out["path"] or ""
+    if path.startswith("components["):
+        out["param"] = out["parameter"]
+    out["connection"] = _index(path, "connections[")
+    rest = _after_place(out)
+    out["reason"] = None if rest is None else _reason(rest)
+    return out
+
+
+def _index(path, head):
+    """The index of a path that starts ``head`` ("connections[2][0]" -> 2), else None."""
+    if not path.startswith(head):
+        return None
+    digits = path[len(head):].partition("]")[0]
+    return int(digits) if digits.isdigit() else None
+
+
+def _after_place(out):
+    """The message after the place its fields name, when the message names that place as
+    the library writes it (``components[3] "mass1" params.mass``, ``connections[2]``,
+    ``mass1.frame_a``), else None: the page then shows the whole message."""
+    message, path = out["message"], out["path"] or ""
+    local = path[max(path.rfind("components["), path.rfind("connections["), 0):]
+    places = []
+    index = _index(local, "components[")
+    if index is not None and out["component"]:
+        head = f'components[{index}] "{out["component"]}"'
+        if out["parameter"]:
+            places.append(f"{head} params.{out['parameter']}")
+        places.append(head)
+    wire = _index(local, "connections[")
+    if wire is not None:
+        places.append(f"connections[{wire}]")
+    if out["component"] and out["port"]:
+        places.append(f"{out['component']}.{out['port']}")
+    for place in places:
+        at = message.find(place)
+        if at >= 0:
+            return message[at + len(place):]
+    return None
+
+
+def _placed(message, names=()):
+    """A problem given as a string alone, placed by the form of its text (the library's
+    places: ``components[i] "name" params.key``, ``connections[i]``, ``comp.port``)."""
     out = {"message": message, "component": None, "port": None, "parameter": None,
            "path": None, "hint": None, "severity": "error", "reason": None,
            "param": None, "connection": None}
