@@ -121,10 +121,11 @@ def create_app(root, token, library=None, model=None, static=None):
     def asset(name: str):
         # no token: the page's scripts and styles are the same for everyone; only the built
         # files are served, and nothing the path could reach outside their folder
+        if "\x00" in name or len(name) > 255:       # realpath raises on a NUL
+            raise StudioError(404, f"no asset {name!r:.80}")
         folder = os.path.realpath(static / "assets")
         path = os.path.realpath(os.path.join(folder, name))
-        if "\x00" in name or os.path.commonpath([path, folder]) != folder or \
-                not os.path.isfile(path):
+        if os.path.commonpath([path, folder]) != folder or not os.path.isfile(path):
             raise StudioError(404, f"no asset {name!r:.80}")
         return FileResponse(path, headers={"Cache-Control": "public, max-age=3600"})
 

@@ -97,6 +97,10 @@ def test_the_page_needs_the_token_and_assets_do_not(root):
     # no token asked of assets: a missing one is a 404, never a 403
     assert c.get("/assets/missing.js").status_code == 404
     assert c.get("/assets/../server.py").status_code == 404
+    # a NUL or an endless name is no asset, never a 500
+    assert c.get("/assets/%00").status_code == 404
+    assert c.get("/assets/a%00.js").status_code == 404
+    assert c.get("/assets/" + "a" * 5000 + ".js").status_code == 404
 
 
 # -- palette, schema, files, examples ------------------------------------------------------------
