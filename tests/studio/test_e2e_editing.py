@@ -98,9 +98,8 @@ def test_a_right_drag_pans_without_opening_the_menu(page, studio):
     page.mouse.down(button="right")
     page.mouse.move(x + 80, y - 40, steps=8)
     page.mouse.up(button="right")
-    page.wait_for_timeout(150)
-    after = page.evaluate("() => document.querySelector('.react-flow__viewport').style.transform")
-    assert after != before
+    page.wait_for_function("b => document.querySelector('.react-flow__viewport')"
+                           ".style.transform !== b", arg=before)
     assert page.locator(tid("context-menu")).count() == 0
 
 
@@ -127,7 +126,9 @@ def test_paste_lands_at_the_pointer(page, studio):
 
 def palette_found(page, query):
     page.fill(tid("palette-search"), query)
-    page.wait_for_timeout(50)
+    # the list drawn for this query (the palette says which query it shows)
+    page.wait_for_function("q => document.querySelector('[data-testid=palette]')"
+                           ".dataset.query === q", arg=query)
     return [el.get_attribute("data-testid")[len("palette-"):]
             for el in page.locator('[data-testid^="palette-"][draggable]').all()]
 

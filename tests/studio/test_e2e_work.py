@@ -113,7 +113,11 @@ def test_closing_the_tab_with_unsaved_changes_asks(page, studio):
         dialog.dismiss()                          # stay on the page
     page.on("dialog", on_dialog)
     page.close(run_before_unload=True)
-    page.wait_for_timeout(300)     # the dialog event comes from the browser, not the page
+    # the dialog event comes from the browser, not the page: waited for, up to 30 s
+    for _ in range(300):
+        if asked:
+            break
+        page.wait_for_timeout(100)       # (Playwright hands events over while it waits)
     assert asked == ["beforeunload"]
 
 
@@ -193,7 +197,7 @@ def test_unsaved_work_is_autosaved_and_offered_on_the_next_start(page, studio, b
     set_field(page, "param-c", "42")
     recovery = studio.root / "models" / ".double_pendulum.json.kinetwork-recovery"
     page.wait_for_function("() => window.__kinetwork.dirty")
-    for _ in range(100):                          # the autosave follows the edit
+    for _ in range(300):                          # the autosave follows the edit
         if recovery.exists():
             break
         page.wait_for_timeout(100)
@@ -230,7 +234,7 @@ def test_a_recovery_declined_is_removed(page, studio):
     open_studio(page, studio)
     page.dblclick(tid("palette-multibody.Ground"))
     recovery = studio.root / ".untitled.json.kinetwork-recovery"
-    for _ in range(100):
+    for _ in range(300):
         if recovery.exists():
             break
         page.wait_for_timeout(100)
@@ -239,7 +243,7 @@ def test_a_recovery_declined_is_removed(page, studio):
     page.locator(tid("recovery")).wait_for()
     page.click(tid("choice-discard"))
     page.wait_for_selector(tid("recovery"), state="detached")
-    for _ in range(50):
+    for _ in range(300):
         if not recovery.exists():
             break
         page.wait_for_timeout(100)

@@ -84,7 +84,7 @@ export default function Palette({ palette, definitions, onAdd }) {
   const info = shown && ((palette && palette.types[shown]) || (definitions || []).find((d) => d.type === shown));
 
   return (
-    <div className="kn-palette" data-testid="palette" data-ready={palette ? "1" : "0"}>
+    <div className="kn-palette" data-testid="palette" data-ready={palette ? "1" : "0"} data-query={query}>
       <input
         className="kn-search"
         type="search"
