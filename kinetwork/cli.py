@@ -253,6 +253,8 @@ def build_parser():
     imp.add_argument("--probes", action="store_true", help="a probe on every joint")
     imp.add_argument("--floating", action="store_true",
                      help="a free-floating base (default: the root link fixed to the ground)")
+    imp.add_argument("--no-limits", action="store_true",
+                     help="leave the joints' position limits out (default: hard end stops)")
     imp.add_argument("--gravity", type=float, nargs=3, metavar=("GX", "GY", "GZ"),
                      default=None, help="gravity of the ground (default 0 0 -9.81)")
     lin, fit = analysis_commands.add_commands(sub)

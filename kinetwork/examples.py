@@ -17,6 +17,7 @@ import shutil
 
 from .components import REGISTRY
 from .errors import ModelError
+from .graph.io import examples_folder
 
 SUFFIX = ".json"
 #: folders the listing does not look into
@@ -24,14 +25,8 @@ _SKIPPED = {"__pycache__", "node_modules"}
 
 
 def folder():
-    """Where the example models are: ``kinetwork/models`` inside the package (a link to the
-    source tree's ``models/`` in a checkout), else ``models/`` next to the package; None when
-    neither exists."""
-    package = pathlib.Path(__file__).resolve().parent
-    for candidate in (package / "models", package.parent / "models"):
-        if candidate.is_dir():
-            return candidate.resolve()
-    return None
+    """Where the example models are (``kinetwork/models`` inside the package), or None."""
+    return examples_folder()
 
 
 @functools.lru_cache(maxsize=1)

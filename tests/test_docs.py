@@ -12,7 +12,13 @@ Setup a reader need not see goes in an HTML comment right before a block:
 (or the code a trailing ``# exits N`` names); lines that set up a machine (``make``, ``pip``,
 ``npm``, ``cd``) and ``kinetwork studio`` (a server that runs until stopped) are not run.
 ``json`` blocks that are whole model files (``"format": "kinetwork.model"``) must load.
+
+A ``print(x)  # value`` line whose comment starts with a Python literal (up to a ``:`` that
+starts the prose: ``# 2: the crank's angle and speed``, ``# ['c.v']``, ``# [1, 2, ...]`` for
+a prefix) must print that value: numbers as rounded to the digits shown, the rest exactly.
 """
+
+import ast
 
 import contextlib
 import io
@@ -65,7 +71,8 @@ def test_page_runs(page, reader_folder):
     for lang, setup, code, line in blocks(page):
         where = f"{page_id(page)}:{line}"
         if lang == "python":
-            source = setup + "\n" * max(1, line - setup.count("\n") - 1) + code
+            source = setup + "\n" * max(1, line - setup.count("\n") - 1) + shown(code)
+            scope["_shown"] = _shown
             with warnings.catch_warnings():
                 warnings.simplefilter("ignore", UserWarning)     # our own idealised examples
                 exec(compile(source, page_id(page), "exec"), scope)  # our own docs
@@ -93,6 +100,64 @@ def test_page_runs(page, reader_folder):
             if data.get("format") == "kinetwork.model":
                 import kinetwork as kn
                 kn.loads(code)
+
+
+PRINTED = re.compile(r"^(?P<indent>\s*)print\((?P<arg>.+)\)\s*#\s*(?P<comment>.+)$")
+
+
+def shown(code):
+    """``code`` with each ``print(x)  # value`` line checking that x is that value."""
+    out = []
+    for number, text in enumerate(code.splitlines(), 1):
+        m = PRINTED.match(text)
+        expected = _literal(m.group("comment")) if m else None
+        if expected is not None and _single(m.group("arg")):
+            text = (f"{m.group('indent')}_shown({m.group('arg')}, "
+                    f"{m.group('comment')!r})")
+        out.append(text)
+    return "\n".join(out) + "\n"
+
+
+def _single(arg):
+    try:
+        tree = ast.parse(arg, mode="eval").body
+    except SyntaxError:
+        return False
+    return not (isinstance(tree, ast.Tuple) and not arg.lstrip().startswith("("))
+
+
+def _literal(comment):
+    """The value a comment starts with (before a ``:`` of prose), or None."""
+    for head in (comment, comment.split(":")[0]):
+        try:
+            return ast.literal_eval(head.strip())
+        except (ValueError, SyntaxError, TypeError, MemoryError, RecursionError):
+            continue
+    return None
+
+
+def _shown(value, comment):
+    print(value)
+    expected = _literal(comment)
+    head = comment.split(":")[0].strip() if _literal(comment.split(":")[0]) is not None \
+        else comment.strip()
+    assert _same(value, expected, head), f"printed {value!r}; the docs say # {comment}"
+
+
+def _same(value, expected, text):
+    if isinstance(expected, (list, tuple)):
+        value = list(value)
+        if expected and expected[-1] is Ellipsis:            # a prefix
+            expected = list(expected[:-1])
+            value = value[:len(expected)]
+        return len(value) == len(expected) and all(
+            _same(v, e, repr(e)) for v, e in zip(value, expected))
+    if isinstance(expected, bool) or not isinstance(expected, (int, float)):
+        return value == expected
+    digits = text.split("e")[0].split("E")[0]
+    decimals = len(digits.split(".")[1]) if "." in digits else 0
+    scale = 10.0 ** int(text.lower().split("e")[1]) if "e" in text.lower() else 1.0
+    return abs(float(value) - expected) <= 0.5 * 10.0 ** -decimals * scale * 1.000001
 
 
 def _commands(code):
@@ -130,3 +195,19 @@ def test_docs_build_without_warnings(tmp_path):
                          env={**os.environ, "NO_MKDOCS_2_WARNING": "1"})
     assert run.returncode == 0, run.stdout[-3000:] + run.stderr[-3000:]
     assert (tmp_path / "site" / "reference" / "components" / "index.html").is_file()
+
+
+@pytest.mark.parametrize("code, right", [
+    ("print(1 + 1)  # 2: prose", True), ("print(1 + 1)  # 3: prose", False),
+    ("print(2 / 3)  # 0.6667", True), ("print(2 / 3)  # 0.6668", False),
+    ("print(['a', 'b', 'c'])  # ['a', 'b', ...]", True),
+    ("print(['a', 'x'])  # ['a', 'b']", False),
+    ("print(1e-9 * 1.2)  # 1.2e-9", True),
+    ("print(5)  # the number of states", True)])       # prose only: nothing to check
+def test_a_value_a_snippet_shows_is_checked(code, right):
+    scope = {"_shown": _shown}
+    if right:
+        exec(shown(code), scope)
+    else:
+        with pytest.raises(AssertionError, match="the docs say"):
+            exec(shown(code), scope)

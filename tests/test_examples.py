@@ -1,6 +1,7 @@
 """The example models ship inside the package: listed, found by name, copied out whole."""
 
 import json
+import os
 import pathlib
 import subprocess
 import sys
@@ -92,3 +93,34 @@ def test_installed_wheel_lists_and_runs_the_examples(tmp_path):
     assert "kinetwork/models/double_pendulum.json" in names
     assert "kinetwork/models/engine_v6/Cylinder.json" in names
     assert not any(n.startswith("models/") for n in names)
+    # installed alone (not the checkout) and used from an empty folder: the docs' paths
+    # (models/double_pendulum.json) and an example's bare name load the installed examples
+    site, folder = tmp_path / "site", tmp_path / "reader"
+    folder.mkdir()
+    subprocess.run([sys.executable, "-m", "pip", "install", "--no-deps", "-q", "--target",
+                    str(site), str(built)], check=True, capture_output=True)
+    script = ("import kinetwork as kn, pathlib\n"
+              "assert pathlib.Path(kn.__file__).parent.parent == pathlib.Path(%r)\n"
+              "a = kn.load('models/double_pendulum.json')\n"
+              "b = kn.load('double_pendulum')\n"
+              "c = kn.load(kn.examples.path('engine_v6/EngineV6'))\n"
+              "res = kn.simulate(a, t_end=0.5)\n"
+              "print(a.name, b.name, c.name, len(res.t))\n" % str(site))
+    out = subprocess.run([sys.executable, "-c", script], cwd=folder, capture_output=True,
+                         text=True, env={**os.environ, "PYTHONPATH": str(site)})
+    assert out.returncode == 0, out.stderr[-2000:]
+    assert out.stdout.split()[:3] == ["double_pendulum", "double_pendulum", "EngineV6"]
+
+
+def test_a_missing_path_that_names_an_example_loads_it(tmp_path, monkeypatch):
+    monkeypatch.chdir(tmp_path)
+    for name in ("double_pendulum", "double_pendulum.json", "models/double_pendulum.json"):
+        assert kn.load(name).name == "double_pendulum"
+    (tmp_path / "models").mkdir()
+    mine = kn.load(ROOT / "models" / "double_pendulum.json")
+    mine.name = "mine"
+    mine.save(tmp_path / "models" / "double_pendulum.json")
+    assert kn.load("models/double_pendulum.json").name == "mine"     # a file that exists wins
+    for name in ("no_such_model", "/abs/double_pendulum.json", "../double_pendulum"):
+        with pytest.raises(kn.ModelError):
+            kn.load(name)

@@ -4,7 +4,8 @@ Each robot in ``tests/data`` is read twice: by kinetwork and by ``pin.buildModel
 (urdfdom, an independent parser and an independent dynamics code). The joint-space mass
 matrix and the forward dynamics (``pin.crba``, ``pin.aba``) must agree to 1e-9 at random
 states, with random joint torques applied through 1-D sources on the joints' flanges and the
-URDF's viscous damping (which ``pin.aba`` leaves out) added to Pinocchio's torques.
+URDF's viscous damping and sliding Coulomb friction (which ``pin.aba`` leaves out) added to
+Pinocchio's torques; within the joints' limits, where their end stops are free.
 
 Conventions mapped (kinetwork.components.multibody): a 1-DOF joint's q and qd are
 Pinocchio's, but for a continuous joint, whose angle Pinocchio keeps as (cos q, sin q). A
@@ -16,8 +17,10 @@ moving frame, mapped the same way in 2-D. Mass matrices compare as
 T^T M_pin T (the same kinetic energy).
 """
 
+import importlib.metadata
 import json
 import pathlib
+import xml.etree.ElementTree as ET
 
 import numpy as np
 import pinocchio as pin
@@ -54,16 +57,16 @@ def quat_R(quat):
 class Pair:
     """A URDF robot in both libraries, and the maps between their coordinates."""
 
-    def __init__(self, name, floating=False, gravity=None):
-        path = DATA / f"{name}.urdf"
+    def __init__(self, name, floating=False, gravity=None, limits=True):
+        path = name if isinstance(name, pathlib.Path) else DATA / f"{name}.urdf"
         kwargs = {} if gravity is None else {"gravity": gravity}
-        self.model = kn.from_urdf(path, floating=floating, **kwargs)
+        self.model = kn.from_urdf(path, floating=floating, limits=limits, **kwargs)
         self.pmodel = (pin.buildModelFromUrdf(str(path), pin.JointModelFreeFlyer())
                        if floating else pin.buildModelFromUrdf(str(path)))
         if gravity is not None:
             self.pmodel.gravity.linear = np.asarray(gravity, dtype=float)
         info = self.model.layout["ground"]["urdf"]
-        self.damping = {}
+        self.damping, self.friction = {}, {}
         # a 1-D source on every 1-DOF joint, its torque or force a model parameter
         for joint in list(self.model.components.values()):
             if getattr(joint, "role", "") != "joint" or joint.dof != 1:
@@ -73,11 +76,16 @@ class Pair:
             self.model.set_parameter(f"u_{joint.name}", 0.0)
             drive = self.model.add(lib(f"drive_{joint.name}", **{key: f"u_{joint.name}"}))
             self.model.connect(drive.flange, joint.axis)
-            d = self.model.layout[joint.name]["urdf"].get("dynamics", {}).get("damping", 0.0)
-            self.damping[joint.name] = d
+            dynamics = self.model.layout[joint.name]["urdf"].get("dynamics", {})
+            self.damping[joint.name] = dynamics.get("damping", 0.0)
+            self.friction[joint.name] = dynamics.get("friction", 0.0)
         self.system = self.model.compile()
         coords, speeds = self.system.coordinate_names, self.system.speed_names
-        assert self.system.state_names == coords + speeds
+        # the joints' end stops add their modes (0: free, as no stop is active here)
+        self.n_modes = self.system.n_states - len(coords) - len(speeds)
+        assert self.system.state_names[:len(coords) + len(speeds)] == coords + speeds
+        assert all(n.endswith(("_limits.mode", "_friction.mode"))
+                   for n in self.system.state_names[len(coords) + len(speeds):])
         self.joints = []              # (pin joint, component, coordinate and speed indices)
         for jid in range(1, self.pmodel.njoints):
             jname = self.pmodel.names[jid]
@@ -90,6 +98,11 @@ class Pair:
             self.joints.append((joint, comp, qi, ui))
         assert sum(len(j[3]) for j in self.joints) == len(speeds) == self.pmodel.nv
         self.nq, self.nu = len(coords), len(speeds)
+        self.ranges = {}
+        for comp in (c for c in self.model.components if c.endswith("_limits")):
+            stop = self.model.components[comp]
+            low, high = [v for k, v in stop.given.items() if k.endswith(("_min", "_max"))]
+            self.ranges[comp[:-len("_limits")]] = (low, high)
 
     def random_state(self, rng):
         q, u = np.zeros(self.nq), rng.uniform(-2.0, 2.0, self.nu)
@@ -98,11 +111,22 @@ class Pair:
             if kind == "FreeMotion":
                 q[qi] = np.concatenate([rng.uniform(-1, 1, 3), rng.normal(size=4)])
                 q[qi[3:]] /= np.linalg.norm(q[qi[3:]])
+            elif comp in self.ranges:      # within its end stops: none of them active
+                q[qi] = rng.uniform(*self.ranges[comp])
             elif kind == "Prismatic":
                 q[qi] = rng.uniform(-0.3, 0.5)
             else:
                 q[qi] = rng.uniform(-np.pi, np.pi, len(qi))
         return q, u
+
+    def state(self, q, u):
+        """kinetwork's state: q, u and the modes of the end stops (0: free) and of the joint
+        frictions (sliding the way the joint turns: +-1)."""
+        speed = {comp: u[ui[0]] for _, comp, _, ui in self.joints if len(ui) == 1}
+        modes = [np.sign(speed[name[:-len("_friction.mode")]])
+                 if name.endswith("_friction.mode") else 0.0
+                 for name in self.system.state_names[self.nq + self.nu:]]
+        return np.concatenate([q, u, modes])
 
     def to_pin(self, q, u):
         """Pinocchio's (q, v) and T with v = T u."""
@@ -172,13 +196,14 @@ class Pair:
         for joint, comp, qi, ui in self.joints:
             if comp in self.damping:
                 params[f"u_{comp}"] = drive[ui[0]]
-                tau[joint.idx_v] = drive[ui[0]] - self.damping[comp] * u[ui[0]]
+                tau[joint.idx_v] = (drive[ui[0]] - self.damping[comp] * u[ui[0]]
+                                    - self.friction[comp] * np.sign(u[ui[0]]))
         a = pin.aba(self.pmodel, self.pmodel.createData(), q_pin, v_pin, tau).copy()
         ref = self.udot(q, u, a)
-        dx = np.asarray(self.system.rhs(0.0, np.concatenate([q, u]), params=params),
+        dx = np.asarray(self.system.rhs(0.0, self.state(q, u), params=params),
                         dtype=float).ravel()
         e_M = np.abs(M - M_ref).max() / np.abs(M_ref).max()
-        e_a = np.abs(dx[self.nq:] - ref).max() / max(1.0, np.abs(ref).max())
+        e_a = np.abs(dx[self.nq:self.nq + self.nu] - ref).max() / max(1.0, np.abs(ref).max())
         return e_M, e_a
 
 
@@ -288,7 +313,7 @@ def test_visuals_sit_where_urdf_puts_them(robot):
         pair.model.connect(probe.port, f"{v['component']}.frame_a")
     system = pair.model.compile()
     q, u = pair.random_state(np.random.default_rng(4))
-    values = probe_values(system, np.concatenate([q, u]))
+    values = probe_values(system, pair.state(q, u))
     data = pair.pmodel.createData()
     pin.framesForwardKinematics(pair.pmodel, data, pair.to_pin(q, u)[0])
     for v in looks:
@@ -303,9 +328,9 @@ def test_visuals_sit_where_urdf_puts_them(robot):
 
 def test_visual_bodies_change_no_dynamics():
     """A massless shape body adds nothing: M equals that of the model without visuals."""
-    with_looks = Pair("planar_arm")
+    with_looks = Pair("planar_arm", limits=False)
     q, u = with_looks.random_state(np.random.default_rng(0))
-    model = kn.from_urdf(DATA / "planar_arm.urdf")
+    model = kn.from_urdf(DATA / "planar_arm.urdf", limits=False)
     for name in [v["component"] for v in model.layout["ground"]["urdf"]["visuals"]]:
         if name is not None:
             model.components[name].mass = 0.0
@@ -337,9 +362,9 @@ def test_floating_base_centre_of_mass_falls_at_g():
     rng = np.random.default_rng(7)
     for _ in range(3):
         q, u = pair.random_state(rng)
-        dx = np.asarray(pair.system.rhs(0.0, np.concatenate([q, u])), dtype=float).ravel()
+        dx = np.asarray(pair.system.rhs(0.0, pair.state(q, u)), dtype=float).ravel()
         q_pin, v_pin, _ = pair.to_pin(q, u)
-        a_pin = pair.pin_acceleration(q, u, dx[pair.nq:])
+        a_pin = pair.pin_acceleration(q, u, dx[pair.nq:pair.nq + pair.nu])
         data = pair.pmodel.createData()
         pin.centerOfMass(pair.pmodel, data, q_pin, v_pin, a_pin)
         np.testing.assert_allclose(data.acom[0], [0.3, -0.4, -9.81], rtol=1e-10, atol=1e-10)
@@ -389,6 +414,10 @@ def test_cli_import(tmp_path, capsys):
     model = kn.load(out)
     assert model.components["ground"].gravity == [0.0, 0.0, -1.62]
     assert type(model.components["torso_floating"]).__name__ == "FreeMotion"
+    assert [c for c in model.components if c.endswith("_limits")]
+    out = tmp_path / "unlimited.json"
+    assert main(["import", str(DATA / "floating_base.urdf"), "-o", str(out), "--no-limits"]) == 0
+    assert not [c for c in kn.load(out).components if c.endswith("_limits")]
 
 
 def test_cli_import_refuses(tmp_path, capsys):
@@ -512,3 +541,52 @@ def test_every_problem_reported_at_once(tmp_path):
     assert len(info.value.problems) == 2          # the tree is checked once the parts parse
     assert "mass" in info.value.problems[0] and "hinge" in info.value.problems[1]
     json.dumps(info.value.problems)
+
+
+# ---------------------------------------------------------------------------------------------
+# Real robots: the Panda and the UR5 of example-robot-data (its URDFs and meshes on PyPI)
+# ---------------------------------------------------------------------------------------------
+ROBOT_DATA = pathlib.Path(importlib.metadata.distribution("example-robot-data").locate_file(
+    "cmeel.prefix/share/example-robot-data/robots"))
+REAL = {"panda": ROBOT_DATA / "panda_description/urdf/panda.urdf",
+        "ur5": ROBOT_DATA / "ur_description/urdf/ur5_robot.urdf"}
+
+
+@pytest.fixture(scope="module", params=sorted(REAL))
+def real(request):
+    return Pair(REAL[request.param])
+
+
+def test_real_robots_agree_with_pinocchio_while_no_stop_is_active(real):
+    """Within their limits (every end stop free), M(q) and the accelerations to 1e-10 of
+    Pinocchio's crba and aba, the URDF's damping added to its torques."""
+    assert real.ranges, "the robot's joint limits are imposed"
+    rng = np.random.default_rng(31)
+    for k in range(6):
+        q, u = real.random_state(rng)
+        drive = rng.uniform(-5.0, 5.0, real.nu)
+        e_M, e_a = real.compare(q, u, drive)
+        assert e_M < 1e-10, f"mass matrix, state {k}: relative error {e_M:.2e}"
+        assert e_a < 1e-10, f"accelerations, state {k}: relative error {e_a:.2e}"
+
+
+def test_panda_joints_stay_within_their_limits():
+    """Falling under gravity from its zero pose (joint 4, whose range excludes 0, starts at
+    its upper limit), every joint stays within the URDF's limits and the fingers within
+    0..0.04 m; without limits, joint 2 falls through its limit."""
+    model = kn.from_urdf(REAL["panda"])
+    res = kn.simulate(model, t_end=1.5, n_points=151)
+    joints = ET.parse(REAL["panda"]).getroot().findall("joint")
+    limited = {j.get("name"): (float(j.find("limit").get("lower")),
+                               float(j.find("limit").get("upper")))
+               for j in joints if j.get("type") in ("revolute", "prismatic")}
+    assert {"panda_finger_joint1", "panda_finger_joint2"} <= set(limited)
+    hit = set()
+    for name, (low, high) in limited.items():
+        q = res[f"{name}.q"]
+        assert q.min() >= low - 1e-9 and q.max() <= high + 1e-9, name
+        if np.isclose(q, low, atol=1e-9).any() or np.isclose(q, high, atol=1e-9).any():
+            hit.add(name)
+    assert {"panda_joint2", "panda_joint4"} <= hit     # they fall onto their stops
+    free = kn.simulate(kn.from_urdf(REAL["panda"], limits=False), t_end=1.5, n_points=151)
+    assert free["panda_joint2.q"].max() > limited["panda_joint2"][1] + 0.1

@@ -8,12 +8,16 @@ import numpy as np
 
 from ..equations.system import mapped
 from ..errors import ModelError
+from .meshes import mesh as mesh_file
 
 FORMAT, VERSION = "kinetwork.animation", 1
 #: the players draw the small axes of every frame when there are at most this many
 FRAMES_SHOWN = 24
 COLORS = {"joint": "#e8453c", "rod": "#9b9b9b", "body": "#0080ff", "spring": "#e0a030",
-          "damper": "#5a5a5a", "grid": "#c8ccd2"}
+          "damper": "#5a5a5a", "grid": "#c8ccd2", "mesh": "#b8bdc6"}
+#: a frame that travels more than this many times as far as the median frame (and than the
+#: scene's size) ran away: the view is framed without it
+RUNAWAY = 8.0
 _X, _Y, _Z = np.eye(3)
 
 
@@ -53,16 +57,24 @@ def animation_data(results, fps=None, model=None):
     positions, quats = np.array(positions), _continuous(_quaternions(np.array(rotations)))
     if fps is not None:
         t, positions, quats = _resample(t, positions, quats, fps)
-    scale = _scale(positions, values)
-    lo, hi = positions.reshape(-1, 3).min(axis=0), positions.reshape(-1, 3).max(axis=0)
+    kept = _framed(positions)
+    scale = _scale(positions[kept], values)
+    lo, hi = positions[kept].reshape(-1, 3).min(axis=0), positions[kept].reshape(-1, 3).max(axis=0)
     for frame, pos, quat in zip(frames, positions, quats):
         still = np.all(pos == pos[0]) and np.all(quat == quat[0])
         frame["position"] = (pos[:1] if still else pos).tolist()
         frame["quaternion"] = (quat[:1] if still else quat).tolist()
     up = _up(system, values)
     scene = Scene(system, results, values, frames, index, bodies, scale, up, (lo, hi))
+    shapes = scene.shapes()
+    for shape in shapes:                # a mesh's extent at the start is in view too
+        if shape["kind"] == "mesh":
+            k = shape["frame"]
+            p0, R0 = positions[k, 0], np.asarray(rotations[k])[0]
+            corners = p0 + np.reshape(shape["vertices"], (-1, 3)) @ R0.T
+            lo, hi = np.minimum(lo, corners.min(axis=0)), np.maximum(hi, corners.max(axis=0))
     return {"format": FORMAT, "version": VERSION, "name": system.model.name,
-            "t": t.tolist(), "frames": frames, "shapes": scene.shapes(),
+            "t": t.tolist(), "frames": frames, "shapes": shapes,
             "scale": scale, "bounds": [lo.tolist(), hi.tolist()],
             "view": {"up": up.tolist(), "target": ((lo + hi) / 2).tolist(),
                      "direction": _direction(up, hi - lo).tolist(), "fov": 35}}
@@ -163,10 +175,32 @@ def _scale(positions, values):
     return float(max(lengths, default=0.0)) or 1.0
 
 
+def _framed(positions):
+    """Which frames the view is framed on: all but those that run away (travel more than
+    RUNAWAY times as far as the median frame and than the scene's size at the start), so a
+    robot whose free finger falls for ever is not shrunk to a dot; all when all do."""
+    if positions.shape[1] < 2:
+        return np.ones(len(positions), dtype=bool)
+    travel = np.ptp(positions, axis=1).max(axis=1)
+    size = np.ptp(positions[:, 0], axis=0).max()
+    kept = travel <= RUNAWAY * max(float(np.median(travel)), float(size), 1e-12)
+    return kept if kept.any() else np.ones(len(positions), dtype=bool)
+
+
 def _up(system, values):
+    """Up: against gravity; without gravity, the up a model's layout gives (a URDF robot's z),
+    else y."""
     world = system.topology.world
     g = np.asarray(values[world.name]["gravity"], dtype=float) if world else np.zeros(3)
-    return -g / np.linalg.norm(g) + 0.0 if np.linalg.norm(g) > 0 else _Y.copy()
+    if np.linalg.norm(g) > 0:
+        return -g / np.linalg.norm(g) + 0.0
+    up = (system.model.layout.get(world.name) or {}).get("up") if world else None
+    try:
+        up = np.asarray(up, dtype=float).reshape(3)
+    except (TypeError, ValueError):
+        return _Y.copy()
+    return up / np.linalg.norm(up) if np.all(np.isfinite(up)) and np.linalg.norm(up) > 0 \
+        else _Y.copy()
 
 
 def _direction(up, extent):
@@ -199,8 +233,10 @@ class Scene:
 
     def shapes(self):
         out = self.ground()
+        meshes, replaced = self.meshes()
+        out += meshes
         for comp in self.system.model.components.values():
-            draw = _visual(comp)
+            draw = None if comp.name in replaced else _visual(comp)
             if draw is not None:
                 out += [dict(s, component=comp.name) for s in draw(self, comp,
                                                                    self.values[comp.name])
@@ -208,6 +244,32 @@ class Scene:
         out += [_axes(k, self.L / 14) for k, f in enumerate(self.frames)
                 if not f["name"].endswith(".cm") and k != self.ground_frame()]
         return [s for s in out if not self.covered(s, out)]
+
+    def meshes(self):
+        """(the mesh shapes, the components they stand in for) of the mesh files a model's
+        layout names: entries ``{"path", "frame": "comp.port", "position", "rotation",
+        "scale", "color", "replaces"}`` in a component's ``layout[...]["meshes"]`` (a URDF
+        robot's link meshes, on its ground). A file not found or not readable is left out."""
+        out, replaced = [], set()
+        for entry in self.system.model.layout.values():
+            for m in (entry.get("meshes") or []) if isinstance(entry, dict) else []:
+                comp, _, port = str(m.get("frame", "")).partition(".")
+                k = (self.frame(self.system.model.components[comp], port)
+                     if comp in self.system.model.components else None)
+                loaded = mesh_file(m["path"]) if k is not None and m.get("path") else None
+                if loaded is None:
+                    continue
+                vertices, triangles = loaded
+                R = np.asarray(m.get("rotation", np.eye(3)), dtype=float)
+                scale = np.asarray(m.get("scale", [1.0] * 3), dtype=float)
+                placed = np.asarray(m.get("position", [0.0] * 3), dtype=float) \
+                    + (vertices * scale) @ R.T
+                out.append({"kind": "mesh", "frame": k, "component": comp,
+                            "color": _color(m.get("color"), COLORS["mesh"]),
+                            "vertices": np.round(placed, 6).ravel().tolist(),
+                            "faces": triangles.ravel().tolist()})
+                replaced.update(m.get("replaces") or [])
+        return out, replaced
 
     def covered(self, shape, shapes):
         """Whether ``shape`` is a body's rod to its centre of mass that lies along another

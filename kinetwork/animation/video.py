@@ -204,6 +204,9 @@ def _mesh(shape):
         lines = [(c + u * k - w * half, c + u * k + w * half) for k in s]
         lines += [(c + w * k - u * half, c + w * k + u * half) for k in s]
         return np.array(lines).reshape(-1, 3), None
+    if kind == "mesh":
+        return (np.reshape(shape["vertices"], (-1, 3)),
+                [np.reshape(np.asarray(shape["faces"], dtype=int), (-1, 3))])
     if kind not in ("box", "cylinder", "sphere"):
         return None
     ld = np.asarray(shape["length_direction"], float)

@@ -321,6 +321,43 @@ class Param:
             raise ModelError(f"{at}: must be <= {self.max}")
 
 
+#: what other tools (Modelica's MSL, Simscape, MapleSim) call a component kinetwork has under
+#: another name, looked up by the name after the library
+ELSEWHERE = {"World": "multibody.Ground", "Body": "multibody.RigidBody",
+             "RigidTransform": "multibody.FixedRotation", "Translation": "multibody.FixedTranslation",
+             "Rotation": "multibody.FixedRotation", "RevoluteJoint": "multibody.Revolute",
+             "PrismaticJoint": "multibody.Prismatic", "SphericalJoint": "multibody.Spherical",
+             "Gear": "rotational.IdealGear", "Motor": "electrical.DCMotor",
+             "Capacitance": "electrical.Capacitor", "Inductance": "electrical.Inductor",
+             "Resistance": "electrical.Resistor", "Source": "signals.Constant"}
+
+
+def type_suggestion(kind):
+    """' (did you mean ...?)' for the unknown component type ``kind`` ("lib.Name"): the same
+    name in the other libraries (``rotational.Mass``: translational.Mass), the kinetwork name
+    of what other tools call it (``multibody.World``: multibody.Ground), else the closest
+    names; '' if none."""
+    name = str(kind).rpartition(".")[2]
+    same = sorted(k for k in REGISTRY if k.rpartition(".")[2].lower() == name.lower()
+                  and k != kind)
+    if not same and ELSEWHERE.get(name) in REGISTRY:
+        same = [ELSEWHERE[name]]
+    if same:
+        return f" (did you mean {' or '.join(repr(k) for k in same[:3])}?)"
+    return suggest(kind, REGISTRY)
+
+
+def library_attribute(library):
+    """The ``__getattr__`` of a library's module: an unknown component is an AttributeError
+    that says what it may be (``kn.multibody.World``: did you mean 'multibody.Ground'?)."""
+    def __getattr__(name):
+        if name.startswith("__"):
+            raise AttributeError(name)
+        raise AttributeError(f"kinetwork.{library} has no component {name!r}"
+                             f"{type_suggestion(f'{library}.{name}')}")
+    return __getattr__
+
+
 @functools.lru_cache(maxsize=4096)
 def _is_quantity(text):
     """Whether ``text`` is a quantity ("5 mm") rather than an expression ("L/2"): it does not

@@ -17,7 +17,7 @@ import casadi as ca
 
 from ..errors import ModelError
 from ..expr import casadi_functions, parse
-from .base import Component, Param, Port, PortRef
+from .base import Component, Param, Port, PortRef, library_attribute
 from .loopjoints import Expansion
 from .signals import ExpressionParam
 
@@ -339,3 +339,5 @@ class DCMotor(Component, library=LIB):
                    "support": "emf.support"}
         return Expansion(self.name, comps, [(port(a), port(b)) for a, b in wires],
                          {k: port(v) for k, v in exposed.items()})
+
+__getattr__ = library_attribute("electrical")

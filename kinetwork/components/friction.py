@@ -255,6 +255,15 @@ class PartialStop(PartialHybrid):
     def first_mode(self, ev):
         if ev.indicator < -ev.tiny:
             raise ValueError("starts beyond its limit")
+        if ev.indicator <= ev.tiny and ev.rate <= ev.tiny:
+            # on its limit and not leaving it (ev.rate: the gap's rate): an impact at the
+            # start if it moves in faster than v_rest and bounces, else resting there, which
+            # lifts off at once where the limit would have to pull (the modes settled at the
+            # start); left free, the gap would open below zero unseen (a ball at rest on the
+            # floor at t = 0 falling through it)
+            if -ev.rate > max(ev.values[1], ev.tiny) and ev.values[0] > 0:
+                return 0, -ev.values[0] * ev.w_rel, "impact"
+            return 1, 0.0, None
         return 0, None, None
 
     def next_mode(self, ev):

@@ -15,7 +15,7 @@ import numpy as np
 
 from ..errors import ModelError
 from ..spatial import cardan_quat, mat3, quat_rate, quat_rotation, rotation, unit, vec3
-from .base import COORDINATES, RATES, Component, Param, Port
+from .base import COORDINATES, RATES, Component, Param, Port, library_attribute
 
 MB = "multibody"
 
@@ -804,3 +804,5 @@ from .loopjoints import JointRRR, SphericalSpherical, UniversalSpherical  # noqa
 from .forces import (Damper, Force, ForceAndTorque, LineForceWithTwoMasses,  # noqa: E402,F401
                      Spring, SpringDamper, Torque, WorldForce, WorldTorque)
 from .rotor import Rotor1D  # noqa: E402,F401
+
+__getattr__ = library_attribute("multibody")

@@ -1,6 +1,6 @@
 """1-D rotational library: angle phi [rad] and torque tau [N*m] on flanges."""
 
-from .base import Param, Port
+from .base import Param, Port, library_attribute
 from .oned import (PartialDamper, PartialFixed, PartialFlowSensor, PartialInertia,
                    PartialMotion, PartialRigid, PartialSensor, PartialSource, PartialSpring,
                    PartialSpringDamper)
@@ -143,3 +143,5 @@ class IdealGear(PartialRigid, library=LIB):
 
 from .rotational_friction import (BearingFriction, Brake, Clutch, ElastoGap,  # noqa: E402,F401
                                   Stop)
+
+__getattr__ = library_attribute("rotational")

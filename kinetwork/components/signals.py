@@ -14,7 +14,7 @@ import numpy as np
 from ..errors import ModelError
 from ..expr import parse
 from ..util import check_number, quote
-from .base import REQUIRED, TABLE_ROWS_LIMIT, Component, Param, Port
+from .base import REQUIRED, TABLE_ROWS_LIMIT, Component, Param, Port, library_attribute
 
 LIB = "signals"
 
@@ -518,3 +518,5 @@ class KinematicPTP(PartialBlock, library=LIB):
                                   ca.if_else(tau < tv, r_c[which],
                                              ca.if_else(tau < te, r_b[which], r_e[which]))))
         return base + delta * r
+
+__getattr__ = library_attribute("signals")

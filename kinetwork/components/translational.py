@@ -1,6 +1,6 @@
 """1-D translational library: position s [m] and force f [N] on flanges."""
 
-from .base import Param
+from .base import Param, library_attribute
 from .oned import (PartialDamper, PartialFixed, PartialFlowSensor, PartialInertia,
                    PartialMotion, PartialSensor, PartialSource, PartialSpring,
                    PartialSpringDamper)
@@ -123,3 +123,5 @@ class Accelerate(PartialMotion, library=LIB):
 
 
 from .translational_friction import ElastoGap, Friction, Stop  # noqa: E402,F401
+
+__getattr__ = library_attribute("translational")

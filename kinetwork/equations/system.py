@@ -71,7 +71,8 @@ class System:
                                  [ca.densify(eq.ode), ca.densify(eq.alg)],
                                  ["t", "x", "z", "p"], ["ode", "alg"])
         self.signals = [sig.described() for sig in asm.signals]
-        self.probe_targets = {probe.name: target.path for probe, target in self.topology.probes}
+        self.probe_targets = {probe.name: _as_wired(model, probe.name, target.path)
+                              for probe, target in self.topology.probes}
         # signals are written in the assembly's coordinates, speeds, their rates and the
         # multipliers; the formulation says what those are in the states (x, z)
         coords = asm.q if eq.q is None else eq.q
@@ -440,3 +441,18 @@ def overflow_message(model, what, p, names):
 def mapped(f, n):
     """``f.map(n)``, made once per Function and size (making it costs ~0.5 ms)."""
     return f.map(n)
+
+
+def _as_wired(model, probe, target):
+    """The port a probe reads as the user wired it: ``motor.p``, not the flat model's
+    ``motor.Ra.p`` inside an aggregate or a subsystem (names the user never wrote)."""
+    source = getattr(model, "_source", None)
+    if source is None or probe not in source.components:
+        return target
+    mine = f"{probe}.port"
+    for a, b in source.connections:
+        ends = (str(getattr(a, "path", a)), str(getattr(b, "path", b)))
+        if mine in ends:
+            return ends[1] if ends[0] == mine else ends[0]
+    return target
+

@@ -12,10 +12,11 @@ from __future__ import annotations
 import json
 import math
 import os
+import pathlib
 import stat
 from collections.abc import Iterable
 
-from ..components.base import _NAME, NAME_LIMIT, REGISTRY
+from ..components.base import _NAME, NAME_LIMIT, REGISTRY, type_suggestion
 from ..errors import ModelError
 from ..util import QUOTE_LIMIT, quote, suggest
 from .initial import check_initial
@@ -47,6 +48,9 @@ def load(path: str | os.PathLike, validate: bool = True,
     Parameters
     ----------
     path : str or os.PathLike
+        A model file; a path that does not exist may name an example that ships with the
+        package (``"double_pendulum"``, or ``"models/double_pendulum.json"`` as in a
+        checkout: see ``kn.examples``).
     validate : bool, optional
         Also check the wiring (``Model.validate``; of a subsystem definition, a model with
         exposed ports, only its values); False reads a model saved half-built.
@@ -66,6 +70,8 @@ def load(path: str | os.PathLike, validate: bool = True,
         Every problem with the file, each message starting with the file name and the place.
     """
     source = os.fspath(path)
+    if not os.path.exists(source):
+        source = os.fspath(example_file(source) or source)
     text = _read(source)
     folder = os.path.dirname(os.path.abspath(source))
     model = loads(text, source=source, validate=validate, library=library, folder=folder)
@@ -99,6 +105,32 @@ def _read(source):
         return raw.decode("utf-8-sig")     # tolerate the BOM some editors write
     except UnicodeDecodeError as exc:
         raise ModelError(f"{source}: not UTF-8 text (byte {exc.start})") from None
+
+
+def examples_folder():
+    """Where the example models are: ``kinetwork/models`` inside the package (a link to the
+    source tree's ``models/`` in a checkout), else ``models/`` next to the package; None when
+    neither exists."""
+    package = pathlib.Path(__file__).resolve().parent.parent
+    for candidate in (package / "models", package.parent / "models"):
+        if candidate.is_dir():
+            return candidate.resolve()
+    return None
+
+
+def example_file(name):
+    """The installed example a relative path that does not exist names, or None: the
+    example's name (``"double_pendulum"``, ``"engine_v6/EngineV6"``), with ``.json`` or
+    as the checkout's ``models/...json`` (so the paths of the docs and of a checkout work
+    wherever the package is installed)."""
+    text = os.fspath(name).replace(os.sep, "/")
+    root = examples_folder()
+    if root is None or os.path.isabs(text) or not text or ".." in text.split("/"):
+        return None
+    key = text[len("models/"):] if text.startswith("models/") else text
+    key = key[:-len(".json")] if key.endswith(".json") else key
+    found = root / f"{key}.json"
+    return found if found.is_file() else None
 
 
 def loads(text: str | bytes, source: str | None = None, validate: bool = True,
@@ -284,7 +316,7 @@ def _component(entry, place, problems, context):
         return Subsystem.from_params(entry["name"], params, place=where, model=definition)
     if not isinstance(kind, str) or kind not in REGISTRY:
         # resolved only through the registry: a dotted path in a file is never imported
-        problems.append(f"{place}: unknown type {quote(kind, 60)}{suggest(kind, REGISTRY)}")
+        problems.append(f"{place}: unknown type {quote(kind, 60)}{type_suggestion(kind)}")
         return None
     return REGISTRY[kind].from_params(entry["name"], params, place=where)
 
@@ -457,7 +489,7 @@ class Context:
                 root = self.root if kind == "folder" else os.path.realpath(folder)
                 return self._file(name, f"{name}.json", root, kind, folder)
         looked = (f"; looked for {name}.json in " + ", ".join(folders)) if folders else ""
-        raise ModelError(f"unknown type {quote(name, 60)}{suggest(name, REGISTRY)}: no "
+        raise ModelError(f"unknown type {quote(name, 60)}{type_suggestion(name)}: no "
                          f"kinetwork component, nor a definition in this file{looked}")
 
     def _file(self, name, ref, root, kind, folder=None):

@@ -68,7 +68,7 @@ class OneDGroup:
     base: int = None
 
 
-@dataclass
+@dataclass(repr=False)
 class Topology:
     """What validation learned about a model; the solver's starting point."""
     world: object
@@ -91,6 +91,15 @@ class Topology:
     def dof(self):
         """Degrees of freedom of the joints, less the coordinates prescribed by motions."""
         return sum(j.dof for j in self.joints) - sum(1 for g in self.oned if g.motion)
+
+    def __repr__(self):
+        # short: ``model.validate()`` at a prompt echoes it (the dataclass's own repr
+        # spells out every connection set, kilobytes for a small model)
+        counts = [(len(self.joints), "joint"), (len(self.bodies), "body"),
+                  (len(self.loops), "kinematic loop"), (len(self.probes), "probe")]
+        return "<Topology: " + ", ".join(
+            f"{n} {word if n == 1 else ('bodies' if word == 'body' else word + 's')}"
+            for n, word in counts) + ">"
 
 
 def analyze(model):

@@ -95,7 +95,7 @@ class Events:
             stuck = self.values(t, held)[i, 3]
         return SimpleNamespace(mode=mode, indicator=row[0], rel=row[1], w_rel=row[2],
                                force=row[3], values=(row[4], row[5]), stuck_force=stuck,
-                               tiny=self.run.atol)
+                               rate=row[RATE], tiny=self.run.atol)
 
     # -- the start -------------------------------------------------------------------------
     def start(self, t, x):

@@ -327,3 +327,23 @@ def test_msl_robot_motor_against_its_circuit_by_nodal_analysis():
     ref = np.array([scipy.linalg.expm(M * t) @ z0 for t in res.t]).T
     assert np.max(abs(res["pi.value"] - ref[0])) < 1e-7
     assert np.max(abs(res["pw.speed"] - ref[2])) < 1e-7
+
+
+def test_probes_on_an_aggregate_name_its_ports_not_its_insides():
+    # a DC motor is a resistor, inductor, EMF and rotor inside: a probe wired to motor.p and
+    # one to motor.flange are titled so in results and plots, never motor.Ra.p
+    import matplotlib
+    matplotlib.use("Agg")
+    m = kn.Model("drive")
+    m.add(E.Ground("gnd"))
+    m.add(E.VoltageSource("src", V=12.0))
+    m.add(E.DCMotor("motor", R=1.0, L=0.01, k=0.1, J=0.01))
+    m.add(kn.Probe("pm", quantities=["voltage"]))
+    m.add(kn.Probe("ps", quantities=["speed"]))
+    for a, b in [("src.p", "motor.p"), ("src.n", "gnd.p"), ("motor.n", "gnd.p"),
+                 ("pm.port", "motor.p"), ("ps.port", "motor.flange")]:
+        m.connect(a, b)
+    res = kn.simulate(m, t_end=0.05, n_points=3, **TOL)
+    assert res.probe_targets == {"pm": "motor.p", "ps": "motor.flange"}
+    titles = [ax.get_title() for ax in kn.plot(res).axes]
+    assert titles == ["pm (motor.p): voltage", "ps (motor.flange): speed"]

@@ -214,6 +214,41 @@ def test_pendulum_hits_its_end_stop_at_the_elliptic_integral_time():
     assert np.all(res["joint.q"] <= q_stop + 1e-12)
 
 
+def ball_on_floor(f, v0=None, e=0.0):
+    """A unit mass on a floor (a Stop with s_min = 0) starting on it, pushed by f."""
+    model = kn.Model("ball")
+    floor = model.add(kn.translational.Fixed("floor"))
+    ball = model.add(kn.translational.Mass("ball", m=1.0, **({} if v0 is None else {"v0": v0})))
+    push = model.add(kn.translational.Force("push", f=f))
+    stop = model.add(kn.translational.Stop("stop", s_min=0.0, e=e))
+    model.connect(floor.flange, stop.flange_a)
+    model.connect(stop.flange_b, ball.flange_a)
+    model.connect(push.flange, ball.flange_b)
+    res = kn.simulate(model, t_end=1.0, n_points=101, method="cvodes", rtol=1e-10,
+                      atol=1e-12, **FAST)
+    return res, res["ball.s"]
+
+
+@pytest.mark.parametrize("f", [-9.81, 9.81])
+def test_a_stop_that_starts_on_its_limit_rests_on_it_or_lifts_off(f):
+    # resting on the floor at t = 0 under its weight, it stays (a free start would fall
+    # through: the gap starts at zero and never crosses it); pulled up, it rises as s = f t^2/2
+    res, s = ball_on_floor(f)
+    reference = np.maximum(f, 0.0) * res.t ** 2 / 2
+    assert np.max(np.abs(s - reference)) < 1e-8
+
+
+def test_a_stop_hit_at_the_start_bounces_at_once():
+    # moving into the floor at 2 m/s at t = 0 with e = 0.5: it leaves at 1 m/s and lands
+    # again at 2 * 1 / g, then at 2 * 0.5 / g later
+    g = 9.81
+    res, s = ball_on_floor(-g, v0=-2.0, e=0.5)
+    times = [e["t"] for e in res.stats["events"] if e["kind"] == "impact"]
+    assert abs(times[0] - 2 / g) < 1e-8 and abs(times[1] - 3 / g) < 1e-8
+    mask = res.t < 2 / g
+    assert np.max(np.abs(s[mask] - (res.t[mask] - g * res.t[mask] ** 2 / 2))) < 1e-8
+
+
 def test_a_stop_without_limits_and_a_midpoint_run_are_refused_by_name():
     model = kn.Model("nolimit")
     wall = model.add(kn.translational.Fixed("wall"))

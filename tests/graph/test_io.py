@@ -214,6 +214,12 @@ DATA_CASES = {
                            ["components[2]: required key 'name' missing"]),
     "unknown type": (lambda d: comp(d, "elbow").__setitem__("type", "multibody.Revolut"),
                      ['components[3] "elbow": unknown type', "did you mean 'multibody.Revolute'"]),
+    "type of another library": (lambda d: comp(d, "elbow").__setitem__("type",
+                                                                        "rotational.Mass"),
+                                ["did you mean 'translational.Mass'"]),
+    "type by another tool's name": (lambda d: comp(d, "elbow").__setitem__("type",
+                                                                           "multibody.World"),
+                                    ["did you mean 'multibody.Ground'"]),
     "dotted path as type": (lambda d: comp(d, "elbow").__setitem__("type", "os.system"),
                             ['components[3] "elbow": unknown type \'os.system\'']),
     "duplicate name": (lambda d: comp(d, "mass2").__setitem__("name", "mass1"),
@@ -450,3 +456,20 @@ def test_killing_a_save_halfway_leaves_the_old_file_whole(tmp_path):
         model = kn.load(path)                    # whole: it parses and validates
         names.add(len(model.components))
     assert names <= {len(small.components), 1201}
+
+
+@pytest.mark.parametrize("written, meant", [
+    ("multibody.World", "multibody.Ground"), ("rotational.Mass", "translational.Mass"),
+    ("translational.Inertia", "rotational.Inertia"), ("multibody.Revolut", "multibody.Revolute"),
+    ("electrical.Capacitance", "electrical.Capacitor"), ("multibody.Body", "multibody.RigidBody")])
+def test_a_component_looked_up_by_another_name_says_which_it_may_be(written, meant):
+    library, name = written.split(".")
+    with pytest.raises(AttributeError, match=f"did you mean '{meant}'"):
+        getattr(getattr(kn, library), name)
+    assert getattr(getattr(kn, meant.split(".")[0]), meant.split(".")[1])     # it exists
+
+
+def test_what_validate_returns_prints_short():
+    # at a prompt, model.validate() echoes its result: a line, not the connection sets
+    shown = repr(kn.load("models/fourbar.json").validate())
+    assert shown == "<Topology: 4 joints, 3 bodies, 1 kinematic loop, 4 probes>"

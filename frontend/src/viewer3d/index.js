@@ -11,9 +11,10 @@
 // linearly and orientations along the shorter arc, so any grid plays smoothly at any speed.
 // Besides: getTime(), isPlaying().
 import {
-  AmbientLight, BoxGeometry, Color, ConeGeometry, CylinderGeometry, DirectionalLight,
-  GridHelper, Group, Matrix4, Mesh, MeshBasicMaterial, MeshStandardMaterial, PerspectiveCamera,
-  Quaternion, Scene, SphereGeometry, TubeGeometry, Curve, Vector3, WebGLRenderer,
+  AmbientLight, BoxGeometry, BufferGeometry, Color, ConeGeometry, CylinderGeometry,
+  DirectionalLight, Float32BufferAttribute, GridHelper, Group, Matrix4, Mesh, MeshBasicMaterial,
+  MeshStandardMaterial, PerspectiveCamera, Quaternion, Scene, SphereGeometry, TubeGeometry, Curve,
+  Vector3, WebGLRenderer,
 } from "three";
 import { OrbitControls } from "three/examples/jsm/controls/OrbitControls.js";
 
@@ -395,6 +396,14 @@ function build(shape) {
     const mesh = new Mesh(geometry, material(shape.color));
     mesh.userData.length = 1;
     return mesh;
+  }
+  if (kind === "mesh") {
+    // a mesh file's triangles, already placed and scaled in the frame's coordinates
+    const geometry = new BufferGeometry();
+    geometry.setAttribute("position", new Float32BufferAttribute(shape.vertices, 3));
+    geometry.setIndex(shape.faces);
+    geometry.computeVertexNormals();
+    return new Mesh(geometry, material(shape.color));
   }
   if (kind === "axes") return axes(shape.length);
   if (kind === "grid") {
