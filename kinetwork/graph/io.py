@@ -84,12 +84,6 @@ def _read(source):
     """The text of a model file, refused past MAX_FILE_SIZE or when not UTF-8."""
     too_big = f"{source}: larger than {MAX_FILE_SIZE // 2**20} MiB, too large for a model file"
     try:
-        # a FIFO or a socket is refused by its kind before it is opened: opening one waits
-        # for a writer (a file named pipe.json in a studio's folder would hold a worker)
-        kind = os.stat(source).st_mode
-        if stat.S_ISFIFO(kind) or stat.S_ISSOCK(kind):
-            raise ModelError(f"{source}: a {'FIFO (named pipe)' if stat.S_ISFIFO(kind) else 'socket'}"
-                             f", not a model file; not opened")
         with open(source, "rb") as fh:
             info = os.fstat(fh.fileno())
             if stat.S_ISREG(info.st_mode) and info.st_size > MAX_FILE_SIZE:
