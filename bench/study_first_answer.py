@@ -85,7 +85,7 @@ import numpy; lap("import numpy")
 import casadi; lap("import casadi")
 import networkx; lap("import networkx")
 import kinetwork as kn
-from kinetwork.cli import _load
+from kinetwork.cli import load_model as _load
 model = _load(sys.argv[1]); lap("import kinetwork's layers + load the model")
 system = model.compile(); lap("build the System")
 res = kn.simulate(system); lap("simulate (cached JIT library)")
@@ -127,7 +127,7 @@ PICTURES = """
 import sys
 import kinetwork as kn
 from kinetwork import quickplot
-from kinetwork.cli import _load
+from kinetwork.cli import load_model as _load
 from kinetwork.plot import save_plot
 model = _load(sys.argv[1])
 res = kn.simulate(model)

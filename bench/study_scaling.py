@@ -17,7 +17,7 @@ memory after that N (``ru_maxrss``: sizes go up, so each row's peak is its own N
 
 The chain of eight four-bar loops in both loop formulations (build, the first run's cold JIT
 from an empty cache, the run again; the default formulation is marked), and what -O0 costs at
-run time: a 256-link chain's right-hand side compiled at -O1 and at -O0 (``jit.O1_STATEMENTS``).
+run time: a 256-link chain's right-hand side compiled at -O1 and at -O0 (the two tiers).
 
 Setting up CVODES (``--setup``, its own run: results/study_scaling_setup.md): the time CasADi
 takes to build the DAE's Jacobian function and a CVODES integrator around a chain's compiled
@@ -61,19 +61,20 @@ BATCHES = 11
 
 
 def per_call(fn, batches=BATCHES):
-    """Median time of one ``fn()`` call: batches of calls sized to ~BATCH_SECONDS each."""
+    """Median CPU time of one ``fn()`` call: batches of calls sized to ~BATCH_SECONDS each
+    (CPU time: on a machine shared past its core count, wall time counts the others' work)."""
     fn()
-    n, start = 1, time.perf_counter()
-    while time.perf_counter() - start < BATCH_SECONDS / 10:
+    n, start = 1, time.process_time()
+    while time.process_time() - start < BATCH_SECONDS / 10:
         fn()
         n += 1
-    calls = max(1, int(n * 10 * BATCH_SECONDS / max(time.perf_counter() - start, 1e-9)) // 10)
+    calls = max(1, int(n * 10 * BATCH_SECONDS / max(time.process_time() - start, 1e-9)) // 10)
     times = []
     for _ in range(batches):
-        start = time.perf_counter()
+        start = time.process_time()
         for _ in range(calls):
             fn()
-        times.append((time.perf_counter() - start) / calls)
+        times.append((time.process_time() - start) / calls)
     return statistics.median(times)
 
 
@@ -184,13 +185,16 @@ def _evaluator(f):
 STRATEGY_TIMEOUT = 150.0
 
 
-def _compile_with(f, jacobian, split, jacobian_o1, o1):
+def _compile_with(f, jacobian, split, jacobian_o1, level):
     """(compiler CPU s, wall s, us per evaluation or None when stopped) of ``f`` compiled by
-    ``jit`` in an empty cache with the given splitting and -O0 thresholds."""
-    saved = (jit.SPLIT_STATEMENTS, jit.JACOBIAN_O1_STATEMENTS, jit.O1_STATEMENTS,
-             jit.COMPILE_TIMEOUT)
-    jit.SPLIT_STATEMENTS, jit.JACOBIAN_O1_STATEMENTS, jit.O1_STATEMENTS = split, jacobian_o1, o1
+    ``jit`` in an empty cache with the given splitting, Jacobian threshold and
+    ``KINETWORK_JIT_LEVEL`` (``optimised``: -O1 in the foreground; ``quick``: -O0, no
+    background build)."""
+    saved = (jit.SPLIT_STATEMENTS, jit.JACOBIAN_O1_STATEMENTS, jit.COMPILE_TIMEOUT,
+             os.environ.get("KINETWORK_JIT_LEVEL"))
+    jit.SPLIT_STATEMENTS, jit.JACOBIAN_O1_STATEMENTS = split, jacobian_o1
     jit.COMPILE_TIMEOUT = STRATEGY_TIMEOUT
+    os.environ["KINETWORK_JIT_LEVEL"] = level
     try:
         with tempfile.TemporaryDirectory() as folder:
             os.environ["KINETWORK_CACHE"] = folder
@@ -208,8 +212,12 @@ def _compile_with(f, jacobian, split, jacobian_o1, o1):
             cost = None if g is None else \
                 per_call(_evaluator(g.jacobian() if jacobian else g), batches=5) * 1e6
     finally:
-        (jit.SPLIT_STATEMENTS, jit.JACOBIAN_O1_STATEMENTS, jit.O1_STATEMENTS,
-         jit.COMPILE_TIMEOUT) = saved
+        (jit.SPLIT_STATEMENTS, jit.JACOBIAN_O1_STATEMENTS, jit.COMPILE_TIMEOUT,
+         level_before) = saved
+        if level_before is None:
+            os.environ.pop("KINETWORK_JIT_LEVEL", None)
+        else:
+            os.environ["KINETWORK_JIT_LEVEL"] = level_before
     return cpu, wall, cost
 
 
@@ -221,23 +229,23 @@ def strategies(quick):
     rhs = scenes.chain(n).compile().f_rhs
     # the partition's DAE and its Jacobian: what IDAS compiles (loops are projected by default)
     dae = fourbar_chain(m).compile(loops="partition").f_dae
-    now = jit.O1_STATEMENTS
+    part = jit.PART_STATEMENTS
     cases = [(f"chain{n} right-hand side", rhs, False,
-              [("one file, -O1", never, never, never),
-               (f"parts of {jit.PART_STATEMENTS}, -O1, side by side", jit.SPLIT_STATEMENTS,
-                never, never),
-               (f"parts of {jit.PART_STATEMENTS}, -O0 over {now:,} statements, side by side "
-                "(now)", jit.SPLIT_STATEMENTS, never, now)]),
+              [("one file, -O1", never, never, "optimised"),
+               (f"parts of {part}, -O1, side by side (the optimised tier)",
+                jit.SPLIT_STATEMENTS, never, "optimised"),
+               (f"parts of {part}, -O0, side by side (the quick tier)", jit.SPLIT_STATEMENTS,
+                never, "quick")]),
              (f"fourbar_chain{m} (partition) DAE + exact Jacobian", dae, True,
-              [("one file each, -O1", never, never, never),
-               ("parts, -O1, side by side", jit.SPLIT_STATEMENTS, never, never),
+              [("one file each, -O1", never, never, "optimised"),
+               ("parts, -O1, side by side", jit.SPLIT_STATEMENTS, never, "optimised"),
                ("parts, Jacobian at -O0, side by side (now)", jit.SPLIT_STATEMENTS,
-                jit.JACOBIAN_O1_STATEMENTS, now)])]
+                jit.JACOBIAN_O1_STATEMENTS, "optimised")])]
     rows = []
     for label, f, jacobian, ways in cases:
         size = (f.jacobian() if jacobian else f).n_instructions()
-        for way, split, jac_o1, o1 in ways:
-            cpu, wall, cost = _compile_with(f, jacobian, split, jac_o1, o1)
+        for way, split, jac_o1, level in ways:
+            cpu, wall, cost = _compile_with(f, jacobian, split, jac_o1, level)
             rows.append({"function": label, "instructions": size, "strategy": way,
                          "compiler_cpu_s": cpu, "wall_s": wall,
                          "eval_us": float("nan") if cost is None else cost})
@@ -319,14 +327,14 @@ def fourbar_rows(m=8):
 
 
 def o0_cost(n=256):
-    """One right-hand-side evaluation of an ``n``-link chain compiled at -O1 and at -O0 (us),
-    and each compiler's CPU time (s): what ``jit.O1_STATEMENTS`` trades."""
+    """One right-hand-side evaluation of an ``n``-link chain from its optimised (-O1) and its
+    quick (-O0) library (us), and each compiler's CPU time (s): what the quick tier trades."""
     system = scenes.chain(n).compile()
     p, x = system.param_vector(), np.random.default_rng(0).uniform(-0.5, 0.5, 2 * n)
-    out, saved = {}, jit.O1_STATEMENTS
+    out, saved = {}, os.environ.get("KINETWORK_JIT_LEVEL")
     try:
-        for label, limit in (("-O1", sys.maxsize), ("-O0", 0)):
-            jit.O1_STATEMENTS = limit
+        for label, level in (("-O1", "optimised"), ("-O0", "quick")):
+            os.environ["KINETWORK_JIT_LEVEL"] = level
             with tempfile.TemporaryDirectory() as folder:
                 os.environ["KINETWORK_CACHE"] = folder
                 children = _children_cpu()
@@ -335,11 +343,39 @@ def o0_cost(n=256):
                 call = numeric(f, p, system.n_states)
                 out[label] = (per_call(lambda: call(0.0, x)) * 1e6, cpu)
     finally:
-        jit.O1_STATEMENTS = saved
+        if saved is None:
+            os.environ.pop("KINETWORK_JIT_LEVEL", None)
+        else:
+            os.environ["KINETWORK_JIT_LEVEL"] = saved
     print(f"  chain{n}: -O1 {out['-O1'][0]:.1f} us ({out['-O1'][1]:.1f} s CPU to compile), "
           f"-O0 {out['-O0'][0]:.1f} us ({out['-O0'][1]:.1f} s)", flush=True)
     return {"N": n, "instructions": system.f_rhs.n_instructions(), **{
         f"{k}_{what}": v[i] for k, v in out.items() for i, what in enumerate(("us", "cpu_s"))}}
+
+
+def first_study(sizes=None):
+    """``--first``: see ``scaling_first.py``; writes results/study_scaling_first.{csv,md}."""
+    import scaling_first
+    clock = time.perf_counter()
+    first = scaling_first.first_answers()
+    costs = {}
+    for label, spec in (("3-D point-mass chain of 128 links",
+                         scenes.point_mass_spec(128, planar=False)),
+                        ("planar chain of 128 rods", scenes.chain_spec(128))):
+        costs[label] = (f"{spec.n} links", scaling_first.evaluation_costs(spec))
+        print(f"  {label}: " + ", ".join(f"{k} {v:.1f} us" for k, v in costs[label][1].items()),
+              flush=True)
+    long_rows = scaling_first.long_chains(tuple(sizes or (256, 512, 1024)))
+    write_csv("study_scaling_first", [
+        {"scene": name, "run": run, **values} for name, runs in first.items()
+        for run, values in runs.items()])
+    if long_rows:
+        write_csv("study_scaling_long_chains", long_rows)
+    text = "\n".join(["## Scaling: first answers, tiers and long chains", "",
+                      f"{machine()}; {load()}. Study wall time "
+                      f"{time.perf_counter() - clock:.0f} s.",
+                      *scaling_first.lines(first, costs, long_rows)])
+    write_markdown("study_scaling_first", text)
 
 
 def integrator_setup(sizes=(64, 128, 256, 512)):
@@ -415,7 +451,7 @@ def fourbar_lines(rows, cost):
                   body), "",
             f"The default formulation ({default}): cold JIT {mine['jit_cold_s']:.1f} s "
             f"(target < 5 s).", "",
-            f"What -O0 costs at run time (functions over {jit.O1_STATEMENTS:,} statements): "
+            f"What the quick tier costs at run time until the optimised library is in: "
             f"the {cost['N']}-link chain's right-hand side ({cost['instructions']:,} "
             f"instructions) evaluates in {cost['-O1_us']:.1f} us at -O1 and "
             f"{cost['-O0_us']:.1f} us at -O0 ({cost['-O0_us'] / cost['-O1_us']:.1f}x), and "
@@ -445,7 +481,16 @@ def measure(n, tools):
         cold = time.perf_counter() - start
         cold_cpu = time.process_time() - cpu
         cold_compilers = _children_cpu() - children
-        gcc = stats.get("jit_seconds", float("nan"))
+        gcc, tier = stats.get("jit_seconds", float("nan")), stats.get("jit_tier", "")
+        p = system.param_vector()
+        x = np.random.default_rng(0).uniform(-0.5, 0.5, 2 * n)
+        c_rhs = numeric(compiled, p, system.n_states)
+        # the quick tier's cost, then the background build's, once it is swapped in
+        first_us = per_call(lambda: c_rhs(0.0, x)) * 1e6
+        children, start = _children_cpu(), time.perf_counter()
+        swapped = jit.wait()
+        assert set(swapped.values()) <= {"optimised"}, swapped
+        optimise_wait, optimise_cpu = time.perf_counter() - start, _children_cpu() - children
         again, stats = scenes.chain(n).compile(), {}       # a new model: a new System
         compiled_of(again).rhs({"stats": stats})
         assert stats.get("jit_cached"), "a new System missed the cache"
@@ -455,9 +500,6 @@ def measure(n, tools):
         start = time.perf_counter()
         kn.simulate(third, t_end=1.0, n_points=101)
         cached_run = time.perf_counter() - start
-        p = system.param_vector()
-        x = np.random.default_rng(0).uniform(-0.5, 0.5, 2 * n)
-        c_rhs = numeric(compiled, p, system.n_states)
         vm_rhs = numeric(system.f_rhs, p, system.n_states)
         assert np.allclose(c_rhs(0.0, x), vm_rhs(0.0, x), rtol=1e-10, atol=1e-10)
         # the same call path around a Function that does nothing but copy x: the overhead
@@ -465,8 +507,8 @@ def measure(n, tools):
                       for i, name in enumerate("txp"))
         empty = numeric(ca.Function("copy", [t_, x_, p_], [x_]), p, system.n_states)
         row = {"N": n, "states": size["states"], "operations": size["operations"],
-               "opt": "-O1" if system.f_rhs.n_instructions() <= jit.O1_STATEMENTS else "-O0",
-               "model_s": model_s, "build_s": build_s, "jit_cold_s": cold,
+               "tier": tier, "rhs_first_us": first_us, "optimise_wait_s": optimise_wait,
+               "optimise_compilers_cpu_s": optimise_cpu, "model_s": model_s, "build_s": build_s, "jit_cold_s": cold,
                "jit_cold_compiler_s": gcc, "jit_warm_s": warm, "cached_run_s": cached_run,
                "build_cpu_s": build_cpu, "jit_cold_cpu_s": cold_cpu,
                "jit_cold_compilers_cpu_s": cold_compilers,
@@ -562,25 +604,32 @@ def charts(rows, tools):
 
 def report(rows, fits, tools, total, quick, extra=None, loops=()):
     last = rows[-1]
-    body = [[r["N"], r["states"], r["operations"], r["opt"], f"{r['model_s'] * 1e3:.1f}",
+    body = [[r["N"], r["states"], r["operations"], r["tier"], f"{r['model_s'] * 1e3:.1f}",
              f"{r['build_s'] * 1e3:.1f}", f"{r['jit_cold_s']:.2f}",
              f"{r['jit_warm_s'] * 1e3:.1f}", f"{r['build_s'] + r['jit_cold_s']:.2f}",
              f"{r['build_cpu_s']:.2f} + {r['jit_cold_cpu_s']:.2f} + "
              f"{r['jit_cold_compilers_cpu_s']:.2f}",
              f"{r['cached_run_s']:.2f}", f"{r['peak_rss_mb']:.0f}",
+             f"{r['rhs_first_us']:.2f}" if r["tier"] == "quick" else "",
+             f"{r['optimise_compilers_cpu_s']:.1f}" if r["tier"] == "quick" else "",
              f"{r['rhs_c_us']:.2f}", f"{r['rhs_vm_us']:.1f}",
              *(f"{r[_key(t)]:.2f}" for t in tools)] for r in rows]
-    header = ["N", "states", "rhs operations", "C", "model [ms]", "build [ms]", "JIT cold [s]",
-              "JIT hit [ms]", "build + JIT cold [s]",
+    header = ["N", "states", "rhs operations", "first tier", "model [ms]", "build [ms]",
+              "JIT cold [s]", "JIT hit [ms]", "build + JIT cold [s]",
               "CPU: build + JIT (Python) + compilers [s]", "cached run 1 s [s]", "peak RSS [MB]",
-              "rhs C [us]", "rhs VM [us]", *(f"{t} [us]" for t in tools)]
+              "rhs C quick [us]", "optimised build CPU [s]", "rhs C [us]", "rhs VM [us]",
+              *(f"{t} [us]" for t in tools)]
     lines = [f"## Scaling: chains of N rods{' (quick smoke run)' if quick else ''}", "",
              f"{machine()}; {load()}. Build: median of repeated `model.compile()` "
              f"(validate, assemble, "
              f"CasADi Functions; no C). JIT cold: `compiled(system).rhs(jit)` with an empty "
-             f"cache folder (code generation + gcc at the level in column C: -O1, -O0 "
-             f"for functions over {jit.O1_STATEMENTS:,} statements; functions over "
-             f"{jit.SPLIT_STATEMENTS:,} statements in parts side by side); JIT hit: what the "
+             f"cache folder (code generation + gcc for the first tier: -O1 up to "
+             f"{jit.QUICK_STATEMENTS:,} statements, else the quick tier, -O0, while the "
+             f"optimised one is built in the background; functions over "
+             f"{jit.SPLIT_STATEMENTS:,} statements in parts side by side). rhs C quick: one "
+             f"evaluation from the quick library; optimised build CPU: the background "
+             f"compilers' CPU time, waited for; rhs C: one evaluation once the optimised code "
+             f"is swapped in. JIT hit: what the "
              f"same call does for a new System of the same model (hashing the Function's "
              f"serialisation, then loading the cached library), median of repeats. Cached run: "
              f"a third System of the same model simulated 1 s (101 points, default method), "
@@ -588,15 +637,19 @@ def report(rows, fits, tools, total, quick, extra=None, loops=()):
              f"process's CPU time for one build and for the cold JIT (code generation), and the "
              f"compilers' (children's) CPU time: on a shared machine whose load average is over "
              f"its core count, wall times stretch and these say what the work itself costs. "
-             f"Per-evaluation times from Python, "
-             f"median over batches of calls; they are noisy when the load average is over "
-             f"the core count. "
+             f"Per-evaluation times from Python, CPU time, "
+             f"median over batches of calls (wall times are the others' too when the load "
+             f"average is over the core count). "
              f"Study wall time {total:.0f} s.", "",
              table(header, body), "",
              *(strategy_lines(*extra) + [""] if extra else
                ["JIT of the largest functions, one file against parts, -O1 against -O0: "
                 "[study_scaling_jit.md](study_scaling_jit.md) (`--strategies`).", ""]),
              *loops, "",
+             "First answers of a 3-D 128-link point-mass chain, EngineV6 and 1024 rods, cold "
+             "and cached; evaluation costs once optimised against the hand route and "
+             "pinocchio; long point-mass chains against pinocchio: "
+             "[study_scaling_first.md](study_scaling_first.md) (`--first`).", "",
              f"Log-log slopes from N = {FIT_FROM} to {last['N']}:", "",
              table(["quantity", "exponent"], [[k, f"{v:.2f}"] for k, v in fits.items()]), "",
              "![evaluation cost](study_scaling.png)", "",
@@ -606,7 +659,8 @@ def report(rows, fits, tools, total, quick, extra=None, loops=()):
              f"{last['call_overhead_us']:.1f} us of the Python call is taken off), "
              f"N^{fits['rhs CasADi VM']:.2f} in CasADi's VM, operations "
              f"N^{fits['operations']:.2f}; target exponent ≤ 1.2. At N = {last['N']}: "
-             f"{last['rhs_c_us']:.1f} us compiled ({last['opt']}), {last['rhs_vm_us']:.0f} us "
+             f"{last['rhs_c_us']:.1f} us compiled (-O1; {last['rhs_first_us']:.1f} us from the "
+             f"quick tier first), {last['rhs_vm_us']:.0f} us "
              f"in the VM" + "".join(f", {last[_key(t)]:.1f} us {t}" for t in tools
                                     if np.isfinite(last[_key(t)])) + ".",
              f"- Build at N = {last['N']}: {last['build_s']:.2f} s ({last['build_cpu_s']:.1f} s "
@@ -645,11 +699,18 @@ if __name__ == "__main__":
                         help="only the JIT strategies on the largest functions "
                              "(results/study_scaling_jit.md)")
     parser.add_argument("--sizes", type=int, nargs="+", help="these N only")
+    parser.add_argument("--first", action="store_true",
+                        help="only the first answers (3-D 128-link point-mass chain, EngineV6, "
+                             "1024 rods), evaluation costs once optimised against the hand "
+                             "route and pinocchio, and long point-mass chains "
+                             "(results/study_scaling_first.md)")
     parser.add_argument("--setup", action="store_true",
                         help="only what CVODES costs to set up around chains of --sizes "
                              "(results/study_scaling_setup.md)")
     args = parser.parse_args()
-    if args.setup:
+    if args.first:
+        first_study(args.sizes)
+    elif args.setup:
         found = integrator_setup(args.sizes or (64, 128, 256, 512))
         write_csv("study_scaling_setup", found)
         write_markdown("study_scaling_setup", "\n".join(setup_lines(found)))

@@ -1,9 +1,10 @@
-"""Probe plots: one panel per recorded quantity, against time, units on every axis.
+"""Probe plots drawn with matplotlib: one panel per recorded quantity, against time, units on
+every axis; several runs overlay on the same panels.
 
-The layout follows the seed paper's probe figures (a joint probe's angle, speed, acceleration
-and torque side by side in one row); probes with fewer quantities share rows, so a figure is
-not mostly empty. Several runs overlay on the same panels. matplotlib is imported only when a plot is asked for, so ``import
-kinetwork`` stays fast and never touches a display.
+Which panels, in which rows, with which titles, labels and margins is ``plotlayout``'s
+(shared with the Pillow renderer of ``quickplot.py``); this module draws it. matplotlib is
+imported only when a plot is asked for, so ``import kinetwork`` stays fast and never touches
+a display.
 """
 
 import os
@@ -11,17 +12,15 @@ import sys
 
 import numpy as np
 
-from .util import atomic_write, callable_module, suggest
+from . import plotlayout as layout
 from .errors import ModelError
-from .solver.results import install_plotter
+from .plotlayout import unit_label  # noqa: F401 -- kinetwork.plot.unit_label, as before
+from .util import atomic_write, callable_module
 
-#: a probe with more quantities than this wraps onto further rows (a frame probe has eight)
-MAX_COLUMNS = 4
 _AXES = "xyz"
-_SUPERSCRIPTS = {"^-1": "\u207b\u00b9", "^2": "\u00b2", "^3": "\u00b3"}
 
 
-def _pyplot():
+def pyplot():
     """pyplot, on the Agg backend when there is no display to open windows on."""
     import matplotlib
     headless = (sys.platform.startswith("linux") and not os.environ.get("DISPLAY")
@@ -31,92 +30,6 @@ def _pyplot():
         matplotlib.use("Agg")
     import matplotlib.pyplot as plt
     return plt
-
-
-def unit_label(unit):
-    """A unit as it reads on an axis: "rad/s^2" -> "rad/s²", "N*m" -> "N·m"."""
-    for plain, sup in _SUPERSCRIPTS.items():
-        unit = unit.replace(plain, sup)
-    return unit.replace("*", "\u00b7")
-
-
-class _Panel:
-    """One panel: the signal it draws (a full name), its title and its axis label."""
-
-    def __init__(self, results, name):
-        self.name = name
-        probe, _, quantity = name.rpartition(".")
-        sig = results.signals.get(name)
-        unit = results.units.get(name, "")
-        if sig is not None:
-            probe, quantity = sig.probe, sig.quantity
-            target = results.probe_targets.get(probe)
-            where = f" ({target})" if target else ""
-            self.title = f"{probe}{where}: {quantity.replace('_', ' ')}"
-        else:                                   # a state
-            self.title = name
-            quantity = quantity or name
-        self.probe = probe
-        self.ylabel = quantity.replace("_", " ") + f" [{unit_label(unit) if unit else '1'}]"
-
-
-def _names(results, selection):
-    """The full names of the panels, in order: every probe's quantities by default; a probe
-    name gives all of its quantities, ``probe.quantity`` (or a state's name) one panel."""
-    available = results.probes
-    if not available and not selection:
-        raise ModelError("nothing to plot: the model has no probes (add a kn.Probe and "
-                         "connect it to the port to record)")
-    if not selection:
-        return [f"{p}.{q}" for p, qs in available.items() for q in qs]
-    names = []
-    for item in selection:
-        if not isinstance(item, str):
-            raise ModelError(f"plot: a probe or signal is named by a string, got {item!r:.60}")
-        if item in available:
-            names += [f"{item}.{q}" for q in available[item]]
-        elif item in results.signals or item in results.state_names:
-            names.append(item)
-        else:
-            known = [*available, *results.signals, *results.state_names]
-            raise ModelError(f"plot: no probe or signal {item!r}{suggest(item, known)}; probes "
-                             f"are {', '.join(available) or 'none'}")
-    return names
-
-
-def _rows(results, names, columns=None):
-    """The panels' names row by row. Each probe's quantities stay together, left to right (the
-    seed paper's layout: one row per joint probe); probes with fewer quantities than a row
-    holds share rows, in order, so a figure is not mostly empty; one with more wraps."""
-    groups = []                                  # consecutive names of one probe
-    for name in names:
-        sig = results.signals.get(name)
-        key = sig.probe if sig is not None else name
-        if groups and groups[-1][0] == key:
-            groups[-1][1].append(name)
-        else:
-            groups.append((key, [name]))
-    n = len(names)
-    widest = max(len(g) for _, g in groups)
-    n_cols = columns or min(MAX_COLUMNS, max(widest, -(-n // -(-n // MAX_COLUMNS))))
-    rows = [[]]
-    for _, group in groups:
-        if len(group) > n_cols - len(rows[-1]) and rows[-1]:
-            rows.append([])
-        for name in group:
-            if len(rows[-1]) == n_cols:
-                rows.append([])
-            rows[-1].append(name)
-    return rows, n_cols
-
-
-def _flat(values):
-    """Whether a signal never changes over the run (to the last bits): a dead panel."""
-    values = np.asarray(values, dtype=float)
-    finite = values[np.isfinite(values)]
-    if finite.size == 0:
-        return False
-    return float(np.ptp(finite)) <= 1e-12 * (1.0 + float(np.max(np.abs(finite))))
 
 
 def plot_results(results, *names, probes=None, title=None, labels=None, hide_flat=False,
@@ -164,7 +77,7 @@ def plot_results(results, *names, probes=None, title=None, labels=None, hide_fla
         names = names + ((probes,) if isinstance(probes, str) else tuple(probes))
     if len(names) == 1 and isinstance(names[0], (list, tuple)):
         names = tuple(names[0])
-    wanted = _names(runs[0], names)
+    wanted = layout.panel_names(runs[0], names)
     for k, run in enumerate(runs[1:], start=2):
         missing = [n for n in wanted if n not in run]
         if missing:
@@ -176,18 +89,12 @@ def plot_results(results, *names, probes=None, title=None, labels=None, hide_fla
         labels = [f"run {k + 1}" for k in range(len(runs))]
     hidden = []
     if hide_flat:
-        kept = [n for n in wanted if not all(_flat(run[n]) for run in runs)]
-        hidden = [n for n in wanted if n not in kept]
-        if not kept:
-            raise ModelError(f"plot: every signal asked for is constant ({', '.join(wanted[:4])}"
-                             f"{', ...' if len(wanted) > 4 else ''}); plot without hide_flat")
-        wanted = kept
-    rows, n_cols = _rows(runs[0], wanted, columns)
+        wanted, hidden = layout.drop_flat(runs, wanted)
+    rows, n_cols = layout.rows(runs[0], wanted, columns)
     n_rows = len(rows)
     if figsize is None:
-        extra = (0.4 if title else 0.0) + (0.3 if len(runs) > 1 else 0.0) + \
-            (0.3 if hidden else 0.0)
-        figsize = (0.4 + 3.5 * n_cols, 0.3 + 2.4 * n_rows + extra)
+        figsize = layout.figure_size(n_cols, n_rows, title=bool(title), legend=len(runs) > 1,
+                                     note=bool(hidden))
     if _detached:
         # for a file: no pyplot, no window, nothing to close; and no layout engine, whose
         # extra pass over every tick doubled the time to draw: margins are measured below
@@ -195,10 +102,10 @@ def plot_results(results, *names, probes=None, title=None, labels=None, hide_fla
         fig = Figure(figsize=figsize)
         axes = fig.subplots(n_rows, n_cols, sharex=True, squeeze=False)
     else:
-        fig, axes = _pyplot().subplots(n_rows, n_cols, figsize=figsize, sharex=True,
+        fig, axes = pyplot().subplots(n_rows, n_cols, figsize=figsize, sharex=True,
                                        squeeze=False, layout="constrained")
-    bottom = {}                     # column -> lowest row holding a panel
-    placed = [(i, j, _Panel(runs[0], name)) for i, row in enumerate(rows)
+    bottom = layout.last_in_column(rows)
+    placed = [(i, j, layout.Panel(runs[0], name)) for i, row in enumerate(rows)
               for j, name in enumerate(row)]
     for i, j, panel in placed:
         ax = axes[i, j]
@@ -212,7 +119,6 @@ def plot_results(results, *names, probes=None, title=None, labels=None, hide_fla
         ax.set_title(panel.title, fontsize="medium")
         ax.set_ylabel(panel.ylabel)
         _event_marks(ax, runs)
-        bottom[j] = i
     for i, row in enumerate(rows):
         for j in range(len(row), n_cols):
             axes[i, j].set_visible(False)
@@ -222,7 +128,7 @@ def plot_results(results, *names, probes=None, title=None, labels=None, hide_fla
             # last row when the last row is not full
             axes[i, j].tick_params(labelbottom=bottom.get(j) == i)
     for j, i in bottom.items():
-        axes[i, j].set_xlabel("time [s]")
+        axes[i, j].set_xlabel(layout.TIME_LABEL)
     t = runs[0].t
     if len(t) > 1:                  # a run that failed at once has a single point
         axes[0, 0].set_xlim(min(r.t[0] for r in runs), max(r.t[-1] for r in runs))
@@ -235,25 +141,18 @@ def plot_results(results, *names, probes=None, title=None, labels=None, hide_fla
     if title:
         heading = fig.suptitle(title)
     if hidden:
-        shown = [f"{n} = {float(np.ravel(runs[0][n])[0]):.4g}" for n in hidden[:6]]
-        more = f" and {len(hidden) - 6} more" if len(hidden) > 6 else ""
-        note = fig.text(0.01, 0.002, "constant, not drawn: " + ", ".join(shown) + more,
+        note = fig.text(0.01, 0.002, layout.flat_note(runs[0], hidden),
                         fontsize="x-small", color="0.35", ha="left", va="bottom")
     if _detached:
         _fit_margins(fig, axes, rows, heading, legend, note)
     return fig
 
 
-#: room around the measured texts [points]: between them, and at the figure's edges
-_GAP, _EDGE = 4.0, 5.0
-
-
 def _fit_margins(fig, axes, rows, heading, legend, note):
     """Place the panels of a figure drawn without a layout engine: margins and gaps are the
     measured sizes of what surrounds the panels (titles, tick labels, axis labels, legends),
     so nothing overlaps and little space is lost, at the cost of laying out a few texts
-    instead of a whole drawing pass. Panels keep one size; each gap between them is as wide
-    as what it holds."""
+    instead of a whole drawing pass (``plotlayout.panel_boxes`` places them)."""
     import matplotlib as mpl
     from matplotlib.backends.backend_agg import FigureCanvasAgg
     from matplotlib.font_manager import FontProperties
@@ -310,32 +209,25 @@ def _fit_margins(fig, axes, rows, heading, legend, note):
                     right[j] = max(right[j], w / 2)     # the last time label overhangs
             below[i] = max(below[i], under)
     width, height = (v * 72.0 for v in fig.get_size_inches())
-    top = _EDGE + sum(size(t)[1] + _GAP for t in (heading, legend) if t is not None)
-    bottom = _EDGE + (size(note)[1] + _GAP if note is not None else 0.0)
-    x0, x1 = left[0] + _EDGE, width - right[-1] - _EDGE
-    y1, y0 = height - top - above[0], bottom + below[-1]
-    # each gap as wide as what fills it: a column with x/y/z legends does not widen the rest
-    wgaps = [right[j] + left[j + 1] + _GAP for j in range(n_cols - 1)] + [0.0]
-    hgaps = [below[i] + above[i + 1] + _GAP for i in range(n_rows - 1)] + [0.0]
-    panel_w = (x1 - x0 - sum(wgaps)) / n_cols
-    panel_h = (y1 - y0 - sum(hgaps)) / n_rows
-    if panel_w <= 0 or panel_h <= 0:            # a figure too small for its texts
+    boxes = layout.panel_boxes((width, height), left, right, above, below,
+                               [size(t)[1] for t in (heading, legend) if t is not None],
+                               [size(note)[1]] if note is not None else [])
+    if boxes is None:                           # a figure too small for its texts
         return
-    lefts = [x0 + j * panel_w + sum(wgaps[:j]) for j in range(n_cols)]
-    tops = [y1 - i * panel_h - sum(hgaps[:i]) for i in range(n_rows)]
     for i in range(n_rows):
         for j in range(n_cols):
-            axes[i, j].set_position([lefts[j] / width, (tops[i] - panel_h) / height,
-                                     panel_w / width, panel_h / height])
-    edge = 1.0 - _EDGE / height
+            x0, y0, x1, y1 = boxes[i][j]        # from the top: matplotlib's y is up
+            axes[i, j].set_position([x0 / width, 1.0 - y1 / height, (x1 - x0) / width,
+                                     (y1 - y0) / height])
+    edge = 1.0 - layout.EDGE / height
     if heading is not None:
         heading.set_y(edge)
-        edge -= (size(heading)[1] + _GAP) / height
+        edge -= (size(heading)[1] + layout.GAP) / height
     if legend is not None:
         legend.set_loc("upper center")
         legend.set_bbox_to_anchor((0.5, edge), transform=fig.transFigure)
     if note is not None:
-        note.set_position((_EDGE / width, _EDGE / height))
+        note.set_position((layout.EDGE / width, layout.EDGE / height))
 
 
 def _panel_width(fig, axes):
@@ -435,9 +327,6 @@ def save_plot(results, path, *names, probes=None, title=None, dpi=150, **kwargs)
     options = {"pil_kwargs": {"compress_level": 1}} if fmt == "png" else {}
     # atomically: a full disk or a signal leaves an old image whole
     atomic_write(path, lambda tmp: fig.savefig(tmp, dpi=dpi, format=fmt, **options))
-
-
-install_plotter(plot_results)
 
 
 def warm_up():

@@ -1,11 +1,11 @@
 """The probe plots of ``kinetwork run --plot`` as PNG files, drawn with Pillow.
 
 matplotlib takes a second to import and more than half a second to draw the seed's eight
-panels; the run itself takes milliseconds. This module draws the same figure (plot.py's panel
-packing, titles, units, 1-2-2.5-5 ticks labelled like matplotlib's ScalarFormatter, tab10
-colours, DejaVu Sans, 150 dpi, the same pixel size) in a tenth of a second: lines at twice
-the size, reduced with a box filter, so they are antialiased; texts by FreeType at the
-file's size, antialiased too.
+panels; the run itself takes milliseconds. This module draws the same figure (the layout of
+``plotlayout``, which ``plot.py`` draws too: panels, titles, units, margins, 1-2-2.5-5 ticks
+labelled like matplotlib's ScalarFormatter; tab10 colours, DejaVu Sans, 150 dpi, the same
+pixel size) in a tenth of a second: lines at twice the size, reduced with a box filter, so
+they are antialiased; texts by FreeType at the file's size, antialiased too.
 
 It draws what the command line's plots hold: one run, scalars and x/y/z vectors, events, nan
 gaps, the hide-flat note. :func:`drawable` says when a file needs matplotlib instead (another
@@ -24,8 +24,9 @@ import zlib
 import numpy as np
 from PIL import Image, ImageDraw, ImageFont
 
+from . import plotlayout as layout
 from .errors import ModelError
-from .plot import _flat, _names, _Panel, _rows
+from .plotlayout import EDGE, Axis, padded, time_limits
 from .util import atomic_write
 
 DPI, SCALE = 150, 2                     # the file's resolution; lines drawn this much larger
@@ -33,13 +34,10 @@ PX = DPI / 72.0                         # points -> pixels of the file
 #: matplotlib's default style (rcParams), in points
 FONT, SUPTITLE, SMALL = 10.0, 12.0, 6.94
 LINE, SPINE, TICK, TICK_PAD, LABEL_PAD, TITLE_PAD = 1.5, 0.8, 3.5, 3.5, 4.0, 6.0
-GAP, EDGE = 4.0, 5.0                    # plot.py's measured margins: between texts, at edges
 TAB10 = ["#1f77b4", "#ff7f0e", "#2ca02c", "#d62728", "#9467bd", "#8c564b", "#e377c2",
          "#7f7f7f", "#bcbd22", "#17becf"]
 GRID = (223, 223, 223)                  # #b0b0b0 at alpha 0.4 on white
 EVENT, NOTE = (140, 140, 140), (89, 89, 89)
-STEPS = (1.0, 2.0, 2.5, 5.0, 10.0)      # matplotlib's AutoLocator
-MINUS = "\u2212"
 
 
 def drawable(path, results, names=()):
@@ -52,7 +50,7 @@ def drawable(path, results, names=()):
     if len(t) > 1 and abs(t[0]) >= 100 * (t[-1] - t[0]):
         return False
     try:
-        wanted = _names(results, names)
+        wanted = layout.panel_names(results, names)
     except ModelError:                  # save_plot says what is wrong with the names
         return False
     return all(np.ndim(results[name]) <= 2 for name in wanted)
@@ -89,26 +87,23 @@ def png_bytes(image):
 
 def render(results, *names, title=None, hide_flat=False):
     """The figure as an RGB image (the file's pixels)."""
-    wanted = _names(results, names)
-    hidden = [n for n in wanted if hide_flat and _flat(results[n])]
-    if hidden == wanted:
-        raise ModelError(f"plot: every signal asked for is constant ({', '.join(wanted[:4])}"
-                         f"{', ...' if len(wanted) > 4 else ''}); plot without hide_flat")
-    rows, n_cols = _rows(results, [n for n in wanted if n not in hidden])
-    note = _note(results, hidden)
-    size = (0.4 + 3.5 * n_cols, 0.3 + 2.4 * len(rows) + (0.4 if title else 0.0)
-            + (0.3 if note else 0.0))
+    wanted, hidden = layout.panel_names(results, names), []
+    if hide_flat:
+        wanted, hidden = layout.drop_flat([results], wanted)
+    rows, n_cols = layout.rows(results, wanted)
+    note = layout.flat_note(results, hidden)
+    size = layout.figure_size(n_cols, len(rows), title=bool(title), note=bool(note))
     width, height = (round(v * DPI) for v in size)
     canvas = Canvas(width, height)
     panels = [[_PanelView(results, name) for name in row] for row in rows]
-    xlim = _time_limits(results.t)
+    xlim = time_limits(results.t)
     boxes = _layout(canvas, panels, n_cols, xlim, title, note)
     placed = [(panel, boxes[i][j]) for i, row in enumerate(panels)
               for j, panel in enumerate(row)]
     for panel, box in placed:
         panel.draw_inside(canvas, box, results, xlim)
     canvas.clear_outside([box for _, box in placed])    # matplotlib clips lines to the axes
-    bottom = {j: i for i, row in enumerate(panels) for j in range(len(row))}
+    bottom = layout.last_in_column(panels)
     for i, row in enumerate(panels):
         for j, panel in enumerate(row):
             panel.draw_around(canvas, boxes[i][j], xlim, last=bottom[j] == i)
@@ -119,128 +114,23 @@ def render(results, *names, title=None, hide_flat=False):
     return canvas.image()
 
 
-def _note(results, hidden):
-    shown = [f"{n} = {float(np.ravel(results[n])[0]):.4g}" for n in hidden[:6]]
-    more = f" and {len(hidden) - 6} more" if len(hidden) > 6 else ""
-    return "constant, not drawn: " + ", ".join(shown) + more if hidden else ""
-
-
-# -- axes: limits, ticks and their labels, as matplotlib's defaults make them ----------------
-
-def _nonsingular(low, high, expander=0.05):
-    """matplotlib's ``nonsingular``: a range of zero width widened around its value."""
-    if not (math.isfinite(low) and math.isfinite(high)):
-        return -expander, expander
-    biggest = max(abs(low), abs(high))
-    if biggest < 1e-300 or high - low <= biggest * 1e-15:
-        if low == 0 and high == 0 or biggest < 1e-300:
-            return -expander, expander
-        return low - expander * abs(low), high + expander * abs(high)
-    return low, high
-
-
-def _time_limits(t):
-    t = np.asarray(t, dtype=float)
-    if len(t) > 1:
-        return float(t[0]), float(t[-1])
-    return _padded(t)
-
-
-def _padded(values):
-    """Autoscaled view limits: the finite data, widened by 5 % on each side."""
-    finite = np.asarray(values, dtype=float)
-    finite = finite[np.isfinite(finite)]
-    low, high = (float(finite.min()), float(finite.max())) if finite.size else (0.0, 1.0)
-    low, high = _nonsingular(low, high)
-    margin = 0.05 * (high - low)
-    return _nonsingular(low - margin, high + margin)
-
-
-def nice_ticks(low, high, length, label_size, per_label):
-    """matplotlib's AutoLocator (MaxNLocator, steps 1, 2, 2.5, 5, 10) on an axis ``length``
-    points long: as many ticks as labels of ``label_size`` points fit, ``per_label`` sizes
-    apart (3 on a time axis, 2 on a value axis), at most 10. Ticks may overhang the range."""
-    n_bins = max(1, min(9, int(length // (label_size * per_label))))
-    span = high - low
-    mean = (low + high) / 2
-    offset = 0.0
-    if span > 0 and abs(mean) / span >= 100:
-        offset = math.copysign(10 ** (math.log10(abs(mean)) // 1), mean)
-    scale = 10 ** (math.log10(span / n_bins) // 1)
-    lo, hi = low - offset, high - offset
-    steps = [s * scale for s in (0.1, 0.2, 0.25, 0.5, *STEPS[:-1], 10.0, 20.0)]
-    raw = (hi - lo) / n_bins
-    first = next(k for k, s in enumerate(steps) if s >= raw)
-    for step in reversed(steps[:first + 1]):
-        base = (lo // step) * step
-        tol = max(1e-10, abs(offset / step) * 1e-10 if offset else 1e-10)   # _Edge_integer
-        k_low = _edge(( lo - base) / step, tol, floor=True)
-        k_high = _edge((hi - base) / step, tol, floor=False)
-        ticks = np.arange(k_low, k_high + 1) * step + base
-        if ((ticks <= hi) & (ticks >= lo)).sum() >= 2:
-            break
-    return ticks + offset
-
-
-def _edge(x, tol, floor):
-    near = round(x)
-    if abs(x - near) < tol:
-        return near
-    return math.floor(x) if floor else math.ceil(x)
-
-
-def tick_labels(ticks, low, high):
-    """matplotlib's ScalarFormatter without offset: the labels of ``ticks`` (one number of
-    decimals for all), and the "1e−6" written above the axis when they are scaled."""
-    inside = [x for x in ticks if low - 1e-10 * (high - low) <= x <= high + 1e-10 * (high - low)]
-    biggest = max((abs(x) for x in inside), default=0.0)
-    oom = math.floor(math.log10(biggest)) if biggest else 0
-    power = oom if oom <= -5 or oom >= 6 else 0
-    locs = np.asarray(ticks if len(ticks) >= 2 else [*ticks, low, high], dtype=float)
-    locs = locs / 10.0 ** power
-    spread = float(np.ptp(locs)) or float(np.max(np.abs(locs))) or 1.0
-    spread_oom = math.floor(math.log10(spread))
-    decimals, thresh = max(0, 3 - spread_oom), 1e-3 * 10 ** spread_oom
-    while decimals >= 0 and np.abs(locs - np.round(locs, decimals)).max() < thresh:
-        decimals -= 1
-    decimals += 1
-    labels = []
-    for x in np.asarray(ticks, dtype=float) / 10.0 ** power:
-        text = f"{0.0 if abs(x) < 1e-8 else x:.{decimals}f}"
-        labels.append(text.replace("-", MINUS))
-    return labels, (f"1e{power}".replace("-", MINUS) if power else "")
-
-
-class _Axis:
-    """One axis of a panel: view limits, the ticks inside them and their labels."""
-
-    def __init__(self, low, high, length, per_label):
-        self.low, self.high = low, high
-        ticks = nice_ticks(low, high, length, FONT, per_label)
-        labels, self.offset = tick_labels(ticks, low, high)
-        span = 1e-10 * (high - low)
-        kept = [(x, s) for x, s in zip(ticks, labels) if low - span <= x <= high + span]
-        self.ticks = [x for x, _ in kept]
-        self.labels = [s for _, s in kept]
-
-
 # -- the figure: panel boxes from measured texts, then each panel drawn ----------------------
 
 class _PanelView:
-    """A panel's texts and curves (plot.py's ``_Panel``), and its value axis limits."""
+    """A panel's texts and curves (``plotlayout.Panel``), and its value axis limits."""
 
     def __init__(self, results, name):
-        meta = _Panel(results, name)
+        meta = layout.Panel(results, name)
         self.title, self.ylabel = meta.title, meta.ylabel
         values = np.asarray(results[name], dtype=float)
         self.curves = [values] if values.ndim == 1 else list(values.T)
         self.legend = ["xyz"[k % 3] for k in range(len(self.curves))] if values.ndim == 2 else []
-        self.ylim = _padded(values)
+        self.ylim = padded(values)
         self.events = [e["t"] for e in (getattr(results, "stats", None) or {}).get("events", ())]
 
     def axes(self, box, xlim):
         x0, y0, x1, y1 = box
-        return (_Axis(*xlim, (x1 - x0) / PX, 3), _Axis(*self.ylim, (y1 - y0) / PX, 2))
+        return (Axis(*xlim, (x1 - x0) / PX, 3, FONT), Axis(*self.ylim, (y1 - y0) / PX, 2, FONT))
 
     def mapping(self, box, xlim):
         """(x axis, y axis, time -> pixel column, value -> pixel row) of the panel in ``box``
@@ -295,11 +185,11 @@ class _PanelView:
             for x, label in zip(to_x(xaxis.ticks), xaxis.labels):
                 canvas.text((x, top), label, FONT, valign="top")
             canvas.text(((x0 + x1) / 2, top + canvas.height_of(FONT) + LABEL_PAD * PX),
-                        "time [s]", FONT, valign="top")
+                        layout.TIME_LABEL, FONT, valign="top")
         self._draw_legend(canvas, box)
 
     def _draw_legend(self, canvas, box):
-        """x, y, z right of the panel, as plot.py's ``_outside_legend`` places them."""
+        """x, y, z right of the panel, where matplotlib puts an outside legend (plot.py)."""
         if not self.legend:
             return
         size = SMALL * PX
@@ -326,16 +216,16 @@ def _finite_pieces(x, y):
 
 
 def _layout(canvas, panels, n_cols, xlim, title, note):
-    """The panels' boxes (x0, y0, x1, y1 in pixels, y down), every panel one size, margins
-    and gaps as wide as the texts they hold: plot.py's ``_fit_margins``, measured with
-    Pillow. Ticks are counted on the default subplot size first, as matplotlib does there."""
+    """The panels' boxes (x0, y0, x1, y1 in pixels, y down): the texts around each panel
+    measured with Pillow, placed by ``plotlayout.panel_boxes`` as ``plot.py`` places them.
+    Ticks are counted on the default subplot size first, as matplotlib does there."""
     n_rows = len(panels)
     width, height = canvas.width / PX, canvas.height / PX          # points
     guess = (0, 0, 0.775 * width / n_cols * PX, 0.77 * height / n_rows * PX)
     label_h = canvas.height_of(FONT) / PX
     left, right = [0.0] * n_cols, [0.0] * n_cols
     above, below = [0.0] * n_rows, [0.0] * n_rows
-    last = {j: i for i, row in enumerate(panels) for j in range(len(row))}
+    last = layout.last_in_column(panels)
     for i, row in enumerate(panels):
         for j, panel in enumerate(row):
             xaxis, yaxis = panel.axes(guess, xlim)
@@ -353,21 +243,12 @@ def _layout(canvas, panels, n_cols, xlim, title, note):
                         if xaxis.labels else 0.0
                     right[j] = max(right[j], overhang)
             below[i] = max(below[i], under)
-    top = EDGE + (canvas.height_of(SUPTITLE) / PX + GAP if title else 0.0)
-    bottom = EDGE + (canvas.height_of(SMALL) / PX + GAP if note else 0.0)
-    x0, x1 = left[0] + EDGE, width - right[-1] - EDGE
-    y_top, y_bottom = top + above[0], height - bottom - below[-1]
-    wgaps = [right[j] + left[j + 1] + GAP for j in range(n_cols - 1)] + [0.0]
-    hgaps = [below[i] + above[i + 1] + GAP for i in range(n_rows - 1)] + [0.0]
-    panel_w = (x1 - x0 - sum(wgaps)) / n_cols
-    panel_h = (y_bottom - y_top - sum(hgaps)) / n_rows
-    boxes = []
-    for i in range(n_rows):
-        y = y_top + i * panel_h + sum(hgaps[:i])
-        boxes.append([tuple(v * PX for v in (x0 + j * panel_w + sum(wgaps[:j]), y,
-                                            x0 + (j + 1) * panel_w + sum(wgaps[:j]),
-                                            y + panel_h)) for j in range(n_cols)])
-    return boxes
+    boxes = layout.panel_boxes((width, height), left, right, above, below,
+                               [canvas.height_of(SUPTITLE) / PX] if title else [],
+                               [canvas.height_of(SMALL) / PX] if note else [])
+    if boxes is None:               # texts fill the figure (not at figure_size's sizes)
+        boxes = [[(0.0, 0.0, 1.0, 1.0)] * n_cols for _ in range(n_rows)]
+    return [[tuple(v * PX for v in box) for box in row] for row in boxes]
 
 
 # -- drawing: Pillow at SCALE times the size, in the file's pixel coordinates ----------------

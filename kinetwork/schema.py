@@ -103,6 +103,9 @@ def _component(type_name):
     cls = REGISTRY[type_name]
     ref = reference(cls)
     params = {info["name"]: _param(cls.params[info["name"]], info) for info in ref["params"]}
+    # a parameter's other name (a joint's "axis" for n) is read too, never with it
+    params.update({alias: params[key] for alias, key in cls.aliases.items()})
+    both = [{"required": [alias, key]} for alias, key in cls.aliases.items()]
     required = [info["name"] for info in ref["params"] if info["required"]]
     ports = ", ".join(f"{p['name']} ({p['domain']})" for p in ref["ports"])
     return {
@@ -113,7 +116,8 @@ def _component(type_name):
             "name": {"type": "string", "pattern": IDENT},
             "type": {"const": type_name},
             "params": {"type": "object", "additionalProperties": False,
-                       "properties": params, "required": required},
+                       "properties": params, "required": required,
+                       **({"not": {"anyOf": both}} if both else {})},
         },
     }
 

@@ -52,6 +52,11 @@ def suggest(name, choices):
     return f" (did you mean {close[0]!r}?)" if close else ""
 
 
+def hint(suggestion):
+    """The hint of a Problem from ``suggest``'s text: "did you mean 'x'?" (None for '')."""
+    return suggestion.strip()[1:-1] or None if suggestion else None
+
+
 def quote(value, limit=QUOTE_LIMIT):
     """``repr(value)``, cut to ``limit`` characters: messages never echo unbounded input."""
     try:

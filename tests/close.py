@@ -14,10 +14,11 @@ RTOL = 1e-12
 
 def assert_same_numbers(a, b, rtol=RTOL):
     """``a`` and ``b`` equal to within ``rtol`` of the larger magnitude in either (an absolute
-    floor at that scale, so values that pass through zero are compared by their scale)."""
+    floor at that scale, so values that pass through zero are compared by their scale); NaN
+    where the other has NaN (a run that stopped: no value after)."""
     a, b = np.asarray(a, dtype=float), np.asarray(b, dtype=float)
     assert a.shape == b.shape, (a.shape, b.shape)
-    scale = max(np.max(np.abs(a), initial=0.0), np.max(np.abs(b), initial=0.0), 1e-300)
+    scale = max(np.nanmax(np.abs(a), initial=0.0), np.nanmax(np.abs(b), initial=0.0), 1e-300)
     np.testing.assert_allclose(a, b, rtol=rtol, atol=rtol * scale)
 
 

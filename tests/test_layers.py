@@ -3,7 +3,7 @@
 Every module is read with ``ast`` (nothing is imported): each import, at any depth (inside
 functions too), relative or absolute, is resolved to the kinetwork module it names. Layers,
 lowest first (the package docstring's list): the helpers ``errors``, ``util``, ``expr``,
-``units``, ``spatial``; ``components``; ``graph``; ``equations``; ``solver``; the faces
+``units``, ``spatial``, ``upcalls``; ``components``; ``graph``; ``equations``; ``solver``; the faces
 ``plot``, ``schema``, ``symbolic``, ``cli`` (and ``kinetwork/__init__.py``, which gathers
 them all). A module of a sub-package is in its package's layer. A module may import from its
 own layer and those below it; the imports must not form a cycle, within a layer either.
@@ -19,10 +19,10 @@ import pytest
 import kinetwork
 
 PACKAGE = pathlib.Path(kinetwork.__file__).resolve().parent
-LAYERS = [("errors", "util", "expr", "units", "spatial"), ("components",), ("graph",),
+LAYERS = [("errors", "util", "expr", "units", "spatial", "upcalls"), ("components",), ("graph",),
           ("equations",), ("solver", "simulation"),
-          ("plot", "plotworker", "quickplot", "schema", "symbolic", "animation", "diagram", "urdf",
-           "examples", "studio", "analysis", "cli", "__main__", "")]
+          ("plot", "plotlayout", "plotworker", "quickplot", "schema", "symbolic", "animation",
+           "diagram", "urdf", "examples", "studio", "analysis", "fmu", "cli", "__main__", "")]
 RANK = {name: rank for rank, names in enumerate(LAYERS) for name in names}
 
 
@@ -120,3 +120,28 @@ def test_imports_are_resolved_to_modules(source, module, expected, monkeypatch, 
     fake.write_text(source + "\n")
     monkeypatch.setitem(MODULES, module, fake)
     assert [target for _, target in imports(module)] == [expected]
+
+
+def test_the_two_plot_renderers_share_one_layout_module():
+    """plot.py (matplotlib) and quickplot.py (Pillow) both draw the layout plotlayout.py
+    decides (panels, ticks, labels, margins); neither imports the other."""
+    for module, other in (("kinetwork.plot", "kinetwork.quickplot"),
+                          ("kinetwork.quickplot", "kinetwork.plot")):
+        targets = {target for _, target in imports(module)}
+        assert other not in targets and "kinetwork.plotlayout" in targets
+
+
+def test_components_are_free_of_casadi_at_import():
+    """A component declares; it builds CasADi expressions only when the equations ask (its
+    methods import CasADi): importing every library, building components and reading a model
+    file without validating it load no CasADi (``components/quantities.py`` says so)."""
+    import subprocess
+    import sys
+    seed = PACKAGE.parent / "models" / "double_pendulum.json"
+    program = ("import sys, kinetwork as kn, kinetwork.components, kinetwork.spatial\n"
+               "kn.multibody.Revolute('j', n=[0, 0, 1]); kn.rotational.IdealGear('g', ratio=2)\n"
+               f"kn.load({str(seed)!r}, validate=False)\n"
+               "print('casadi' in sys.modules)\n")
+    done = subprocess.run([sys.executable, "-c", program], capture_output=True, text=True)
+    assert done.returncode == 0, done.stderr[-2000:]
+    assert done.stdout.strip() == "False"

@@ -14,7 +14,7 @@ import pytest
 from PIL import Image
 
 import kinetwork as kn
-from kinetwork import quickplot
+from kinetwork import plotlayout, quickplot
 from kinetwork.plot import plot_results
 from kinetwork.plotworker import PlotSignal
 from kinetwork.solver.results import Results
@@ -159,7 +159,7 @@ def test_ticks_and_labels_are_matplotlib_s(bins):
         ax.ticklabel_format(axis="y", useOffset=False)
         ax.set_ylim(low, high)
         expected = locator.tick_values(low, high)
-        ticks = quickplot.nice_ticks(low, high, bins * 20.0 + 1.0, 10.0, 2)
+        ticks = plotlayout.nice_ticks(low, high, bins * 20.0 + 1.0, 10.0, 2)
         np.testing.assert_allclose(ticks, expected, rtol=1e-12, atol=1e-12 * (high - low))
         step = np.diff(ticks)[0]
         mantissa = step / 10.0 ** np.floor(np.log10(step) + 1e-9)
@@ -167,7 +167,7 @@ def test_ticks_and_labels_are_matplotlib_s(bins):
         assert ticks[0] <= low + 1e-9 * step and ticks[-1] >= high - 1e-9 * step
         formatter = ax.yaxis.get_major_formatter()
         labels = formatter.format_ticks(expected)
-        mine, offset = quickplot.tick_labels(ticks, low, high)
+        mine, offset = plotlayout.tick_labels(ticks, low, high)
         assert mine == labels, (low, high)
         assert offset == formatter.get_offset(), (low, high)
 

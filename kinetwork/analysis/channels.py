@@ -118,7 +118,7 @@ class Plant:
 
     def _reached(self, t, p):
         """The full state a simulation (the model's settings) reaches at time t."""
-        from ..solver.driver import simulate
+        from ..solver.plan import simulate
         if t == 0.0:
             return np.concatenate(self.system.initial_full_p(p))
         if t < 0:
@@ -166,6 +166,14 @@ def plant(model, inputs=()):
     units = [_input_unit(flat, name) for name in inputs]
     return Plant(system, source, inputs, units, [system.param_names.index(d) for d in names],
                  nominal)
+
+
+def driven(flat, inputs):
+    """A twin of the flat model ``flat`` in which each input of ``inputs`` (a signals.Input
+    block's name, or an open signal input "component.port") is the value of a new model
+    parameter: (twin, the names of those parameters, the inputs' operating values). What an
+    analysis and an exported FMU drive a model through."""
+    return _twin(flat, list(inputs))
 
 
 def _twin(flat, inputs):

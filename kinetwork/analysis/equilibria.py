@@ -11,6 +11,7 @@ import numpy as np
 from ..equations.modes import operating_modes
 from ..equations.system import System
 from ..errors import ModelError, SimulationError
+from ..solver.plan import lifted_model
 from ..util import quote, suggest
 from .channels import plant
 
@@ -51,12 +52,14 @@ def equilibrium(model, at=None, inputs=(), free=(), fix=None, params=None, t=0.0
         Input channels (open signal inputs ``"motor.u"``, ``signals.Input`` blocks), held at
         their operating values, or at the values a dict gives, unless freed.
     free : list of str
-        Inputs or model parameters to solve for (trim): each frees one equation, so as many
-        states must be held in ``fix``.
+        Inputs or parameters to solve for (trim): each frees one equation, so as many states
+        must be held in ``fix``. A parameter is a model parameter or a component parameter by
+        path (``"spring.c"``, lifted to a model parameter once, see ``kn.simulate``).
     fix : dict, optional
         {state name: value} held; the other states are solved for.
     params : dict, optional
-        Model parameter values (the starting values of freed ones).
+        Parameter values (model parameters, or component parameters by path), the starting
+        values of freed ones.
     t : float
         Time at which the rates are taken (for sources given in time).
     tol : float
@@ -74,9 +77,15 @@ def equilibrium(model, at=None, inputs=(), free=(), fix=None, params=None, t=0.0
     names = list(inputs) if not isinstance(inputs, str) else [inputs]
     free = [free] if isinstance(free, str) else list(free)
     flat = (model.model if isinstance(model, System) else model).flat()
-    # a freed input need not be listed in inputs as well
+    # a freed input need not be listed in inputs as well; a freed or given component
+    # parameter by path ("spring.c") is lifted to a model parameter
     names += [k for k in free if k not in flat.parameters and k not in names
-              and (k in flat.components or "." in k)]
+              and (k in flat.components or _is_input(flat, k))]
+    lifted = [k for k in [*free, *(params or {})] if k not in names]
+    model, aliases = lifted_model(model, lifted)
+    params = {aliases.get(k, k): v for k, v in (params or {}).items()}
+    free = [aliases.get(k, k) for k in free]
+    shown = {v: k for k, v in aliases.items()}
     pl = plant(model, names)
     s = pl.system
     p = pl.param_vector(params, given, t)
@@ -123,7 +132,7 @@ def equilibrium(model, at=None, inputs=(), free=(), fix=None, params=None, t=0.0
         it += more
     if norm <= tol:
         operating_modes(s, t, X, p)          # a stuck friction holds within its limit
-        return _done(pl, t, X, p, states, where, norm, it, J, unknown)
+        return _done(pl, t, X, p, states, where, norm, it, J, unknown, shown)
     worst = np.argsort(-np.abs(R))[:3] if n else []
     rates = ", ".join(f"d({states[k]})/dt = {R[k]:.3g}" if k < s.n_states else
                       f"closure of {states[k]}: {R[k]:.3g}" for k in worst)
@@ -133,6 +142,13 @@ def equilibrium(model, at=None, inputs=(), free=(), fix=None, params=None, t=0.0
         f"there may be none (a load nothing can hold), or none near the start: give another "
         f"'at'",
         reason="no equilibrium")
+
+
+def _is_input(flat, name):
+    """Whether ``name`` ("motor.u") is a signal input of a component of ``flat``."""
+    comp, _, port = name.rpartition(".")
+    spec = getattr(flat.components.get(comp), "ports", {}).get(port)
+    return spec is not None and spec.domain == "signal_in"
 
 
 def _newton(evaluate, v, tol, max_iter):
@@ -176,7 +192,7 @@ def _trust_region(evaluate, v0, tol, max_iter):
     return out.x, R, J, float(np.max(np.abs(R))), int(out.nfev)
 
 
-def _done(pl, t, X, p, states, where, norm, iterations, J, unknown):
+def _done(pl, t, X, p, states, where, norm, iterations, J, unknown, shown):
     s = pl.system
     # directions Newton leaves free: the null space of the Jacobian in the unknowns
     sv, vec = np.linalg.svd(J)[1:] if J.size else (np.zeros(0), np.zeros((0, 0)))
@@ -185,8 +201,8 @@ def _done(pl, t, X, p, states, where, norm, iterations, J, unknown):
     loose = sorted({unknown[k] for row in null for k in np.flatnonzero(np.abs(row[:len(unknown)])
                                                                        > 1e-6)})
     return Equilibrium(t, X.copy(), states, pl.input_values(p),
-                       {s.param_names[k]: float(p[k]) for k in where
-                        if k not in pl.input_index}, float(norm), iterations,
+                       {shown.get(s.param_names[k], s.param_names[k]): float(p[k])
+                        for k in where if k not in pl.input_index}, float(norm), iterations,
                        [states[k] for k in loose])
 
 

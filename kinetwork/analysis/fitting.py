@@ -14,11 +14,10 @@ import pathlib
 
 import numpy as np
 
-from ..equations.system import System
 from ..errors import ModelError, SimulationError
 from ..util import quote, suggest
 from .channels import output_channels
-from .sensitivities import DEFAULTS, evaluate, param_index, trajectory
+from .sensitivities import Trajectory, analysis_plan, param_index
 
 
 class Fit:
@@ -66,7 +65,9 @@ def fit(model, data, params, columns=None, values=None, weights=None, level=0.95
         values}.
     params : dict or list
         Parameters to fit: name -> (low, high) bounds (None for no bound on that side), or a
-        list of names (unbounded). Each starts at the model's value (clipped into bounds).
+        list of names (unbounded): model parameters, or component parameters by path
+        (``"spring.c"``, lifted to model parameters once, see ``kn.simulate``). Each starts
+        at the model's value (clipped into bounds).
     columns : list of str, optional
         Measured columns to fit (default: every column the model has a probe or state for).
     values : dict, optional
@@ -78,18 +79,22 @@ def fit(model, data, params, columns=None, values=None, weights=None, level=0.95
         Confidence level of the intervals (default 0.95), from the Jacobian at the optimum:
         covariance s^2 (J^T J)^-1 with s^2 the residual variance, Student's t quantile.
     rtol, atol : float
-        Tolerances of the integrations (default: the model's settings).
+        Tolerances of the integrations (default: the model's settings), meaning what they
+        mean for ``kn.simulate``: the trajectories are the model's integration plan's.
 
     Returns
     -------
     Fit
     """
     from scipy import optimize, stats
-    system = model if isinstance(model, System) else model.compile()
     t, table = _read(data)
     bounds = _bounds(params)
-    index = param_index(system, list(bounds))
-    names = [system.param_names[k] for k in index]
+    names = list(bounds)
+    # the integration starts at t = 0; data from a later time skips the first point
+    grid, skip = (t, 0) if t[0] == 0.0 else (np.concatenate([[0.0], t]), 1)
+    plan = analysis_plan(model, names + list(values or {}), grid, None, None, rtol, atol, None)
+    system = plan.system
+    index = param_index(plan, names)
     wanted = columns if columns is not None else [c for c in table if _known(system, c)]
     if isinstance(wanted, str):
         wanted = [wanted]
@@ -103,18 +108,14 @@ def fit(model, data, params, columns=None, values=None, weights=None, level=0.95
     cols, _, rows = output_channels(system, wanted)
     measured = np.column_stack([table[c] for c in cols])
     w = _weights(cols, measured, weights)
-    p = system.param_vector(values)
+    p = plan.vector(values)
     lo = np.array([bounds[k][0] for k in names])
     hi = np.array([bounds[k][1] for k in names])
     start = np.clip(p[index], lo, hi)
     if len(t) * len(cols) <= len(index):
         raise ModelError(f"data: {len(t) * len(cols)} values cannot fit {len(index)} "
                          f"parameters (more data than parameters are needed)")
-    # the integration starts at t = 0; data from a later time skips the first point
-    grid, skip = (t, 0) if t[0] == 0.0 else (np.concatenate([[0.0], t]), 1)
-    settings = {**DEFAULTS, **system.model.simulation}
-    f = trajectory(system, index, rows, grid, rtol or settings["rtol"],
-                   atol or settings["atol"])
+    f = Trajectory(plan, index, rows)
     memo = {}
 
     def solve(v):
@@ -123,7 +124,7 @@ def fit(model, data, params, columns=None, values=None, weights=None, level=0.95
             memo.clear()
             q = p.copy()
             q[index] = v
-            Y, J = evaluate(f, system, q, index)
+            Y, J = f.evaluate(q)
             n_out = len(rows)
             J = J.reshape(len(grid), n_out, -1)[skip:]
             memo[key] = (((Y[skip:] - measured) * w).ravel(),

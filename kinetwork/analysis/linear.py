@@ -13,6 +13,7 @@ import numpy as np
 
 from ..equations.modes import operating_modes
 from ..errors import ModelError
+from ..solver.plan import lifted_model
 from .channels import output_channels, output_expression, plant
 
 #: System -> {(input positions, output rows): the Jacobians' Function}
@@ -110,7 +111,9 @@ def linearize(model, at=None, inputs=(), outputs=None, params=None):
         Probe quantities (``"probe1.angle"``, ``"probe.position[1]"``; a vector's name for
         all its entries) or state names; default: every probe quantity.
     params : dict, optional
-        Model parameter values.
+        Parameter values: model parameters, or component parameters by path
+        (``"spring.c"``, lifted to model parameters once, see ``kn.simulate``); numbers, or
+        numbers with a unit.
 
     Returns
     -------
@@ -119,6 +122,8 @@ def linearize(model, at=None, inputs=(), outputs=None, params=None):
     """
     # at an Equilibrium: its inputs, and the parameters it solved for
     params = {**(params or {}), **(getattr(at, "params", None) or {})}
+    model, aliases = lifted_model(model, list(params))
+    params = {aliases.get(k, k): v for k, v in params.items()}
     pl = plant(model, inputs)
     s = pl.system
     input_values = getattr(at, "inputs", None) or {}

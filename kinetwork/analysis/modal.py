@@ -115,7 +115,8 @@ def plot_bode(lin, inputs=None, outputs=None, omega=None, figsize=None):
     -------
     matplotlib.figure.Figure
     """
-    from ..plot import _pyplot, unit_label
+    from ..plot import pyplot
+    from ..plotlayout import unit_label
     inputs = lin.input_names if inputs is None else \
         [inputs] if isinstance(inputs, str) else list(inputs)
     outputs = lin.output_names if outputs is None else \
@@ -127,7 +128,7 @@ def plot_bode(lin, inputs=None, outputs=None, omega=None, figsize=None):
     if not inputs or not outputs:
         raise ModelError("bode: name at least one input and one output")
     omega = default_omega(lin) if omega is None else np.asarray(omega, dtype=float)
-    plt = _pyplot()
+    plt = pyplot()
     n_rows, n_cols = 2 * len(outputs), len(inputs)
     fig, axes = plt.subplots(n_rows, n_cols, squeeze=False, sharex=True, layout="constrained",
                              figsize=figsize or (0.4 + 4.0 * n_cols, 0.3 + 2.0 * n_rows))

@@ -1,6 +1,7 @@
 """Parameter sensitivities along a trajectory: d(probe)/d(parameter) at every output time,
 from the forward sensitivities CasADi's integrators (CVODES, IDAS) compute when a Function
-through them is differentiated; no finite differences.
+through them is differentiated; no finite differences. The integrator is the model's
+integration plan's (``kinetwork.solver.plan``): its method, its tolerances.
 
 The initial state follows the parameters too: exactly, by its own expressions, for a model
 without loops; with loops the dependent coordinates follow the closure (the implicit
@@ -12,7 +13,8 @@ import numpy as np
 
 from ..equations.system import System
 from ..errors import ModelError, SimulationError
-from ..util import quote, suggest
+from ..solver.plan import Plan
+from ..util import suggest
 from .channels import output_channels
 
 DEFAULTS = {"t_end": 10.0, "n_points": 1001, "rtol": 1e-8, "atol": 1e-10}
@@ -50,77 +52,65 @@ class Sensitivity:
 
 
 def sensitivity(model, params, t_end=None, n_points=None, outputs=None, values=None,
-                rtol=None, atol=None, t=None):
+                rtol=None, atol=None, t=None, method=None, jit=None):
     """d(output)/d(parameter) along the trajectory of ``model``.
+
+    The trajectory is integrated by the model's integration plan (``kinetwork.solver.plan``):
+    the method ``kn.simulate`` would take (``auto``: Adams, or BDF when the stiffness test
+    says so, BDF again when Adams fails), with the same mapping of the tolerance asked to the
+    solver's, so that rtol means for the values and their sensitivities what it means for a
+    run; CasADi derives the forward sensitivities of that integrator, their errors controlled
+    with the states'.
 
     Parameters
     ----------
     model : Model or System
     params : list of str
-        Model parameters to differentiate with respect to.
+        Parameters to differentiate with respect to: model parameters, or component
+        parameters by path (``"spring.c"``, lifted to model parameters once, see
+        ``kn.simulate``).
     t_end, n_points : float, int
         The output grid from 0 (default: the model's simulation settings); or ``t``, the
         output times themselves (increasing, from 0).
     outputs : list of str, optional
         Probe quantities or states (as ``kn.linearize``'s); default every probe quantity.
     values : dict, optional
-        Model parameter values at which to differentiate.
+        Parameter values at which to differentiate (numbers, or numbers with a unit).
     rtol, atol : float
-        Tolerances of the integration (its sensitivities are controlled to them too).
+        Tolerances (default: the model's settings, else 1e-8 and 1e-10).
+    method : str, optional
+        A CasADi method (``auto``, ``cvodes``, ``cvodes-adams``, ``idas``, ``rk``,
+        ``collocation``): the others have no sensitivities to give.
 
     Returns
     -------
     Sensitivity
     """
-    system = model if isinstance(model, System) else model.compile()
-    settings = {**DEFAULTS, **{k: v for k, v in system.model.simulation.items()
-                               if k in DEFAULTS}}
+    names = _names(params)
+    plan = analysis_plan(model, names + list(values or {}), t, t_end, n_points, rtol, atol, method,
+                 jit)
+    system = plan.system
+    out_names, units, rows = output_channels(system, outputs)
+    index = param_index(plan, names)
+    p = plan.vector(values)
+    f = Trajectory(plan, index, rows)
+    Y, J = f.evaluate(p)
+    return Sensitivity(plan.grid, out_names, units, names, Y,
+                       J.reshape(len(plan.grid), len(rows), len(index)))
+
+
+def analysis_plan(model, names, t, t_end, n_points, rtol, atol, method, jit=None):
+    """The integration plan of a sensitivity or a fit: the model's settings, with this
+    module's DEFAULTS where it has none."""
+    simulation = getattr(model.model if isinstance(model, System) else model, "simulation", {})
+    settings = {**DEFAULTS, **{k: v for k, v in simulation.items() if k in DEFAULTS}}
+    given = {"rtol": rtol, "atol": atol, "method": method}
+    settings.update({k: v for k, v in given.items() if v is not None})
     grid = _grid(t, t_end if t_end is not None else settings["t_end"],
                  n_points if n_points is not None else settings["n_points"])
-    names, units, rows = output_channels(system, outputs)
-    index = param_index(system, params)
-    p = system.param_vector(values)
-    f = trajectory(system, index, rows, grid, rtol or settings["rtol"], atol or settings["atol"])
-    Y, J = evaluate(f, system, p, index)
-    return Sensitivity(grid, names, units, [system.param_names[k] for k in index], Y,
-                       J.reshape(len(grid), len(rows), len(index)))
-
-
-def param_index(system, params):
-    """Positions in p of the named model parameters (ModelError naming unknown ones)."""
-    if isinstance(params, str):
-        params = [params]
-    params = list(params)
-    bad = [k for k in params if k not in system.param_names]
-    if bad or not params:
-        raise ModelError([f"params: {quote(k)} is not a model parameter"
-                          f"{suggest(k, system.param_names)}; parameters are "
-                          f"{', '.join(system.param_names) or 'none'}" for k in bad] or
-                         ["params: name at least one model parameter"])
-    if len(set(params)) != len(params):
-        raise ModelError(f"params: named twice in {params}")
-    return [system.param_names.index(k) for k in params]
-
-
-def evaluate(f, system, p, index):
-    """(outputs (n_t, n_out), Jacobian (n_t * n_out, n_params)) of a ``trajectory``
-    Function at the parameter vector p."""
-    p = np.asarray(p, dtype=float)
-    x0, z0 = system.initial_full_p(p)
-    try:
-        Y, J = f(p[index], p, x0, z0)
-    except RuntimeError as exc:
-        raise SimulationError(f"the integration of the sensitivities failed: "
-                              f"{str(exc).splitlines()[-1][:300]}",
-                              reason="integration of the sensitivities failed") from None
-    Y, J = np.asarray(Y, dtype=float), np.asarray(J, dtype=float)
-    if not (np.all(np.isfinite(Y)) and np.all(np.isfinite(J))):
-        raise SimulationError("the outputs or their sensitivities are not finite",
-                              reason="not finite")
-    # Y is (n_out, n_t) column-major: rows of J follow vec(Y), time-major after the .T
-    n_out, n_t = Y.shape
-    J = J.reshape(n_t, n_out, -1)
-    return Y.T, J.reshape(n_t * n_out, -1)
+    settings.pop("t_end")
+    settings.pop("n_points")
+    return Plan(model, names=names, grid=grid, jit=jit, **settings)
 
 
 def _grid(t, t_end, n_points):
@@ -136,11 +126,92 @@ def _grid(t, t_end, n_points):
     return grid
 
 
-def trajectory(system, index, rows, grid, rtol, atol):
-    """The Function (p[index], p, x0, z0) -> (outputs on the grid (n_rows, n_t), their
-    Jacobian in p[index]): an integrator whose forward sensitivities CasADi derives. x0 and
-    z0 are the initial state at p (``System.initial_full_p``), which a model without loops
-    replaces by its start's own expressions in p (so that they are differentiated too)."""
+def _names(params):
+    if isinstance(params, str):
+        params = [params]
+    params = list(params)
+    if not params:
+        raise ModelError("params: name at least one parameter")
+    if len(set(params)) != len(params):
+        raise ModelError(f"params: named twice in {params}")
+    return params
+
+
+def param_index(plan, params):
+    """Positions in p of the named parameters (ModelError naming unknown ones)."""
+    problems, index = [], []
+    for k in params:
+        try:
+            index.append(plan.system.param_names.index(plan.param_name(k)))
+        except ModelError as exc:
+            problems.extend(exc.problems)
+    if problems:
+        raise ModelError(problems)
+    return index
+
+
+class Trajectory:
+    """The plan's trajectory as a Function of the parameters: (p[index], p, x0, z0) ->
+    (outputs ``rows`` on the grid (n_rows, n_t), their Jacobian in p[index]), one for each
+    method the plan tries in turn (``auto``: Adams, then BDF); CasADi derives the forward
+    sensitivities of each integrator. x0 and z0 are the initial state at p, which a model
+    without loops replaces by its start's own expressions in p (so that they are
+    differentiated too)."""
+
+    def __init__(self, plan, index, rows):
+        self.plan, self.index, self.rows = plan, list(index), list(rows)
+        self.functions = {}
+        self.method = None              # the one that worked last
+
+    def evaluate(self, p):
+        """(outputs (n_t, n_out), Jacobian (n_t * n_out, n_params)) at the parameter
+        vector p; a failed integration is the SimulationError ``kn.simulate`` raises for p,
+        with its results up to the failure."""
+        plan, system = self.plan, self.plan.system
+        p = np.asarray(p, dtype=float)
+        x0 = plan.start(p)
+        nx = system.n_states
+        names = [self.method] if self.method else plan.methods(plan.new_run(p, x0))[0]
+        failure = None
+        for name in names:
+            f = self._function(name)
+            try:
+                Y, J = f(p[self.index], p, x0[:nx], x0[nx:])
+            except RuntimeError as exc:
+                failure = exc
+                continue
+            Y, J = np.asarray(Y, dtype=float), np.asarray(J, dtype=float)
+            if np.all(np.isfinite(Y)) and np.all(np.isfinite(J)):
+                self.method = name
+                # Y is (n_out, n_t) column-major: rows of J follow vec(Y), time-major
+                n_out, n_t = Y.shape
+                return Y.T, J.reshape(n_t * n_out, -1)
+            failure = RuntimeError("the outputs or their sensitivities are not finite")
+        self.method = None
+        self._fail(p, failure)
+
+    def _fail(self, p, failure):
+        """Raise what ``kn.simulate`` says for p, or, when it runs, that the sensitivities
+        failed (its results attached)."""
+        try:
+            results = self.plan.run(p=p)
+        except SimulationError:
+            raise
+        words = str(failure).strip().splitlines()[-1][:300] if str(failure).strip() else ""
+        raise SimulationError(f"the integration of the sensitivities failed, though the "
+                              f"trajectory itself runs: {words}", results=results,
+                              t_reached=float(self.plan.grid[0]),
+                              reason="integration of the sensitivities failed")
+
+    def _function(self, name):
+        if name not in self.functions:
+            self.functions[name] = _trajectory(self.plan, name, self.index, self.rows)
+        return self.functions[name]
+
+
+def _trajectory(plan, name, index, rows):
+    """The Function of ``Trajectory`` for the method ``name``."""
+    system, grid = plan.system, plan.grid
     eq, a = system.eq, system.asm
     w = ca.MX.sym("w", len(index))
     pm = ca.MX.sym("p", a.p.numel())
@@ -150,14 +221,9 @@ def trajectory(system, index, rows, grid, rtol, atol):
     x0 = ca.MX.sym("x0", eq.x.numel())
     z0 = ca.MX.sym("z0", eq.z.numel())
     X0, Z0 = _start(system, P, x0, z0)
-    dae = {"x": eq.x, "z": eq.z, "p": a.p, "t": a.t, "ode": eq.ode, "alg": eq.alg}
-    if not system.n_algebraic:
-        dae = {k: v for k, v in dae.items() if k not in ("z", "alg")}
-    plugin = "idas" if system.n_algebraic else "cvodes"
-    opts = {"abstol": atol, "reltol": rtol, "max_num_steps": 100000,
-            "show_eval_warnings": False}
-    F = ca.integrator("sensitivity", plugin, dae, float(grid[0]), grid[1:].tolist(), opts)
-    res = F(x0=X0, z0=Z0, p=P) if system.n_algebraic else F(x0=X0, p=P)
+    F = plan.differentiable(name)
+    pt = ca.vertcat(P, float(grid[0]))
+    res = F(x0=X0, z0=Z0, p=pt) if system.n_algebraic else F(x0=X0, p=pt)
     XF = ca.horzcat(X0, res["xf"])
     if system.n_algebraic:
         XF = ca.vertcat(XF, ca.horzcat(Z0, res["zf"]))

@@ -63,12 +63,9 @@ the length). ``color`` is three numbers 0-255 (Modelica's), or 0-1 when none exc
 a "#rrggbb" string.
 """
 
-from ..solver.results import install_animator
 from .files import animate, cli_animate, html_page, player_script
 from .scene import FORMAT, VERSION, animation_data
 from .video import find_ffmpeg, write_gif, write_mp4
 
 __all__ = ["FORMAT", "VERSION", "animate", "animation_data", "cli_animate", "find_ffmpeg",
            "html_page", "player_script", "write_gif", "write_mp4"]
-
-install_animator(animate)

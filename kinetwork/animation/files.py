@@ -152,7 +152,7 @@ def cli_animate(args, model):
     """``kinetwork animate MODEL --html out.html [--gif out.gif] [--mp4 out.mp4]``: simulate
     the model (its ``simulation`` block, ``--t-end``) and write its animation."""
     from ..errors import SimulationError
-    from ..solver.driver import simulate
+    from ..solver.plan import simulate
     outputs = [("--html", args.html), ("--gif", args.gif), ("--mp4", args.mp4)]
     outputs = [(flag, path) for flag, path in outputs if path]
     if not outputs:

@@ -9,6 +9,8 @@ import warnings
 
 import numpy as np
 
+from ..errors import KinetworkWarning
+
 #: triangles per mesh at most, as drawn
 FACES = 500
 #: cells per side of the clustering grids tried, finest first
@@ -21,8 +23,8 @@ def mesh(path, faces=FACES):
     try:
         stamp = os.stat(path).st_mtime_ns
     except OSError:
-        warnings.warn(f"animation: mesh file {path!r:.200} not found: drawn without it",
-                      stacklevel=3)
+        warnings.warn(KinetworkWarning(f"animation: mesh file {path!r:.200} not found: drawn "
+                                       f"without it"), stacklevel=3)
         return None
     return _read(os.path.abspath(path), stamp, faces)
 
@@ -32,15 +34,17 @@ def _read(path, stamp, faces):
     try:
         import trimesh
     except ImportError:
-        warnings.warn("animation: meshes need trimesh (pip install trimesh pycollada): the "
-                      "robot is drawn without them", stacklevel=4)
+        warnings.warn(KinetworkWarning("animation: meshes need trimesh (pip install trimesh "
+                                       "pycollada): the robot is drawn without them"),
+                      stacklevel=4)
         return None
     try:
         loaded = trimesh.load(path, force="mesh", process=False)
         vertices = np.asarray(loaded.vertices, dtype=float)
         triangles = np.asarray(loaded.faces, dtype=np.int64).reshape(-1, 3)
     except Exception as exc:         # a loader's own error, whatever it is: drawn without
-        warnings.warn(f"animation: cannot read mesh {path!r:.200}: {exc}", stacklevel=4)
+        warnings.warn(KinetworkWarning(f"animation: cannot read mesh {path!r:.200}: {exc}"),
+                      stacklevel=4)
         return None
     if not len(triangles) or not np.all(np.isfinite(vertices)):
         return None

@@ -6,7 +6,7 @@ import math
 import casadi as ca
 import numpy as np
 
-from ..equations.system import mapped
+from ..equations.system import pointwise
 from ..errors import ModelError
 from .meshes import mesh as mesh_file
 
@@ -82,7 +82,7 @@ def animation_data(results, fps=None, model=None):
 
 def _frame_poses(system, results, params):
     """(frames, {frame set: index}, positions, rotations) of every frame connection set: one
-    mapped call of ``System.f_frames`` over the grid; positions (n, 3) and rotations
+    mapped evaluation of ``System.f_frames`` over the grid; positions (n, 3) and rotations
     (n, 3, 3) per frame."""
     t, sets = np.asarray(results.t, dtype=float), system.frame_sets
     if not sets:
@@ -90,8 +90,8 @@ def _frame_poses(system, results, params):
     if not len(t):
         raise ModelError("nothing to animate: the results hold no time point")
     p = system.param_vector(params)
-    out = np.asarray(mapped(system.f_frames, len(t))(t[None, :], results.states.T, p))
-    out = out.reshape(12, len(t), len(sets)).transpose(2, 1, 0)          # set, time, 12
+    out = pointwise(system.f_frames, t[:, None], results.states, p)[0]
+    out = out.reshape(len(t), len(sets), 12).transpose(1, 0, 2)          # set, time, 12
     bad = ~np.all(np.isfinite(out), axis=(0, 2))
     if bad.any():
         raise ModelError(f"cannot animate {system.model.name!r}: its poses are not finite from "
@@ -310,7 +310,7 @@ class Scene:
                 dict(_axes(k, self.L / 6), component=None)]
 
     # what each kind of component looks like
-    def joint(self, comp, v, axis="axis"):
+    def joint(self, comp, v, axis="n"):
         n = unit_vector(_get(v, axis, _Z))
         length, width = self.L / 10, self.L / 20
         return [_shape("cylinder", self.frame(comp, "frame_a"), -n * length / 2, n, length,
@@ -332,7 +332,7 @@ class Scene:
         return [e for e in ends if e is not None] + rod
 
     def prismatic(self, comp, v):
-        n = unit_vector(_get(v, "axis", _X))
+        n = unit_vector(_get(v, "n", _X))
         name = f"{comp.name}.q"
         q = self.results[name] if name in self.results else np.zeros(1)
         lo, hi = min(q.min(), 0.0), max(q.max(), 0.0)
@@ -459,7 +459,7 @@ def _color(value, default):
 #: type name -> how it looks; a subclass looks like its nearest registered ancestor
 VISUALS = {
     "multibody.Revolute": Scene.joint,
-    "multibody.Cylindrical": Scene.joint,
+    "multibody.Cylindrical": lambda s, c, v: s.joint(c, v, axis="axis"),
     "multibody.Prismatic": Scene.prismatic,
     "multibody.Spherical": Scene.ball,
     "multibody.Universal": Scene.ball,
@@ -474,6 +474,8 @@ VISUALS = {
     "multibody.BodyBox": lambda s, c, v: s.msl_body(c, v, "box"),
     "multibody.BodyCylinder": lambda s, c, v: s.msl_body(c, v, "cylinder"),
     "multibody.BodySphere": Scene.sphere_body,
+    "multibody.PointMass": lambda s, c, v: s.sphere_body(c, {"diameter": v.get("sphereDiameter"),
+                                                             "color": v.get("color")}),
     "multibody.SpringDamper": Scene.line_force,
     "multibody.Spring": Scene.line_force,
     "multibody.Damper": Scene.line_force,

@@ -13,9 +13,9 @@ import re
 import numpy as np
 
 from .. import units
-from ..errors import ModelError
+from ..errors import ModelError, Problem
 from ..expr import parse
-from ..util import check_number, quote, suggest
+from ..util import check_number, hint, quote, suggest
 from .reference import docstring, signature
 
 
@@ -63,8 +63,11 @@ class Port:
         return self if instance is None else PortRef(instance, self.name)
 
     def __set__(self, instance, value):
+        also = [key for key, spec in instance.params.items() if self.name in spec.aliases]
+        where = (f"; the parameter of that name in files is {instance.name}.{also[0]}"
+                 if also else "")
         raise ModelError(f"{instance.name}.{self.name} is a port, not a parameter: wire it with "
-                         f"model.connect")
+                         f"model.connect{where}", component=instance.name, port=self.name)
 
 
 class PortRef:
@@ -111,7 +114,7 @@ class Param:
 
     def __init__(self, default=REQUIRED, *, unit="", min=None, max=None, shape=(), doc="",
                  time=False, optional=False, nonzero=False, kind="real", choices=None,
-                 name=None, positive=False, signals=False):
+                 positive=False, signals=False, aliases=(), name=None):
         self.default, self.min, self.max = default, min, max
         # ``signals``: the expression may also read signal outputs of the model's components
         # by dotted name ("pos.y", "cyl1.pos.y"), as a force law in sensor signals
@@ -120,12 +123,20 @@ class Param:
         self.shape, self.doc, self.time, self.optional = tuple(shape), doc, time, optional
         self.nonzero, self.kind, self.choices = nonzero, kind, choices
         self.positive = positive
-        # ``name`` lets a parameter share its file name with a port (a joint's "axis")
+        # other names a keyword or a file may give it by, kept as written when saved: a
+        # joint's direction ``n`` (Modelica's name; its 1-D flange is ``axis``) was "axis"
+        self.aliases = tuple(aliases)
+        # a declaration in a class body is named by its attribute; ``name`` names one made
+        # outside a class (a subsystem's parameters)
         self.name = name
         self.__doc__ = self.describe()        # what help() shows under the attribute
 
     def __set_name__(self, owner, name):
-        self.name = self.name or name
+        if self.name not in (None, name):
+            # one name reads, writes, documents and files a parameter
+            raise TypeError(f"{owner.__name__}.{name}: a parameter declared in a class is "
+                            f"named by its attribute, not {self.name!r}")
+        self.name = name
 
     def __get__(self, instance, owner):
         return self if instance is None else instance._values[self.name]
@@ -165,7 +176,7 @@ class Param:
                 "default": None if self.required else _plain(self.default),
                 "min": self.min, "max": self.max, "positive": self.positive,
                 "nonzero": self.nonzero, "optional": self.optional, "time": self.time,
-                "signals": self.signals,
+                "signals": self.signals, "aliases": list(self.aliases),
                 "choices": list(self.choices) if self.choices else None, "doc": self.doc}
 
     def resolved(self, owner):
@@ -420,6 +431,10 @@ class Component:
     #: 1-D ports whose position is a joint coordinate (port -> coordinate index) or zero
     coordinate_ports = {}
     zero_ports = ()
+    #: another name a parameter is given by -> its name (``Param(aliases=...)``)
+    aliases = {}
+    #: parameter -> the alias it was given by, kept for the file it is saved to
+    _spelling = {}
     #: groups of signal ports that carry signals of one unit (an Add's inputs and output, a
     #: PID's set point and measurement): how units spread along signal wires to the plots
     same_unit_ports = ()
@@ -433,6 +448,7 @@ class Component:
         super().__init_subclass__(**kwargs)
         cls.ports = {}
         cls.params = {}
+        cls.aliases = {}
         for klass in reversed(cls.__mro__):
             for key, val in vars(klass).items():
                 if isinstance(val, Port):
@@ -442,6 +458,7 @@ class Component:
                     cls.ports[key] = val
                 elif isinstance(val, Param):
                     cls.params[val.name] = val.resolved(cls)
+        cls.aliases = {alias: key for key, spec in cls.params.items() for alias in spec.aliases}
         # a subclass declared without ``library=`` is not a file type (not its parent's either)
         cls.type_name = None
         cls._own_doc = inspect.cleandoc(vars(cls).get("__doc__") or "") or cls._own_doc
@@ -474,24 +491,43 @@ class Component:
                              f"(letters, digits, underscore; not starting with a digit{size})")
         object.__setattr__(self, "name", name)
         kind = self.type_name or type(self).__name__
-        problems = [f"{place(key)}: unknown parameter{suggest(key, self.params)}; "
-                    f"{kind} has {', '.join(self.params) or 'none'}"
-                    for key in params if key not in self.params]
+        problems = [Problem(f"{place(key)}: unknown parameter{close}; {kind} has "
+                            f"{self._listed()}", component=name, parameter=_cut(key),
+                            hint=hint(close))
+                    for key in params if key not in self.params and key not in self.aliases
+                    for close in [suggest(key, [*self.params, *self.aliases])]]
+        object.__setattr__(self, "_spelling", {})
+        for alias, key in self.aliases.items():
+            if alias in params and key in params:
+                problems.append(Problem(f"{place(alias)}: {alias} and {key} are one "
+                                        f"parameter; give {key} alone", component=name,
+                                        parameter=alias, hint=f"remove {alias}"))
+            elif alias in params:
+                params = {key if k == alias else k: v for k, v in params.items()}
+                self._spelling[key] = alias
         object.__setattr__(self, "given", {})
         object.__setattr__(self, "_values", {})
         for key, spec in self.params.items():
+            written = self._spelling.get(key, key)
             try:
                 if key in params:
-                    self.given[key] = spec.normalize(params[key], place(key))
+                    self.given[key] = spec.normalize(params[key], place(written))
                     self._values[key] = spec.si(self.given[key])
                 elif spec.required:
-                    problems.append(f"{place(key)}: a value is required ({spec.describe()})")
+                    problems.append(Problem(f"{place(key)}: a value is required "
+                                            f"({spec.describe()})", parameter=key))
                 else:
                     self._values[key] = spec.si(spec.normalize(spec.default, place(key)))
             except ModelError as exc:
-                problems.extend(exc.problems)
+                problems.extend(p.where(parameter=written) for p in exc.problems)
         if problems:
-            raise ModelError(problems)
+            raise ModelError(problems, component=name)
+
+    def _listed(self):
+        """The parameters, each with its other names: "cut, n (or axis), q0"."""
+        also = {key: [a for a, k in self.aliases.items() if k == key] for key in self.params}
+        return ", ".join(f"{key} (or {', '.join(also[key])})" if also[key] else key
+                         for key in self.params) or "none"
 
     def check_values(self, values, place):
         """Problems of the evaluated parameters ``values`` taken together (a hole no wider than
@@ -509,13 +545,29 @@ class Component:
         The new value is what ``Model.save``, ``numeric_values`` and ``simulate`` see; a
         compiled System of a model holding this component is rebuilt on its next use.
         """
-        if key not in self.params:
+        if key in self.aliases:
+            self._spelling = {**self._spelling, self.aliases[key]: key}
+            key = self.aliases[key]
+        elif key not in self.params:
+            close = suggest(key, self.params)
             raise ModelError(f"{type(self).__name__} {self.name!r} has no parameter "
-                             f"{quote(key)}{suggest(key, self.params)}; parameters: "
-                             f"{', '.join(self.params) or 'none'}")
-        value = self.params[key].normalize(value, f"{self.name}.{key}")
+                             f"{quote(key)}{close}; parameters: {self._listed()}",
+                             component=self.name, hint=hint(close),
+                             parameter=_cut(key) if isinstance(key, str) else None)
+        elif key in self._spelling:
+            self._spelling = {k: v for k, v in self._spelling.items() if k != key}
+        try:
+            value = self.params[key].normalize(value, f"{self.name}.{key}")
+        except ModelError as exc:
+            raise ModelError(exc.problems, component=self.name, parameter=key) from None
         self.given[key] = value
         self._values[key] = self.params[key].si(value)
+
+    def written_params(self):
+        """The given parameters as a file holds them: each by the name it was given by (a
+        joint's ``n`` given as ``axis`` is saved as ``axis``)."""
+        return {self._spelling.get(key, key): copy.deepcopy(value)
+                for key, value in self.given.items()}
 
     def __setattr__(self, key, value):
         declared = getattr(type(self), key, None)
@@ -524,31 +576,38 @@ class Component:
             return
         if key == "name":
             raise ModelError(f"{self.name!r}: a component cannot be renamed; build a new one "
-                             f"(a model refers to its components by name)")
-        if key in self.params:         # a parameter whose attribute has another name
+                             f"(a model refers to its components by name)",
+                             component=self.name)
+        if key in self.params or key in self.aliases:     # a subsystem's, or another name
             self.set_param(key, value)
             return
+        close = suggest(key, [*self.params, *self.ports])
         raise ModelError(f"{type(self).__name__} {self.name!r} has no parameter "
-                         f"{quote(key)}{suggest(key, [*self.params, *self.ports])}; change a "
-                         f"parameter with comp.<parameter> = value or comp.set_param(name, "
-                         f"value); parameters: {', '.join(self.params) or 'none'}")
+                         f"{quote(key)}{close}; change a parameter with comp.<parameter> = "
+                         f"value or comp.set_param(name, value); parameters: "
+                         f"{self._listed()}", component=self.name, hint=hint(close))
 
     def __delattr__(self, key):
-        raise ModelError(f"{self.name}.{key}: parameters and ports cannot be deleted")
+        raise ModelError(f"{self.name}.{key}: parameters and ports cannot be deleted",
+                         component=self.name)
 
     def __getattr__(self, key):
         # reached only when normal lookup fails: a misspelt port or parameter
         if key.startswith("_"):
             raise AttributeError(key)
+        close = suggest(key, [*self.ports, *self.params])
         raise ModelError(f"{type(self).__name__} {self.name!r} has no port or parameter "
-                         f"{key!r}{suggest(key, [*self.ports, *self.params])}; ports: "
-                         f"{', '.join(self.ports)}")
+                         f"{key!r}{close}; ports: {', '.join(self.ports)}",
+                         component=self.name, hint=hint(close))
 
     def port_ref(self, name):
         """The ``PortRef`` called ``name``; a ModelError suggesting close names otherwise."""
         if name not in self.ports:
+            close = suggest(name, self.ports)
             raise ModelError(f"{type(self).__name__} {self.name!r} has no port {quote(name)}"
-                             f"{suggest(name, self.ports)}; ports: {', '.join(self.ports)}")
+                             f"{close}; ports: {', '.join(self.ports)}", component=self.name,
+                             port=_cut(name) if isinstance(name, str) else None,
+                             hint=hint(close))
         return PortRef(self, name)
 
     def bound(self, values):

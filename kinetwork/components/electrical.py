@@ -8,12 +8,11 @@ at every connection set, and solves the circuit by structural analysis (the conn
 are the alias elimination of the potentials; a block-lower-triangular sort of the rest).
 What a component is handed, ``e``, reads ``e.v("p")``, ``e.i("p")``, ``e.x`` (its states),
 ``e.t``, ``e.u`` (the signal at u, or None when unwired), ``e.parameters`` (the model's
-parameters as symbols), ``e.place(key)`` (where a parameter is, for messages) and, for an EMF,
-``e.w`` (the speed of its flange relative to its support). A law may be nonlinear (a diode):
-the circuit's solver then leaves the unknowns it reads nonlinearly to IDAS.
+parameters as symbols), ``e.place(key)`` and ``e.fields(key)`` (where a parameter is, for
+messages and as a Problem's fields) and, for an EMF, ``e.w`` (the speed of its flange
+relative to its support). A law may be nonlinear (a diode): the circuit's solver then leaves
+the unknowns it reads nonlinearly to IDAS.
 """
-
-import casadi as ca
 
 from ..errors import ModelError
 from ..expr import casadi_functions, parse
@@ -84,7 +83,8 @@ class NonlinearResistor(PartialTwoPin, library=LIB):
         if unknown:
             raise ModelError(f"{e.place('i')}: unknown name {unknown[0]!r} in {self.i!r}; "
                              f"names are v (the voltage), t and the model's parameters "
-                             f"{', '.join(e.parameters) or '(none)'}")
+                             f"{', '.join(e.parameters) or '(none)'}", **e.fields("i"))
+        import casadi as ca
         return i - ca.SX(expr.evaluate(env, casadi_functions()))
 
 
@@ -99,6 +99,7 @@ class Diode(PartialTwoPin, library=LIB):
     R = Param(1e8, unit="Ohm", positive=True, doc="Parallel ohmic resistance")
 
     def law(self, v, i, e):
+        import casadi as ca
         x = v / self.Vt
         exlin = ca.exp(ca.fmin(x, self.Maxexp)) * (1 + ca.fmax(x - self.Maxexp, 0))
         return i - (self.Ids * (exlin - 1) + v / self.R)

@@ -9,9 +9,7 @@ weighted mean of its frames' origins. The solver turns both into generalized for
 inertia, once, for all of them.
 """
 
-import casadi as ca
-
-from ..spatial import line_length
+from ..spatial import line_length, zero3
 from .base import Component, Param, Port
 
 MB = "multibody"
@@ -19,7 +17,6 @@ MB = "multibody"
 RESOLVE_AB = ("world", "frame_a", "frame_b", "frame_resolve")
 #: frames a WorldForce or WorldTorque may resolve its vector in
 RESOLVE_B = ("world", "frame_b")
-ZERO = ca.DM.zeros(3)
 
 
 class PartialFrameForce(Component):
@@ -51,6 +48,7 @@ class PartialFrameForce(Component):
 
 def _given(param, ports, inputs):
     """A 3-vector parameter with each entry replaced by its signal input where that is wired."""
+    import casadi as ca
     return ca.vertcat(*[param[i] if inputs.get(p) is None else inputs[p]
                         for i, p in enumerate(ports)])
 
@@ -89,12 +87,13 @@ class PartialLineForce(PartialFrameForce):
         raise NotImplementedError
 
     def wrenches(self, frames, inputs):
+        import casadi as ca
         a, b = frames["frame_a"], frames["frame_b"]
         d = b.r - a.r
         s = line_length(d)        # regularised: no force, and no NaN, at zero length
         e = d / s
         force = self.law(s, ca.dot(e, b.v - a.v)) * e
-        return {"frame_a": (force, ZERO), "frame_b": (-force, ZERO)}
+        return {"frame_a": (force, zero3()), "frame_b": (-force, zero3())}
 
     def point_masses(self):
         h = self.length_fraction
@@ -220,13 +219,14 @@ class PartialResolved(PartialFrameForce):
 
     def force(self, inputs):
         """The force as given (resolved in ``resolve_in``)."""
-        return ZERO
+        return zero3()
 
     def torque(self, inputs):
         """The torque as given (resolved in ``resolve_in``)."""
-        return ZERO
+        return zero3()
 
     def wrenches(self, frames, inputs):
+        import casadi as ca
         a, b = frames["frame_a"], frames["frame_b"]
         R = ca.DM.eye(3) if self.resolve_in == "world" else frames[self.resolve_in].R
         f, t = R @ self.force(inputs), R @ self.torque(inputs)
@@ -317,7 +317,7 @@ class WorldForce(PartialFrameForce, library=MB):
         f = _given(self.force, ("f1", "f2", "f3"), inputs)
         if self.resolve_in == "frame_b":
             f = frames["frame_b"].R @ f
-        return {"frame_b": (f, ZERO)}
+        return {"frame_b": (f, zero3())}
 
 
 class WorldTorque(PartialFrameForce, library=MB):
@@ -335,7 +335,7 @@ class WorldTorque(PartialFrameForce, library=MB):
         t = _given(self.torque, ("t1", "t2", "t3"), inputs)
         if self.resolve_in == "frame_b":
             t = frames["frame_b"].R @ t
-        return {"frame_b": (ZERO, t)}
+        return {"frame_b": (zero3(), t)}
 
 
 __all__ = ["Damper", "Force", "ForceAndTorque", "LineForceWithTwoMasses", "Spring",

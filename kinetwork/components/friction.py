@@ -20,9 +20,8 @@ Modes of friction: +1 sliding forward (w_rel > 0), -1 sliding backward, 0 stuck 
 ``Forward``, ``Backward``, ``Stuck``). No regularisation: a stuck element is exactly stuck.
 """
 
-import casadi as ca
-
 from .base import ONED, Component, Port
+from .oned import named
 
 #: a stuck friction holds up to its static limit and at it, to rounding: a load that keeps
 #: it exactly at the limit (a ramp that levels off there, a controller's steady torque)
@@ -40,19 +39,23 @@ class PartialHybrid(Component):
 
     def held(self, mode):
         """1 where the mode holds the flanges together, else 0 (an SX of the mode)."""
+        import casadi as ca
         return ca.SX(0)
 
     def law(self, rel, w_rel, mode, u):
         """The force into flange b when not held."""
+        import casadi as ca
         return ca.SX(0)
 
     def free_mode(self, rel, w_rel):
         """The mode the state itself gives, without events (the equations shown as M, V, G:
         ``equations/modes.py``)."""
+        import casadi as ca
         return ca.SX(0)
 
     def values(self, t, u):
         """Two numbers the events read (a static limit, a restitution), as SX."""
+        import casadi as ca
         return ca.SX(0), ca.SX(0)
 
     def indicator(self, mode, rel, w_rel, force, values, power=None):
@@ -93,14 +96,17 @@ class PartialFriction(PartialHybrid):
         return mode * self.kinetic(u) + self.d * w_rel
 
     def free_mode(self, rel, w_rel):
+        import casadi as ca
         return ca.sign(w_rel)
 
     def values(self, t, u):
+        import casadi as ca
         return self.peak * self.kinetic(u), ca.SX(0)
 
     def indicator(self, mode, rel, w_rel, force, values, power=None):
         # sliding: the speed in the direction of sliding; stuck: the margin to the limit,
         # which holds up to and at the limit itself (MSL: stuck while |f| <= f_static)
+        import casadi as ca
         margin = values[0] * (1 + EDGE) - ca.fabs(force)
         return mode * mode * (mode * w_rel) + (1 - mode * mode) * margin
 
@@ -137,6 +143,8 @@ class PartialTwoFlanges(PartialFriction):
 
 
 class PartialBearingFriction(PartialTwoFlanges):
+    """Coulomb friction of a constant force (torque): ``tau_c`` or ``f_c``."""
+    f_kinetic = named("{flow}_c", "Coulomb friction force or torque")
 
     def kinetic(self, u):
         return self.f_kinetic
@@ -159,18 +167,22 @@ class PartialNormalForceFriction(PartialFriction):
         return self.fn_max * (self.f_normalized if u is None else u)
 
     def kinetic(self, u):
+        import casadi as ca
         return self.mu * self.cgeo * ca.fmax(self.normal_force(u), 0)
 
     def held(self, mode):
+        import casadi as ca
         return ca.if_else(mode == 0, 1, 0)
 
     def law(self, rel, w_rel, mode, u):
+        import casadi as ca
         return ca.if_else(mode == self.FREE, 0, mode) * self.kinetic(u) + self.d * w_rel
 
     def values(self, t, u):
         return self.peak * self.kinetic(u), self.normal_force(u)
 
     def indicator(self, mode, rel, w_rel, force, values, power=None):
+        import casadi as ca
         engaged = ca.fmin(super().indicator(mode, rel, w_rel, force, values), values[1])
         edge = EDGE * (1 + ca.fabs(self.fn_max))
         return ca.if_else(mode == self.FREE, edge - values[1], engaged)
@@ -196,11 +208,13 @@ class PartialElastoGap(PartialHybrid):
     """MSL's ElastoGap: a linear spring and damper acting only while the gap is closed
     (rel < rel0); the damping force is limited so that it never pulls (MSL 4.0's law)."""
     modes = {0: "open", 1: "contact"}
+    rel0 = named("{position}_rel0", "Relative position where contact begins")
     state_mode = True        # contact exactly while closed: a function of the state
     flange_a = Port(ONED, "Flange a")
     flange_b = Port(ONED, "Flange b")
 
     def law(self, rel, w_rel, mode, u):
+        import casadi as ca
         spring = self.c * (rel - self.rel0)
         reach = ca.fabs(spring)
         return mode * (spring + ca.fmin(ca.fmax(self.d * w_rel, -reach), reach))
@@ -209,6 +223,7 @@ class PartialElastoGap(PartialHybrid):
         return (1 - 2 * mode) * (rel - self.rel0)
 
     def free_mode(self, rel, w_rel):
+        import casadi as ca
         return ca.if_else(rel < self.rel0, 1, 0)
 
     def first_mode(self, ev):
@@ -224,6 +239,8 @@ class PartialStop(PartialHybrid):
     impact: an impulse through the mechanism); an impact slower than v_rest leaves it resting
     on the limit until the force holding it there would have to pull."""
     modes = {0: "free", 1: "resting"}
+    rel_min = named("{position}_min", "Lower limit")
+    rel_max = named("{position}_max", "Upper limit")
     hold_mode = 1
     flange_a = Port(ONED, "Flange a (the reference side: a joint's support)")
     flange_b = Port(ONED, "Flange b (a joint's axis)")
@@ -233,6 +250,7 @@ class PartialStop(PartialHybrid):
 
     def _side(self, rel):
         """+1 nearer the lower limit, -1 nearer the upper."""
+        import casadi as ca
         if self.rel_min is None:
             return ca.SX(-1)
         if self.rel_max is None:
@@ -240,12 +258,14 @@ class PartialStop(PartialHybrid):
         return ca.if_else(rel - self.rel_min <= self.rel_max - rel, 1, -1)
 
     def _gap(self, rel):
+        import casadi as ca
         gaps = [g for g in (None if self.rel_min is None else rel - self.rel_min,
                             None if self.rel_max is None else self.rel_max - rel)
                 if g is not None]
         return gaps[0] if len(gaps) == 1 else ca.fmin(*gaps)
 
     def values(self, t, u):
+        import casadi as ca
         return ca.SX(self.e), ca.SX(self.v_rest)
 
     def indicator(self, mode, rel, w_rel, force, values, power=None):
@@ -290,6 +310,7 @@ class GearModes:
         return 0
 
     def values(self, t, u):
+        import casadi as ca
         return ca.SX(0), ca.SX(0)
 
     def indicator(self, mode, rel, w_rel, force, values, power=None):

@@ -17,7 +17,6 @@ motion is that of three Revolutes.
 
 from dataclasses import dataclass, field
 
-import casadi as ca
 import numpy as np
 
 from ..errors import ModelError
@@ -47,6 +46,7 @@ class PartialRod(Component):
 
     def closure(self, rel_R, rel_p, q):
         """(|r|^2 - L^2) / (2 L): the distance error to first order, smooth everywhere."""
+        import casadi as ca
         length = self.rod_length()
         return (ca.dot(rel_p, rel_p) - length**2) / (2 * length)
 
@@ -83,12 +83,14 @@ class UniversalSpherical(PartialRod, library=MB):
     placed_frames = ("frame_ia",)
 
     def rod_length(self):
+        import casadi as ca
         return ca.norm_2(vec3(self.r_rod))
 
     def frames(self, rel_R, rel_p):
         """The frames this joint places from where frame_b is (``rel_R``, ``rel_p`` in
         frame_a): port -> (orientation, origin) in frame_a. frame_ia maps the rod's axes in
         frame_ia (rod, axis 2, their normal) onto the same axes in frame_a, as MSL."""
+        import casadi as ca
         n = vec3(self.n_a)
         e_ia = unit(vec3(self.r_rod))
         e2_ia = unit(ca.cross(n, e_ia))
@@ -167,11 +169,11 @@ class JointRRR(Component, library=MB):
         n_a in frame_b too, the loop being planar)."""
         g = self.q0_guess
         revolute, rod = REGISTRY[f"{MB}.Revolute"], REGISTRY[f"{MB}.FixedTranslation"]
-        parts = [revolute("rev1", axis=self.n_a, q0_guess=g[0]),
+        parts = [revolute("rev1", n=self.n_a, q0_guess=g[0]),
                  rod("rod1", r=self.r_rod1),
-                 revolute("rev2", axis=self.n_a, q0_guess=g[1]),
+                 revolute("rev2", n=self.n_a, q0_guess=g[1]),
                  rod("rod2", r=_negated(self.r_rod2)),
-                 revolute("rev3", axis=_negated(self.n_a), q0_guess=g[2], cut=True)]
+                 revolute("rev3", n=_negated(self.n_a), q0_guess=g[2], cut=True)]
         comps = {c.name: c for c in parts}
 
         def port(path):

@@ -1,21 +1,70 @@
 """Partials shared by the 1-D rotational and translational libraries.
 
 Each law is written once here; a library subclasses with ``domain`` set and declares the
-parameters with its own names and units (``rel0`` is ``phi_rel0`` in rotational and
-``s_rel0`` in translational). Flows are positive into the component, as in Modelica.
+parameters with Modelica's names and its units (``phi_rel0`` in rotational, ``s_rel0`` in
+translational): what ``help()``, files and attributes all use. A law reads them under one
+name, a role (``rel0``), which ``named`` maps to the library's parameter. Flows are positive
+into the component, as in Modelica.
 """
 
 import math
 
+from ..errors import ModelError
 from .base import ONED, Component, Port
 from .quantities import QUANTITIES
 
+#: each 1-D library's symbols, as its parameter names use them (Modelica's phi_rel0 and
+#: s_rel0, w0 and v0, tau_c and f_c), and the probe quantity of each (its unit)
+SYMBOLS = {
+    "rotational": {"position": "phi", "speed": "w", "acceleration": "a", "flow": "tau"},
+    "translational": {"position": "s", "speed": "v", "acceleration": "a", "flow": "f"},
+}
+QUANTITY = {
+    "rotational": {"position": "angle", "speed": "speed", "acceleration": "acceleration",
+                   "flow": "torque"},
+    "translational": {"position": "position", "speed": "velocity",
+                      "acceleration": "acceleration", "flow": "force"},
+}
+
 
 def _unit(domain, which):
-    """The unit of a 1-D domain's position (0), speed (1), acceleration (2) or flow (3): the
-    units a probe on its flange records, in that order."""
-    quantities = list(QUANTITIES.get(domain, {}).values())
-    return quantities[which].unit if which < len(quantities) else None
+    """The unit of a 1-D domain's "position", "speed", "acceleration" or "flow": that of the
+    quantity a probe on its flange records by that name (None outside the 1-D domains)."""
+    quantity = QUANTITY.get(domain, {}).get(which)
+    return None if quantity is None else QUANTITIES[domain][quantity].unit
+
+
+class named:
+    """A role of a partial's law (``rel0``): the parameter the library names ``template``
+    with its symbols ("{position}_rel0": phi_rel0 in rotational, s_rel0 in translational).
+    On an instance it reads that parameter's value; on a library's class it is that
+    parameter's declaration (``Inertia.position0.name == "phi0"``). Read-only: a parameter is
+    set by its own name."""
+
+    def __init__(self, template, doc):
+        self.template, self.__doc__ = template, f"{doc} (the parameter {template})"
+        self.role = None
+
+    def __set_name__(self, owner, name):
+        self.role = name
+
+    def __get__(self, instance, owner):
+        if instance is None:
+            if getattr(owner, "domain", None) not in SYMBOLS:
+                return self                         # a partial, before a library names it
+            return owner.params[parameter_name(owner, self.template)]
+        return getattr(instance, parameter_name(instance, self.template))
+
+    def __set__(self, instance, value):
+        key = parameter_name(instance, self.template)
+        raise ModelError(f"{instance.name}.{self.role} is {instance.name}.{key}: set it by "
+                         f"that name", component=instance.name, parameter=key)
+
+
+def parameter_name(comp, template):
+    """The name of the parameter ``template`` ("{position}0") in the library of ``comp`` (a
+    component or its class)."""
+    return template.format(**SYMBOLS[comp.domain])
 
 #: Modelica's second-order Bessel filter of a position source (Rotational.Sources.Position):
 #: the coefficients af, bf of phi_ref / (1 + af s / w_crit + bf s^2 / w_crit^2)
@@ -42,6 +91,7 @@ class PartialCompliant(Component):
 
 class PartialSpringDamper(PartialCompliant):
     """Linear spring and damper in parallel."""
+    rel0 = named("{position}_rel0", "Unstretched relative position")
 
     def law(self, rel, rel_d):
         return self.c * (rel - self.rel0) + self.d * rel_d
@@ -49,6 +99,7 @@ class PartialSpringDamper(PartialCompliant):
 
 class PartialSpring(PartialCompliant):
     """Linear spring."""
+    rel0 = named("{position}_rel0", "Unstretched relative position")
 
     def law(self, rel, rel_d):
         return self.c * (rel - self.rel0)
@@ -74,7 +125,7 @@ class PartialSource(Component):
         raise NotImplementedError
 
     def signal_unit(self, port):
-        return _unit(self.domain, 3) if port == "u" else None
+        return _unit(self.domain, "flow") if port == "u" else None
 
     def flows(self, pos, vel, t, u=None):
         f = self.applied() if u is None else u
@@ -84,6 +135,7 @@ class PartialSource(Component):
 class PartialFixed(Component):
     """A flange held at ``position0``; it takes whatever flow the network sends it."""
     role = "fixed"
+    position0 = named("{position}0", "Fixed position")
     flange = Port(ONED, "Fixed flange")
 
     def position(self):
@@ -102,7 +154,8 @@ class PartialRigid(Component):
     flange_b = Port(ONED, "Flange b")
     has_inertia = False
 
-    def ratio(self):
+    def position_ratio(self):
+        """position(flange_a) / position(flange_b)."""
         return 1.0
 
     def length(self):
@@ -119,6 +172,8 @@ class PartialInertia(PartialRigid):
     flange_a = Port(ONED, "Flange a", optional=True)
     flange_b = Port(ONED, "Flange b", optional=True)
     has_inertia = True
+    position0 = named("{position}0", "Initial position when it moves freely (None: 0)")
+    speed0 = named("{speed}0", "Initial speed when it moves freely (None: 0)")
 
     def inertia(self):
         raise NotImplementedError
@@ -132,8 +187,7 @@ class PartialSensor(Component):
     quantity = None           # "position", "speed" or "acceleration"
 
     def signal_unit(self, port):
-        which = ("position", "speed", "acceleration").index(self.quantity)
-        return _unit(self.domain, which) if port == "y" else None
+        return _unit(self.domain, self.quantity) if port == "y" else None
 
 
 class PartialFlowSensor(PartialRigid):
@@ -142,7 +196,22 @@ class PartialFlowSensor(PartialRigid):
     quantity = "flow"
 
     def signal_unit(self, port):
-        return _unit(self.domain, 3) if port == "y" else None
+        return _unit(self.domain, "flow") if port == "y" else None
+
+
+class PartialPowerSensor(PartialRigid):
+    """MSL's PowerSensor and MultiSensor: rigid and massless, wired in series; at flange_a it
+    reads the flow into it, its speed and their product, the power flowing from flange_a to
+    flange_b, each on the output port ``outputs`` names for it."""
+    quantity = "flow"
+    #: output port -> what it carries: "flow", "speed" or "power"
+    outputs = {}
+
+    def signal_unit(self, port):
+        what = self.outputs.get(port)
+        if what == "power":
+            return "W"
+        return None if what is None else _unit(self.domain, 3 if what == "flow" else 1)
 
 
 class PartialMotion(Component):
@@ -167,8 +236,23 @@ class PartialMotion(Component):
     support = Port(ONED, "Reaction flange (unwired: the world)", optional=True)
     u = Port("signal_in", "Reference signal (instead of the parameter)", optional=True)
 
+    #: what the reference prescribes, by ``derivative``
+    prescribed = ("position", "speed", "acceleration")
+    position0 = named("{position}0", "Initial position")
+    speed0 = named("{speed}0", "Initial speed")
+
+    @property
+    def reference_param(self):
+        """The name of the reference parameter: phi_ref, w_ref, a_ref; s_ref, v_ref."""
+        return parameter_name(self, f"{{{self.prescribed[self.derivative]}}}_ref")
+
+    @property
+    def reference(self):
+        """The reference (the parameter ``reference_param``), or None."""
+        return getattr(self, self.reference_param)
+
     def signal_unit(self, port):
-        return _unit(self.domain, self.derivative) if port == "u" else None
+        return _unit(self.domain, self.prescribed[self.derivative]) if port == "u" else None
 
     @property
     def n_states(self):

@@ -149,7 +149,8 @@ def docstring(cls):
     if ref["params"]:
         out += ["", "Parameters", "----------"]
         for info in ref["params"]:
-            out += [f"{info['name']} : {param_line(info)}", f"    {info['doc']}"]
+            also = f" (also given as {', '.join(info['aliases'])})" if info["aliases"] else ""
+            out += [f"{info['name']} : {param_line(info)}", f"    {info['doc']}{also}"]
         out += ["", "A value in another unit is written with it (\"5 mm\", \"30 deg\"): it "
                 "is converted to the unit above (1: dimensionless)."]
     if ref["ports"]:

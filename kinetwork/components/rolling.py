@@ -17,8 +17,6 @@ force is the joint's cut force: a probe on frame_b reads it as ``force`` (at the
 centre), and ``torque`` is its moment about the centre.
 """
 
-import casadi as ca
-
 from ..errors import ModelError
 from ..spatial import rotation
 from .base import REGISTRY, Component, Param, Port, PortRef
@@ -26,29 +24,37 @@ from .loopjoints import Expansion
 from .multibody import PartialJoint
 
 MB = "multibody"
-EX, EY, EZ = ca.DM([1, 0, 0]), ca.DM([0, 1, 0]), ca.DM([0, 0, 1])
+
+
+def _axes():
+    """The unit vectors x, y, z of frame_a, as CasADi column vectors."""
+    import casadi as ca
+    return ca.DM([1, 0, 0]), ca.DM([0, 1, 0]), ca.DM([0, 0, 1])
 
 
 def wheel_orientation(angles):
     """The wheel frame's axes in frame_a: turned about z by angles[0], then about the new y
     by angles[1], then about the new x by angles[2] (MSL's axesRotations {3, 2, 1})."""
-    return rotation(EZ, angles[0]) @ rotation(EY, angles[1]) @ rotation(EX, angles[2])
+    ex, ey, ez = _axes()
+    return rotation(ez, angles[0]) @ rotation(ey, angles[1]) @ rotation(ex, angles[2])
 
 
 def contact_vector(R, radius):
     """From the wheel centre to the contact point, in frame_a: in the wheel's plane (normal
     to its axis R[:, 1]), ``radius`` long, pointing down the steepest line of that plane
     (MSL's delta_0). Singular where the wheel lies flat (axis along z)."""
+    import casadi as ca
     axis = R[:, 1]
-    along = ca.cross(EZ, axis)                 # the rolling direction (MSL's e_long)
+    along = ca.cross(_axes()[2], axis)         # the rolling direction (MSL's e_long)
     along = along / ca.norm_2(along)
     return radius * ca.cross(along, axis)
 
 
 def angular_velocity(angles, rates):
     """The wheel's angular velocity in frame_a from the angles' rates."""
-    Rz = rotation(EZ, angles[0])
-    return rates[0] * EZ + rates[1] * (Rz @ EY) + rates[2] * (Rz @ rotation(EY, angles[1]) @ EX)
+    ex, ey, ez = _axes()
+    Rz = rotation(ez, angles[0])
+    return rates[0] * ez + rates[1] * (Rz @ ey) + rates[2] * (Rz @ rotation(ey, angles[1]) @ ex)
 
 
 class RollingWheelJoint(PartialJoint, library=MB):
@@ -100,6 +106,7 @@ class RollingWheelJoint(PartialJoint, library=MB):
         return [f"der_angles[{i}]" for i in range(3)]
 
     def transform(self, q):
+        import casadi as ca
         R = wheel_orientation(q[2:5])
         centre = -contact_vector(R, self.radius)
         return R, ca.vertcat(q[0], q[1], centre[2])
@@ -107,6 +114,7 @@ class RollingWheelJoint(PartialJoint, library=MB):
     def rate(self, q, u):
         """dx/dt, dy/dt from rolling (the contact point at rest: v = -w x delta), then the
         angles' rates (the speeds)."""
+        import casadi as ca
         R = wheel_orientation(q[2:5])
         v = -ca.cross(angular_velocity(q[2:5], u), contact_vector(R, self.radius))
         return ca.vertcat(v[0], v[1], u)

@@ -2,8 +2,8 @@
 
 from .base import Param, Port, library_attribute
 from .oned import (PartialDamper, PartialFixed, PartialFlowSensor, PartialInertia,
-                   PartialMotion, PartialRigid, PartialSensor, PartialSource, PartialSpring,
-                   PartialSpringDamper)
+                   PartialMotion, PartialPowerSensor, PartialRigid, PartialSensor,
+                   PartialSource, PartialSpring, PartialSpringDamper)
 
 LIB = "rotational"
 
@@ -13,14 +13,14 @@ class SpringDamper(PartialSpringDamper, library=LIB):
     domain = LIB
     c = Param(unit="N*m/rad", min=0.0, doc="Spring constant")
     d = Param(unit="N*m*s/rad", min=0.0, doc="Damping constant")
-    rel0 = Param(0.0, unit="rad", name="phi_rel0", doc="Unstretched relative angle")
+    phi_rel0 = Param(0.0, unit="rad", doc="Unstretched relative angle")
 
 
 class Spring(PartialSpring, library=LIB):
     """Linear rotational spring."""
     domain = LIB
     c = Param(unit="N*m/rad", min=0.0, doc="Spring constant")
-    rel0 = Param(0.0, unit="rad", name="phi_rel0", doc="Unstretched relative angle")
+    phi_rel0 = Param(0.0, unit="rad", doc="Unstretched relative angle")
 
 
 class Damper(PartialDamper, library=LIB):
@@ -42,7 +42,7 @@ class Torque(PartialSource, library=LIB):
 class Fixed(PartialFixed, library=LIB):
     """Flange fixed at an angle in the world."""
     domain = LIB
-    position0 = Param(0.0, unit="rad", name="phi0", doc="Fixed angle")
+    phi0 = Param(0.0, unit="rad", doc="Fixed angle")
 
 
 class Inertia(PartialInertia, library=LIB):
@@ -54,10 +54,10 @@ class Inertia(PartialInertia, library=LIB):
     own q0, a motion, a Fixed, another inertia) they must agree, or the model is refused."""
     domain = LIB
     J = Param(unit="kg*m^2", min=0.0, doc="Moment of inertia")
-    position0 = Param(None, optional=True, unit="rad", name="phi0",
-                      doc="Initial angle (None: from what it is tied to, else 0)")
-    speed0 = Param(None, optional=True, unit="rad/s", name="w0",
-                   doc="Initial speed (None: from what it is tied to, else 0)")
+    phi0 = Param(None, optional=True, unit="rad",
+                 doc="Initial angle (None: from what it is tied to, else 0)")
+    w0 = Param(None, optional=True, unit="rad/s",
+               doc="Initial speed (None: from what it is tied to, else 0)")
 
     def inertia(self):
         return self.J
@@ -86,12 +86,31 @@ class TorqueSensor(PartialFlowSensor, library=LIB):
     domain = LIB
 
 
+class PowerSensor(PartialPowerSensor, library=LIB):
+    """The power flowing from flange_a to flange_b, flange_a.tau * der(flange_a.phi), as the
+    signal ``power`` (MSL's Rotational.Sensors.PowerSensor); wire it in series."""
+    domain = LIB
+    power = Port("signal_out", "Power from flange_a to flange_b [W]", optional=True)
+    outputs = {"power": "power"}
+
+
+class MultiSensor(PartialPowerSensor, library=LIB):
+    """The torque into flange_a (``tau``), the flanges' speed (``w``) and the power flowing
+    from flange_a to flange_b, tau * w (``power``), as MSL's Rotational.Sensors.MultiSensor;
+    wire it in series."""
+    domain = LIB
+    power = Port("signal_out", "Power from flange_a to flange_b [W]", optional=True)
+    w = Port("signal_out", "Speed of the flanges [rad/s]", optional=True)
+    tau = Port("signal_out", "Torque into flange_a [N*m]", optional=True)
+    outputs = {"power": "power", "w": "speed", "tau": "flow"}
+
+
 class Position(PartialMotion, library=LIB):
     """Moves its flange to phi_ref: an expression in time and model parameters, or the signal at
     u; exact (differentiated exactly) or filtered (second-order Bessel filter, f_crit)."""
     domain = LIB
-    reference = Param(None, optional=True, unit="rad", time=True, name="phi_ref",
-                      doc="Prescribed angle (when u is not wired)")
+    phi_ref = Param(None, optional=True, unit="rad", time=True,
+                    doc="Prescribed angle (when u is not wired)")
     exact = Param(True, kind="bool", doc="Differentiate the reference exactly (else filter it)")
     f_crit = Param(50.0, unit="Hz", positive=True, doc="Cut-off frequency of the filter")
 
@@ -101,11 +120,11 @@ class Speed(PartialMotion, library=LIB):
     at u) from phi0: the angle is integrated; exact or filtered (first order, f_crit)."""
     domain = LIB
     derivative = 1
-    reference = Param(None, optional=True, unit="rad/s", time=True, name="w_ref",
-                      doc="Prescribed speed (when u is not wired)")
+    w_ref = Param(None, optional=True, unit="rad/s", time=True,
+                  doc="Prescribed speed (when u is not wired)")
     exact = Param(True, kind="bool", doc="Differentiate the reference exactly (else filter it)")
     f_crit = Param(50.0, unit="Hz", positive=True, doc="Cut-off frequency of the filter")
-    position0 = Param(0.0, unit="rad", name="phi0", doc="Initial angle")
+    phi0 = Param(0.0, unit="rad", doc="Initial angle")
 
 
 class Accelerate(PartialMotion, library=LIB):
@@ -113,10 +132,10 @@ class Accelerate(PartialMotion, library=LIB):
     or the signal at u) from phi0 at w0: speed and angle are integrated."""
     domain = LIB
     derivative = 2
-    reference = Param(None, optional=True, unit="rad/s^2", time=True, name="a_ref",
-                      doc="Prescribed acceleration (when u is not wired)")
-    position0 = Param(0.0, unit="rad", name="phi0", doc="Initial angle")
-    speed0 = Param(0.0, unit="rad/s", name="w0", doc="Initial speed")
+    a_ref = Param(None, optional=True, unit="rad/s^2", time=True,
+                  doc="Prescribed acceleration (when u is not wired)")
+    phi0 = Param(0.0, unit="rad", doc="Initial angle")
+    w0 = Param(0.0, unit="rad/s", doc="Initial speed")
 
 
 class IdealGear(PartialRigid, library=LIB):
@@ -131,14 +150,12 @@ class IdealGear(PartialRigid, library=LIB):
     domain = LIB
     lossy = True
     support = Port("1d", "Reaction flange (unwired: the world)", optional=True)
-    gear_ratio = Param(unit="1", name="ratio", nonzero=True,
-                       doc="flange_a angle / flange_b angle")
-
+    ratio = Param(unit="1", nonzero=True, doc="flange_a angle / flange_b angle")
     eta = Param(1.0, unit="1", positive=True, max=1.0,
                 doc="Efficiency (1: lossless, no mode; below 1: the loss of the driven side)")
 
-    def ratio(self):
-        return self.gear_ratio
+    def position_ratio(self):
+        return self.ratio
 
 
 from .rotational_friction import (BearingFriction, Brake, Clutch, ElastoGap,  # noqa: E402,F401

@@ -9,7 +9,7 @@ class BearingFriction(PartialBearingFriction, library="rotational"):
     viscous): stuck while the torque holding the flange to its support stays within
     peak * tau_c, else sliding against tau_c + d * w."""
     domain = "rotational"
-    f_kinetic = Param(unit="N*m", min=0.0, name="tau_c", doc="Coulomb friction torque")
+    tau_c = Param(unit="N*m", min=0.0, doc="Coulomb friction torque")
     peak = Param(1.0, unit="1", min=1.0, doc="Static over Coulomb friction torque")
     d = Param(0.0, unit="N*m*s/rad", min=0.0, doc="Viscous friction coefficient")
 
@@ -49,16 +49,16 @@ class ElastoGap(PartialElastoGap, library="rotational"):
     domain = "rotational"
     c = Param(unit="N*m/rad", min=0.0, doc="Spring constant")
     d = Param(0.0, unit="N*m*s/rad", min=0.0, doc="Damping constant")
-    rel0 = Param(0.0, unit="rad", name="phi_rel0", doc="Relative angle where contact begins")
+    phi_rel0 = Param(0.0, unit="rad", doc="Relative angle where contact begins")
 
 
 class Stop(PartialStop, library="rotational"):
     """Hard end stops on a relative angle (a joint's axis against its support), with
     restitution e."""
     domain = "rotational"
-    rel_min = Param(None, optional=True, unit="rad", name="phi_min",
+    phi_min = Param(None, optional=True, unit="rad",
                     doc="Lower limit of flange_b relative to flange_a (None: none)")
-    rel_max = Param(None, optional=True, unit="rad", name="phi_max",
+    phi_max = Param(None, optional=True, unit="rad",
                     doc="Upper limit of flange_b relative to flange_a (None: none)")
     e = Param(0.8, unit="1", min=0.0, max=1.0, doc="Coefficient of restitution")
     v_rest = Param(1e-4, unit="rad/s", min=0.0,

@@ -21,8 +21,6 @@ of frames near the rotor take the reaction to rest in the world, as for any join
 
 import numbers
 
-import casadi as ca
-
 from ..spatial import unit, vec3
 from .base import REGISTRY, Component, Param, Port, PortRef
 from .loopjoints import Expansion
@@ -49,6 +47,7 @@ class RotorHousing(Component):
               doc="Rotor axis, in frame_a")
 
     def mass_properties(self):
+        import casadi as ca
         e = unit(vec3(self.n))
         return 0.0, ca.DM.zeros(3), -self.J * (e @ e.T)
 
@@ -93,7 +92,7 @@ class Rotor1D(Component, library=MB):
 
     def expand(self):
         """A revolute about n with the inertia J n n^T, and -J n n^T on frame_a."""
-        spin = REGISTRY[f"{MB}.Revolute"]("spin", axis=self.n, q0=self.phi0, qd0=self.w0)
+        spin = REGISTRY[f"{MB}.Revolute"]("spin", n=self.n, q0=self.phi0, qd0=self.w0)
         rotor = REGISTRY[f"{MB}.RigidBody"]("rotor", mass=0.0,
                                             inertia=_axial(self.J, self.n, 1))
         housing = RotorHousing("housing", J=self.J, n=self.n)

@@ -8,7 +8,6 @@ Unwired optional inputs read as None. A block that needs the model's own dynamic
 computed-torque controller) overrides ``evaluate``, which is handed them.
 """
 
-import casadi as ca
 import numpy as np
 
 from ..errors import ModelError
@@ -69,6 +68,7 @@ class Step(PartialBlock, library=LIB):
     start_time = Param(0.0, unit="s", doc="Time of the step")
 
     def output(self, u, x, t):
+        import casadi as ca
         return self.offset + ca.if_else(t >= self.start_time, self.height, 0)
 
 
@@ -80,6 +80,7 @@ class Ramp(PartialBlock, library=LIB):
     start_time = Param(0.0, unit="s", doc="Start of the ramp")
 
     def output(self, u, x, t):
+        import casadi as ca
         frac = ca.fmin(ca.fmax((t - self.start_time) / ca.fmax(self.duration, 1e-300), 0), 1)
         return self.offset + self.height * frac
 
@@ -93,6 +94,7 @@ class Sine(PartialBlock, library=LIB):
     start_time = Param(0.0, unit="s", doc="Start of the sine")
 
     def output(self, u, x, t):
+        import casadi as ca
         wave = self.amplitude * ca.sin(2 * ca.pi * self.f * (t - self.start_time) + self.phase)
         return self.offset + ca.if_else(t >= self.start_time, wave, 0)
 
@@ -126,6 +128,7 @@ class Sum(PartialBlock, library=LIB):
     u4 = Port("signal_in", "Input 4", optional=True)
 
     def output(self, u, x, t):
+        import casadi as ca
         return sum((u[k] for k in ("u1", "u2", "u3", "u4") if u[k] is not None), ca.SX(0))
 
 
@@ -145,6 +148,7 @@ class Limiter(PartialSISO, library=LIB):
     u_min = Param(None, optional=True, doc="Lower limit (None: -u_max)")
 
     def output(self, u, x, t):
+        import casadi as ca
         low = -self.u_max if self.u_min is None else self.u_min
         return ca.fmin(ca.fmax(u["u"], low), self.u_max)
 
@@ -161,6 +165,7 @@ class Table(PartialBlock, library=LIB):
     expression_rows = 100
 
     def output(self, u, x, t):
+        import casadi as ca
         at = t if u["u"] is None else u["u"]
         xs = [row[0] for row in self.table]
         ys = [row[1] for row in self.table]
@@ -241,6 +246,7 @@ class PID(PartialBlock, library=LIB):
     xi_start = Param(0.0, doc="Initial integral state")
 
     def _parts(self, u, x):
+        import casadi as ca
         e = u["u_s"] - u["u_m"]
         integral = x[0] if self.Ti is not None else 0
         deriv = self._when_d(self.Nd * (e - x[1]))
@@ -255,6 +261,7 @@ class PID(PartialBlock, library=LIB):
         """``value`` where the derivative part is on (Td > 0), else 0. Td may be a symbol (a
         model parameter set per run): then the choice is made at run time, and the division
         by Td = 0 in the branch not taken is discarded, not propagated."""
+        import casadi as ca
         td = ca.SX(self.Td)
         if td.is_constant():
             return value if float(td) > 0 else 0
@@ -337,6 +344,7 @@ class Expression(PartialBlock, library=LIB):
     inputs = ("u1", "u2", "u3", "u4")
 
     def evaluate(self, u, x, t, mechanics):
+        import casadi as ca
         from ..expr import casadi_functions
         if not isinstance(self.expression, str):
             return ca.SX(self.expression)
@@ -418,6 +426,7 @@ class Table2D(PartialBlock, library=LIB):
     expression_cells = 400
 
     def output(self, u, x, t):
+        import casadi as ca
         grid1 = [r[0] for r in self.table[1:]]
         grid2 = self.table[0][1:]
         values = np.array([r[1:] for r in self.table[1:]])
@@ -430,6 +439,7 @@ class Table2D(PartialBlock, library=LIB):
 def _hats(at, grid):
     """The piecewise-linear hat functions of ``grid`` at ``at``, extrapolated linearly (they
     sum to one): a linear interpolant is their product with the values."""
+    import casadi as ca
     eye = np.eye(len(grid))
     return ca.vertcat(*[ca.pw_lin(at, ca.DM(grid), ca.DM(eye[k])) for k in range(len(grid))])
 
@@ -497,6 +507,7 @@ class KinematicPTP(PartialBlock, library=LIB):
         return sd, sdd, ta2, 1 / sd, 1 / sd + ta2
 
     def output(self, u, x, t):
+        import casadi as ca
         k = int(float(ca.DM(self.axis))) - 1         # a number: it picks an axis
         delta = self.q_end[k] - self.q_begin[k]
         base = self.q_begin[k] if self.quantity == "q" else 0.0

@@ -1,9 +1,9 @@
 """1-D translational library: position s [m] and force f [N] on flanges."""
 
-from .base import Param, library_attribute
+from .base import Param, Port, library_attribute
 from .oned import (PartialDamper, PartialFixed, PartialFlowSensor, PartialInertia,
-                   PartialMotion, PartialSensor, PartialSource, PartialSpring,
-                   PartialSpringDamper)
+                   PartialMotion, PartialPowerSensor, PartialRigid, PartialSensor,
+                   PartialSource, PartialSpring, PartialSpringDamper)
 
 LIB = "translational"
 
@@ -13,14 +13,14 @@ class SpringDamper(PartialSpringDamper, library=LIB):
     domain = LIB
     c = Param(unit="N/m", min=0.0, doc="Spring constant")
     d = Param(unit="N*s/m", min=0.0, doc="Damping constant")
-    rel0 = Param(0.0, unit="m", name="s_rel0", doc="Unstretched relative length")
+    s_rel0 = Param(0.0, unit="m", doc="Unstretched relative length")
 
 
 class Spring(PartialSpring, library=LIB):
     """Linear translational spring."""
     domain = LIB
     c = Param(unit="N/m", min=0.0, doc="Spring constant")
-    rel0 = Param(0.0, unit="m", name="s_rel0", doc="Unstretched relative length")
+    s_rel0 = Param(0.0, unit="m", doc="Unstretched relative length")
 
 
 class Damper(PartialDamper, library=LIB):
@@ -42,7 +42,18 @@ class Force(PartialSource, library=LIB):
 class Fixed(PartialFixed, library=LIB):
     """Flange fixed at a position in the world."""
     domain = LIB
-    position0 = Param(0.0, unit="m", name="s0", doc="Fixed position")
+    s0 = Param(0.0, unit="m", doc="Fixed position")
+
+
+class Rod(PartialRigid, library=LIB):
+    """A rigid massless rod of length L between flange_a and flange_b, MSL's
+    Translational.Components.Rod: flange_b.s = flange_a.s + L, and the force it takes at one
+    flange it passes whole to the other."""
+    domain = LIB
+    L = Param(0.0, unit="m", doc="Length, from flange_a to flange_b (flange_b.s - flange_a.s)")
+
+    def length(self):
+        return self.L
 
 
 class Mass(PartialInertia, library=LIB):
@@ -53,11 +64,10 @@ class Mass(PartialInertia, library=LIB):
     domain = LIB
     m = Param(unit="kg", min=0.0, doc="Mass")
     L = Param(0.0, unit="m", doc="Length, from flange_a to flange_b (flange_b.s - flange_a.s)")
-    position0 = Param(None, optional=True, unit="m", name="s0",
-                      doc="Initial position of the centre (None: from what it is tied to, "
-                          "else 0)")
-    speed0 = Param(None, optional=True, unit="m/s", name="v0",
-                   doc="Initial speed (None: from what it is tied to, else 0)")
+    s0 = Param(None, optional=True, unit="m",
+               doc="Initial position of the centre (None: from what it is tied to, else 0)")
+    v0 = Param(None, optional=True, unit="m/s",
+               doc="Initial speed (None: from what it is tied to, else 0)")
 
     def inertia(self):
         return self.m
@@ -89,12 +99,31 @@ class ForceSensor(PartialFlowSensor, library=LIB):
     domain = LIB
 
 
+class PowerSensor(PartialPowerSensor, library=LIB):
+    """The power flowing from flange_a to flange_b, flange_a.f * der(flange_a.s), as the
+    signal ``power`` (MSL's Translational.Sensors.PowerSensor); wire it in series."""
+    domain = LIB
+    power = Port("signal_out", "Power from flange_a to flange_b [W]", optional=True)
+    outputs = {"power": "power"}
+
+
+class MultiSensor(PartialPowerSensor, library=LIB):
+    """The force into flange_a (``f``), the flanges' velocity (``v``) and the power flowing
+    from flange_a to flange_b, f * v (``power``), as MSL's Translational.Sensors.MultiSensor;
+    wire it in series."""
+    domain = LIB
+    power = Port("signal_out", "Power from flange_a to flange_b [W]", optional=True)
+    f = Port("signal_out", "Force into flange_a [N]", optional=True)
+    v = Port("signal_out", "Velocity of the flanges [m/s]", optional=True)
+    outputs = {"power": "power", "f": "flow", "v": "speed"}
+
+
 class Position(PartialMotion, library=LIB):
     """Moves its flange to s_ref: an expression in time and model parameters, or the signal at
     u; exact (differentiated exactly) or filtered (second-order Bessel filter, f_crit)."""
     domain = LIB
-    reference = Param(None, optional=True, unit="m", time=True, name="s_ref",
-                      doc="Prescribed position (when u is not wired)")
+    s_ref = Param(None, optional=True, unit="m", time=True,
+                  doc="Prescribed position (when u is not wired)")
     exact = Param(True, kind="bool", doc="Differentiate the reference exactly (else filter it)")
     f_crit = Param(50.0, unit="Hz", positive=True, doc="Cut-off frequency of the filter")
 
@@ -104,11 +133,11 @@ class Speed(PartialMotion, library=LIB):
     at u) from s0: the position is integrated; exact or filtered (first order, f_crit)."""
     domain = LIB
     derivative = 1
-    reference = Param(None, optional=True, unit="m/s", time=True, name="v_ref",
-                      doc="Prescribed speed (when u is not wired)")
+    v_ref = Param(None, optional=True, unit="m/s", time=True,
+                  doc="Prescribed speed (when u is not wired)")
     exact = Param(True, kind="bool", doc="Differentiate the reference exactly (else filter it)")
     f_crit = Param(50.0, unit="Hz", positive=True, doc="Cut-off frequency of the filter")
-    position0 = Param(0.0, unit="m", name="s0", doc="Initial position")
+    s0 = Param(0.0, unit="m", doc="Initial position")
 
 
 class Accelerate(PartialMotion, library=LIB):
@@ -116,10 +145,10 @@ class Accelerate(PartialMotion, library=LIB):
     or the signal at u) from s0 at v0: speed and position are integrated."""
     domain = LIB
     derivative = 2
-    reference = Param(None, optional=True, unit="m/s^2", time=True, name="a_ref",
-                      doc="Prescribed acceleration (when u is not wired)")
-    position0 = Param(0.0, unit="m", name="s0", doc="Initial position")
-    speed0 = Param(0.0, unit="m/s", name="v0", doc="Initial speed")
+    a_ref = Param(None, optional=True, unit="m/s^2", time=True,
+                  doc="Prescribed acceleration (when u is not wired)")
+    s0 = Param(0.0, unit="m", doc="Initial position")
+    v0 = Param(0.0, unit="m/s", doc="Initial speed")
 
 
 from .translational_friction import ElastoGap, Friction, Stop  # noqa: E402,F401

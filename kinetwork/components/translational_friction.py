@@ -9,7 +9,7 @@ class Friction(PartialBearingFriction, library="translational"):
     surface: f_c = mu * m * g): stuck while the force holding it stays within peak * f_c, else
     sliding against f_c + d * v."""
     domain = "translational"
-    f_kinetic = Param(unit="N", min=0.0, name="f_c", doc="Coulomb friction force")
+    f_c = Param(unit="N", min=0.0, doc="Coulomb friction force")
     peak = Param(1.0, unit="1", min=1.0, doc="Static over Coulomb friction force")
     d = Param(0.0, unit="N*s/m", min=0.0, doc="Viscous friction coefficient")
 
@@ -19,17 +19,17 @@ class ElastoGap(PartialElastoGap, library="translational"):
     domain = "translational"
     c = Param(unit="N/m", min=0.0, doc="Spring constant")
     d = Param(0.0, unit="N*s/m", min=0.0, doc="Damping constant")
-    rel0 = Param(0.0, unit="m", name="s_rel0", doc="Relative distance where contact begins")
+    s_rel0 = Param(0.0, unit="m", doc="Relative distance where contact begins")
 
 
 class Stop(PartialStop, library="translational"):
     """Hard end stops on a relative position (a slider against its support, a ball on the
     floor), with restitution e."""
     domain = "translational"
-    rel_min = Param(None, optional=True, unit="m", name="s_min",
-                    doc="Lower limit of flange_b relative to flange_a (None: none)")
-    rel_max = Param(None, optional=True, unit="m", name="s_max",
-                    doc="Upper limit of flange_b relative to flange_a (None: none)")
+    s_min = Param(None, optional=True, unit="m",
+                  doc="Lower limit of flange_b relative to flange_a (None: none)")
+    s_max = Param(None, optional=True, unit="m",
+                  doc="Upper limit of flange_b relative to flange_a (None: none)")
     e = Param(0.8, unit="1", min=0.0, max=1.0, doc="Coefficient of restitution")
     v_rest = Param(1e-4, unit="m/s", min=0.0,
                    doc="Impact speed below which the flange comes to rest on the limit")

@@ -25,6 +25,7 @@ from dataclasses import dataclass
 import casadi as ca
 
 from ..errors import ModelError
+from ..spatial import vee
 from .newton_euler import aba
 
 
@@ -39,14 +40,16 @@ class Frame:
 
 
 @dataclass
-class PointMass:
-    """A point mass of a force element, at ``position`` (world, in q)."""
+class Rider:
+    """Inertia that moves with the tree without being one of its bodies: a point mass of a
+    force element, or a body (or an assembly's point mass) on a frame an assembly places.
+    Its velocity rows are J u (3 for a point: the velocity; 6 for a body: the angular
+    velocity, then the velocity of its centre of mass, in the world), its inertia W in those
+    rows (m I, or diag(I_world, m I)); ``bias`` is (dJ/dt) u."""
     element: str
-    mass: ca.SX
-    weights: dict               # port -> share of the position (and of the inertial force)
-    position: ca.SX
-    J: ca.SX                    # 3 x n: d(velocity)/d(speeds)
-    bias: ca.SX                 # (dJ/dt) u: its acceleration at zero speed rates
+    W: ca.SX
+    J: ca.SX
+    bias: ca.SX
 
 
 class Extra:
@@ -59,7 +62,7 @@ class Extra:
     terms, -m J^T (dJ/dt) u; ``Q`` their sum.
     """
 
-    def __init__(self, topo, bound, bodies, place, q, u, qdot):
+    def __init__(self, topo, bound, bodies, place, q, u, qdot, placing=None):
         n = u.shape[0]
         self.bodies, self.u = bodies, u
         world = bound[topo.world.name] if topo.world else None
@@ -78,14 +81,22 @@ class Extra:
 
         def rate(x):
             return ca.jtimes(x, q, qdot)
+        inner = placing.sets if placing is not None else set()
         if uniform is None:
             for body, s in topo.bodies:
-                if place[s][0] < 0:
+                if place[s][0] < 0 or s in inner:
                     continue            # welded to the ground: it takes what it weighs
                 m, c, _ = bound[body.name].mass_properties()
                 R, p = _set_pose(poses, place, s)
                 cw = p + R @ c
                 self.Q_gravity += ca.jtimes(rate(cw), u, m * self.field(cw), True)
+        for body, s in topo.bodies:
+            if s in inner:
+                self._body(body.name, bound[body.name].mass_properties(),
+                           _set_pose(poses, place, s), q, u, qdot)
+        for name, m, k, r in placing.masses if placing is not None else ():
+            R, p = poses[k] if k >= 0 else (ca.SX.eye(3), ca.SX.zeros(3))
+            self._point(name, m, p + R @ r, q, u, qdot)
         for comp in topo.forces:
             for m, weights in bound[comp.name].point_masses():
                 if ca.SX(m).is_zero() or set(topo.junctions) & {
@@ -93,34 +104,54 @@ class Extra:
                     continue            # no mass: nothing to add, not even a solve
                 r = mass_position(weights, {port: position(topo.set_of[comp.port_ref(port)])
                                             for port in weights})
-                J = ca.jacobian(rate(r), u)
-                bias = ca.jtimes(J @ u, q, qdot)
-                self.masses.append(PointMass(comp.name, m, weights, r, J, bias))
-                self.Q_gravity += J.T @ (m * self.field(r))
-                self.Q_inertia -= J.T @ (m * bias)
+                self._point(comp.name, m, r, q, u, qdot)
         self.Q = self.Q_gravity + self.Q_inertia
 
+    def _point(self, name, m, r, q, u, qdot):
+        """A point mass m at the world point r(q)."""
+        J = ca.jacobian(ca.jtimes(r, q, qdot), u)
+        bias = ca.jtimes(J @ u, q, qdot)
+        self.masses.append(Rider(name, m * ca.SX.eye(3), J, bias))
+        self.Q_gravity += J.T @ (m * self.field(r))
+        self.Q_inertia -= J.T @ (m * bias)
+
+    def _body(self, name, properties, pose, q, u, qdot):
+        """A body (mass, centre of mass and inertia in its frame) on a frame at the world
+        ``pose`` (R, p in q) that is no body of the tree: Newton and Euler's equations
+        m (a_c - g) and I alpha + w x I w, taken to the speeds by J^T."""
+        m, c, Ic = properties
+        R, p = pose
+        cw = p + R @ c
+        w = vee(ca.reshape(ca.jtimes(ca.vec(R), q, qdot), 3, 3) @ R.T)
+        J = ca.jacobian(ca.vertcat(w, ca.jtimes(cw, q, qdot)), u)
+        Iw = R @ Ic @ R.T
+        W = ca.diagcat(Iw, m * ca.SX.eye(3))
+        bias = ca.jtimes(J @ u, q, qdot)
+        self.masses.append(Rider(name, W, J, bias))
+        self.Q_gravity += J[3:, :].T @ (m * self.field(cw))
+        self.Q_inertia -= J.T @ (W @ bias) + J[:3, :].T @ ca.cross(w, Iw @ w)
+
     def mass_matrix(self):
-        """sum m J^T J over the point masses (None without any)."""
+        """sum J^T W J over the riders (None without any)."""
         if not self.masses:
             return None
-        return sum((pm.mass * (pm.J.T @ pm.J) for pm in self.masses),
+        return sum((r.J.T @ r.W @ r.J for r in self.masses),
                    ca.SX.zeros(self.u.shape[0], self.u.shape[0]))
 
     def mass_times(self, w):
-        """sum m J^T J w over the point masses (O(n) each)."""
-        return sum((pm.J.T @ (pm.mass * (pm.J @ w)) for pm in self.masses),
+        """sum J^T W J w over the riders (O(n) each)."""
+        return sum((r.J.T @ (r.W @ (r.J @ w)) for r in self.masses),
                    ca.SX.zeros(self.u.shape[0]))
 
     def forward(self, a0, armature):
-        """The speeds' rates with the point masses, from ``a0``, those of the tree alone
-        under all the generalized forces (Q included): a0 - Y W (I + J Y W)^-1 J a0."""
+        """The speeds' rates with the riders, from ``a0``, those of the tree alone under all
+        the generalized forces (Q included): a0 - Y W (I + J Y W)^-1 J a0."""
         if not self.masses:
             return a0
         n = self.u.shape[0]
         zero = ca.SX.zeros(n)
-        J = ca.vertcat(*[pm.J for pm in self.masses])
-        W = ca.diag(ca.vertcat(*[ca.repmat(pm.mass, 3, 1) for pm in self.masses]))
+        J = ca.vertcat(*[r.J for r in self.masses])
+        W = ca.diagcat(*[r.W for r in self.masses])
         # M^-1 J^T column by column: the articulated-body algorithm with no speed, no gravity
         Y = ca.horzcat(*[ca.substitute(aba(self.bodies, zero, J[i, :].T, ca.SX.zeros(6),
                                            armature), self.u, zero)
@@ -147,7 +178,7 @@ def element_forces(asm, topo, bound):
             raise ModelError(f"algebraic loop through {comp.name} and the mechanics: a "
                              f"signal input of {comp.name} reads an acceleration or a force "
                              f"at the same instant; break it with a state (an Integrator, a "
-                             f"FirstOrder or a filtered Derivative)")
+                             f"FirstOrder or a filtered Derivative)", component=comp.name)
     return Q + asm.junctions.Q if junctions else Q
 
 

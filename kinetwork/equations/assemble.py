@@ -15,7 +15,7 @@ import numpy as np
 from ..errors import ModelError
 from ..expr import casadi_functions, parse
 from ..spatial import vee
-from . import applied, junctions, loopstart, network
+from . import applied, junctions, loopstart, network, placed
 from . import starts as inertia_starts
 from .newton_euler import Body, aba, crba, motion_subspace, rnea, spatial_inertia
 from .signals import probe_signals
@@ -73,6 +73,12 @@ class Assembly:
     junctions: object = None
     #: the rows a loop's cut joint's start values add to the start (loopstart.StartRows)
     start_rows: object = None
+    #: what assemblies place in closed form (placed.Placed)
+    placed: object = None
+    #: the speeds' rates by a dense solve with the whole mass matrix: the riders (bodies on
+    #: an assembly's frames) carry inertia that the tree alone lacks (a massless crank), where
+    #: the articulated-body algorithm would divide by zero
+    dense: bool = False
 
     def mass_matrix(self):
         M = crba(self.bodies, self.u.shape[0], self.armature)
@@ -89,6 +95,8 @@ class Assembly:
 
     def solve_mass(self, w):
         """M(q)^-1 w by the articulated-body algorithm (no speed, no gravity): O(n)."""
+        if self.dense:
+            return ca.solve(self.mass_matrix(), w)
         zero = ca.SX.zeros(self.u.shape[0])
         tree = ca.substitute(aba(self.bodies, zero, w, ca.SX.zeros(6), self.armature),
                              self.u, zero)
@@ -124,26 +132,10 @@ class Assembly:
         return self._poses[frame_set]
 
     def relative_poses(self, set_a, set_b):
-        """(Ra, pa, Rb, pb): two frame sets placed in the nearest body both hang from."""
-        def chain(k):
-            out = []
-            while k >= 0:
-                out.append(k)
-                k = self.bodies[k].parent
-            return out
-        ka, Ra, pa = self.place[set_a]
-        kb, Rb, pb = self.place[set_b]
-        common = set(chain(kb))
-        anc = next((k for k in chain(ka) if k in common), -1)
-
-        def up(k, R, pos, until):
-            while k != until:
-                b = self.bodies[k]
-                R, pos = b.R @ R, b.p + b.R @ pos
-                k = b.parent
-            return R, pos
-        self.base = up(anc, ca.SX.eye(3), ca.SX.zeros(3), -1)   # the shared body, in the world
-        return (*up(ka, Ra, pa, anc), *up(kb, Rb, pb, anc))
+        """(Ra, pa, Rb, pb): two frame sets placed in the nearest body both hang from (whose
+        world pose is ``base`` after the call)."""
+        *poses, self.base = placed.relative_poses(self.bodies, self.place, set_a, set_b)
+        return tuple(poses)
 
     def rate(self, expr, accelerations=True):
         """Time derivative of an expression in (q, u), with u's rate ``udot`` (or, without
@@ -165,10 +157,12 @@ class Assembly:
         return vee(self.rate(R, accelerations) @ R.T)
 
 
-def assemble(model, topo, values):
+def assemble(model, topo, values, branch_start=None):
     """Build the Assembly of a validated model (``topo`` from ``model.validate()``);
     ``values`` are the model parameters' values, at which structural choices that depend on
-    numbers (a singular algebraic loop) are checked. Every model parameter stays a symbol."""
+    numbers (a singular algebraic loop) are checked. Every model parameter stays a symbol.
+    ``branch_start`` (the start's coordinates, in p) is where assemblies choose their roots
+    (by default, the joints' own starts or guesses)."""
     names = list(model.parameters)
     p = ca.SX.sym("p", len(names))
     t = ca.SX.sym("t")
@@ -182,8 +176,11 @@ def assemble(model, topo, values):
     env_r = {**env_t, **{n: sym for r in reads.values() for n, (sym, _) in r.items()}}
 
     def bind(comp, env):
-        return comp.bound({k: _symbolic(v, env, funcs) if comp.params[k].kind == "real"
+        twin = comp.bound({k: _symbolic(v, env, funcs) if comp.params[k].kind == "real"
                            else v for k, v in comp._values.items()})
+        # the names its expressions of other variables may read (a Ground's gravity field)
+        object.__setattr__(twin, "_environment", env)
+        return twin
     bound = {name: bind(comp, env_r if name in reads else env_t)
              for name, comp in model.components.items()}
 
@@ -211,7 +208,11 @@ def assemble(model, topo, values):
                                                           u[uindex[joint.name]])
 
     bodies, place = _bodies(topo, bound, q, u, qindex, uindex)
-    extra = applied.Extra(topo, bound, bodies, place, q, u, qdot)
+    own = _own_starts(topo, bound)
+    placing = placed.place_assemblies(topo, bound, bodies, place, q,
+                                      ca.vertcat(*own) if branch_start is None else branch_start)
+    derived = {ref: _moving(pos, q, u, qdot, udot) for ref, pos in placing.coordinates.items()}
+    extra = applied.Extra(topo, bound, bodies, place, q, u, qdot, placing)
     gravity = extra.uniform
     a_grav = ca.vertcat(ca.SX.zeros(3), -gravity)
 
@@ -219,7 +220,7 @@ def assemble(model, topo, values):
         tree = rnea(bodies, u, a, a_grav, armature) - passive
         return tree + extra.mass_times(a) - extra.Q if n else tree
     net = network.build(model, topo, bound, q, u, udot, qindex, uindex, t, inverse, p,
-                        [values[k] for k in names], reads)
+                        [values[k] for k in names], reads, derived)
     for name in reads:
         if model.components[name].role != "source":       # a force on frames
             bound[name] = bind(model.components[name],
@@ -227,11 +228,9 @@ def assemble(model, topo, values):
                                             reads[name].items()}})
     Q = net.Q
 
-    starts, given, u_start, u_given = [], [], [], []
+    starts, given, u_start, u_given = list(own), [], [], []
     for joint in topo.joints:
         q0, u0 = bound[joint.name].initial()
-        guess = bound[joint.name].guesses() if joint.regular else [0] * len(q0)
-        starts += [g if v is None else v for v, g in zip(q0, guess)]
         given += [v is not None for v in q0]
         u_start += [0 if v is None else v for v in u0]
         u_given += [v is not None for v in u0]
@@ -248,11 +247,17 @@ def assemble(model, topo, values):
                    ca.vertcat(*u_start) if u_start else ca.SX(0, 1), given, u_given, regular,
                    speed_of, Q, None, qdot, gravity, udot, place=place)
     asm.armature, asm.net = net.armature, net
-    asm.applied = extra
+    asm.applied, asm.placed = extra, placing
     asm.junctions = junctions.build(asm, topo, bound)
     asm.Q = Q + _frame_forces(asm, topo, bound, t) + extra.Q
-    asm.udot_tree = extra.forward(aba(bodies, u, asm.Q, ca.vertcat(ca.SX.zeros(3), -gravity),
-                                      net.armature), net.armature) if n else ca.SX(0, 1)
+    asm.dense = bool(n and extra.masses and placing.sets) and _tree_singular(
+        bodies, n, net.armature, q, p, ca.vertcat(*starts), [values[k] for k in names])
+    if asm.dense:
+        asm.udot_tree = ca.solve(asm.mass_matrix(), asm.Q - rnea(bodies, u, ca.SX.zeros(n),
+                                                                a_grav))
+    else:
+        asm.udot_tree = extra.forward(aba(bodies, u, asm.Q, a_grav, net.armature),
+                                      net.armature) if n else ca.SX(0, 1)
     asm.cuts = [(cut, _closure(asm, cut, bound[cut.component.name], qindex))
                 for cut in topo.cuts]
     _place_cut_frames(asm, topo, bound)
@@ -263,7 +268,44 @@ def assemble(model, topo, values):
     asm.qindex, asm.uindex, asm.Q_drive = qindex, uindex, net.axis_flow
     asm.signals = probe_signals(asm, topo, net, bound, model)
     inertia_starts.check(model, topo, asm, bound, [values[k] for k in names])
+    if branch_start is None and placing.branches and _branches_differ(
+            placing, q, ca.vertcat(*own), asm.q_start, p, [values[k] for k in names]):
+        # an inertia on a joint axis or a motion moves the start: choose the roots there
+        return assemble(model, topo, values, asm.q_start)
     return asm
+
+
+def _own_starts(topo, bound):
+    """Each joint's own start coordinates (q0, or its guess where q0 is not given)."""
+    out = []
+    for joint in topo.joints:
+        q0, _ = bound[joint.name].initial()
+        guess = bound[joint.name].guesses() if joint.regular else [0] * len(q0)
+        out += [g if v is None else v for v, g in zip(q0, guess)]
+    return out
+
+
+def _tree_singular(bodies, n, armature, q, p, q_start, p_values):
+    """Whether the tree's own mass matrix (its bodies and armature, without what rides on
+    assemblies) is singular at the start, at the parameters' values."""
+    f = ca.Function("M_tree", [q, p], [crba(bodies, n, armature)])
+    M = np.asarray(f(ca.Function("q0", [p], [q_start])(p_values), p_values), dtype=float)
+    scale = max(np.max(np.abs(M)), 1e-300)
+    return not np.all(np.isfinite(M)) or np.linalg.eigvalsh((M + M.T) / 2)[0] <= 1e-12 * scale
+
+
+def _moving(pos, q, u, qdot, udot):
+    """(position, speed, acceleration) of an expression in q: its rates, exactly."""
+    vel = ca.jtimes(pos, q, qdot)
+    return pos, vel, ca.jtimes(vel, q, qdot) + ca.jtimes(vel, u, udot)
+
+
+def _branches_differ(placing, q, own, start, p, p_values):
+    """Whether the assemblies' roots chosen at the joints' own starts differ from those at
+    the start (where inertias and motions put it), at the parameters' values."""
+    rule = ca.Function("branches", [q, p], [ca.vertcat(*placing.branch_rule.values())])
+    at = [ca.Function("at", [p], [where])(p_values) for where in (own, start)]
+    return bool(np.any(np.asarray(rule(at[0], p_values)) != np.asarray(rule(at[1], p_values))))
 
 
 def _prescribed_starts(model, net, t, q, u, starts, u_start, given, u_given, p, p_values):
@@ -320,6 +362,9 @@ def _symbols(names, suffix):
 
 
 def _speed_units(joint):
+    # looked up on the class: a component's __getattr__ refuses unknown names as a ModelError
+    if hasattr(type(joint), "speed_units"):
+        return joint.speed_units()
     return ["m/s"] * 3 + ["rad/s"] * 3 if joint.dof == 6 else ["rad/s"] * joint.dof
 
 
@@ -353,7 +398,10 @@ def _bodies(topo, bound, q, u, qindex, uindex):
             cJ = ca.jtimes(S @ uj, qj, comp.rate(qj, uj))
         bodies.append(Body(comp.name, k, R, pos, S, cJ, ca.SX.zeros(6, 6), uindex[comp.name]))
         place[edge.child] = (len(bodies) - 1, ca.SX.eye(3), ca.SX.zeros(3))
+    inner = topo.inner
     for body, frame_set in topo.bodies:
+        if frame_set in inner:
+            continue            # moves with an assembly's loop: ``applied.Extra`` takes it
         k, Rs, ps = place[frame_set]
         if k < 0:
             continue            # welded to the ground: no motion, no state

@@ -29,7 +29,7 @@ import casadi as ca
 import networkx as nx
 import numpy as np
 
-from ..errors import ModelError
+from ..errors import ModelError, Problem
 from .circuit_dae import Candidate, Dae, couple
 from .blocks import solve_blocks
 from .structure import Singular, reduce_index
@@ -56,6 +56,10 @@ class _Pins:
 
     def place(self, key):
         return self._c.model.place(self._comp, key)
+
+    def fields(self, key):
+        """The fields of a Problem about this component's parameter ``key``."""
+        return self._c.model.fields(self._comp, key)
 
 
 class Circuit:
@@ -202,11 +206,13 @@ class Circuit:
             wired = s in self.topo.signal_source
             given = c._values[key] is not None
             if wired and given:
-                problems.append(f"{self.model.place(c, key)}: {c.name}.u is wired too; the "
-                                f"value comes from one of them: remove {key} or the wire")
+                problems.append(self.model.problem(
+                    f"{c.name}.u is wired too; the value comes from one of them: remove {key} "
+                    f"or the wire", c, key))
             elif not wired and not given:
-                problems.append(f"{self.model.place(c, key)}: no value: give {key} (an "
-                                f"expression in time t) or wire a signal to {c.name}.u")
+                problems.append(self.model.problem(
+                    f"no value: give {key} (an expression in time t) or wire a signal to "
+                    f"{c.name}.u", c, key))
             elif wired:
                 placeholder = ca.SX.sym(f"u_{c.name}")
                 self.sources[c.name] = placeholder
@@ -229,9 +235,12 @@ class Circuit:
             if not part & grounded:
                 names = sorted({r.component.name for s in part for r in self.topo.sets[s]
                                 if r.component.role != "probe"})
-                problems.append(f"circuit of {', '.join(names)} has no electrical.Ground: its "
-                                f"potentials are not defined; wire a Ground to one of its "
-                                f"pins")
+                # marked on its first component: the studio shows where to add the Ground
+                problems.append(Problem(
+                    f"circuit of {', '.join(names)} has no electrical.Ground: its potentials "
+                    f"are not defined; wire a Ground to one of its pins",
+                    **(self.model.fields(self.model.components[names[0]]) if names else {}),
+                    hint="wire an electrical.Ground to one of its pins"))
         if problems:
             raise ModelError(problems)
 
@@ -358,14 +367,17 @@ class Circuit:
             where = self.model.place(cand.comp, cand.key)
             why = self.demoted[cand.name]
             if not at0.is_constant():
-                problems.append(f"{where}: {cand.name} is no state ({why}); its start follows "
-                                f"from signals, so it cannot be given: remove {cand.key}")
+                problems.append(Problem(
+                    f"{where}: {cand.name} is no state ({why}); its start follows from "
+                    f"signals, so it cannot be given: remove {cand.key}",
+                    **self.model.fields(cand.comp, cand.key)))
                 continue
             fixed = float(at0)
             if abs(fixed - given) > START_TOL * (1 + abs(fixed)):
-                problems.append(f"{where} = {given:g}: {cand.name} is no state ({why}), and "
-                                f"the constraint gives {fixed:g} at the start: remove "
-                                f"{cand.key} or make it agree")
+                problems.append(Problem(
+                    f"{where} = {given:g}: {cand.name} is no state ({why}), and the "
+                    f"constraint gives {fixed:g} at the start: remove {cand.key} or make it "
+                    f"agree", **self.model.fields(cand.comp, cand.key)))
         if problems:
             raise ModelError(problems)
 
@@ -442,13 +454,18 @@ class Circuit:
                 reason = ("it needs the derivative of the forces on a rotor the circuit "
                           "constrains (a constraint of the mechanism's accelerations)")
             return ModelError(f"circuit: the equations of {what} cannot be solved: {reason}"
-                              + (f"; undetermined: {', '.join(lost)}" if lost else ""))
+                              + (f"; undetermined: {', '.join(lost)}" if lost else ""),
+                              **self._fields_of(comps))
         return ModelError(
             f"circuit: the equations of {what} constrain their unknowns twice and leave "
             f"{', '.join(lost) or 'nothing'} undetermined: the circuit is structurally "
             f"singular (two voltage sources in parallel, a loop of voltage sources, a current "
             f"source in series with another, an open current source, an ideal op-amp with "
-            f"no feedback)")
+            f"no feedback)", **self._fields_of(comps))
+
+    def _fields_of(self, names):
+        """The fields of a refusal naming components ``names``: the first one's (sorted)."""
+        return self.model.fields(self.model.components[names[0]]) if names else {}
 
     # -- what the network reads -------------------------------------------------------------
     def output(self, comp):

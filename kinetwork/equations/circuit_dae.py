@@ -81,13 +81,13 @@ def couple(circuit, dae, emfs):
             if group is None or group.kind in ("fixed", "world"):
                 continue
             if group.kind != "free":
-                raise ModelError(
-                    f"{model.place(c)}: the circuit fixes the voltage across {c.name} (it is "
+                raise ModelError(model.problem(
+                    f"the circuit fixes the voltage across {c.name} (it is "
                     f"wired across a voltage source, a capacitor or another EMF with no "
                     f"resistance or inductance in between), so it constrains the speed at "
                     f"{c.name}.{pn}, which is {_what(group)}: kinetwork reduces such a "
                     f"constraint only on free rotors and masses; add the armature's "
-                    f"resistance or inductance")
+                    f"resistance or inductance", c, port=pn))
             groups[group.index] = group
     turning = [c for c in circuit.comps if c.name in circuit.speeds and any(
         b.group_of.get(b.topo.set_of[c.port_ref(pn)]) in groups.values()

@@ -63,10 +63,31 @@ from ..util import quiet, summary
 from . import loopstart
 from .newton_euler import aba, rnea
 
-def _qr(*args, **kwargs):
-    """scipy's pivoted QR, imported when a model has loops (scipy.linalg is slow to load)."""
-    import scipy.linalg
-    return scipy.linalg.qr(*args, **kwargs)
+def _pivoted_qr(a):
+    """The QR factorisation of ``a`` with column pivoting (Businger-Golub: at each step the
+    column of largest remaining norm, the first of equals): (|diagonal of R|, column order).
+
+    numpy has no pivoted QR and scipy.linalg costs 0.3 s to import in every process that
+    builds a loop; the matrices here are a few dozen rows and columns.
+    """
+    r = np.array(a, dtype=float)
+    m, n = r.shape
+    order = np.arange(n)
+    diag = np.zeros(min(m, n))
+    for k in range(min(m, n)):
+        norms = np.sqrt(np.einsum("ij,ij->j", r[k:, k:], r[k:, k:]))
+        j = k + int(np.argmax(norms))
+        if j != k:
+            r[:, [k, j]] = r[:, [j, k]]
+            order[[k, j]] = order[[j, k]]
+        diag[k] = norms[j - k]
+        if diag[k] == 0.0:
+            break                      # what remains is zero
+        v = r[k:, k].copy()
+        v[0] += math.copysign(diag[k], v[0])
+        v /= np.linalg.norm(v)
+        r[k:, k:] -= 2.0 * np.outer(v, v @ r[k:, k:])
+    return diag, order
 
 
 FORMULATIONS = ("partition", "projected", "baumgarte")
@@ -470,7 +491,7 @@ class _Loops:
             return [], []
         s = np.linalg.svd(J, compute_uv=False)
         rank = int(np.sum(s > RANK_TOL * max(s[0], 1.0)))
-        _, _, piv = _qr(J.T, pivoting=True)
+        _, piv = _pivoted_qr(J.T)
         rows = sorted(piv[:rank].tolist())
         Jr = J[rows]
         # speeds that may be dependent: of regular loop coordinates; preference tiers
@@ -497,8 +518,7 @@ class _Loops:
             if basis.shape[1]:                 # what the chosen columns do not reach yet
                 Qb, _ = np.linalg.qr(basis)
                 cols = cols - Qb @ (Qb.T @ cols)
-            _, R, piv = _qr(cols, pivoting=True, mode="economic")
-            diag = np.abs(np.diag(R)) if R.size else np.zeros(0)
+            diag, piv = _pivoted_qr(cols)
             for j, d in zip(piv, diag):
                 if len(dep) == rank or d <= RANK_TOL * max(np.abs(Jr).max(), 1.0):
                     break
@@ -549,7 +569,7 @@ class _Loops:
         rank = int(np.sum(s > RANK_TOL * max(s[0], 1.0))) if s.size else 0
         if rank < len(self.rows):
             return None
-        _, _, piv = _qr(J.T, pivoting=True)
+        _, piv = _pivoted_qr(J.T)
         rows = sorted(piv[:rank].tolist())
         cand = self.candidates()
         Jc = J[rows][:, cand]
@@ -559,7 +579,7 @@ class _Loops:
         if math.comb(len(cand), rank) <= PARTITION_CHOICES:
             choices = itertools.combinations(range(len(cand)), rank)
         else:
-            _, _, piv = _qr(Jc, pivoting=True)
+            _, piv = _pivoted_qr(Jc)
             choices = [sorted(piv[:rank].tolist())]
         out = []
         for dep in choices:

@@ -136,11 +136,15 @@ def branch(loops, q, p):
         listed = ", ".join(
             f"{names[k]} = {q[k]:.6g}{' ' + units[k] if units[k] else ''} (other branch: "
             f"{z:.6g}, guess {start[k]:.6g})" for k, z in zip(free, nearest[1]))
-        warnings.warn(
+        # the place is the joint judged farthest from its guess (a piston's prismatic)
+        farthest = free[int(np.argmax(np.where(judged, mine, -1.0)))]
+        warnings.warn(AssemblyBranchWarning(
             f"kinematic loop through {', '.join(cut.loop)}: Newton from the guesses "
             f"(q0_guess) assembled the start on another branch than the one they point to "
             f"({listed}): the start is the first; if the other is meant (a piston inside its "
-            f"cylinder), give its values as q0_guess", AssemblyBranchWarning, stacklevel=2)
+            f"cylinder), give its values as q0_guess",
+            component=names[farthest].rsplit(".", 1)[0], parameter="q0_guess",
+            hint="give q0_guess on the branch meant"), stacklevel=2)
 
 
 #: random starts of the search for other assemblies of a loop (Gauss-Newton from each)

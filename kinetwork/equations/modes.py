@@ -50,7 +50,7 @@ def close(asm, eq, model):
         raise ModelError(f"{', '.join(names)}: friction and stops are handled by events, which "
                          f"need the equations as ODEs; this model has algebraic variables "
                          f"({', '.join(eq.algebraic_names)}): compile it with "
-                         f"loops='projected' (the default)")
+                         f"loops='projected' (the default)", component=names[0])
     q = asm.q if eq.q is None else eq.q
     lam = eq.lam if eq.lam is not None else ca.SX(0, 1)
 
@@ -119,7 +119,7 @@ def free_terms(asm, exprs):
         if free is None:
             raise ModelError(f"{h.comp.name}: its mode (which flange drives) is not a function "
                              f"of the state, so M, V, G cannot show it: give it eta = 1 to see "
-                             f"the equations")
+                             f"the equations", component=h.comp.name)
         modes.append(free(at(net.pos, h.b) - at(net.pos, h.a),
                           at(net.vel, h.b) - at(net.vel, h.a)))
     symbols = ca.vertcat(*[h.mode for h in net.hybrid], *[h.F for h in net.hybrid])
@@ -162,6 +162,7 @@ def operating_modes(system, t, X, p, check=True):
                 raise ModelError(f"{comp.name}: at rest there, it would have to hold "
                                  f"{abs(table[i, 3]):.6g} beyond its static limit "
                                  f"{table[i, 4]:.6g}, so it slides, and friction is not smooth "
-                                 f"at zero speed: take a point where it holds or slides")
+                                 f"at zero speed: take a point where it holds or slides",
+                                 component=comp.name)
     X[:n] = x
     return X

@@ -105,8 +105,12 @@ class Network:
 
 
 def build(model, topo, bound, q, u, udot, qindex, uindex, t, inverse=None, p=None,
-          p_values=None, reads=None):
+          p_values=None, reads=None, derived=None):
     """The Network of a validated model, in the symbols of the Assembly.
+
+    ``derived``: the flanges whose position an assembly gives (its axis, the angle or
+    distance that closes its loop), PortRef -> (position, speed, acceleration) in (q, u,
+    udot); the generalized force on such a flange reaches the speeds by virtual work.
 
     ``inverse(a, armature, Q)`` is the tree's inverse dynamics (for InverseDynamics blocks):
     the generalized forces for speeds' rates ``a`` with the given armature, less ``Q``.
@@ -116,6 +120,7 @@ def build(model, topo, bound, q, u, udot, qindex, uindex, t, inverse=None, p=Non
     builder = _Builder(model, topo, bound, q, u, udot, qindex, uindex, t, inverse, p,
                        p_values)
     builder.reads = reads or {}
+    builder.derived = derived or {}
     return builder.run()
 
 
@@ -225,7 +230,7 @@ class _Builder:
                 self.c[s] = ca.SX(0)
                 self.ride[s] = [] if group.base is None else [(ca.SX(1), group.base)]
                 continue
-            r = self.bound[element.name].ratio()
+            r = self.bound[element.name].position_ratio()
             length = self.bound[element.name].length()
             a_here = self.topo.set_of[element.port_ref("flange_a")] == s
             # position(flange_a) = r * (position(flange_b) - length), relative to the
@@ -251,7 +256,8 @@ class _Builder:
             raise ModelError(f"{self.model.place(element, 'eta')}: a gear with a loss is "
                              f"taken between rotors that move freely (a drive train of "
                              f"inertias), not yet on a joint's axis or a prescribed motion; "
-                             f"set eta = 1 there, or put the loss in a BearingFriction")
+                             f"set eta = 1 there, or put the loss in a BearingFriction",
+                             **self.model.fields(element, "eta"))
         if element.name not in self.losses:
             from ..components.friction import GearModes
             mode = self._state(f"{element.name}.mode", "", 1, ca.SX(0))
@@ -283,6 +289,8 @@ class _Builder:
             self._motion(group, group.definer, placeholders)
         elif kind == "free":
             self._free(group)
+        elif kind == "assembly":
+            self.coord[group.index] = tuple(ca.SX(v) for v in self.derived[group.definer])
         elif kind == "massless":
             theta, w = ca.SX.sym(f"g{group.index}_pos"), ca.SX.sym(f"g{group.index}_vel")
             a = ca.SX.sym(f"g{group.index}_acc")
@@ -358,6 +366,14 @@ class _Builder:
 
     def _output(self, comp):
         """Evaluate a block's or a sensor's output into its signal set."""
+        if getattr(type(comp), "outputs", None):
+            # a power or multi sensor: the flow into flange_a, its speed, their product
+            ref = comp.port_ref("flange_a")
+            read = {"flow": self.net.flow[ref], "speed": self.net.vel[ref]}
+            read["power"] = read["flow"] * read["speed"]
+            for pname, what in comp.outputs.items():
+                self.net.signal[self.topo.set_of[comp.port_ref(pname)]] = ca.SX(read[what])
+            return
         s = self.topo.set_of[comp.port_ref("y")]
         b = self.bound[comp.name]
         if comp.role == "block":
@@ -370,7 +386,8 @@ class _Builder:
         else:
             ref = comp.port_ref("flange")
             if comp.quantity == "acceleration" and self._massless_at(ref):
-                raise ModelError(acceleration_unavailable(self.model.place(comp), ref))
+                raise ModelError(acceleration_unavailable(self.model.place(comp), ref),
+                                 **self.model.fields(comp, port="flange"))
             value = {"position": self.net.pos, "speed": self.net.vel,
                      "acceleration": self.net.acc}[comp.quantity][ref]
         self.net.signal[s] = ca.SX(value)
@@ -545,7 +562,8 @@ class _Builder:
             if group is not None and group.kind == "massless":
                 raise ModelError(f"{self.model.place(comp)}: {ref.path} is on a massless "
                                  f"flange, which has no acceleration for {comp.name} to hold "
-                                 f"or stop: give it an inertia or a mass")
+                                 f"or stop: give it an inertia or a mass",
+                                 **self.model.fields(comp, port=pn))
         b._mode = self._state(f"{comp.name}.mode", "", 0, ca.SX(0))
         b._F = ca.SX.sym(f"F_{comp.name}")
         u = self.topo.set_of[comp.port_ref("u")] if "u" in comp.ports else None
@@ -579,6 +597,13 @@ class _Builder:
             u = self._speed(group)
             self.net.armature[u] += inertia
             self._passive[u] += self._generalized(group, ("compliant",))
+        elif group.kind == "assembly":
+            self._passive += self._virtual(group, self._generalized(group, ("compliant",)))
+
+    def _virtual(self, group, gen):
+        """The generalized forces on the speeds of a force ``gen`` on an assembly's axis:
+        (d(speed of the axis)/du)^T gen, by virtual work."""
+        return ca.jtimes(self.coord[group.index][1], self.u, ca.SX(gen), True)
 
     def _speed(self, group):
         joint = group.definer.component
@@ -591,6 +616,8 @@ class _Builder:
         theta, w, a = self.coord[group.index]
         if group.kind == "joint":
             self.net.Q[self._speed(group)] += gen
+        elif group.kind == "assembly":
+            self.net.Q += self._virtual(group, gen)
         elif group.kind == "free" and group.index in self.circuit.coupled:
             # a rotor a circuit's constraint holds: its acceleration came with the circuit's
             # solution, in the generalized force of all but the circuit's EMFs
@@ -646,9 +673,9 @@ class _Builder:
             if element.has_inertia:
                 flow[near] = b.inertia() * self.kin[s][2] - flow[far]
             elif far.name == "flange_a":          # torque_b = -ratio * torque_a
-                flow[near] = -b.ratio() * self.losses.get(element.name, 1) * flow[far]
+                flow[near] = -b.position_ratio() * self.losses.get(element.name, 1) * flow[far]
             else:
-                flow[near] = -flow[far] / (b.ratio() * self.losses.get(element.name, 1))
+                flow[near] = -flow[far] / (b.position_ratio() * self.losses.get(element.name, 1))
             if "support" in element.ports:        # MSL: support.tau = -flange_a.tau - flange_b.tau
                 flow[element.port_ref("support")] = -(flow[far] + flow[near])
             beyond[parent] = beyond[parent] + flow[near]
@@ -742,7 +769,7 @@ class _Builder:
                         f"must follow time only (an expression in t, or signal blocks fed "
                         f"by time); the reference of {m.comp.name} depends on the motion of "
                         f"the model: set exact=False to follow it through its filter "
-                        f"(f_crit)")
+                        f"(f_crit)", **self.model.fields(m.source, "exact"))
                 states = [x for x in self.net.x if ca.depends_on(e, x)]
                 out = ca.jacobian(e, self.t)
                 if states:
@@ -754,7 +781,8 @@ class _Builder:
                 raise ModelError(f"{where}: the acceleration {m.comp.name} prescribes depends "
                                  f"on accelerations of the model at the same instant (an "
                                  f"algebraic loop through the mechanics): break it with a "
-                                 f"state (exact=False, a FirstOrder)")
+                                 f"state (exact=False, a FirstOrder)",
+                                 **self.model.fields(m.source))
             r0 = ca.substitute(sub(m.reference), self.t, ca.SX(0))
             for x, rate, start in zip(m.x, rates, m.comp.initial(r0)):
                 self.net.rate[self._at(x)] = rate

@@ -92,6 +92,15 @@ class System:
             "dependent_jacobian", [ca.vertcat(eq.x, eq.z), asm.p],
             [ca.densify(ca.substitute(jd, asm.q, ca.densify(coords)))])
         self.dependent_names = eq.dependent_names or []
+        checks = asm.placed.checks if asm.placed is not None else []
+        #: what stays positive away from the singular positions of assemblies that close
+        #: their loops in closed form, of the full state (None: no assembly)
+        self.f_assembly_checks = None if not checks else ca.Function(
+            "assembly_checks", [asm.t, ca.vertcat(eq.x, eq.z), asm.p],
+            [ca.densify(ca.substitute(ca.vertcat(*[c for c, _, _ in checks]), asm.q,
+                                      ca.densify(coords)))])
+        #: (assembly, what is singular) of each check
+        self.assembly_check_names = [(name, what) for _, name, what in checks]
         if self.formulation in ("tree", "hybrid") and self.speed_names and \
                 not self.n_algebraic:
             self._check_mass_matrix()
@@ -107,8 +116,8 @@ class System:
         """Refuse a mass matrix that is singular at the initial state (a joint that moves no
         mass or inertia: a chain of bodies with zero mass, a slider carrying nothing, a free
         body with no inertia about an axis), naming the joints it cannot accelerate, rather
-        than integrating NaNs or, worse, zeros. Of a model with prescribed joints, the
-        mass matrix of the others."""
+        than integrating NaNs or, worse, zeros (``_singular_directions``). Of a model with
+        prescribed joints, the mass matrix of the others."""
         p = self.param_vector()
         x0 = self.initial_full_p(p)[0]
         # M column by column as inverse dynamics of unit accelerations (no speed, no
@@ -125,24 +134,20 @@ class System:
         if not np.all(np.isfinite(M)):
             raise ModelError(overflow_message(self.model, "the mass matrix", p,
                                               self.param_names))
-        scale = max(np.max(np.abs(M)), 1.0)
-        sym = (M + M.T) / 2
-        try:        # smallest eigenvalue above the bound, at a tenth of eigh's cost (N = 512)
-            np.linalg.cholesky(sym - 1e-12 * scale * np.eye(len(free)))
+        involved = [self.speed_names[free[k]] for k in _singular_directions(M)]
+        if not involved:
             return
-        except np.linalg.LinAlgError:
-            pass
-        values, vectors = np.linalg.eigh(sym)
-        if values[0] > 1e-12 * scale:
-            return
-        null = vectors[:, values <= 1e-12 * scale]
-        involved = [self.speed_names[k] for i, k in enumerate(free)
-                    if np.max(np.abs(null[i])) > 1e-3]
         joints = list(dict.fromkeys(n.rsplit(".", 1)[0] for n in involved))
         raise ModelError(f"the mass matrix is singular at the initial state: "
                          f"{', '.join(joints)} move(s) no mass or inertia in the direction of "
                          f"{', '.join(involved)} (give the bodies they carry mass or inertia, "
-                         f"or lock the joint)")
+                         f"or lock the joint)", **self._fields_of(joints[0]))
+
+    def _fields_of(self, name):
+        """The fields of a Problem about component ``name`` of the model (none if it is no
+        component of it)."""
+        comp = self.model.components.get(name)
+        return {} if comp is None else self.model.fields(comp)
 
     def polish(self, X, p, t=None):
         """Full states X (n_points, n_states + n_algebraic) with the algebraic variables
@@ -156,8 +161,7 @@ class System:
         if timed and t is None:
             return X
         times = np.zeros(len(X)) if t is None else np.asarray(t, dtype=float)
-        Z = np.asarray(mapped(self._f_polish, len(X))(np.asarray(X).T, p,
-                                                       times[None, :])).T
+        Z = pointwise(self._f_polish, X, p, times[:, None])[0]
         out = np.array(X, dtype=float)
         ok = np.all(np.isfinite(Z), axis=1)
         out[ok, self.n_states:] = Z[ok]
@@ -199,7 +203,25 @@ class System:
         X = np.atleast_2d(np.asarray(X, dtype=float))
         if self.eq.residual is None:
             return np.zeros(len(X))
-        return np.asarray(mapped(self._f_residual, len(X))(X.T, p)).ravel()
+        return pointwise(self._f_residual, X, p)[0].ravel()
+
+    def assembly_singular(self, times, X, p, margin=0.0):
+        """(row, messages): the first row of full states X (at ``times``) at which an
+        assembly that closes its loop in closed form is at (or past, or within ``margin``
+        of) a singular position, and what is singular there; (None, []) where none is."""
+        if self.f_assembly_checks is None or not len(X):
+            return None, []
+        X = np.atleast_2d(np.asarray(X, dtype=float))
+        values = np.asarray(mapped(self.f_assembly_checks, len(X))(
+            np.atleast_1d(times)[None, :], X.T, p)).T
+        with np.errstate(invalid="ignore"):
+            bad = ~(values > margin)
+        rows = np.nonzero(bad.any(axis=1))[0]
+        if not len(rows):
+            return None, []
+        return int(rows[0]), [f"{name} {'is at' if not margin else 'nears'} a singular "
+                              f"position of its loop: {what}" for (name, what), b in
+                              zip(self.assembly_check_names, bad[rows[0]]) if b]
 
     @functools.cached_property
     def _f_residual(self):
@@ -345,7 +367,7 @@ class System:
         f = f_out or self.f_out
         if f.nnz_out(0) == 0:       # no probes: nothing to evaluate (the state grid of a
             return np.zeros((len(t), 0))    # 128-link chain took 0.25 s to convert)
-        return np.asarray(mapped(f, len(t))(t[None, :], X.T, p)).T
+        return pointwise(f, t[:, None], X, p)[0]
 
     @functools.cached_property
     def frame_sets(self):
@@ -422,6 +444,45 @@ class System:
                 f"{len(self.signal_names)} signals>")
 
 
+#: a joint whose articulated inertia (what it still moves with the joints beyond it free) is
+#: below this fraction of its own inertia (what it moves with them locked), times the
+#: number of joints, is taken as moving nothing: round-off in the factorisation is about
+#: eps per joint, where a 1024-link point-mass chain's first joint keeps 3e-9 of its own
+PIVOT_FLOOR = 64 * np.finfo(float).eps
+
+
+def _singular_directions(M):
+    """The indices of the speeds that the mass matrix ``M`` cannot accelerate (empty when it
+    is positive definite).
+
+    The test is a Cholesky factorisation of M with each joint's diagonal scaled to one,
+    eliminating the last joints first: on a tree whose joints come parents first, its pivots
+    are the articulated inertias of the articulated-body algorithm, each relative to the
+    joint's own (1 for a leaf; ~3/N^3 for the first joint of an N-link point-mass chain).
+    A singular M has a zero pivot; a regular one has none, however wide its eigenvalues
+    spread: the condition number of a chain's M in relative coordinates grows as N^4, and a
+    bound on the smallest eigenvalue relative to the largest refused point-mass chains from
+    192 links, which pinocchio and MuJoCo run. A joint with no inertia at all is named as
+    it is; otherwise the directions of the scaled M's eigenvalues at the floor."""
+    sym = (M + M.T) / 2
+    n, d = len(sym), np.diag(sym)
+    zero = [k for k in range(n) if not d[k] > 0]
+    if zero:
+        return zero
+    s = 1 / np.sqrt(d)
+    scaled = sym * s[:, None] * s[None, :]
+    floor = PIVOT_FLOOR * n
+    try:
+        pivots = np.diag(np.linalg.cholesky(scaled[::-1, ::-1])) ** 2
+        if np.min(pivots) > floor:
+            return []
+    except np.linalg.LinAlgError:
+        pass
+    values, vectors = np.linalg.eigh(scaled)
+    null = vectors[:, values <= max(floor, values[0])]
+    return [k for k in range(n) if np.max(np.abs(null[k])) > 1e-3]
+
+
 #: a number beyond this in the state or its rate at the start is taken as an overflow to come
 #: (its square is beyond double precision): no physical model has one
 OVERFLOW = 1e150
@@ -437,10 +498,75 @@ def overflow_message(model, what, p, names):
                                  if big else "") + " and the initial values")
 
 
+#: points per call of ``pointwise``: a map over every point of a long run cost more to make
+#: than to evaluate (1e6 points: 14 s to make, 19 s to call with its DM conversions, 8 s to
+#: read back, against 0.3 s to evaluate)
+POINTS_PER_CALL = 4096
+
+
+@functools.lru_cache(maxsize=64)
+def _mapped(f, n, shared):
+    """``f`` mapped over ``n`` points, the inputs ``shared`` the same for all; made once per
+    Function, size and sharing (making it costs ~0.5 ms)."""
+    return f.map(f"{f.name()}_points", "serial", n, list(shared), [])
+
+
 @functools.lru_cache(maxsize=64)
 def mapped(f, n):
-    """``f.map(n)``, made once per Function and size (making it costs ~0.5 ms)."""
+    """``f.map(n)``, made once per Function and size (making it costs ~0.5 ms): for callers
+    that read the call's return status themselves (``solver.batch``)."""
     return f.map(n)
+
+
+def pointwise(f, *args):
+    """Each output of ``f`` at every point: one array (n_points, numel) per output, each
+    row the output at that point flattened column-major.
+
+    An argument is an array of one row per point (2-D: (n_points, nnz of the input)), or
+    one value for all (1-D, its nnz). ``f`` runs over POINTS_PER_CALL points per call of
+    its map, through ``Function.buffer`` straight from and into numpy arrays (no DM)."""
+    rows = [np.ascontiguousarray(a, dtype=float) if np.ndim(a) == 2 else None for a in args]
+    n = next(len(r) for r in rows if r is not None)
+    shared = tuple(i for i, r in enumerate(rows) if r is None)
+    fixed = [None if r is not None else np.ascontiguousarray(np.ravel(a), dtype=float)
+             for r, a in zip(rows, args)]
+    outs = [np.zeros((n, f.nnz_out(j))) for j in range(f.n_out())]
+    size = min(n, POINTS_PER_CALL)
+    if size:
+        F = _mapped(f, size, shared)
+        buf, trigger = F.buffer()
+        for i, value in enumerate(fixed):
+            if value is not None:
+                buf.set_arg(i, memoryview(value))
+        for k in range(0, n, size):
+            m = min(size, n - k)
+            # the last call's missing points repeat its last one; CasADi keeps raw
+            # pointers: the arrays are kept alive (``blocks``, ``out``) until it has run
+            blocks = [None if r is None else r[k:k + size] if m == size else
+                      np.concatenate([r[k:], np.repeat(r[-1:], size - m, axis=0)])
+                      for r in rows]
+            for i, block in enumerate(blocks):
+                if block is not None:
+                    buf.set_arg(i, memoryview(block))
+            out = [o[k:k + size] if m == size else np.zeros((size, o.shape[1]))
+                   for o in outs]
+            for j, o in enumerate(out):
+                buf.set_res(j, memoryview(o))
+            trigger()
+            if m < size:
+                for o, partial in zip(outs, out):
+                    o[k:] = partial[:m]
+    return [_dense(f.sparsity_out(j), o) for j, o in enumerate(outs)]
+
+
+def _dense(sparsity, values):
+    """Rows of nonzeros of ``sparsity`` as rows of its dense, column-major entries."""
+    if sparsity.is_dense():
+        return values
+    rows, cols = sparsity.get_triplet()
+    out = np.zeros((len(values), sparsity.numel()))
+    out[:, np.asarray(rows) + sparsity.size1() * np.asarray(cols)] = values
+    return out
 
 
 def _as_wired(model, probe, target):
@@ -455,4 +581,3 @@ def _as_wired(model, probe, target):
         if mine in ends:
             return ends[1] if ends[0] == mine else ends[0]
     return target
-

@@ -8,6 +8,11 @@ the component) is what the rest of the model exerts on it there:
   on;
 - a force element (line force, world force) takes minus the force it applies;
 - a cut joint takes minus the constraint wrench it applies, from the loops' multipliers;
+- an assembly that closes its loop in closed form has no mass and no multiplier: at its
+  inner frames it takes what the rest exerts there, and at frame_a and frame_b the wrench that
+  makes its power vanish with those (virtual work through its kinematics: MSL computes the
+  same by hand, its f_rod), its point masses' inertia and weight and its axis's force
+  included;
 - a joint or rigid part of the spanning tree passes on everything behind it: through its
   port away from the ground flows minus the sum of the flows into every body, force element
   and cut joint of the subtree beyond it, less the drives of the joints there (the inward
@@ -24,7 +29,7 @@ probe reports the torque about the frame's own origin.
 
 import casadi as ca
 
-from ..spatial import skew
+from ..spatial import skew, vee
 from .applied import element_wrench
 from .newton_euler import motion_subspace
 
@@ -43,6 +48,11 @@ class _Balance:
             self.children.setdefault(e.parent, []).append(e.child)
             self.edge_of[e.component.name] = e
         self.cut_of = {c.component.name: (i, c) for i, c in enumerate(topo.cuts)}
+        self.assembly_of = {c.component.name: c for c in topo.assemblies}
+        for e in topo.placements:          # rigid parts hanging from an assembly's frames
+            if e.component.name not in self.assembly_of:
+                self.children.setdefault(e.parent, []).append(e.child)
+                self.edge_of[e.component.name] = e
         self.rows = {}
         start = 0
         for i, (_, r) in enumerate(asm.cuts):
@@ -67,6 +77,12 @@ class _Balance:
             return -f, -m
         if comp.role == "world":
             return self._minus_rest(set_, comp)
+        if name in self.assembly_of:
+            if port in ("frame_a", "frame_b"):
+                return self._assembly(self.assembly_of[name], port)
+            if port in getattr(type(comp), "placed_frames", ()):
+                return self._minus_rest(set_, comp)
+            return ca.SX.zeros(3), ca.SX.zeros(3)
         if name in self.cut_of:
             if port not in ("frame_a", "frame_b"):     # a frame it places: for probes only
                 return ca.SX.zeros(3), ca.SX.zeros(3)
@@ -104,7 +120,8 @@ class _Balance:
             stack.extend(self.children.get(s, []))
             for ref in self.topo.sets[s]:
                 comp = ref.component
-                if comp.role in ("body", "frame_force") or comp.name in self.cut_of:
+                if comp.role in ("body", "frame_force") or comp.name in self.cut_of or (
+                        comp.name in self.assembly_of and ref.name in ("frame_a", "frame_b")):
                     df, dm = self._flow(comp, ref.name)
                     f, m = f + df, m + dm
                 if _massive(comp) and ref.name == "frame_a":
@@ -115,6 +132,49 @@ class _Balance:
                     df, dm = self._drive(comp)
                     f, m = f - df, m - dm
         return f, m
+
+    def _assembly(self, cut, port):
+        """Flow into an assembly at its frame_a or frame_b: minus d(power of its loads)/d(twist
+        of that end), the other end held. Its loads are what the rest exerts at its inner
+        frames, its axis's force and its point masses' inertia and weight; the twist (w, v)
+        is the world angular velocity and the velocity of the point at the world origin,
+        whose dual is (moment about the world origin, force)."""
+        asm, comp = self.asm, self.bound[cut.component.name]
+        Ra, pa, Rb, pb = asm.relative_poses(cut.set_a, cut.set_b)
+        R0, p0 = asm.base
+        R_s, p_s = ca.SX.sym("R", 3, 3), ca.SX.sym("p", 3)
+        w, v = ca.SX.sym("w", 3), ca.SX.sym("v", 3)
+        if port == "frame_a":
+            rel, (Rf, pf), actual = (R_s.T @ Rb, R_s.T @ (pb - p_s)), (R_s, p_s), (Ra, pa)
+        else:
+            rel, (Rf, pf), actual = (Ra.T @ R_s, Ra.T @ (p_s - pa)), (Ra, pa), (Rb, pb)
+        placement = comp.place(*rel, asm.placed.branches[comp.name])
+        moving = ca.vertcat(ca.vec(R_s), p_s)
+        # in the shared body's axes the end turns at R0^T w and its origin moves at
+        # R0^T (v + w x its world position)
+        rate = ca.vertcat(ca.vec(skew(R0.T @ w) @ R_s),
+                          R0.T @ (v + ca.cross(w, p0 + R0 @ p_s)))
+
+        def world(R, p):
+            return R0 @ Rf @ R, p0 + R0 @ (pf + Rf @ p)
+        power = ca.SX(0)
+        for pname, (R, p) in placement.frames.items():
+            Rw, pw = world(R, p)
+            f, m = self._minus_rest(self.topo.set_of[cut.component.port_ref(pname)],
+                                    cut.component)
+            omega = vee(ca.reshape(ca.jtimes(ca.vec(Rw), moving, rate), 3, 3) @ Rw.T)
+            power += ca.dot(m - ca.cross(pw, f), omega) + ca.dot(f, ca.jtimes(pw, moving, rate))
+        if placement.coordinate is not None:
+            axis = asm.net.flow.get(cut.component.port_ref("axis"), 0)
+            power += axis * ca.jtimes(placement.coordinate, moving, rate)
+        for mass, r in placement.masses:
+            rw = world(ca.SX.eye(3), r)[1]
+            real = ca.substitute(rw, moving, ca.vertcat(ca.vec(actual[0]), actual[1]))
+            f = -mass * (asm.rate(asm.rate(real)) - asm.applied.field(real))
+            power += ca.dot(f, ca.jtimes(rw, moving, rate))
+        G = ca.substitute(ca.jacobian(power, ca.vertcat(w, v)), moving,
+                          ca.densify(ca.vertcat(ca.vec(actual[0]), actual[1])))
+        return -G[3:].T, -G[:3].T
 
     def _drive(self, comp):
         """Wrench the 1-D flanges of a joint apply on its frame_b (force, moment about the

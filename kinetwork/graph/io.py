@@ -10,17 +10,18 @@ when the whole file is sound.
 from __future__ import annotations
 
 import json
-import math
 import os
 import pathlib
 import stat
 from collections.abc import Iterable
 
 from ..components.base import _NAME, NAME_LIMIT, REGISTRY, type_suggestion
-from ..errors import ModelError
-from ..util import QUOTE_LIMIT, quote, suggest
+from ..errors import ModelError, Problem
+from ..util import hint, quote, suggest
 from .initial import check_initial
 from .model import Model, model_name_problem, text_problem
+from .reading import (JSONObject, at_source, attempt, cut, fill, plain_copy, read_int,
+                      repeated_keys)
 from .settings import check_setting, check_steps
 from .subsystem import Subsystem
 from .writer import (DEFINITION_KEYS, FORMAT, KEYS, KEYS_V2, VERSION, _kind, _plain, dumps,
@@ -144,9 +145,9 @@ def loads(text: str | bytes, source: str | None = None, validate: bool = True,
         without it a text may not reference files.
     """
     if not isinstance(text, (str, bytes, bytearray)):
-        raise ModelError(_at(source, f"expected JSON text, got {type(text).__name__}"))
+        raise ModelError(at_source(source, f"expected JSON text, got {type(text).__name__}"))
     if len(text) > MAX_FILE_SIZE:
-        raise ModelError(_at(source, f"{len(text)} characters, more than the "
+        raise ModelError(at_source(source, f"{len(text)} characters, more than the "
                                      f"{MAX_FILE_SIZE} a model may have"))
     return model_from_dict(_parse(text, source), source=source, validate=validate,
                            context=Context.top(folder, library))
@@ -156,13 +157,13 @@ def _parse(text, source):
     """The JSON of a model text (keys given twice remembered), or a ModelError saying where
     it stops being JSON."""
     try:
-        return json.loads(text, object_pairs_hook=_Object.from_pairs, parse_int=_int)
+        return json.loads(text, object_pairs_hook=JSONObject.from_pairs, parse_int=read_int)
     except json.JSONDecodeError as exc:
         end = " (the text ends early: truncated?)" if exc.pos >= len(text.rstrip()) else ""
-        raise ModelError(_at(source, f"line {exc.lineno} column {exc.colno}: invalid JSON: "
+        raise ModelError(at_source(source, f"line {exc.lineno} column {exc.colno}: invalid JSON: "
                                      f"{exc.msg}{end}")) from None
     except (ValueError, RecursionError) as exc:
-        raise ModelError(_at(source, f"invalid JSON ({exc})")) from None
+        raise ModelError(at_source(source, f"invalid JSON ({exc})")) from None
 
 
 def model_from_dict(data, source=None, validate=True, context=None):
@@ -182,16 +183,16 @@ def model_from_dict(data, source=None, validate=True, context=None):
     """
     problems = []
     context = context or Context.top(None, None)
-    model = _attempt(problems, "top level", _build, data, problems, context)
+    model = attempt(problems, "top level", _build, data, problems, context)
     if problems:
-        raise ModelError([_at(source, p) for p in problems])
+        raise ModelError([at_source(source, p) for p in problems])
     if validate:
         try:
             # a definition (a model with exposed ports) is wired where it is placed: alone,
             # only its values are checked
             model.numeric_values() if model.exposed else model.validate()
         except ModelError as exc:
-            raise ModelError([_at(source, p) for p in exc.problems]) from None
+            raise ModelError([at_source(source, p) for p in exc.problems]) from None
     return model
 
 
@@ -199,37 +200,39 @@ def _build(data, problems, context):
     if not isinstance(data, dict):
         problems.append(f"top level: must be an object {{...}}, got {_kind(data)}")
         return None
-    _repeated(data, "", problems)
+    repeated_keys(data, "", problems)
     fmt, version = data.get("format", FORMAT), data.get("version", VERSION)
     keys = KEYS_V2 if version == 2 else KEYS
-    problems.extend(f"{quote(key)}: unknown key{suggest(key, keys)}; keys are "
-                    f"{', '.join(keys)}" + (" (ports and definitions need version 2)"
-                                            if key in KEYS_V2 else "")
-                    for key in data if key not in keys)
-    problems.extend(f"{key}: required key missing" for key in REQUIRED if key not in data)
+    problems.extend(Problem(f"{quote(key)}: unknown key{close}; keys are {', '.join(keys)}"
+                            + (" (ports and definitions need version 2)"
+                               if key in KEYS_V2 else ""), path=cut(str(key)),
+                            hint=hint(close))
+                    for key in data if key not in keys for close in [suggest(key, keys)])
+    problems.extend(Problem(f"{key}: required key missing", path=key)
+                    for key in REQUIRED if key not in data)
     # another format or version: whatever else looks wrong is noise, so stop here
     if fmt != FORMAT:
-        problems.append(f"format: {quote(fmt)} is not a kinetwork model file "
-                        f"(expected {FORMAT!r})")
+        problems.append(Problem(f"format: {quote(fmt)} is not a kinetwork model file "
+                                f"(expected {FORMAT!r})", path="format"))
         return None
     if type(version) is not int or version not in SUPPORTED:
-        problems.append(f"version: {quote(version)} is not supported; this kinetwork reads "
-                        f"version "
-                        f"{', '.join(map(str, SUPPORTED))}")
+        problems.append(Problem(f"version: {quote(version)} is not supported; this "
+                                f"kinetwork reads version {', '.join(map(str, SUPPORTED))}",
+                                path="version"))
         return None
     name = data.get("name", "unnamed")
     problem = model_name_problem(name)
     if problem:
-        problems.append(f"name: {problem}")
+        problems.append(Problem(f"name: {problem}", path="name"))
         name = "unnamed"
     model = Model(name)
-    context = context.file(_attempt(problems, "definitions", _entries,
-                                    data.get("definitions", {})) or {})
+    context = context.file(attempt(problems, "definitions", _entries,
+                                    data.get("definitions", {}), path="definitions") or {})
     model.definitions = context.build_all(problems)
     _body(model, data, problems, context)
     model.simulation = _simulation(data.get("simulation", {}), problems)
     found = check_initial(data.get("initial", {}))
-    problems.extend(found)
+    problems.extend(Problem.of(p, path="initial") for p in found)
     if not found:
         model.initial = data.get("initial", {})
     return model
@@ -240,51 +243,67 @@ def _body(model, data, problems, context):
     ports, components, connections and layout."""
     model.description = data.get("description", "")
     if not isinstance(model.description, str):
-        problems.append(f"description: must be a string, got {_kind(model.description)}")
+        problems.append(Problem(f"description: must be a string, got "
+                                f"{_kind(model.description)}", path="description"))
     elif (problem := text_problem(model.description, allowed="\t\n\r")):
-        problems.append(f"description: {problem}")
+        problems.append(Problem(f"description: {problem}", path="description"))
     parameters = data.get("parameters", {})
     if not isinstance(parameters, dict):
-        problems.append(f"parameters: must be an object of numbers (or numbers with "
-                        f"units, '500 mm'), got {_kind(parameters)}")
+        problems.append(Problem(f"parameters: must be an object of numbers (or numbers with "
+                                f"units, '500 mm'), got {_kind(parameters)}",
+                                path="parameters"))
     else:
         for key, value in parameters.items():
             if not _NAME.fullmatch(key):     # said here with the name cut
-                problems.append(f"parameters: parameter name {quote(key)}: must be an "
-                                f"identifier (letters, digits, underscore; not starting with a "
-                                f"digit; at most {NAME_LIMIT} characters)")
+                problems.append(Problem(f"parameters: parameter name {quote(key)}: must be an "
+                                        f"identifier (letters, digits, underscore; not "
+                                        f"starting with a digit; at most {NAME_LIMIT} "
+                                        f"characters)", path="parameters"))
             else:
-                _attempt(problems, "parameters", model.set_parameter, key, value)
+                attempt(problems, "parameters", model.set_parameter, key, value,
+                         path=f"parameters.{key}", parameter=key)
     broken = (_components(model, data["components"], problems, context)
               if "components" in data else {UNNAMED})
     _connections(model, data.get("connections", []), broken, problems)
     _ports(model, data.get("ports", {}), broken, problems)
-    model.layout = _attempt(problems, "layout", _layout, model, data.get("layout", {}),
+    before = len(problems)
+    model.layout = attempt(problems, "layout", _layout, model, data.get("layout", {}),
                             broken, problems)
+    fill(problems, before, path="layout")
 
 
 def _components(model, entries, problems, context):
     """Add each entry; return the names of the failed ones, whose wiring goes unchecked."""
     if not isinstance(entries, list):
-        problems.append(f"components: must be a list, got {_kind(entries)}")
+        problems.append(Problem(f"components: must be a list, got {_kind(entries)}",
+                                path="components"))
         return {UNNAMED}
     broken, seen = set(), {}
     for i, entry in enumerate(entries):
         name = entry.get("name") if isinstance(entry, dict) else None
-        place = f'components[{i}] "{_cut(name)}"' if isinstance(name, str) else \
+        place = f'components[{i}] "{cut(name)}"' if isinstance(name, str) else \
             f"components[{i}]"
+        at = {"path": f"components[{i}]",
+              "component": cut(name) if isinstance(name, str) else None}
         if isinstance(name, str) and name in seen:
-            problems.append(f"{place}: duplicate name, already used by components[{seen[name]}]")
+            problems.append(Problem(f"{place}: duplicate name, already used by "
+                                    f"components[{seen[name]}]", **at))
             continue
         before = len(problems)
-        comp = _attempt(problems, place, _component, entry, place, problems, context)
+        comp = attempt(problems, place, _component, entry, place, problems, context)
         if isinstance(name, str):
             seen[name] = i
         if comp is None or len(problems) > before:
             broken.add(name if isinstance(name, str) else UNNAMED)
         else:
-            _attempt(problems, place, model.add, comp)
+            attempt(problems, place, model.add, comp)
             model.places[comp.name] = context.where + place
+            model.paths[comp.name] = at["path"]
+        # a parameter's problem is at its own key, the others at the entry
+        problems[before:] = [Problem.of(p).where(**at) if not getattr(p, "parameter", None)
+                             else Problem.of(p).where(path=f"{at['path']}.params.{p.parameter}",
+                                                      component=at["component"])
+                             for p in problems[before:]]
     return broken
 
 
@@ -304,33 +323,42 @@ def _component(entry, place, problems, context):
     if not isinstance(params, dict):
         problems.append(f"{place} params: must be an object, got {_kind(params)}")
         return None
-    where = (lambda key: f"{place} params.{_cut(key)}")
+    where = (lambda key: f"{place} params.{cut(key)}")
     if isinstance(kind, str) and kind not in REGISTRY and _NAME.fullmatch(kind):
         definition = context.definition(kind, place)      # a subsystem
         return Subsystem.from_params(entry["name"], params, place=where, model=definition)
     if not isinstance(kind, str) or kind not in REGISTRY:
         # resolved only through the registry: a dotted path in a file is never imported
-        problems.append(f"{place}: unknown type {quote(kind, 60)}{type_suggestion(kind)}")
+        close = type_suggestion(kind)
+        problems.append(Problem(f"{place}: unknown type {quote(kind, 60)}{close}",
+                                hint=hint(close)))
         return None
     return REGISTRY[kind].from_params(entry["name"], params, place=where)
 
 
 def _connections(model, pairs, broken, problems):
     if not isinstance(pairs, list):
-        problems.append(f"connections: must be a list of pairs, got {_kind(pairs)}")
+        problems.append(Problem(f"connections: must be a list of pairs, got {_kind(pairs)}",
+                                path="connections"))
         return
     for i, pair in enumerate(pairs):
         if not isinstance(pair, list) or len(pair) != 2:
-            problems.append(f'connections[{i}]: must be a pair ["component.port", '
-                            f'"component.port"], got {quote(pair, 80)}')
+            problems.append(Problem(f'connections[{i}]: must be a pair ["component.port", '
+                                    f'"component.port"], got {quote(pair, 80)}',
+                                    path=f"connections[{i}]"))
             continue
-        refs = []
+        refs, before = [], len(problems)
         for j, ref in enumerate(pair):
-            place = f'connections[{i}][{j}] "{_cut(ref)}"' if isinstance(ref, str) else \
+            place = f'connections[{i}][{j}] "{cut(ref)}"' if isinstance(ref, str) else \
                 f"connections[{i}][{j}]"
-            refs.append(_attempt(problems, place, _port, model, ref, broken))
+            refs.append(attempt(problems, place, _port, model, ref, broken,
+                                 path=f"connections[{i}][{j}]"))
         if all(refs):
-            _attempt(problems, f"connections[{i}]", model.connect, *refs)
+            attempt(problems, f"connections[{i}]", model.connect, *refs,
+                     path=f"connections[{i}]")
+        # a wire's problem is on the wire (its path), not on the block it names
+        problems[before:] = [Problem(p.message, path=p.path, hint=p.hint)
+                             for p in map(Problem.of, problems[before:])]
 
 
 def _port(model, ref, broken):
@@ -348,25 +376,29 @@ def _port(model, ref, broken):
 def _ports(model, ports, broken, problems):
     """The exposed ports: name -> "component.port"."""
     if not isinstance(ports, dict):
-        problems.append(f"ports: must be an object of \"name\": \"component.port\", got "
-                        f"{_kind(ports)}")
+        problems.append(Problem(f"ports: must be an object of \"name\": \"component.port\","
+                                f" got {_kind(ports)}", path="ports"))
         return
     for name, ref in ports.items():
-        place = f'ports.{_cut(name)} "{_cut(ref)}"' if isinstance(ref, str) else \
-            f"ports.{_cut(name)}"
-        target = _attempt(problems, place, _port, model, ref, broken)
+        place = f'ports.{cut(name)} "{cut(ref)}"' if isinstance(ref, str) else \
+            f"ports.{cut(name)}"
+        at = f"ports.{cut(name)}"
+        target = attempt(problems, place, _port, model, ref, broken, path=at)
         if target is not None:
-            _attempt(problems, f"ports.{_cut(name)}", model.expose, name, target)
+            attempt(problems, at, model.expose, name, target, path=at)
 
 
 def _simulation(settings, problems):
     """The experiment settings, checked as ``simulate`` will use them."""
     if not isinstance(settings, dict):
-        problems.append(f"simulation: must be an object, got {_kind(settings)}")
+        problems.append(Problem(f"simulation: must be an object, got {_kind(settings)}",
+                                path="simulation"))
         return {}
-    found = [p for p in (check_setting(k, v) for k, v in settings.items()) if p]
+    found = [Problem(p, path=f"simulation.{cut(str(k))}")
+             for k, v in settings.items() if (p := check_setting(k, v))]
     if not found and "step" in settings and "t_end" in settings:     # what they cost together
-        found = [p for p in [check_steps(settings["t_end"], settings["step"])] if p]
+        found = [Problem(p, path="simulation.step")
+                 for p in [check_steps(settings["t_end"], settings["step"])] if p]
     problems.extend(found)
     return dict(settings)
 
@@ -378,10 +410,10 @@ def _layout(model, layout, broken, problems):
         return {}
     for key, value in layout.items():
         if key not in model.components and key not in broken and UNNAMED not in broken:
-            problems.append(f"layout.{_cut(key)}: no component {quote(key)}"
+            problems.append(f"layout.{cut(key)}: no component {quote(key)}"
                             f"{suggest(key, model.components)}")
-        _plain(value, f"layout.{_cut(key)}", problems)
-    return _copy(layout)
+        _plain(value, f"layout.{cut(key)}", problems)
+    return plain_copy(layout)
 
 
 # -- subsystem definitions ---------------------------------------------------------------------
@@ -424,8 +456,8 @@ class Context:
         """Every definition of the file (a file keeps those no component uses yet)."""
         out = {}
         for name in self.entries:
-            model = _attempt(problems, f"definitions.{_cut(name)}", self.definition, name,
-                             f"definitions.{_cut(name)}")
+            model = attempt(problems, f"definitions.{cut(name)}", self.definition, name,
+                             f"definitions.{cut(name)}", path=f"definitions.{cut(name)}")
             if model is not None:
                 out[name] = model
         return out
@@ -452,7 +484,7 @@ class Context:
         return model
 
     def _entry(self, name, entry):
-        where = f"definitions.{_cut(name)}"
+        where = f"definitions.{cut(name)}"
         if isinstance(entry, dict) and "file" in entry:
             extra = [k for k in entry if k != "file"]
             if extra:
@@ -469,7 +501,9 @@ class Context:
         model = Model(name)
         inner = []
         _body(model, entry, inner, self.inline(name))
-        problems.extend(p if p.startswith(where) else f"{where}.{p}" for p in inner)
+        # an inline definition's paths are in the file too, under it
+        problems.extend((p if p.startswith(where) else p.where(f"{where}.")).under(where)
+                        for p in map(Problem.of, inner))
         if problems:
             raise ModelError(problems)
         return model
@@ -488,7 +522,7 @@ class Context:
 
     def _file(self, name, ref, root, kind, folder=None):
         """Read the definition file ``ref`` (relative to the file being read)."""
-        where = f"definitions.{_cut(name)}" if kind == "file" else f"{name}.json"
+        where = f"definitions.{cut(name)}" if kind == "file" else f"{name}.json"
         if not isinstance(ref, str) or not ref:
             raise ModelError(f"{where}: file must be a relative path, got {quote(ref)}")
         if "://" in ref or ref.startswith(("/", "\\")) or os.path.isabs(ref) or \
@@ -535,73 +569,3 @@ def _entries(definitions):
     if problems:
         raise ModelError(problems)
     return dict(definitions)
-
-
-# -- helpers ----------------------------------------------------------------------------------
-class _Object(dict):
-    """A parsed JSON object that remembers keys given twice (``json`` keeps the last)."""
-
-    @classmethod
-    def from_pairs(cls, pairs):
-        obj = cls()
-        obj.repeated = []
-        for key, value in pairs:
-            if key in obj:
-                obj.repeated.append(key)
-            obj[key] = value
-        return obj
-
-
-def _repeated(value, where, problems):
-    if isinstance(value, dict):
-        problems.extend(f"{where or 'top level'}: key {quote(key)} appears more than once"
-                        for key in getattr(value, "repeated", ()))
-        for key, item in value.items():
-            _repeated(item, f"{where}.{_cut(key)}" if where else _cut(key), problems)
-    elif isinstance(value, list):
-        for j, item in enumerate(value):
-            _repeated(item, f"{where}[{j}]", problems)
-
-
-def _attempt(problems, place, fn, *args):
-    """``fn(*args)``, or None with its failure recorded as a problem at ``place``."""
-    try:
-        return fn(*args)
-    except ModelError as exc:
-        problems.extend(p if p.startswith(place) else f"{place}: {p}" for p in exc.problems)
-    except Exception as exc:    # noqa: BLE001
-        # odd shapes in a file reach code written for well-formed values: a file may be
-        # refused, but never crash the loader
-        problems.append(f"{place}: cannot be read ({type(exc).__name__}: "
-                        f"{_cut(str(exc), QUOTE_LIMIT)})")
-    return None
-
-
-def _int(text):
-    # an integer beyond float range would overflow in later bounds checks: read it as the
-    # infinity it amounts to, then refused as non-finite at its place
-    try:
-        value = int(text)
-        float(value)
-        return value
-    except (ValueError, OverflowError):
-        return -math.inf if text.startswith("-") else math.inf
-
-
-def _copy(value):
-    # plain dicts and lists in the model, not the parser's _Object
-    return ({k: _copy(v) for k, v in value.items()} if isinstance(value, dict) else
-            [_copy(v) for v in value] if isinstance(value, list) else value)
-
-
-def _at(source, problem):
-    return f"{source}: {problem}" if source else problem
-
-
-def _cut(text, limit=NAME_LIMIT):
-    """Text from the file for a message's place: as it is when short, else cut; characters
-    that do not print (a newline, a lone surrogate) escaped as in Python."""
-    text = text if len(text) <= limit else text[:limit - 3] + "..."
-    return "".join(c if c.isprintable() else repr(c)[1:-1] for c in text)
-
-

@@ -12,12 +12,13 @@ from typing import TYPE_CHECKING, Any, TypeVar
 import numpy as np
 
 from ..components.base import ANY, Component, PortRef
-from ..util import quote, suggest
+from ..util import hint, quote, suggest
 from . import quantities
 from .subsystem import Subsystem, check_placement, check_port_name, flatten, has_subsystems
 from .writer import save
-from ..errors import ModelError
+from ..errors import ModelError, Problem
 from ..expr import CONSTANTS, FUNCTIONS, parse
+from ..upcalls import upcall
 
 if TYPE_CHECKING:       # annotations only: a model does not import what compiles it
     from ..equations.system import System
@@ -34,17 +35,7 @@ RESERVED = {"t", *CONSTANTS, *FUNCTIONS}
 MODEL_NAME_LIMIT = 200
 _NOT_TEXT = re.compile("[\x00-\x1f\x7f-\x9f\ud800-\udfff\u2028\u2029]")
 
-#: what turns a validated model into a System: installed by ``kinetwork.equations`` when it
-#: is imported (layers only look down, so the model does not import what compiles it)
-_compiler = None
 _compile_lock = threading.RLock()
-
-
-def install_compiler(build):
-    """Set the function ``build(model, loops, baumgarte_rate, topology)`` -> System that
-    ``Model.compile`` calls."""
-    global _compiler
-    _compiler = build
 
 
 class Model:
@@ -93,6 +84,9 @@ class Model:
         #: component name -> how messages locate it (files say 'components[3] "mass1"'; a
         #: flat model's inner components (path shown, place in their definition's file))
         self.places = {}
+        #: component name -> the JSON path of its entry in the file the model was read from
+        #: ("components[3]"); in a flat model, an inner component's is its subsystem's
+        self.paths = {}
         self._validated = None         # (content key, parameter values, Topology)
         self._compiled = {}            # (content key, loops, rate) -> System
         self._flat = None              # (content key, flat model) of a model of subsystems
@@ -152,9 +146,10 @@ class Model:
     def add(self, component: C) -> C:
         """Add ``component`` and return it."""
         if not isinstance(component, Component):
-            raise ModelError(f"model.add expects a component, got {component!r}")
+            raise ModelError(f"model.add expects a component, got {quote(component)}")
         if component.name in self.components:
-            raise ModelError(f"duplicate component name {component.name!r}")
+            raise ModelError(f"duplicate component name {component.name!r}",
+                             component=component.name)
         if isinstance(component, Subsystem):
             check_placement(self, component)
         self.components[component.name] = component
@@ -183,8 +178,8 @@ class Model:
         try:
             self.exposed[name] = self.port(port)
         except ModelError as exc:
-            raise ModelError([f"{self.name} port {name!r}: {p}" for p in exc.problems]) \
-                from None
+            raise ModelError([p.where(f"{self.name} port {name!r}: ")
+                              for p in exc.problems]) from None
 
     def connect(self, a: PortRef | str, b: PortRef | str) -> None:
         """Wire two ports, given as ``comp.port`` attributes or ``"comp.port"`` strings."""
@@ -209,14 +204,16 @@ class Model:
             comp = self.components.get(ref.component.name)
             if comp is not ref.component:
                 raise ModelError(f"{ref.path}: component {ref.component.name!r} is not in "
-                                 f"model {self.name!r} (add it first)")
+                                 f"model {self.name!r} (add it first)",
+                                 hint=f"model.add({ref.component.name!r}) first")
             return ref
         if not isinstance(ref, str) or ref.count(".") != 1:
             raise ModelError(f"port reference {quote(ref)}: expected 'component.port'")
         cname, pname = ref.split(".")
         if cname not in self.components:
-            raise ModelError(f"{quote(ref)}: no component {quote(cname, 60)}"
-                             f"{suggest(cname, self.components)}")
+            close = suggest(cname, self.components)
+            raise ModelError(f"{quote(ref)}: no component {quote(cname, 60)}{close}",
+                             hint=hint(close))
         return self.components[cname].port_ref(pname)
 
     # -- checking -----------------------------------------------------------------------
@@ -232,6 +229,24 @@ class Model:
         if base is None:
             return f"{component.name}.{key}" if key else component.name
         return f"{base} params.{key}" if key else base
+
+    def problem(self, text, component=None, key=None, port=None, hint=None,
+                severity="error"):
+        """A Problem about ``component`` (its parameter ``key``, or its port ``port``): the
+        message ``text`` after its place (``place``), its fields set (``fields``)."""
+        if component is None:
+            return Problem(text, hint=hint, severity=severity)
+        return Problem(f"{self.place(component, key)}: {text}", hint=hint, severity=severity,
+                       **self.fields(component, key, port))
+
+    def fields(self, component, key=None, port=None):
+        """The fields of a Problem about ``component`` (and its parameter ``key`` or port
+        ``port``): its name, and its path in the file it was read from (a parameter's own
+        when the component is the file's entry, else the entry of the subsystem it is in)."""
+        entry = self.paths.get(component.name)
+        own = entry is not None and "." not in component.name
+        return {"component": component.name, "parameter": key, "port": port,
+                "path": f"{entry}.params.{key}" if own and key else entry}
 
     def flat(self) -> Model:
         """The model with every subsystem expanded in place, names by path: what validation
@@ -269,7 +284,7 @@ class Model:
             values[key] = quantities.to_si(value, f"params.{key}")
             if isinstance(value, str):
                 problems = quantities.check_use(value, quantities.uses(self, key),
-                                                f"params.{key}")
+                                                f"params.{key}", parameter=key)
                 if problems:
                     raise ModelError(problems)
         return values
@@ -298,7 +313,7 @@ class Model:
                     vals[key] = evaluate(comp._values[key], spec, env_t, where,
                                          signal_outputs(self) if spec.signals else None)
                 except ModelError as exc:
-                    problems.extend(exc.problems)
+                    problems.extend(p.where(**self.fields(comp, key)) for p in exc.problems)
             out[comp.name] = vals
         if problems:
             raise ModelError(problems)
@@ -351,11 +366,9 @@ class Model:
         key = (self.content_key(), loops, baumgarte_rate)
         with _compile_lock:
             if key not in self._compiled:
-                if _compiler is None:
-                    raise ModelError("no compiler installed: import kinetwork (its equations "
-                                     "layer installs one)")
-                system = _compiler(self, loops=loops, baumgarte_rate=baumgarte_rate,
-                                   topology=self.validate())
+                # the equations layer builds it: kinetwork.equations.system.System
+                system = upcall("compile")(self, loops=loops, baumgarte_rate=baumgarte_rate,
+                                           topology=self.validate())
                 # a System is built for one content: any other is stale now
                 self._compiled = {k: v for k, v in self._compiled.items() if k[0] == key[0]}
                 self._compiled[key] = system
@@ -364,6 +377,10 @@ class Model:
     def save(self, path: str | os.PathLike) -> None:
         """Write the model as JSON (atomically: a failed save leaves the old file whole)."""
         save(self, path)
+
+    def _repr_svg_(self):
+        """Jupyter shows a model as its wiring diagram (``kinetwork.diagram.svg``)."""
+        return upcall("diagram")(self)
 
     def __repr__(self):
         return (f"<Model {self.name!r}: {len(self.components)} components, "
@@ -403,14 +420,16 @@ def _scalar(value, spec, env, where, bounds=True, signals=None):
         if read:
             wrong = [n for n in read if signals is not None and n not in signals]
             if wrong:
+                close = suggest(wrong[0], signals)
                 raise ModelError(f"{where} = {value!r}: {wrong[0]!r} is not a signal output "
-                                 f"of this model{suggest(wrong[0], signals)}; signal outputs "
-                                 f"are {', '.join(signals) or 'none'}")
+                                 f"of this model{close}; signal outputs are "
+                                 f"{', '.join(signals) or 'none'}", hint=hint(close))
         unknown = sorted(expr.names - set(env) - set(read))
         if unknown:
-            raise ModelError(f"{where} = {value!r}: unknown name {unknown[0]!r}"
-                             f"{suggest(unknown[0], env)}; model parameters are "
-                             f"{', '.join(k for k in env if k != 't') or 'none'}")
+            close = suggest(unknown[0], env)
+            raise ModelError(f"{where} = {value!r}: unknown name {unknown[0]!r}{close}; model "
+                             f"parameters are {', '.join(k for k in env if k != 't') or 'none'}",
+                             hint=hint(close))
         if read:
             return math.nan
         try:

@@ -15,7 +15,7 @@ not checked: a parameter given as a plain number has no dimension to combine wit
 import ast
 
 from .. import units
-from ..errors import ModelError
+from ..errors import ModelError, Problem
 from ..expr import parse
 from ..util import check_number, quote
 from .subsystem import DEPTH_LIMIT, Subsystem, definitions, has_subsystems
@@ -100,14 +100,16 @@ def uses(model, name, depth=0):
     return found
 
 
-def check_use(text, uses_, what):
-    """Problems of quantity ``text`` (given as ``what``) at each of ``uses_``."""
+def check_use(text, uses_, what, **fields):
+    """Problems of quantity ``text`` (given as ``what``) at each of ``uses_``, with the
+    Problem ``fields`` of where it was given."""
     problems = []
     for where, unit in uses_:
         try:
             units.to_si(text, unit)
         except ModelError as exc:
-            problems.append(f"{what} = {quote(text)} is used as {where} [{unit}]: {exc}")
+            problems.append(Problem(f"{what} = {quote(text)} is used as {where} [{unit}]: "
+                                    f"{exc}", **fields))
     return problems
 
 
@@ -120,12 +122,14 @@ def problems(model):
         label = "" if m is model else f"definition {m.name!r}: "
         for name, text in m.written_parameters().items():
             if isinstance(text, str):
-                found += check_use(text, uses(m, name), f"{label}parameters.{name}")
+                at = {"parameter": name, "path": f"parameters.{name}"} if m is model else {}
+                found += check_use(text, uses(m, name), f"{label}parameters.{name}", **at)
         for comp in m.components.values():
             if isinstance(comp, Subsystem):
                 for key, value in comp.given.items():
                     if isinstance(value, str) and is_quantity(value):
                         inner = [(f"{comp.name}/{where}", unit)
                                  for where, unit in uses(comp.definition, key)]
-                        found += check_use(value, inner, f"{label}{m.place(comp, key)}")
+                        at = m.fields(comp, key) if m is model else {}
+                        found += check_use(value, inner, f"{label}{m.place(comp, key)}", **at)
     return found

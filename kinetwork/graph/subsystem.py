@@ -18,9 +18,9 @@ import copy
 import networkx as nx
 
 from ..components.base import ANY, Component, Param, Port, PortRef, _NAME
-from ..errors import ModelError
+from ..errors import ModelError, Problem
 from ..expr import parse, rename
-from ..util import quote, suggest
+from ..util import hint, quote, suggest
 
 #: how deep subsystems may nest (a cycle is refused by name long before)
 DEPTH_LIMIT = 64
@@ -84,9 +84,12 @@ class Subsystem(Component):
 
     def port_ref(self, name):
         if name not in self.ports:
+            close = suggest(name, self.ports)
             raise ModelError(f"subsystem {self.name!r} ({self.definition.name}) has no port "
-                             f"{quote(name)}{suggest(name, self.ports)}; ports: "
-                             f"{', '.join(self.ports) or 'none (expose some in the definition)'}")
+                             f"{quote(name)}{close}; ports: "
+                             f"{', '.join(self.ports) or 'none (expose some in the definition)'}",
+                             component=self.name, hint=hint(close),
+                             port=name if isinstance(name, str) else None)
         return PortRef(self, name)
 
     def signature(self):
@@ -191,20 +194,24 @@ class _Flat:
             self.expanded[id(comp)] = (comp, comp.expand())
         return self.expanded[id(comp)][1]
 
-    def walk(self, m, prefix, scope, display, depth):
+    def walk(self, m, prefix, scope, display, depth, entry=None):
         """Add ``m``'s components under ``prefix``; ``scope`` maps m's parameter names to
-        their text in flat names."""
+        their text in flat names; ``entry`` is the file path of the top model's component
+        they are inside (problems about them point there)."""
         if depth > DEPTH_LIMIT:
             raise ModelError(f"{display}: subsystems nested more than {DEPTH_LIMIT} deep")
         for comp in m.components.values():
             path, shown = prefix + comp.name, display + comp.name
+            at = m.paths.get(comp.name) if not prefix else entry
             if isinstance(comp, Subsystem):
                 self.walk(comp.definition, path + ".", self.scope_of(m, comp, path, scope),
-                          shown + "/", depth + 1)
+                          shown + "/", depth + 1, at)
                 continue
             if _aggregate(comp):          # its parts take its parameters' own words
-                self.walk(self.expansion(comp), path + ".", scope, shown + "/", depth + 1)
+                self.walk(self.expansion(comp), path + ".", scope, shown + "/", depth + 1, at)
                 continue
+            if at is not None:
+                self.flat.paths[path] = at
             twin = copy.copy(comp)
             object.__setattr__(twin, "name", path)
             given, values = {}, {}
@@ -214,7 +221,7 @@ class _Flat:
                     # signal outputs a force law reads ("pos.y") are named by path too
                     local = {**scope, **_read_signals(value, prefix)} \
                         if spec.signals and prefix else scope
-                    value = self.constant(value, local, m, comp, shown, key)
+                    value = self.constant(value, local, m, comp, shown, key, path)
                 elif spec.kind == "name" and value is not None and prefix:
                     value = prefix + value
                 values[key] = value
@@ -233,7 +240,7 @@ class _Flat:
             if pa is not None and pb is not None:
                 self.flat.connections.append((pa, pb))
 
-    def constant(self, value, scope, m, comp, shown, key):
+    def constant(self, value, scope, m, comp, shown, key, flat):
         """``value`` (a parameter of a component inside a subsystem) in flat names, its
         expressions without free names as numbers; one that cannot be evaluated (a division
         by zero, a root of a negative number once the instance's numbers are in) is a
@@ -243,8 +250,10 @@ class _Flat:
         except (ZeroDivisionError, ValueError, OverflowError, TypeError) as exc:
             where = m.place(comp, key)
             place = f"{shown}.{key}" + ("" if where == f"{comp.name}.{key}" else f" ({where})")
-            self.problems.append(f"{place} = {quote(value, 60)}: cannot be evaluated with "
-                                 f"this instance's parameters ({exc})")
+            self.problems.append(Problem(f"{place} = {quote(value, 60)}: cannot be evaluated "
+                                         f"with this instance's parameters ({exc})",
+                                         component=flat, parameter=key,
+                                         path=self.flat.paths.get(flat)))
             return value
 
     def scope_of(self, m, sub, path, scope):
@@ -259,11 +268,12 @@ class _Flat:
                 expr = parse(value)
                 unknown = sorted(expr.names - set(scope))
                 if unknown:
-                    where = m.place(sub, key)
-                    self.problems.append(
-                        f"{where} = {value!r}: unknown name {unknown[0]!r}"
-                        f"{suggest(unknown[0], scope)}; parameters here are "
-                        f"{', '.join(scope) or 'none'}")
+                    where, close = m.place(sub, key), suggest(unknown[0], scope)
+                    self.problems.append(Problem(
+                        f"{where} = {value!r}: unknown name {unknown[0]!r}{close}; parameters "
+                        f"here are {', '.join(scope) or 'none'}", component=path,
+                        parameter=key, hint=hint(close),
+                        path=m.fields(sub, key)["path"] if m is self.model else None))
                     inner[key] = "0"
                 else:
                     inner[key] = f"({rename(value, scope)})"
@@ -276,16 +286,20 @@ class _Flat:
         for _ in range(DEPTH_LIMIT):
             comp = ref.component
             if m.components.get(comp.name) is not comp:
-                self.problems.append(f"{prefix}{ref.path}: component {comp.name!r} is not in "
-                                     f"model {m.name!r} any more (remove its connections too)")
+                self.problems.append(Problem(f"{prefix}{ref.path}: component {comp.name!r} is "
+                                             f"not in model {m.name!r} any more (remove its "
+                                             f"connections too)",
+                                             component=prefix + comp.name, port=ref.name))
                 return None
             inner = comp.definition if isinstance(comp, Subsystem) else self.expansion(comp)
             if inner is None:
                 return PortRef(self.flat.components[prefix + comp.name], ref.name)
             target = inner.exposed.get(ref.name)
             if target is None:
-                self.problems.append(f"{prefix}{ref.path}: {inner.name!r} exposes no "
-                                     f"port {ref.name!r}{suggest(ref.name, inner.exposed)}")
+                close = suggest(ref.name, inner.exposed)
+                self.problems.append(Problem(f"{prefix}{ref.path}: {inner.name!r} exposes no "
+                                             f"port {ref.name!r}{close}", hint=hint(close),
+                                             component=prefix + comp.name, port=ref.name))
                 return None
             m, prefix, ref = inner, f"{prefix}{comp.name}.", target
         raise ModelError(f"{prefix}{ref.path}: subsystems nested more than {DEPTH_LIMIT} deep")

@@ -63,14 +63,14 @@ def rings(topo, problems):
 
 def _refusal(element, group, carrier, values):
     """Why ``element``'s group cannot ride on ``carrier`` (empty when it can)."""
-    if carrier.kind in ("joint", "massless"):
-        return (f"a gear whose housing turns with "
-                f"{'a joint axis' if carrier.kind == 'joint' else 'a massless flange'} "
+    if carrier.kind in ("joint", "massless", "assembly"):
+        return (f"a gear whose housing turns with {_what(carrier)} "
                 f"is not supported: give the housing an inertia of its own, or wire the "
                 f"support to the joint's support flange (the joint's frame_a side)")
     if group.kind != "free":
         what = {"joint": "a joint axis", "prescribed": "a prescribed motion",
-                "massless": "no inertia", "fixed": "a fixed flange"}[group.kind]
+                "massless": "no inertia", "fixed": "a fixed flange",
+                "assembly": "an assembly's axis"}[group.kind]
         return (f"its gear train is tied to {what}, where a moving housing is not supported: "
                 f"the train riding on a housing must move freely (inertias, springs, "
                 f"sources)")
@@ -84,7 +84,8 @@ def _refusal(element, group, carrier, values):
 
 def _what(group):
     return {"free": "a free rotor", "prescribed": "a prescribed motion", "joint": "a joint "
-            "axis", "massless": "a massless flange"}.get(group.kind, group.kind)
+            "axis", "massless": "a massless flange",
+            "assembly": "an assembly's axis"}.get(group.kind, group.kind)
 
 
 def _names(group):

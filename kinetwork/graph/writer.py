@@ -93,7 +93,7 @@ def _body(model, problems, where):
                             f"{type(comp).__name__} is not in the component registry, so no "
                             f"file could load it")
         components.append({"name": comp.name, "type": comp.type_name,
-                           "params": copy.deepcopy(comp.given)})
+                           "params": comp.written_params()})
     body = {"description": "" if model.description is None else model.description,
             "parameters": model.written_parameters(),     # "500 mm" as written
             "ports": {name: ref.path for name, ref in model.exposed.items()},

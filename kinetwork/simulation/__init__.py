@@ -2,7 +2,7 @@
 layout gives it, ``kinetwork.solver``. Code written against the old name keeps working for a
 release: ``kinetwork.simulation.driver`` and the rest are the ``kinetwork.solver`` modules
 themselves (not copies), reached through a finder that aliases the names, with a
-DeprecationWarning on first use."""
+DeprecationWarning (a ``KinetworkDeprecationWarning``) on first use."""
 
 import importlib
 import importlib.abc
@@ -10,10 +10,13 @@ import importlib.util
 import sys
 import warnings
 
+from ..errors import KinetworkDeprecationWarning
+
 _OLD, _NEW = __name__, __name__.rpartition(".")[0] + ".solver"
 
-warnings.warn(f"{_OLD} is now {_NEW}; the old name goes in the next release",
-              DeprecationWarning, stacklevel=2)
+warnings.warn(KinetworkDeprecationWarning(
+    f"{_OLD} is now {_NEW}; the old name goes in the next release",
+    hint=f"import {_NEW} instead"), stacklevel=2)
 
 
 class _Alias(importlib.abc.MetaPathFinder, importlib.abc.Loader):

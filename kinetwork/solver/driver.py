@@ -1,4 +1,4 @@
-"""simulate(): the one integrator driver.
+"""The integrator driver: what runs one member of an integration plan (``plan.py``).
 
 The driver owns everything around the integration: the output grid, the step budget, the
 time limit, progress reports, cancellation (SIGINT, SIGTERM, or a ``cancel`` callable), the
@@ -33,26 +33,18 @@ import signal
 import tempfile
 import threading
 import time
-from collections.abc import Callable, Mapping
-from typing import TYPE_CHECKING
 
 import numpy as np
 
-from ..equations.system import OVERFLOW, System, overflow_message
-from ..errors import ModelError, SimulationError
+from ..equations.system import OVERFLOW, overflow_message
+from ..errors import ModelError
 from ..graph.settings import check_output, check_settings
 from ..util import quote, suggest
-from . import estimate
-from . import jit as _jit
-from .capture import SOLVER_LOCK, last_words, solver_output
+from .capture import SOLVER_LOCK, solver_output
 from .compiled import compiled
-from .events import EVENT_CHUNK, Events
+from .events import EVENT_CHUNK
 from .loopwatch import Partitions, near_singular
 from .methods import METHODS, Failure, Interrupted, choose, shift_times
-from .results import Results
-
-if TYPE_CHECKING:                     # annotations only
-    from ..graph.model import Model
 
 DEFAULTS = {"t_end": 10.0, "n_points": 1001, "method": "auto", "rtol": 1e-6, "atol": 1e-8,
             "step": None}
@@ -71,7 +63,9 @@ CHUNK_GROWTH = 16
 MAX_RESTARTS = 3
 #: a restarted run must keep the loops closed to this (m, or rotation-matrix entries)
 RESTART_CLOSURE = 1e-6
-
+#: an assembly whose (dimensionless) measure of a singular position is below this at the last
+#: output of a failed run is named as near its singular position there
+NEAR_SINGULAR_ASSEMBLY = 1e-3
 
 
 _SINK = {}
@@ -167,157 +161,6 @@ class Run:
             raise Failure(reason, states)
 
 
-def simulate(model: Model | System, t_end: float | None = None, n_points: int | None = None,
-             method: str | None = None, rtol: float | None = None, atol: float | None = None,
-             params: Mapping[str, float | str] | None = None, t_start: float = 0.0,
-             step: float | None = None, jit: bool | None = None, max_steps: int | None = None,
-             time_limit: float | None = None, progress: Callable[[float], object] | None = None,
-             cancel: Callable[[], object] | None = None, restart: bool = False,
-             repartition: bool = True, error_estimate: bool = False) -> Results:
-    """Integrate ``model`` (a Model or a compiled System) and record its probes.
-
-    Settings not given come from the model's ``simulation`` block, then from DEFAULTS.
-
-    Parameters
-    ----------
-    model : Model or System
-        A Model is compiled (once: an unchanged model gives back its System).
-    t_end : float
-        End time [s]; the output grid has ``n_points`` equally spaced points from ``t_start``.
-    method : str
-        One of METHODS (``kinetwork methods`` lists them). ``auto`` (default): CVODES Adams,
-        or CVODES BDF when the stiffness test finds the problem stiff at the start, or when
-        Adams fails on it; IDAS for models with algebraic variables (loops compiled with
-        ``loops="partition"``, massless junctions).
-    rtol, atol : float
-        Tolerances of the variable-step methods.
-    step : float, optional
-        Largest step [s] of the fixed-step methods (``rk``, ``collocation``, ``midpoint``);
-        default: the output spacing.
-    params : dict, optional
-        Model parameter values for this run, numbers (SI) or numbers with a unit
-        (``{"c": "2 N*m/rad"}``, see ``Model.parameter_values``); no recompilation.
-    jit : bool, optional
-        Compile the equations to C (cached on disk, see ``kinetwork.solver.jit``). True
-        insists (a ModelError when it cannot be done); None (default) compiles when a C
-        compiler is found and ``KINETWORK_JIT`` is not 0, and falls back to CasADi's virtual
-        machine, with a warning, when compilation fails.
-    max_steps : int, optional
-        Step budget per output interval (SUNDIALS' mxstep; counted here for scipy's, whose
-        default is SCIPY_STEP_BUDGET): when it runs out the run stops with a SimulationError.
-    time_limit : float, optional
-        Wall-clock limit [s] of the run, compilation included.
-    progress : callable, optional
-        Called with the simulated time reached, now and then.
-    cancel : callable, optional
-        Called now and then; a true answer stops the run (a SimulationError holding what was
-        computed). SIGINT and SIGTERM stop a run in the main thread the same way.
-    restart : bool, optional
-        After a solver failure, start the method afresh from the last state reached (at most
-        MAX_RESTARTS times), if that state is sound: finite, the loops closed, and the
-        restarted run continuing it without a jump. Each restart is in ``stats["restarts"]``.
-        Off by default: a failure is a SimulationError.
-    repartition : bool, optional
-        With kinematic loops: where the partition of the speeds into independent and
-        dependent ones nears a singular configuration (a dead point of the independent
-        coordinates, or a change point of the mechanism), choose another partition there and
-        go on (``kinetwork.solver.loopwatch``); ``stats["repartitions"]`` counts them,
-        ``stats["repartition_times"]`` says when. False: stop there with a SimulationError.
-    error_estimate : bool, optional
-        Run again at tighter tolerances on the same compiled System and put an estimate of
-        each probe signal's and state's global error in ``stats["error_estimate"]``, with the
-        time after which it means nothing on chaotic motion (``estimate.py``).
-
-    Returns
-    -------
-    Results
-        ``results.settings["method"]`` is the method that ran; ``results.stats`` its counts.
-
-    Raises
-    ------
-    ModelError
-        Bad settings or parameters.
-    SimulationError
-        The integration failed or was stopped; ``err.results`` holds the results up to
-        ``err.t_reached``.
-    """
-    system = model if isinstance(model, System) else model.compile()
-    given = {"t_end": t_end, "n_points": n_points, "method": method, "rtol": rtol,
-             "atol": atol, "step": step}
-    settings = {**DEFAULTS, **system.model.simulation,
-                **{k: v for k, v in given.items() if v is not None}}
-    key = _check(system, settings, t_start, max_steps, time_limit)
-    chosen = METHODS[key]
-    chosen.check(system)
-    p = system.param_vector(params)        # checks the overrides once for the whole run
-    # consistent with the loops and the initial equations: solved once per parameter values
-    x0 = compiled(system).memo(("initial state", np.asarray(p, dtype=float).tobytes()),
-                               lambda: np.concatenate(system.initial_full_p(p))).copy()
-    _check_finite_start(system, t_start, x0, p)
-    grid = np.linspace(t_start, settings["t_end"], int(settings["n_points"]))
-    settings.update(max_steps=max_steps, time_limit=time_limit, n_points=len(grid),
-                    rtol=float(settings["rtol"]), atol=float(settings["atol"]))
-    stats = {}
-    jit_on = _jit.enabled(jit) and system.n_states > 0
-    run = Run(system, p, x0, grid, settings, None, cancel, progress, restart)
-    run.repartition = bool(repartition)
-    if system.modes is not None:       # modes consistent with the start, before any method
-        run.events = Events(run)
-        run.x0 = run.events.start(float(grid[0]), run.x0)
-    with _running(run):
-        if jit_on:
-            run.jit = {"stats": stats, "required": jit is True, "deadline": run.deadline,
-                       "cancelled": lambda: run.stop_reason() is not None}
-        if not system.n_states:       # everything welded to the ground: nothing to integrate
-            X, failure, key = np.tile(x0, (len(grid), 1)), None, "none"
-        elif key == "auto":
-            X, failure, key = _auto(run, stats)
-        else:
-            X, failure, method_stats = _integrate(run, chosen)
-            stats.update(method_stats)
-    if run.said:
-        stats["solver_output"] = "".join(run.said)
-    if run.events is not None:
-        stats["events"] = run.events.log
-    stats["jit"] = bool(run.jit) and not stats.get("jit_fallback")
-    t = grid[:len(X)]
-    parts = getattr(run, "partitions", None)
-    if parts is not None and parts.events:     # re-partitioned: each part by its equations
-        X, outputs = parts.finish(t, X)
-    else:
-        X = system.polish(X, p, t)
-        f_out = compiled(system).outputs(run.jit)
-        outputs = system.outputs_p(t, X, p, f_out) if len(t) else np.zeros((0, 0))
-    results = Results(t, X, system.state_names + system.algebraic_names, outputs,
-                      system.signals, stats=stats,
-                      state_units=system.state_units + system.algebraic_units,
-                      settings={"t_start": t_start, "t_end": settings["t_end"],
-                                "n_points": settings["n_points"], "method": key,
-                                "rtol": settings["rtol"], "atol": settings["atol"],
-                                "step": settings["step"], "jit": stats["jit"],
-                                "max_steps": max_steps, "time_limit": time_limit,
-                                "restart": restart, "params": dict(params or {})},
-                      probe_targets=system.probe_targets, system=system)
-    if failure is not None:
-        reached = float(t[-1]) if len(t) else float(t_start)
-        results.partial = {"t_reached": reached, "reason": failure}
-        said = last_words(stats.get("solver_output", ""))
-        raise SimulationError(f"{key} failed after t = {reached:g} s (of "
-                              f"{settings['t_end']:g} s): {failure}"
-                              + (f" (the solver said: {said})" if said else ""),
-                              results=results, t_reached=reached, reason=failure,
-                              signal=run.signal)
-    if error_estimate:
-        again = {"t_end": settings["t_end"], "n_points": settings["n_points"],
-                 "method": key if key in METHODS else None,
-                 "rtol": settings["rtol"], "atol": settings["atol"], "step": settings["step"],
-                 "params": params, "t_start": t_start, "jit": jit, "max_steps": max_steps,
-                 "time_limit": time_limit, "cancel": cancel, "restart": restart,
-                 "repartition": repartition}
-        estimate.attach(results, lambda **tighter: simulate(system, **{**again, **tighter}))
-    return results
-
-
 def _check(system, settings, t_start, max_steps, time_limit):
     """The method's table key, once every setting is checked (one ModelError for all)."""
     if not isinstance(t_start, (int, float)) or isinstance(t_start, bool) or \
@@ -364,6 +207,10 @@ def _check_finite_start(system, t, x0, p):
 
 
 def _finite_start(system, t, x0, p):
+    _, singular = system.assembly_singular([t], x0[None, :], p)
+    if singular:
+        raise ModelError([f"at the start (t = {t:g} s): {m}; give other start values or "
+                          f"guesses" for m in singular])
     values = [x0]
     if system.n_states:
         nx = system.n_states
@@ -440,6 +287,7 @@ def _integrate(run, method):
             except Failure as exc:
                 failure = exc.reason
         turn = None
+        new, failure = _assembly_watch(run, X, new, failure)
         if run.system.f_dependent is not None:
             new, failure, turn = parts.watch(X, new, failure)
         X.extend(new)
@@ -475,6 +323,27 @@ def _integrate(run, method):
         stats["restarts"] = [{"t": r["t"], "after": r["after"]} for r in restarts]
     stats.update(parts.done())
     return np.array(X), failure, stats
+
+
+def _assembly_watch(run, X, new, failure):
+    """(rows, failure): the new rows before an assembly that closes its loop in closed form
+    reaches a singular position (its two solutions meet, MSL's assertion), and the failure
+    that stops the run there; for a run that failed, the last row's singular positions
+    appended to its reason."""
+    system = run.system
+    if system.f_assembly_checks is None:
+        return new, failure
+    times = run.grid[len(X):len(X) + len(new)]
+    i, singular = system.assembly_singular(times, new, run.p)
+    if i is not None:
+        return new[:i], f"at t = {times[i]:g} s, " + "; ".join(singular)
+    if failure is not None:
+        last, t = (new[-1], times[-1]) if len(new) else (X[-1], run.grid[len(X) - 1])
+        _, near = system.assembly_singular([t], np.atleast_2d(last), run.p,
+                                           NEAR_SINGULAR_ASSEMBLY)
+        if near:
+            failure += f"; at the last output (t = {t:g} s) " + "; ".join(near)
+    return new, failure
 
 
 def _first_chunk(run, method, intervals):
@@ -626,3 +495,4 @@ def _running(run):
     finally:
         for sig, handler in saved.items():
             _signal.signal(sig, handler)
+

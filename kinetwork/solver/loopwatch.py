@@ -26,7 +26,7 @@ singular configuration, saying so."""
 import casadi as ca
 import numpy as np
 
-from ..equations.system import System, mapped
+from ..equations.system import System, pointwise
 from .compiled import compiled
 from .methods import METHODS, Failure
 
@@ -71,8 +71,7 @@ def conditioning(run, X):
     if f is None or not len(X):
         return None
     n = f.size1_out(0)
-    J = np.asarray(mapped(f, len(X))(np.asarray(X).T, run.p)).reshape(n, len(X), n)
-    J = np.transpose(J, (1, 0, 2))
+    J = pointwise(f, X, run.p)[0].reshape(len(X), n, n).transpose(0, 2, 1)
     with np.errstate(all="ignore"):
         s = np.linalg.svd(J, compute_uv=False)
         cond = np.where(s[:, -1] > 0, s[:, 0] / s[:, -1], np.inf)
@@ -251,8 +250,7 @@ class Partitions:
         run = self.run
         f = run.system.f_dependent
         n = f.size1_out(0)
-        J = np.asarray(mapped(f, len(rows))(rows.T, run.p)).reshape(n, len(rows), n)
-        J = np.transpose(J, (1, 0, 2))
+        J = pointwise(f, rows, run.p)[0].reshape(len(rows), n, n).transpose(0, 2, 1)
         with np.errstate(all="ignore"):
             s = np.linalg.svd(J, compute_uv=False)
             cond = np.where(s[:, -1] > 0, s[:, 0] / s[:, -1], np.inf)
@@ -388,9 +386,8 @@ def coordinates(system, t, X, p):
         return ca.Function("coordinates", [a.t, ca.vertcat(eq.x, eq.z), a.p],
                            [ca.densify(q), ca.densify(eq.u)])
     f = compiled(system).memo("coordinates", build)
-    q, u = mapped(f, len(X))(np.asarray(t, dtype=float)[None, :],
-                             np.asarray(X, dtype=float).T, p)
-    return np.asarray(q).T, np.asarray(u).T
+    q, u = pointwise(f, np.asarray(t, dtype=float)[:, None], X, p)
+    return q, u
 
 
 def convert(a, b, t, X, p):

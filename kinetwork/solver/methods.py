@@ -152,6 +152,14 @@ class _CasadiRun:
         """An integrator over ``times`` in the time since ``self.t``: on an output grid of
         equal intervals, the same one for every chunk of as many intervals (unless
         ``exact``: times an event is looked for at, which must not be rounded to the grid)."""
+        key, build = self.recipe(times, opts, exact)
+        if self.method.plugin == "idas":    # its options hold the state's rate: not reusable
+            return build()
+        return self.run.compiled.integrator(key, build)
+
+    def recipe(self, times, opts, exact=False):
+        """(the key its System keeps it by, the function that builds it) of ``integrator``:
+        a batch of members maps the very integrator a run builds (``batch.py``)."""
         m, run = self.method, self.run
         dae = run.compiled.dae(run.jit, m.newton)
         n = len(times)
@@ -163,10 +171,7 @@ class _CasadiRun:
             grid = tuple((np.asarray(times, dtype=float) - self.t).tolist())
             taus = lambda: list(grid)  # noqa: E731
         key = ("integrator", m.plugin, grid, tuple(sorted(opts.items())), bool(run.jit))
-        build = lambda: ca.integrator("simulate", m.plugin, dae, 0.0, taus(), opts)  # noqa: E731
-        if m.plugin == "idas":          # its options hold the state's rate: not reusable
-            return build()
-        return run.compiled.integrator(key, build)
+        return key, lambda: ca.integrator("simulate", m.plugin, dae, 0.0, taus(), opts)
 
     def advance(self, times, exact=False):
         m, run = self.method, self.run
@@ -454,7 +459,7 @@ def stiffness(rhs, t_start, t_end, x0):
     return stiff, sigma, omega
 
 
-def choose(run):
+def choose(run, keep=True):
     """What ``auto`` runs: (method names to try in order, why). IDAS for models with
     algebraic variables (loops compiled with ``loops="partition"``, massless junctions); else
     Adams (loops too: their default formulation is the projected ODE) unless the stiffness
@@ -463,6 +468,9 @@ def choose(run):
     A model without damping (generalized forces independent of the speeds) is conservative
     up to its time-dependent drives: its eigenvalues come in ±λ pairs and it is never stiff by
     the test, so the test (an eigenvalue problem of 2n x 2n) is not run.
+
+    ``keep``: the answer is kept per start, horizon and parameter values (a model run again
+    asks the same); a sweep's members, each asking once, do not fill that table.
     """
     system = run.system
     if system.n_algebraic:
@@ -475,7 +483,7 @@ def choose(run):
         # once per start, horizon and parameter values: a model run again asks the same
         key = ("stiffness", float(run.t_start), float(run.t_end),
                np.asarray(run.x0, float).tobytes(), np.asarray(run.p, float).tobytes())
-        stiff, sigma, omega = run.compiled.memo(key, test)
+        stiff, sigma, omega = run.compiled.memo(key, test) if keep else test()
         why.update(stiff=bool(stiff), decay_rate=sigma, motion_rate=omega)
     return (["cvodes"] if why["stiff"] else ["cvodes-adams", "cvodes"]), why
 

@@ -20,7 +20,7 @@ import numpy as np
 
 from . import jit as _jit
 from ..equations.newton_euler import rnea
-from ..equations.system import mapped
+from ..equations.system import pointwise
 from .compiled import JACOBIAN_JIT_LIMIT
 
 
@@ -126,7 +126,7 @@ class Midpoint:
             failure = (f"the midpoint rule's Newton iteration did not converge with steps of "
                        f"{h:g} s (the motion changes too much within a step): take a smaller "
                        f"step")
-        qd = np.asarray(mapped(self._velocity, len(Z))(Z[:, :n].T, Z[:, n:2 * n].T, p)).T
+        qd = pointwise(self._velocity, Z[:, :n], Z[:, n:2 * n], p)[0]
         X = np.hstack([Z[:, :n], qd])
         return X, failure, {"steps": (len(Z) - 1) * m, "step": h,
                             "residual": float(Z[-1, -1])}

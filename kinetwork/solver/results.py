@@ -15,6 +15,7 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
+from ..upcalls import upcall
 from ..util import atomic_write, suggest
 
 if TYPE_CHECKING:                     # annotations only
@@ -23,6 +24,28 @@ if TYPE_CHECKING:                     # annotations only
     import pandas
     import xarray
     from matplotlib.figure import Figure
+
+
+#: the name of the time dimension of every xarray kinetwork gives (``Results.to_xarray``,
+#: ``kn.sweep``, ``kn.sample``): ``t``, as ``res.t`` and the CSV's first column
+TIME = "t"
+
+
+def signal_dims(shape):
+    """The xarray dimensions of one value of a signal of ``shape``: none for a scalar,
+    ``axis`` (x, y, z) for a vector, ``row`` and ``col`` for an orientation."""
+    return {0: (), 1: ("axis",), 2: ("row", "col")}[len(shape)]
+
+
+def signal_coords(signals):
+    """The coordinates of the dimensions ``signal_dims`` gives ``signals``."""
+    shapes = {len(sig.shape): sig.shape for sig in signals}
+    coords = {}
+    if 1 in shapes and shapes[1] == (3,):
+        coords["axis"] = ["x", "y", "z"]
+    if 2 in shapes:
+        coords.update(row=[1, 2, 3], col=[1, 2, 3])
+    return coords
 
 
 class Results:
@@ -151,7 +174,7 @@ class Results:
         xr = _optional("xarray", "to_xarray")
         variables = {}
         for name, sig in self.signals.items():
-            dims = ("t",) + {0: (), 1: ("axis",), 2: ("row", "col")}[len(sig.shape)]
+            dims = (TIME,) + signal_dims(sig.shape)
             attrs = {"units": sig.unit, "probe": sig.probe, "quantity": sig.quantity}
             target = self.probe_targets.get(sig.probe)
             if target:
@@ -159,14 +182,10 @@ class Results:
             variables[name] = xr.Variable(dims, self._values[name], attrs)
         if states:
             for name in self.state_names:
-                variables[name] = xr.Variable(("t",), self[name],
+                variables[name] = xr.Variable((TIME,), self[name],
                                               {"units": self.units.get(name, "")})
-        coords = {"t": ("t", self.t, {"units": "s", "long_name": "time"})}
-        shapes = {len(sig.shape): sig.shape for sig in self.signals.values()}
-        if 1 in shapes and shapes[1] == (3,):
-            coords["axis"] = ["x", "y", "z"]
-        if 2 in shapes:
-            coords.update(row=[1, 2, 3], col=[1, 2, 3])
+        coords = {TIME: (TIME, self.t, {"units": "s", "long_name": "time"}),
+                  **signal_coords(self.signals.values())}
         return xr.Dataset(variables, coords=coords, attrs=self._attrs())
 
     def _attrs(self):
@@ -213,9 +232,9 @@ class Results:
         table = ("<table><thead><tr><th>signal</th><th>unit</th><th>at the end</th></tr>"
                  f"</thead><tbody>{''.join(rows)}</tbody></table>") if rows else ""
         figure = ""
-        if self.signals and _plotter is not None and len(self.t) > 1:
+        if self.signals and len(self.t) > 1:
             try:
-                figure = _svg(_plotter(self, _detached=True))
+                figure = _svg(upcall("plot")(self, _detached=True))
             except Exception as exc:        # a display must never raise in a notebook
                 figure = f"<p>(no plot: {html.escape(str(exc))})</p>"
         return f"<div class='kinetwork-results'><p>{text}</p>{table}{figure}</div>"
@@ -224,17 +243,13 @@ class Results:
         """Probe plots (a matplotlib Figure): every probe, or the probes and signals named
         (``res.plot("probe1.angle", "probe2")``); options as ``kinetwork.plot.plot_results``
         (``title``, ``hide_flat``, ``columns``, ...)."""
-        if _plotter is None:
-            raise RuntimeError("no plotter installed: import kinetwork")
-        return _plotter(self, *names, **kwargs)
+        return upcall("plot")(self, *names, **kwargs)
 
     def animate(self, path: str | os.PathLike | None = None, **kwargs: Any) -> Any:
         """3-D animation of the run: a self-contained HTML page at ``path`` (the three.js
         player inlined, opens without a network) and ``gif=``/``mp4=`` videos; returns the
         Animation (see ``kinetwork.animation.animate`` for the options)."""
-        if _animator is None:
-            raise RuntimeError("no animator installed: import kinetwork")
-        return _animator(self, path, **kwargs)
+        return upcall("animate")(self, path, **kwargs)
 
     def __repr__(self):
         return (f"<Results {len(self.t)} points, t = {self.t[0]:g} .. {self.t[-1]:g}, "
@@ -257,25 +272,3 @@ def _svg(fig):
     fig.savefig(buffer, format="svg")
     text = buffer.getvalue()
     return text[text.index("<svg"):]
-
-
-#: what draws ``Results.plot``: installed by ``kinetwork.plot`` when it is imported (the plot
-#: is a face over the results, a layer above them)
-_plotter = None
-
-
-def install_plotter(plot):
-    """Set the function ``plot(results, probes=None, **kwargs)`` -> Figure of
-    ``Results.plot``."""
-    global _plotter
-    _plotter = plot
-
-
-#: what draws ``Results.animate``: installed by ``kinetwork.animation`` when it is imported
-_animator = None
-
-
-def install_animator(animate):
-    """Set the function ``animate(results, path=None, **kwargs)`` of ``Results.animate``."""
-    global _animator
-    _animator = animate

@@ -3,18 +3,19 @@ each problem placed on its block, and a layout for a diagram without one.
 
 Nothing here is new judgement: the palette is read from the component declarations, and a
 model is checked by ``kinetwork.graph.io.model_from_dict``, the checker behind ``kn.load``.
+A problem goes to the page as the fields of its ``Problem`` record (``API.md``): nothing here
+reads a message's text.
 """
 
 import collections
 import logging
 import math
 import os
-import re
 
 import numpy as np
 
 from ..components.base import REGISTRY
-from ..errors import ModelError
+from ..errors import ModelError, Problem
 from ..graph.io import Context, model_from_dict
 
 log = logging.getLogger("kinetwork.studio")
@@ -26,13 +27,6 @@ LIBRARY_ORDER = ("multibody", "rotational", "translational", "signals", "electri
 COMPILE_LIMIT = 400
 #: problems sent to the page at most (a model of a million broken parts lists the first)
 MAX_PROBLEMS = 200
-#: where a problem is: components[i] "name" params.key, connections[i], or comp.port
-_PLACE = re.compile(r'components\[(?P<index>\d+)\](?: "(?P<name>[^"]*)")?'
-                    r'(?: params\.(?P<param>[A-Za-z_][A-Za-z0-9_]*))?'
-                    r'|connections\[(?P<wire>\d+)\]'
-                    r'|(?P<ref>[A-Za-z_][A-Za-z0-9_]*)\.[A-Za-z_][A-Za-z0-9_]*(?=[:\s])')
-#: the definition a problem is in: "definitions.Axis. ..." (after the file's name, if any)
-_SCOPE = re.compile(r'(?:[^\s:]+\.json: )?definitions\.(?P<name>[A-Za-z_][A-Za-z0-9_]*)\.')
 GRID_COLUMNS, GRID_DX, GRID_DY = 4, 220, 140
 
 
@@ -61,7 +55,8 @@ def type_info(type_name, cls):
                     "min": plain(spec.min), "max": plain(spec.max), "shape": list(spec.shape),
                     "kind": spec.kind,
                     "choices": None if spec.choices is None else plain(list(spec.choices)),
-                    "doc": spec.doc, "required": spec.required, "time": bool(spec.time)}
+                    "doc": spec.doc, "required": spec.required, "time": bool(spec.time),
+                    "aliases": list(spec.aliases)}
                    for name, spec in cls.params.items()],
     }
 
@@ -97,38 +92,42 @@ def build(data, ctx, validate):
 
 
 def validate(data, ctx):
-    """``{"ok", "problems", "summary"}`` of a model file's top-level object: :func:`check`,
-    then :func:`summarize` when the check passes."""
+    """``{"ok", "problems", "warnings", "summary"}`` of a model file's top-level object:
+    :func:`check`, then :func:`summarize` when the check passes. What the checks warn about
+    (an idealised inertia) is in ``warnings``: problems of severity "warning"."""
     answer = check(data, ctx)
     if answer.pop("compile"):
         more = summarize(data, ctx)
         if more.get("problems"):
-            return {"ok": False, "problems": more["problems"], "summary": answer["summary"]}
+            return {**answer, "ok": False, "problems": more["problems"], "warnings": []}
         answer["summary"].update(more["summary"])
+        answer["warnings"] = more["warnings"]
     return answer
 
 
 def check(data, ctx):
     """The checks of ``kn.load`` on a model file's top-level object: ``{"ok", "problems",
-    "summary": {"dof", "states", "components"}, "compile"}``, ``compile`` saying whether
-    :func:`summarize` has more to tell (a sound model that is not a definition)."""
+    "warnings", "summary": {"dof", "states", "components"}, "compile"}``, ``compile`` saying
+    whether :func:`summarize` has more to tell (a sound model that is not a definition)."""
     components = data.get("components")
     summary = {"dof": None, "states": None,
                "components": len(components) if isinstance(components, list) else 0}
     try:
         model = build(data, ctx, validate=True)
     except ModelError as exc:
-        return {"ok": False, "problems": problems_of(exc, data), "summary": summary,
-                "compile": False}
+        return {"ok": False, "problems": problems_of(exc), "warnings": [],
+                "summary": summary, "compile": False}
     summary["components"] = len(model.components)
     # a definition is wired where it is placed: nothing to count alone
-    return {"ok": True, "problems": [], "summary": summary, "compile": not model.exposed}
+    return {"ok": True, "problems": [], "warnings": [], "summary": summary,
+            "compile": not model.exposed}
 
 
 def summarize(data, ctx):
     """What compiling a sound model tells (up to COMPILE_LIMIT flat components): its degrees
-    of freedom and states, ``{"summary": {"dof", "states"}}``, or ``{"problems": [...]}``
-    for what would refuse to run (a mass matrix singular at the start)."""
+    of freedom and states and what it is accepted with, ``{"summary": {"dof", "states"},
+    "warnings": [...]}``, or ``{"problems": [...]}`` for what would refuse to run (a mass
+    matrix singular at the start)."""
     out = {"dof": None, "states": None}
     try:
         model = build(data, ctx, validate=True)
@@ -141,42 +140,30 @@ def summarize(data, ctx):
             free = sum(1 for group in topo.oned if group.kind == "free")
             out["dof"] = int(topo.dof + free)
     except ModelError as exc:
-        return {"problems": problems_of(exc, data)}
-    return {"summary": out}
+        return {"problems": problems_of(exc)}
+    return {"summary": out, "warnings": [problem(p) for p in topo.warnings[:MAX_PROBLEMS]]}
 
 
-def problems_of(exc, data=None):
-    """The problems of a ModelError, each with the component, parameter and connection its
-    place names, so the page can show it on the block or the wire."""
-    names = []
-    if isinstance(data, dict) and isinstance(data.get("components"), list):
-        names = [c.get("name") if isinstance(c, dict) else None for c in data["components"]]
-    listed = [problem(message, names) for message in exc.problems[:MAX_PROBLEMS]]
+def problems_of(exc):
+    """The problems of a ModelError as the page reads them (:func:`problem`), the first
+    MAX_PROBLEMS of them and a last one saying how many more there are."""
+    listed = [problem(p) for p in exc.problems[:MAX_PROBLEMS]]
     if len(exc.problems) > MAX_PROBLEMS:
         listed.append(problem(f"... and {len(exc.problems) - MAX_PROBLEMS:,} more problems "
                               f"(the first {MAX_PROBLEMS} are listed)"))
     return listed
 
 
-def problem(record, names=()):
-    """A problem as the page reads it (API.md): ``{"message", "component", "port",
-    "parameter", "path", "hint", "severity", "reason"}`` (``reason``: what is wrong, without
-    the place, for the page to say it in the user's words), and the older keys ``param``
-    and ``connection``.
-
-    A ``kinetwork.Problem`` record is read by its fields; a plain string (a library that
-    does not yet give its problems fields) is placed by :func:`_placed`.
-    """
-    if getattr(record, "severity", None) is None:
-        return _placed(str(record), names)
-    out = {"message": str(record), "reason": None, "param": None, "connection": None}
-    for key in ("component", "port", "parameter", "path", "hint"):
-        value = getattr(record, key, None)
-        out[key] = value if isinstance(value, str) else None
-    out["severity"] = "warning" if record.severity == "warning" else "error"
+def problem(record):
+    """A ``Problem`` as JSON (API.md): ``{"message", "component", "port", "parameter",
+    "path", "hint", "severity"}``; ``reason``, what is wrong without the place, for the page
+    to say it in the user's words (``mass1.mass: must be >= 0 (got -1 kg)``); and the keys
+    the page read before those fields: ``param`` (the parameter of a component of the file
+    itself) and ``connection`` (the index of the wire ``path`` is on). The place is read
+    from the fields only; a plain string is a problem with no place."""
+    out = Problem.of(record).to_dict()
     path = out["path"] or ""
-    if path.startswith("components["):
-        out["param"] = out["parameter"]
+    out["param"] = out["parameter"] if path.startswith("components[") else None
     out["connection"] = _index(path, "connections[")
     rest = _after_place(out)
     out["reason"] = None if rest is None else _reason(rest)
@@ -214,41 +201,6 @@ def _after_place(out):
         if at >= 0:
             return message[at + len(place):]
     return None
-
-
-def _placed(message, names=()):
-    """A problem given as a string alone, placed by the form of its text (the library's
-    places: ``components[i] "name" params.key``, ``connections[i]``, ``comp.port``)."""
-    out = {"message": message, "component": None, "port": None, "parameter": None,
-           "path": None, "hint": None, "severity": "error", "reason": None,
-           "param": None, "connection": None}
-    # a problem inside an inline definition: placed in it ("definitions.Axis." first)
-    scope = _SCOPE.match(message)
-    text, prefix = (message[scope.end():], f"definitions.{scope['name']}.") if scope \
-        else (message, "")
-    if scope:
-        names = ()
-    match = _PLACE.match(text)
-    if match is None:
-        return out
-    rest = text[match.end():]
-    if match["index"] is not None:
-        i = int(match["index"])
-        name = match["name"]
-        if name is None or name.endswith("..."):      # not quoted, or cut: the file's own
-            name = names[i] if i < len(names) and isinstance(names[i], str) else name
-        out["component"], out["param"] = name, match["param"]
-        out["parameter"] = match["param"]
-        out["path"] = prefix + f"components[{i}]" + \
-            (f".params.{match['param']}" if match["param"] else "")
-    elif match["wire"] is not None:
-        out["connection"] = None if scope else int(match["wire"])
-        out["path"] = prefix + f"connections[{match['wire']}]"
-    elif match["ref"] in names:
-        out["component"] = match["ref"]
-        out["port"] = text[len(match["ref"]) + 1:match.end()]
-    out["reason"] = _reason(rest)
-    return out
 
 
 def _reason(rest):

@@ -235,7 +235,7 @@ def _routes(api, studio):
         except StudioError as exc:
             if exc.status != 503:
                 raise
-            return StudioJSON({"ok": False, "summary": None,
+            return StudioJSON({"ok": False, "summary": None, "warnings": [],
                                "problems": [checks.problem(exc.message)]})
         if answer.pop("compile"):
             try:
@@ -244,11 +244,12 @@ def _routes(api, studio):
             except StudioError as exc:      # too long to count: the check's answer stands
                 if exc.status != 503:
                     raise
-                more = {"summary": {}}
+                more = {"summary": {}, "warnings": []}
             if more.get("problems"):
                 answer.update(ok=False, problems=more["problems"])
             else:
                 answer["summary"].update(more["summary"])
+                answer["warnings"] = more["warnings"]
         return StudioJSON(answer)
 
     @api.post("/save")

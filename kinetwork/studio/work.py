@@ -15,7 +15,9 @@ import numpy as np
 from ..errors import ModelError, SimulationError
 from ..graph.io import loads
 from ..graph.writer import dumps, render_json
-from ..solver.driver import DEFAULTS, simulate
+from ..solver.driver import DEFAULTS
+from ..solver.plan import simulate
+from ..solver.results import TIME
 from . import checks
 from .results import encode, results_json
 
@@ -50,7 +52,7 @@ def layout(data, folder, library, channel):
     try:
         model = checks.build(data, _ctx(folder, library), validate=False)
     except ModelError as exc:
-        return {"problems": checks.problems_of(exc, data)}
+        return {"problems": checks.problems_of(exc)}
     return {"layout": checks.layout(model)}
 
 
@@ -68,12 +70,12 @@ def render(data, text, folder, library, channel):
             loads(text, validate=False, library=library, folder=folder)
             return {"text": text, "problems": [], "canonical": True}
         except ModelError as exc:
-            return {"text": text, "problems": checks.problems_of(exc, data), "canonical": False}
+            return {"text": text, "problems": checks.problems_of(exc), "canonical": False}
     try:
         model = checks.build(data, _ctx(folder, library), validate=False)
         return {"text": dumps(model, folder), "problems": [], "canonical": True}
     except ModelError as exc:
-        problems = checks.problems_of(exc, data)
+        problems = checks.problems_of(exc)
     try:
         return {"text": render_json(data), "problems": problems, "canonical": False}
     except ModelError as exc:       # not plain JSON: nothing a file can hold
@@ -123,7 +125,7 @@ def run(data, settings, folder, library, channel):
         return _final("cancelled" if cancelled else "failed", error=None if cancelled else str(exc),
                       results=partial, phase=phase)
     except ModelError as exc:
-        return _final("failed", error=str(exc), problems=checks.problems_of(exc, data), phase=phase)
+        return _final("failed", error=str(exc), problems=checks.problems_of(exc), phase=phase)
     except KeyboardInterrupt:          # cancelled before the integration kept anything
         return _final("cancelled", phase=phase)
 
@@ -196,7 +198,7 @@ def sweep(data, spec, folder, library, channel):
                               "parameters": names})
     except ModelError as exc:
         return "failed", encode({"state": "failed", "progress": None, "error": str(exc),
-                                 "problems": checks.problems_of(exc, data), "members": None})
+                                 "problems": checks.problems_of(exc), "members": None})
     except KeyboardInterrupt:          # cancelled before any member finished
         return "cancelled", encode({"state": "cancelled", "progress": None, "error": None,
                                     "problems": [], "members": None})
@@ -251,7 +253,7 @@ def _members(ds, system, names, kind):
     """Each member of a sweep's Dataset: its parameter values, status and results."""
     shape = [ds.sizes[d] for d in (names if kind == "grid" else ["member"])]
     count = int(np.prod(shape))
-    t = ds["time"].values
+    t = ds[TIME].values
     columns = {}
     for sig in system.signals:
         block = ds[sig.name].values

@@ -68,5 +68,25 @@ def test_a_loop_starts_where_the_values_asked_put_it():
 
 
 def test_unknown_parameters_are_refused():
-    with pytest.raises(kn.ModelError, match="'cc' is not a model parameter.*'c'"):
+    with pytest.raises(kn.ModelError, match="'cc' is no model parameter.*'c'"):
         kn.sensitivity(double_pendulum(), ["cc"], t_end=1.0)
+
+
+@pytest.mark.parametrize("rtol", [1e-6, 1e-8])
+def test_sensitivities_are_as_accurate_as_rtol_says(rtol):
+    """At large angles, the shoulder's and elbow's sensitivity to c at the tolerance asked
+    (the plan's mapping of rtol, not the solver's tolerance as asked) against Richardson's
+    extrapolation of central differences of the paper's closed form (scipy DOP853 at
+    1e-13): within rtol times their size."""
+    from scenes.reference import seed_reference
+    t = np.linspace(0.0, 2.0, 21)
+
+    def ref(c):
+        return seed_reference(t, x0=(1.0, 0.5, 0.0, 0.0), c=c, rtol=1e-13, atol=1e-15)[:, :2]
+
+    def cd(h):
+        return (ref(1 + h) - ref(1 - h)) / (2 * h)
+    exact = (4 * cd(1e-3) - cd(2e-3)) / 3
+    sens = kn.sensitivity(double_pendulum(q0=(1.0, 0.5)), ["c"], t=t, rtol=rtol,
+                          atol=rtol / 100, outputs=["shoulder.q", "elbow.q"])
+    assert np.abs(sens.S[:, :, 0] - exact).max() <= rtol * np.abs(exact).max()

@@ -78,15 +78,22 @@ def test_an_assignment_is_what_save_numeric_values_and_simulate_see(tmp_path):
     np.testing.assert_allclose(after.states, heavier.states, rtol=0, atol=1e-8)
 
 
-def test_a_parameter_named_apart_from_its_attribute_is_assigned_by_either_name():
+def test_a_joint_direction_is_n_and_is_also_given_as_axis():
     joint = kn.multibody.Revolute("j")
-    joint.direction = [1, 0, 0]                 # attribute name; the file calls it "axis"
-    assert joint.given["axis"] == [1, 0, 0]
-    joint.set_param("axis", [0, 1, 0])
-    assert joint.direction == [0, 1, 0]
-    spring = kn.rotational.SpringDamper("sd", c=1.0, d=0.0)
-    spring.phi_rel0 = 0.2                       # file name of the attribute ``rel0``
-    assert spring.rel0 == 0.2 and spring.given["phi_rel0"] == 0.2
+    joint.n = [1, 0, 0]                         # Modelica's name; the flange is ``axis``
+    assert joint.given["n"] == [1, 0, 0] and joint.written_params() == {"n": [1, 0, 0]}
+    joint.set_param("axis", [0, 1, 0])          # the name files used: accepted, kept
+    assert joint.n == [0, 1, 0] and joint.written_params() == {"axis": [0, 1, 0]}
+    joint.set_param("n", [0, 0, 1])
+    assert joint.written_params() == {"n": [0, 0, 1]}
+    with pytest.raises(kn.ModelError, match=r"j\.axis is a port, not a parameter.*j\.n"):
+        joint.axis = [1, 0, 0]
+    with pytest.raises(kn.ModelError, match="axis and n are one parameter"):
+        kn.multibody.Revolute("j", n=[1, 0, 0], axis=[1, 0, 0])
+    spring = kn.rotational.SpringDamper("sd", c=1.0, d=0.0, phi_rel0=0.1)
+    assert spring.phi_rel0 == 0.1
+    spring.phi_rel0 = 0.2
+    assert spring.phi_rel0 == 0.2 and spring.given["phi_rel0"] == 0.2
 
 
 @pytest.mark.parametrize("assign, message", [

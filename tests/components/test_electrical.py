@@ -220,19 +220,25 @@ def _circuit(*parts, wires):
 def test_circuits_that_cannot_be_solved_are_refused_by_name():
     no_ground = _circuit(E.VoltageSource("src", V=1.0), E.Resistor("r", R=1.0),
                          wires=[("src.p", "r.p"), ("r.n", "src.n")])
-    with pytest.raises(kn.ModelError, match="src, r has no electrical.Ground|r, src has no"):
+    with pytest.raises(kn.ModelError, match="src, r has no electrical.Ground|r, src has no") \
+            as caught:
         no_ground.compile()
+    # each refusal's place as data (the studio marks the block from the fields)
+    assert caught.value.problems[0].component == "r"
     parallel = _circuit(E.Ground("g"), E.VoltageSource("a", V=1.0), E.VoltageSource("b", V=2.0),
                         E.Resistor("r", R=1.0),
                         wires=[("a.p", "b.p"), ("a.n", "b.n"), ("g.p", "a.n"), ("r.p", "a.p"),
                                ("r.n", "a.n")])
     with pytest.raises(kn.ModelError, match="equations of a, b, g constrain their unknowns "
-                                            "twice.*structurally singular"):
+                                            "twice.*structurally singular") as caught:
         parallel.compile()
+    assert caught.value.problems[0].component == "a"
     silent = _circuit(E.Ground("g"), E.VoltageSource("src"), E.Resistor("r", R=1.0),
                       wires=[("src.p", "r.p"), ("r.n", "src.n"), ("g.p", "src.n")])
-    with pytest.raises(kn.ModelError, match=r"src.*V: no value"):
+    with pytest.raises(kn.ModelError, match=r"src.*V: no value") as caught:
         silent.compile()
+    assert (caught.value.problems[0].component, caught.value.problems[0].parameter) == \
+        ("src", "V")
     shorted = _circuit(E.Ground("g"), E.VoltageSource("src", V=1.0), E.Resistor("r", R=0.0),
                        wires=[("src.p", "r.p"), ("r.n", "src.n"), ("g.p", "src.n")])
     with pytest.raises(kn.ModelError, match="singular"):

@@ -156,8 +156,10 @@ def test_the_law_names_what_it_may_read(tmp_path):
                   E.NonlinearResistor("r", i="v/Rx")],
                  [("src.p", "r.p"), ("r.n", "src.n"), ("g.p", "src.n")], {"R0": 2.0})
     with pytest.raises(kn.ModelError, match=r"r\.i: unknown name 'Rx' in 'v/Rx'; names are v "
-                                            r"\(the voltage\), t and the model's parameters R0"):
+                                            r"\(the voltage\), t and the model's parameters R0") \
+            as caught:
         m.compile()
+    assert (caught.value.problems[0].component, caught.value.problems[0].parameter) == ("r", "i")
     m = chua_circuit()
     m.save(tmp_path / "chua.json")
     again = kn.load(tmp_path / "chua.json")

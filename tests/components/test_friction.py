@@ -358,8 +358,10 @@ def test_a_gear_with_a_loss_on_a_joint_axis_is_refused_by_name():
     model.connect(joint.frame_b, bob.frame_a)
     model.connect(rotor.flange_b, gear.flange_a)
     model.connect(gear.flange_b, joint.axis)
-    with pytest.raises(kn.ModelError, match="gear.eta: a gear with a loss"):
+    with pytest.raises(kn.ModelError, match="gear.eta: a gear with a loss") as caught:
         model.compile()
+    assert (caught.value.problems[0].component, caught.value.problems[0].parameter) == \
+        ("gear", "eta")
     gear.eta = 1.0                                   # lossless: the rotor is armature
     assert model.compile().state_names == ["joint.q", "joint.qd"]
 

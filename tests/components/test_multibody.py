@@ -15,11 +15,11 @@ def numbers(expr):
     return np.array(ca.evalf(ca.SX(expr)), dtype=float)
 
 
-def test_joint_axis_parameter_and_flange_share_a_name():
+def test_joint_direction_n_is_given_as_axis_in_files_and_keywords():
     joint = kn.multibody.Revolute("j", axis=[1, 0, 0])
     assert joint.axis.path == "j.axis"                 # the flange port
-    assert joint.direction == [1, 0, 0]                # the direction parameter
-    assert joint.given == {"axis": [1, 0, 0]}
+    assert joint.n == [1, 0, 0]                        # the direction parameter, as MSL's n
+    assert joint.given == {"n": [1, 0, 0]} and joint.written_params() == {"axis": [1, 0, 0]}
 
 
 def test_inertia_diagonal_shorthand():

@@ -61,9 +61,10 @@ def test_rigid_elements_and_their_inertias():
     assert rot.Inertia("J", J=0.3).inertia() == 0.3 and rot.Inertia.has_inertia
     assert tr.Mass("m", m=2.0).inertia() == 2.0 and tr.Mass.has_inertia
     sensor = rot.TorqueSensor("s")
-    assert (sensor.inertia(), sensor.ratio(), sensor.has_inertia) == (0.0, 1.0, False)
-    assert tr.ForceSensor("f").ratio() == 1.0
-    assert rot.IdealGear("g", ratio=50.0).ratio() == 50.0
+    assert (sensor.inertia(), sensor.position_ratio(), sensor.has_inertia) == (0.0, 1.0, False)
+    assert tr.ForceSensor("f").position_ratio() == 1.0
+    gear = rot.IdealGear("g", ratio=50.0)
+    assert gear.ratio == 50.0 and gear.position_ratio() == 50.0
     with pytest.raises(kn.ModelError, match="must not be 0"):
         rot.IdealGear("g", ratio=0)
     with pytest.raises(kn.ModelError, match=r"J\.J = -1 kg\*m\^2: must be >= 0"):

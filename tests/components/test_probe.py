@@ -48,3 +48,24 @@ def test_unknown_or_repeated_quantities_are_refused(quantities, message):
 def test_a_probe_connects_to_any_domain():
     assert kn.Probe.ports["port"].domain == "any"
     assert kn.Probe.type_name == "Probe"
+
+
+SENSOR_UNITS = {
+    kn.rotational.AngleSensor: "rad", kn.rotational.SpeedSensor: "rad/s",
+    kn.rotational.AccSensor: "rad/s^2", kn.rotational.TorqueSensor: "N*m",
+    kn.translational.PositionSensor: "m", kn.translational.SpeedSensor: "m/s",
+    kn.translational.AccSensor: "m/s^2", kn.translational.ForceSensor: "N",
+}
+
+
+def test_a_sensor_finds_its_unit_by_the_quantity_s_name(monkeypatch):
+    """A quantity added to a 1-D domain's table, anywhere in it, leaves every sensor's unit
+    as it was: sensors read the table by name, not by position."""
+    from kinetwork.components.quantities import Quantity
+    for domain in ("rotational", "translational"):
+        added = {"power": Quantity("W", (), lambda p: p.flow * p.vel)}
+        # first, so that every quantity after it moves one place
+        monkeypatch.setitem(QUANTITIES, domain, {**added, **QUANTITIES[domain],
+                                                 "jerk": Quantity("m/s^3", (), None)})
+    for cls, unit in SENSOR_UNITS.items():
+        assert cls("s").signal_unit("y") == unit, cls.__name__

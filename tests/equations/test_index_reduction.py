@@ -59,8 +59,9 @@ def test_a_start_that_contradicts_the_constraint_is_refused():
     assert _across(v0=0.0).compile().state_names == []
     m = _across(v0=1.0)
     with pytest.raises(kn.ModelError, match=r"c\.v0 = 1: c\.v is no state .*the constraint "
-                                            r"gives 0 at the start: remove v0"):
+                                            r"gives 0 at the start: remove v0") as caught:
         m.compile()
+    assert (caught.value.problems[0].component, caught.value.problems[0].parameter) == ("c", "v0")
 
 
 def _parallel(**starts):
@@ -480,8 +481,9 @@ def test_a_circuit_that_constrains_a_joint_is_refused_naming_it():
                   ("V.n", "e.n"), ("g.p", "e.n")])
     with pytest.raises(kn.ModelError, match=r"e: the circuit fixes the voltage across e .*"
                                             r"constrains the speed at e\.flange, which is a "
-                                            r"joint's axis"):
+                                            r"joint's axis") as caught:
         m.compile()
+    assert (caught.value.problems[0].component, caught.value.problems[0].port) == ("e", "flange")
 
 
 # -- large circuits ----------------------------------------------------------------------------

@@ -291,8 +291,10 @@ def test_exact_differentiation_needs_a_reference_in_time():
         model.connect("sensor.y", "drive.u")
         return model
     with pytest.raises(kn.ModelError, match="exact=True differentiates the reference "
-                                            "exactly.*set exact=False"):
+                                            "exactly.*set exact=False") as caught:
         follower(True).compile()
+    assert (caught.value.problems[0].component, caught.value.problems[0].parameter) == \
+        ("drive", "exact")
     res = kn.simulate(follower(False), t_end=1.0, n_points=11, **TOL)
     assert res["probe1.angle"][0] == pytest.approx(0.3) and np.all(np.isfinite(res.states))
 

@@ -66,7 +66,8 @@ def test_load_save_load_gives_equal_dicts(saved):
 def test_loaded_model_is_the_built_one(saved):
     model = kn.load(saved)
     assert list(model.components) == list(pendulum().components)
-    assert model.components["shoulder"].given == {"axis": [0, 0, 1], "q0": 0.05, "qd0": 0.0}
+    assert model.components["shoulder"].given == {"n": [0, 0, 1], "q0": 0.05, "qd0": 0.0}
+    assert model.components["shoulder"].written_params()["axis"] == [0, 0, 1]   # as written
     assert model.layout["shoulder"] == {"x": 120.5, "y": -40, "flip": True}
     assert model.simulation["rtol"] == 1e-8 and isinstance(model.simulation["n_points"], int)
     assert model.places["mass1"] == 'components[4] "mass1"'

@@ -28,7 +28,7 @@ def test_every_component_type_has_its_branch():
     assert sorted(b["properties"]["type"]["const"] for b in branches) == sorted(REGISTRY)
     revolute = next(b for b in branches if b["title"] == "multibody.Revolute")
     assert set(revolute["properties"]["params"]["properties"]) == \
-        set(REGISTRY["multibody.Revolute"].params)
+        set(REGISTRY["multibody.Revolute"].params) | {"axis"}     # n's other name
     body = next(b for b in branches if b["title"] == "multibody.RigidBody")
     assert body["properties"]["params"]["required"] == ["mass"]
 
@@ -68,3 +68,13 @@ def test_an_unknown_method_fails_the_schema_and_the_run(validator):
     assert list(validator.iter_errors(data))
     with pytest.raises(kn.ModelError, match="method 'euler': unknown"):
         kn.simulate(kn.loads(json.dumps(data)), t_end=0.1)
+
+
+def test_a_joint_direction_is_n_or_axis_never_both(validator):
+    def model(params):
+        return {"format": "kinetwork.model", "version": 1, "name": "m",
+                "components": [{"name": "j", "type": "multibody.Revolute", "params": params}],
+                "connections": []}
+    assert not list(validator.iter_errors(model({"n": [0, 0, 1]})))
+    assert not list(validator.iter_errors(model({"axis": [0, 0, 1]})))
+    assert list(validator.iter_errors(model({"n": [0, 0, 1], "axis": [0, 0, 1]})))

@@ -11,6 +11,9 @@ Builders (re-exported here: ``from scenes import double_pendulum, chain, fourbar
 ``loops``         kinematic loops, free bodies, line forces (``fourbar``, ``slider_crank``...)
 ``drives``        drives, gears, sensors, feedback (``arm_pid``, ``drive_train``...)
 ``random_trees``  random spatial chains and trees (``random_mechanism``, ``build_kinetwork``)
+``oscillator``    a mass on a spring without model parameters, alone and in a subsystem: the
+                  scene of component parameters by path, with its closed form (imported by
+                  module: ``from scenes.oscillator import oscillator``)
 
 References (nothing of kinetwork in them; imported by module: ``from scenes import
 reference``):

@@ -12,6 +12,8 @@ stiff      the seed with its shoulder spring-damper ``k`` times stiffer (c = d =
 chain      N identical uniform rods (1 m, 1 kg, radius 1 cm) on revolute z joints in relative
            coordinates, hanging under gravity, released from the first joint at 0.5 rad,
            undamped
+point masses  N point masses of 1 kg on massless 1 m links, a damper of 0.1 N m s/rad on each
+           joint, about z (planar) or about z and x in turn (3-D)
 spatial    N links on skew revolute axes with full inertia tensors (seeded), undamped
 """
 
@@ -107,6 +109,21 @@ def chain_spec(n, length=1.0, mass=1.0, q0=0.5):
                      gravity=np.array([0.0, -G, 0.0]), q0=q)
 
 
+def point_mass_spec(n, planar=True, length=1.0, mass=1.0, damping=0.1, q0=0.5):
+    """N point masses, each at the end of a massless link, on revolute joints with a linear
+    damper each, hanging along -y: about z only (``planar``), or about z and x in turn (3-D);
+    the first joint released at ``q0`` rad. Relative coordinates make the mass matrix's
+    condition number grow as N^4 (2e12 at N = 1024) while it stays positive definite."""
+    axes = [[0.0, 0.0, 1.0]] if planar else [[0.0, 0.0, 1.0], [1.0, 0.0, 0.0]]
+    q = np.zeros(n)
+    q[0] = q0
+    return ChainSpec(offset=np.tile([0.0, -length, 0.0], (n, 1)),
+                     axis=np.array([axes[i % len(axes)] for i in range(n)]),
+                     mass=np.full(n, mass), r_cm=np.tile([0.0, -length, 0.0], (n, 1)),
+                     inertia=np.zeros((n, 3, 3)), gravity=np.array([0.0, -G, 0.0]), q0=q,
+                     damping=np.full(n, damping))
+
+
 def spatial_spec(n, seed=7):
     """N links on random skew axes with random full inertia tensors, seeded."""
     rng = np.random.default_rng(seed)
@@ -161,6 +178,11 @@ def chain(n):
 
 def spatial(n):
     return chain_model(spatial_spec(n), f"spatial{n}")
+
+
+def point_masses(n, planar=True):
+    return chain_model(point_mass_spec(n, planar), f"{'planar' if planar else 'spatial'}"
+                                                   f"_point_masses{n}")
 
 
 def joint_angles(results):

@@ -76,16 +76,18 @@ What differs from MSL, and why
   of its ``partition`` formulation drops the out-of-plane ones as redundant at the initial
   configuration (9 of 12 per cylinder), which is what RevolutePlanarLoopConstraint does by
   hand. Nothing else had to change: no Spherical / Universal substitute was needed.
-* Gas force: kinetwork has no position-dependent 1-D force element, so GasForce2 is built
-  from signal blocks on the prismatic joint's flanges: a PositionSensor feeds two Tables (the
-  compression and expansion pressure polynomials sampled into force vs s, GAS_ROWS rows each,
-  denser near the top dead centre), a SpeedSensor feeds a third Table, a smooth step
-  w(v) = (1 - tanh(v / v_blend)) / 2 (1 for compression, 0 for expansion, sampled), and
-  F = F_exp + w (F_comp - F_exp) drives a translational Force between the prismatic's
-  support and axis. MSL switches discontinuously at v_rel = 0 (an event); the blend smears
-  the switch over |v| < ~2 v_blend (default 0.01 m/s, about 1e-3 of the piston speed at
-  10 rad/s) and the tables interpolate linearly (error < 0.3 % of the peak force). MSL's
-  asserts 0 <= s_rel <= L are not reproduced (the tables extrapolate linearly).
+* Gas force: GasForce2 is one translational Force between the prismatic's support and axis
+  whose law is MSL's own, written as one expression (``gas_force_law``) in a PositionSensor's
+  and a SpeedSensor's outputs on the prismatic's axis: the pressure polynomials in
+  x = 1 - s/L, compression when v < 0, and the force p pi d^2/4 pushing the piston down the
+  cylinder, as ``models/engine1b.json`` writes Engine1b's. MSL switches at v = 0 with an
+  event; here the switch is in the expression (``if_else``), without one: v = 0 is a dead
+  centre, where the force has no lever on the crank, so the torque it drives stays
+  continuous. (It was a piecewise-linear Table of each polynomial, 81 rows, blended by a
+  third over v: the Tables' 160 kinks per stroke and cylinder cost CVODES 7x more steps,
+  1.3 million for the 5 s default run, and each kink's search 2.5x more operations per
+  evaluation; the blend cost nothing measurable.) MSL's asserts 0 <= s_rel <= L are not
+  reproduced.
 * The filter's initType = SteadyState (filter states start at the initial engine torque) is
   not available: the two FirstOrder stages start at 0, so ``filteredEngineTorque`` has a
   start transient of ~0.1 s that MSL's has not. It is an output only; ``filter=False``
@@ -133,16 +135,16 @@ V6_CYLINDERS = [(-30.0, -30.0), (90.0, 30.0), (210.0, -30.0),
 #: the engine-torque filter (CriticalDamping, n = 2)
 ENGINE = {"J_load": 1.0, "phi0": 0.0, "w0": 10.0,
           "tau_nominal": -100.0, "w_nominal": 200.0, "filter_f": 5.0, "filter_n": 2}
+#: EngineV6.mo's experiment (StopTime = 1.01 s: the engine from 10 to about 560 rad/s, 55
+#: revolutions), outputs every millisecond. Each revolution costs about 390 steps at rtol
+#: 1e-6 (six gas-force peaks, each over 1.4 % of the stroke), so a run's cost grows with the
+#: revolutions: 5 s (470 revolutions) took 7x the CPU of these 1.01 s.
+EXPERIMENT = {"t_end": 1.01, "n_points": 1011, "method": "auto", "rtol": 1e-6, "atol": 1e-8}
 #: MultiBody's defaults: BodyBox / BodyCylinder density [kg/m^3], World gravity [m/s^2]
 DENSITY = 7700.0
 GRAVITY = [0.0, -9.81, 0.0]
 #: GasForce2(d = 0.1) in Cylinder.mo: cylinder bore [m]
 BORE = 0.1
-#: rows of each gas-force table (a Table of <= 100 rows stays a CasADi expression)
-GAS_ROWS = 81
-#: rows of the compression/expansion blend table, and its speed scale v_blend [m/s]
-BLEND_ROWS = 41
-V_BLEND = 0.01
 
 #: the external frames of one cylinder (the future subsystem's ports) -> internal ports
 CYLINDER_PORTS = {"crank_a": "crankAngle1.frame_a", "crank_b": "crankAngle2.frame_b",
@@ -257,23 +259,25 @@ def gas_force(s, compression, L, d=BORE):
     return gas_pressure(1 - np.asarray(s, float) / L, compression) * math.pi * d ** 2 / 4
 
 
-def gas_table(compression, L, s_min, rows=GAS_ROWS, d=BORE):
-    """Rows [s, force] over s in [s_min, L]: half of them evenly, half crowded towards the
-    top dead centre s_min, where the pressure is steep."""
-    u = np.linspace(0.0, 1.0, rows)
-    s = s_min + (L - s_min) * (0.5 * u + 0.5 * u ** 2)          # denser near s_min
-    return [[float(a), float(b)] for a, b in zip(s, gas_force(s, compression, L, d))]
+def gas_force_law(s, v, L, d=BORE):
+    """GasForce2's force [N] pushing the piston down the cylinder, as a kinetwork expression
+    in the names ``s`` (the position sensed on the prismatic's axis) and ``v`` (its speed):
+    MSL's polynomials and switches as ``gas_pressure`` has them, times pi d^2/4."""
+    x = f"(1 - {s}/{L!r})"
 
-
-def blend_table(v_blend=V_BLEND, rows=BLEND_ROWS):
-    """Rows [v, w(v)], w = (1 - tanh(v / v_blend)) / 2 over |v| <= 4 v_blend, flat beyond
-    (first and last segments flat, so the Table's linear extrapolation stays flat)."""
-    v = np.linspace(-4 * v_blend, 4 * v_blend, rows)
-    w = 0.5 * (1 - np.tanh(v / v_blend))
-    w[0], w[-1] = 1.0, 0.0
-    v = np.concatenate([[-1e3], v, [1e3]])
-    w = np.concatenate([[1.0], w, [0.0]])
-    return [[float(a), float(b)] for a, b in zip(v, w)]
+    def poly(c):
+        out = f"{c[0]!r}*{x}^4"
+        for coef, power in zip(c[1:], ("^3", "^2", "", None)):
+            out += (" - " if coef < 0 else " + ") + f"{abs(coef)!r}" + (
+                "" if power is None else f"*{x}{power}")
+        return f"({out})"
+    compression = (f"if_else({x} < 0.986061, "
+                   f"{poly((177.4132, -287.2189, 151.8252, -24.9973, 2.4))}, "
+                   f"{poly((2836360, -10569296, 14761814, -9158505, 2129670))})")
+    expansion = (f"if_else({x} > 0.933, "
+                 f"{poly((-3929704, 14748765, -20747000, 12964477, -3036495))}, "
+                 f"{poly((145.930, -131.707, 17.3438, 17.9272, 2.4))})")
+    return f"1e5*if_else({v} < 0, {compression}, {expansion})*pi*{d!r}^2/4"
 
 
 # ---------------------------------------------------------------------------------------
@@ -331,7 +335,7 @@ def s_top(**params):
 
 
 def add_cylinder(model, prefix, crank_frame, cylinder_frame, *, phi0=0.0, gas=True,
-                 probes=True, rod_shape_offset=0.02, v_blend=V_BLEND, **params):
+                 probes=True, rod_shape_offset=0.02, **params):
     """Add one MSL ``Utilities.Cylinder`` to ``model``; return ``CylinderPorts``.
 
     ``crank_frame`` (the previous crankshaft piece, or the bearing) is wired to this
@@ -341,9 +345,8 @@ def add_cylinder(model, prefix, crank_frame, cylinder_frame, *, phi0=0.0, gas=Tr
     body is the future subsystem definition, its ports ``CYLINDER_PORTS``.
 
     ``params`` are Cylinder.mo's (``CYLINDER``; angles in rad). ``phi0`` is the crankshaft
-    angle at the start: only the loop joints' starting guesses use it. ``gas`` adds the
-    GasForce2 approximation (``v_blend``: its compression/expansion switch speed),
-    ``probes`` a probe ``<prefix>_piston_probe`` (position, velocity, force) on the
+    angle at the start: only the loop joints' starting guesses use it. ``gas`` adds
+    GasForce2, ``probes`` a probe ``<prefix>_piston_probe`` (position, velocity, force) on the
     prismatic's axis; ``rod_shape_offset`` is the rod's r_shape (MSL: 0.02 m).
     """
     p = {**CYLINDER, **params}
@@ -402,26 +405,13 @@ def add_cylinder(model, prefix, crank_frame, cylinder_frame, *, phi0=0.0, gas=Tr
     model.connect(n("cylinder.frame_b"), piston_top)
 
     if gas:
-        # GasForce2 from signal blocks between the prismatic's support and axis (see the
-        # module docstring): F = F_exp(s) + w(v) (F_comp(s) - F_exp(s))
-        L, s_min = cylinder_length(**p), s_top(**p)
+        # GasForce2 between the prismatic's support and axis (see the module docstring)
         add(tr.PositionSensor(n("gas_s")))
         add(tr.SpeedSensor(n("gas_v")))
-        add(sig.Table(n("gas_compression"), table=gas_table(True, L, s_min)))
-        add(sig.Table(n("gas_expansion"), table=gas_table(False, L, s_min)))
-        add(sig.Table(n("gas_blend"), table=blend_table(v_blend)))
-        add(sig.Add(n("gas_difference"), k2=-1.0))
-        add(sig.Product(n("gas_mix")))
-        add(sig.Add(n("gas_total")))
-        add(tr.Force(n("gasForce")))
+        add(tr.Force(n("gasForce"), f=gas_force_law(n("gas_s") + ".y", n("gas_v") + ".y",
+                                                    cylinder_length(**p))))
         for a, b in [("gas_s.flange", "cylinder.axis"), ("gas_v.flange", "cylinder.axis"),
-                     ("gas_s.y", "gas_compression.u"), ("gas_s.y", "gas_expansion.u"),
-                     ("gas_v.y", "gas_blend.u"),
-                     ("gas_compression.y", "gas_difference.u1"),
-                     ("gas_expansion.y", "gas_difference.u2"),
-                     ("gas_blend.y", "gas_mix.u1"), ("gas_difference.y", "gas_mix.u2"),
-                     ("gas_expansion.y", "gas_total.u1"), ("gas_mix.y", "gas_total.u2"),
-                     ("gas_total.y", "gasForce.u"), ("gasForce.flange", "cylinder.axis"),
+                     ("gasForce.flange", "cylinder.axis"),
                      ("gasForce.support", "cylinder.support")]:
             model.connect(n(a), n(b))
     if probes:
@@ -485,7 +475,7 @@ def _add_crankshaft(model, phi0, w0, J_load, load2=True, filter=True, gravity=GR
 
 def build_engine_v6(cylinders=V6_CYLINDERS, phi0=ENGINE["phi0"], w0=ENGINE["w0"],
                     J_load=ENGINE["J_load"], load2=True, filter=True, gas=True, probes=True,
-                    v_blend=V_BLEND, **cylinder_params):
+                    **cylinder_params):
     """MSL's EngineV6 as a flat kn.Model: ``cylinders`` lists (crankAngleOffset,
     cylinderInclination) in degrees per cylinder (``V6_CYLINDERS``), named cyl1, cyl2, ...
     ``J_load=None`` leaves out the load, torque sensor, load2 and filter."""
@@ -495,22 +485,21 @@ def build_engine_v6(cylinders=V6_CYLINDERS, phi0=ENGINE["phi0"], w0=ENGINE["w0"]
             "Modelica.Mechanics.MultiBody.Examples.Loops.EngineV6 (MSL 3.2.x) built flat from "
             "kinetwork components: six cylinders in a 60-degree V on one crankshaft (6 planar "
             "loops, each cut at the crank-pin revolute b1; 1 degree of freedom), GasForce2 "
-            "approximated by signal tables, a 1 kg m^2 load started at 10 rad/s, load2 = "
+            "as MSL's polynomials, a 1 kg m^2 load started at 10 rad/s, load2 = "
             "-100 N m (w/200)^2. See tests/scenes/engine.py."),
-        simulation={"t_end": 5.0, "n_points": 5001, "method": "auto",
-                    "rtol": 1e-6, "atol": 1e-8})
+        simulation=dict(EXPERIMENT))
     _add_crankshaft(model, phi0, w0, J_load, load2=load2 and J_load is not None,
                     filter=filter and J_load is not None)
     crank, block = "bearing.frame_b", "world.frame"
     for i, (offset, inclination) in enumerate(cylinders, start=1):
         crank, block = add_cylinder(
             model, f"cyl{i}", crank, block, phi0=phi0, gas=gas, probes=probes,
-            v_blend=v_blend, crankAngleOffset=math.radians(offset),
+            crankAngleOffset=math.radians(offset),
             cylinderInclination=math.radians(inclination), **cylinder_params)
     return model
 
 
-def cylinder_definition(gas=True, probes=True, v_blend=V_BLEND, **params):
+def cylinder_definition(gas=True, probes=True, **params):
     """MSL's ``Loops.Utilities.Cylinder`` as a subsystem definition: the content of
     :func:`add_cylinder`, its four frames exposed (``CYLINDER_PORTS``). Its parameters are
     what differs between the cylinders of an engine: ``crankAngleOffset`` and
@@ -522,11 +511,11 @@ def cylinder_definition(gas=True, probes=True, v_blend=V_BLEND, **params):
         "Modelica.Mechanics.MultiBody.Examples.Loops.Utilities.Cylinder: a piece of "
         "crankshaft (crank_a to crank_b), the crank pin, connecting rod and piston in a "
         "cylinder of the engine block (cylinder_a to cylinder_b), a planar loop cut at the "
-        "crank-pin revolute b1, and GasForce2 approximated by signal tables of the "
-        "compression and expansion pressures. Parameters: crankAngleOffset and "
+        "crank-pin revolute b1, and GasForce2 (MSL's pressure polynomials, the law of one "
+        "Force in the sensed piston position and speed). Parameters: crankAngleOffset and "
         "cylinderInclination [rad], phi0 the crankshaft angle at the start."))
     add_cylinder(model, None, None, None, phi0="phi0", gas=gas, probes=probes,
-                 v_blend=v_blend, crankAngleOffset="crankAngleOffset",
+                 crankAngleOffset="crankAngleOffset",
                  cylinderInclination="cylinderInclination", **params)
     for port, inner in CYLINDER_PORTS.items():
         model.expose(port, inner)
@@ -535,7 +524,7 @@ def cylinder_definition(gas=True, probes=True, v_blend=V_BLEND, **params):
 
 def build_engine_v6_subsystems(cylinders=V6_CYLINDERS, phi0=ENGINE["phi0"], w0=ENGINE["w0"],
                                J_load=ENGINE["J_load"], load2=True, filter=True, gas=True,
-                               probes=True, v_blend=V_BLEND, definition=None):
+                               probes=True, definition=None):
     """:func:`build_engine_v6` with each cylinder one instance of :func:`cylinder_definition`
     (or ``definition``): ``cyl1`` ... ``cyl6``, their parts named by path
     (``cyl3.piston``)."""
@@ -544,11 +533,10 @@ def build_engine_v6_subsystems(cylinders=V6_CYLINDERS, phi0=ENGINE["phi0"], w0=E
         "one Cylinder subsystem in a 60-degree V on one crankshaft (6 planar loops, 1 degree "
         "of freedom), a 1 kg m^2 load started at 10 rad/s, load2 = -100 N m (w/200)^2 and "
         "the engine torque filtered. See tests/scenes/engine.py."),
-        simulation={"t_end": 5.0, "n_points": 5001, "method": "auto", "rtol": 1e-6,
-                    "atol": 1e-8})
+        simulation=dict(EXPERIMENT))
     _add_crankshaft(model, phi0, w0, J_load, load2=load2 and J_load is not None,
                     filter=filter and J_load is not None)
-    cylinder = definition or cylinder_definition(gas=gas, probes=probes, v_blend=v_blend)
+    cylinder = definition or cylinder_definition(gas=gas, probes=probes)
     crank, block = "bearing.frame_b", "world.frame"
     for i, (offset, inclination) in enumerate(cylinders, start=1):
         model.add(kn.Subsystem(f"cyl{i}", cylinder, params={

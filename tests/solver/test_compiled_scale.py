@@ -62,19 +62,6 @@ def test_the_default_run_of_the_seed_still_meets_its_closed_form(cache):
     assert np.max(np.abs(res.states[:, :2] - ref[:, :2])) < 1e-7
 
 
-def test_a_large_function_compiles_at_O0_with_the_same_numbers(cache, monkeypatch):
-    system = chains.chain(8).compile()
-    monkeypatch.setattr(jit, "O1_STATEMENTS", 100)        # the chain's right-hand side: -O0
-    sources = jit._plan("rhs", [system.f_rhs], jit.compiler())[0]()
-    assert all(flags[0] == "-O0" for _, flags in sources.values())
-    p, rng = system.param_vector(), np.random.default_rng(3)
-    c = numeric(compiled(system).rhs({"stats": {}, "required": True}), p, system.n_states)
-    vm = numeric(system.f_rhs, p, system.n_states)
-    for _ in range(5):
-        x = rng.uniform(-1, 1, system.n_states)
-        np.testing.assert_allclose(c(0.0, x), vm(0.0, x), rtol=1e-12, atol=1e-12)
-
-
 def test_the_one_call_steps_meet_the_composite_rigid_body_mass_matrix():
     """The per-body Functions of the articulated-body and inverse-dynamics passes against the
     mass matrix of the composite-rigid-body algorithm, which sums the bodies' inertias

@@ -14,7 +14,7 @@ import numpy as np
 import pytest
 
 from kinetwork.errors import ModelError
-from kinetwork.solver import jit
+from kinetwork.solver import jit, jit_build
 from kinetwork.solver.jit import JitFallbackWarning
 
 X = np.array([0.3, -1.2])
@@ -139,7 +139,7 @@ def unusable(kind, tmp_path, monkeypatch):
     if kind == "full disk":
         def full(folder):
             raise OSError(28, "No space left on device")
-        monkeypatch.setattr(jit, "_build_folder", full)
+        monkeypatch.setattr(jit_build, "build_folder", full)
         return "no space left"
     raise AssertionError(kind)
 

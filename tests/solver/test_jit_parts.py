@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 from scenes import build_kinetwork, random_mechanism
 
-from kinetwork.solver import jit
+from kinetwork.solver import jit, jit_source
 
 
 
@@ -56,9 +56,9 @@ def test_a_split_that_cannot_apply_leaves_the_source_whole():
     gen = ca.CodeGenerator("f.c", {"with_header": False})
     gen.add(f)
     source = gen.dump()
-    assert jit._split(source, 1000) == {"main.c": source}          # short
+    assert jit_source.split(source, 1000) == {"main.c": source}          # short
     looped = source.replace("  return 0;\n}", "  for (;;) break;\n  return 0;\n}", 1)
-    assert jit._split(looped, 2) == {"main.c": looped}                # not straight-line
+    assert jit_source.split(looped, 2) == {"main.c": looped}                # not straight-line
 
 
 def test_a_cache_hit_generates_no_c(cache, monkeypatch, system):
@@ -85,3 +85,14 @@ def test_the_key_follows_the_function_and_the_jacobian(system):
     assert name(f) == name(rebuilt)
     assert name(f) != name(f, True)
     assert name(f) != name(build_kinetwork(*random_mechanism(4, 3)).compile().f_rhs)
+
+
+def test_entry_points_become_swappable_only_in_casadis_usual_form():
+    x = ca.SX.sym("x", 3)
+    f = ca.Function("f", [x], [ca.sin(x) * x[0]])
+    source = jit_source.sources("f", f, ["-O0"])["f_main.c"][0]
+    swapped = jit_source.swappable(source)
+    assert swapped.count("f_kinetwork_swap") == 1 and "KINETWORK_LOAD(kinetwork_impl_f)" in swapped
+    odd = source.replace("  return casadi_f0(arg, res, iw, w, mem);",
+                         "  int r = casadi_f0(arg, res, iw, w, mem);\n  return r;")
+    assert jit_source.swappable(odd) is None                 # left as it is: no tier swap

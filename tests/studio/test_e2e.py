@@ -51,8 +51,8 @@ SEED_TYPES = {
 }
 SEED_PARAMS = {
     "ground": {"gravity": "[0, -g, 0]"},
-    "shoulder": {"axis": "[0, 0, 1]", "q0": "0.05"},
-    "elbow": {"axis": "[0, 0, 1]", "q0": "0.05"},
+    "shoulder": {"n": "[0, 0, 1]", "q0": "0.05"},
+    "elbow": {"n": "[0, 0, 1]", "q0": "0.05"},
     "link1": {"r": "[0, -L1, 0]"},
     "mass1": {"mass": "m1", "r_cm": "[0, -L1/2, 0]"},
     "mass2": {"mass": "m2", "r_cm": "[0, -L2/2, 0]"},

@@ -314,6 +314,27 @@ def test_validate_names_the_component_of_a_port_problem(client):
     assert {"shoulder", "mass1"} <= {p["component"] for p in problems}
 
 
+@pytest.mark.filterwarnings("ignore::kinetwork.IdealisedInertiaWarning")   # sent as data
+def test_validate_sends_the_fields_of_each_problem_and_its_warnings(client):
+    data = with_params(seed(client), "mass1", mass=-1.0)
+    answer = client.post("/api/validate", json={"model": data}).json()
+    index = [c["name"] for c in data["components"]].index("mass1")
+    problem = next(p for p in answer["problems"] if p["component"] == "mass1")
+    assert set(problem) == {"message", "component", "port", "parameter", "path", "hint",
+                            "severity", "reason", "param", "connection"}
+    assert (problem["parameter"], problem["path"], problem["severity"]) == \
+        ("mass", f"components[{index}].params.mass", "error")
+    assert problem["param"] == "mass" and answer["warnings"] == []
+    # an inertia no rigid body has: accepted, with a warning on the body and its parameter
+    data = with_params(seed(client), "mass1", inertia=[1.0, 0.1, 0.1])
+    answer = client.post("/api/validate", json={"model": data}).json()
+    assert answer["ok"] and answer["problems"] == []
+    [warning] = answer["warnings"]
+    assert (warning["component"], warning["parameter"], warning["severity"]) == \
+        ("mass1", "inertia", "warning")
+    assert warning["path"] == f"components[{index}].params.inertia"
+
+
 def test_validate_finds_subsystem_files_next_to_the_model(client):
     path = "models/robot/arm_axes.json"
     data = client.get("/api/open", params={"path": path}).json()["model"]
@@ -345,9 +366,16 @@ def test_a_run_gives_what_kn_simulate_gives(client, root):
     for signal in results["signals"]:
         assert signal["unit"] == expected.units[signal["name"]]
         assert tuple(signal["shape"]) == expected[signal["name"]].shape[1:]
+        # the descriptor, so the page never splits names
+        described = expected.signals[signal["name"]]
+        assert (signal["probe"], signal["quantity"], signal["port"]) == \
+            (described.probe, described.quantity, described.target)
         np.testing.assert_allclose(signal["values"], expected[signal["name"]], rtol=0,
                                    atol=1e-12)
     assert results["partial"] is None
+    angle = next(s for s in results["signals"] if s["name"] == "probe1.angle")
+    assert (angle["probe"], angle["quantity"], angle["port"]) == \
+        ("probe1", "angle", "shoulder.axis")
 
 
 def test_results_carry_the_animation(client):

@@ -1,0 +1,7 @@
+"""``python -m kinetwork.cli``: the ``kinetwork`` command."""
+
+import sys
+
+from . import main
+
+sys.exit(main())
