@@ -30,8 +30,10 @@ from .description import SOURCES, build_description, model_description
 HEADERS = ("fmi2Functions.h", "fmi2FunctionTypes.h", "fmi2TypesPlatform.h")
 RUNTIME = pathlib.Path(__file__).with_name("c") / "kinetwork_fmi2.c"
 #: -O1 compiles CasADi's straight-line code as fast as -O2 runs it (``solver/jit.py``); past
-#: jit.O1_STATEMENTS lines gcc's register allocation takes minutes, so -O0
+#: O1_LINES lines gcc's register allocation takes minutes (18.7 s of CPU on a 256-link chain's
+#: 37,000), so -O0
 CFLAGS = ("-std=c99", "-fPIC", "-shared", "-fvisibility=hidden")
+O1_LINES = 40_000
 #: a compiler still running after this long (s) is taken to hang
 COMPILE_TIMEOUT = 900.0
 KINDS = ("both", "me", "cs")
@@ -265,7 +267,7 @@ def _config(c, uid):
 def _compile(cc, sources, library, model_c):
     """Compile the sources into ``library``; a ModelError with the compiler's words when it
     fails."""
-    big = model_c.count("\n") > jit.O1_STATEMENTS
+    big = model_c.count("\n") > O1_LINES
     cmd = [cc, "-O0" if big else "-O1", *CFLAGS, f"-I{sources}", "-o", str(library),
            *(str(sources / name) for name in SOURCES), "-lm"]
     try:
