@@ -7,6 +7,13 @@ Modelica and Maple (``"L^2"`` is ``L**2``). Conditionals are a function, as CasA
 condition, so a piecewise law such as MSL's GasForce2 is one expression. An expression is
 evaluated over any numeric type that supports arithmetic (floats, CasADi SX), so the same
 parsed tree serves validation with numbers and compilation with symbols.
+
+Comparisons ``<``, ``<=``, ``>``, ``>=`` are events, as Modelica's relations are: the
+integration stops where one changes (``kinetwork.equations.relations`` finds them in the
+compiled equations). ``noEvent(e)`` takes the comparisons, ``abs``, ``sign``, ``min`` and
+``max`` inside ``e`` literally, as Modelica's ``noEvent``: the integrator steps across them
+without stopping. Over CasADi they are then built from ``copysign`` and logical not
+(``literal_functions``), which the event detection does not read as relations.
 """
 
 import ast
@@ -25,6 +32,7 @@ FUNCTIONS = {
     "exp": math.exp, "log": math.log, "sqrt": math.sqrt, "abs": abs,
     "min": min, "max": max, "sign": lambda x: math.copysign(1.0, x) if x else 0.0,
     "if_else": lambda cond, a, b: a if cond else b,
+    "noEvent": lambda e: e,
 }
 CONSTANTS = {"pi": math.pi, "e": math.e}
 #: how many arguments each function takes (CasADi's fmin/fmax take two, as does atan2)
@@ -134,10 +142,13 @@ class Expression:
                              f"{_ALLOWED})")
 
     def evaluate(self, env, functions=None):
-        """Evaluate with ``env`` mapping names to values; ``functions`` overrides FUNCTIONS."""
+        """Evaluate with ``env`` mapping names to values; ``functions`` overrides FUNCTIONS.
+        Within ``noEvent(...)``, comparisons and the functions that ``functions[LITERAL]``
+        holds (when it has that key) are built by those instead."""
         funcs = functions or FUNCTIONS
+        literal = funcs.get(LITERAL, {})
 
-        def ev(node):
+        def ev(node, plain=True):
             if isinstance(node, ast.Constant):
                 return float(node.value)
             if isinstance(node, ast.Name):
@@ -147,13 +158,19 @@ class Expression:
             if isinstance(node, ast.Attribute):
                 return env[dotted(node)]
             if isinstance(node, ast.BinOp):
-                return _BINARY[type(node.op)](ev(node.left), ev(node.right))
+                return _BINARY[type(node.op)](ev(node.left, plain), ev(node.right, plain))
             if isinstance(node, ast.UnaryOp):
-                return _UNARY[type(node.op)](ev(node.operand))
+                return _UNARY[type(node.op)](ev(node.operand, plain))
             if isinstance(node, ast.Compare):
-                result = _COMPARE[type(node.ops[0])](ev(node.left), ev(node.comparators[0]))
+                compare = _COMPARE if plain else literal or _COMPARE
+                result = compare[type(node.ops[0])](ev(node.left, plain),
+                                                    ev(node.comparators[0], plain))
                 return float(result) if isinstance(result, bool) else result
-            return funcs[node.func.id](*[ev(a) for a in node.args])
+            name = node.func.id
+            if name == "noEvent":
+                return ev(node.args[0], False)
+            call = funcs[name] if plain else literal.get(name, funcs[name])
+            return call(*[ev(a, plain) for a in node.args])
 
         try:
             return ev(self._tree)
@@ -212,14 +229,44 @@ def _replacement(text):
 
 
 def casadi_functions():
-    """FUNCTIONS over CasADi SX (imported lazily so components stay light)."""
+    """FUNCTIONS over CasADi SX (imported lazily so components stay light), with the
+    literal builds of ``noEvent`` under LITERAL."""
     import casadi as ca
     return {
         "sin": ca.sin, "cos": ca.cos, "tan": ca.tan, "asin": ca.asin, "acos": ca.acos,
         "atan": ca.atan, "atan2": ca.atan2, "sinh": ca.sinh, "cosh": ca.cosh, "tanh": ca.tanh,
         "exp": ca.exp, "log": ca.log, "sqrt": ca.sqrt, "abs": ca.fabs, "min": ca.fmin,
-        "max": ca.fmax, "sign": ca.sign, "if_else": ca.if_else,
+        "max": ca.fmax, "sign": ca.sign, "if_else": ca.if_else, "noEvent": lambda e: e,
+        LITERAL: literal_functions(),
     }
+
+
+#: the key of ``casadi_functions`` holding what noEvent builds comparisons and kinks with
+LITERAL = "literal"
+
+
+def literal_functions():
+    """Comparisons (by their ``ast`` operator type), ``abs``, ``sign``, ``min`` and ``max``
+    over CasADi SX, built without CasADi's relations or kinked operations (from
+    ``copysign`` and logical not): the same numbers and derivatives, but nothing that
+    ``kinetwork.equations.relations`` takes for an event. What ``noEvent(...)`` means, and
+    what a component uses for a guard that must never stop the integration (a direction
+    whose length may pass zero)."""
+    import casadi as ca
+
+    def positive(d):
+        """1 where d > 0, else 0 (also at d = -0 and +0)."""
+        return (ca.copysign(1, d) + 1) / 2 * (1 - ca.logic_not(d))
+
+    def sign(v):
+        return positive(v) - positive(-v)
+    return {ast.Lt: lambda a, b: positive(b - a), ast.Gt: lambda a, b: positive(a - b),
+            ast.LtE: lambda a, b: 1 - positive(a - b), ast.GtE: lambda a, b: 1 - positive(b - a),
+            ast.Eq: lambda a, b: ca.logic_not(a - b),
+            ast.NotEq: lambda a, b: 1 - ca.logic_not(a - b),
+            "abs": lambda v: v * sign(v), "sign": sign,
+            "min": lambda a, b: a + positive(a - b) * (b - a),
+            "max": lambda a, b: a + positive(b - a) * (b - a)}
 
 
 @functools.lru_cache(maxsize=4096)

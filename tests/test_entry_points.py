@@ -55,19 +55,19 @@ assert res["probe1.angle"].shape == (11,)
 """,
     "Results.plot": """
 from kinetwork.graph.io import load
-from kinetwork.solver.driver import simulate
+from kinetwork.solver.plan import simulate
 res = simulate(load(SEED), t_end=0.1, n_points=11)
 assert len(res.plot().axes) >= 4
 """,
     "Results._repr_html_": """
 from kinetwork.graph.io import load
-from kinetwork.solver.driver import simulate
+from kinetwork.solver.plan import simulate
 assert "<svg" in simulate(load(SEED), t_end=0.1, n_points=11)._repr_html_()
 """,
     "Results.animate": """
 import os, tempfile
 from kinetwork.graph.io import load
-from kinetwork.solver.driver import simulate
+from kinetwork.solver.plan import simulate
 res = simulate(load(SEED), t_end=0.1, n_points=11)
 path = os.path.join(tempfile.mkdtemp(), "a.html")
 res.animate(path)

@@ -126,6 +126,23 @@ def _grid(t, t_end, n_points):
     return grid
 
 
+def _refuse_events(system, grid):
+    """A ModelError when the run over ``grid`` meets events (``kinetwork.solver.events``),
+    which this one integration of the sensitivities does not stop at: its answer would be
+    the law of one side carried past them."""
+    from ..solver.schedule import Schedule
+    rel = system.relations
+    if rel is None:
+        return
+    times = Schedule(rel, system.param_vector(), grid[0], grid[-1]).times
+    if len(rel.state) or len(times):
+        what = f"a relation on the states, {rel.text(rel.state[0])}" if len(rel.state) \
+            else f"time events at {', '.join(f'{t:g}' for t in times[:4])} s"
+        raise ModelError(f"{system.model.name!r} has events in this run ({what}), which the "
+                         f"integration of sensitivities does not stop at yet: differentiate "
+                         f"runs of kn.simulate instead (central differences), which do")
+
+
 def _names(params):
     if isinstance(params, str):
         params = [params]
@@ -212,6 +229,7 @@ class Trajectory:
 def _trajectory(plan, name, index, rows):
     """The Function of ``Trajectory`` for the method ``name``."""
     system, grid = plan.system, plan.grid
+    _refuse_events(system, grid)
     eq, a = system.eq, system.asm
     w = ca.MX.sym("w", len(index))
     pm = ca.MX.sym("p", a.p.numel())
@@ -222,7 +240,7 @@ def _trajectory(plan, name, index, rows):
     z0 = ca.MX.sym("z0", eq.z.numel())
     X0, Z0 = _start(system, P, x0, z0)
     F = plan.differentiable(name)
-    pt = ca.vertcat(P, float(grid[0]))
+    pt = ca.vertcat(P, _held(system, grid, P), float(grid[0]))
     res = F(x0=X0, z0=Z0, p=pt) if system.n_algebraic else F(x0=X0, p=pt)
     XF = ca.horzcat(X0, res["xf"])
     if system.n_algebraic:
@@ -233,6 +251,22 @@ def _trajectory(plan, name, index, rows):
     picked = ca.vertcat(*[XF[-1 - r, :] if r < 0 else Y[r, :] for r in rows])
     return ca.Function("trajectory", [w, pm, x0, z0],
                        [picked, ca.jacobian(ca.vec(picked), w)])
+
+
+def _held(system, grid, P):
+    """The values the integrators' equations hold the relations at over the run, as
+    expressions of P (none without relations): with no event in it (``_refuse_events``),
+    the time nodes' values at its middle, nested ones read again until they agree (as
+    ``kinetwork.solver.switches`` holds them over a stretch)."""
+    rel = system.relations
+    if rel is None:
+        return ca.MX(0, 1)
+    mid = float(grid[0] + grid[-1]) / 2
+    state = ca.MX.zeros(system.n_states + system.n_algebraic)
+    r = ca.MX.zeros(rel.n)
+    for _ in range(len(rel.time) + 1):
+        r = rel.f_select(mid, state, ca.vertcat(P, r))
+    return r
 
 
 def _start(system, P, x0, z0):

@@ -68,7 +68,7 @@ def sweep(model, grid, *, params=None, outputs=None, workers=None, batch=None,
         called as each member finishes.
     **settings
         As for ``kn.simulate``: ``t_end``, ``n_points``, ``method``, ``rtol``, ``atol``,
-        ``step``, ``t_start``, ``jit``, ``max_steps``, ``time_limit``, ``restart``
+        ``step``, ``max_step``, ``t_start``, ``jit``, ``max_steps``, ``time_limit``, ``restart``
         (settings not given come from the model's ``simulation``).
 
     Returns

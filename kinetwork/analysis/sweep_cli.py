@@ -64,6 +64,8 @@ def add_command(sub):
                      help=f"integrator: {', '.join(METHODS)}")
     cmd.add_argument("--rtol", type=float, metavar="R", help="relative tolerance")
     cmd.add_argument("--atol", type=float, metavar="A", help="absolute tolerance")
+    cmd.add_argument("--max-step", type=float, metavar="H",
+                     help="largest step [s] of every method (as kinetwork run's)")
     cmd.add_argument("--jit", action=argparse.BooleanOptionalAction,
                      help="compile the equations to C (default: when a compiler is found)")
     cmd.add_argument("--output", action="append", default=None, metavar="NAME",
@@ -94,8 +96,8 @@ def run_command(args, model):
         raise ModelError("--param: a parameter is given twice")
     progress = args.progress if args.progress is not None else sys.stderr.isatty()
     ds = sweep(model, grid, t_end=args.t_end, n_points=args.n_points, method=args.method,
-               rtol=args.rtol, atol=args.atol, jit=args.jit, outputs=args.outputs,
-               workers=args.workers,
+               rtol=args.rtol, atol=args.atol, max_step=args.max_step, jit=args.jit,
+               outputs=args.outputs, workers=args.workers,
                batch=args.batch, scheduler=args.scheduler, progress=progress)
     print(summary(ds))
     if args.out:

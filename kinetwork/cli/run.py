@@ -31,6 +31,9 @@ def add(sub):
     parser.add_argument("--step", type=float, metavar="H",
                         help="largest step [s] of the fixed-step methods (rk, collocation, "
                              "midpoint; default: the output spacing)")
+    parser.add_argument("--max-step", type=float, metavar="H",
+                        help="largest step [s] of every method (the variable-step ones too: "
+                             "an input no event announces cannot be stepped over)")
     parser.add_argument("--jit", action=argparse.BooleanOptionalAction,
                         help="compile the equations to C with the system's compiler, cached on "
                              "disk (default: when a compiler is found)")
@@ -89,7 +92,8 @@ def run(args):
         else:
             params[name] = value
     given = {"t_end": args.t_end, "n_points": args.n_points, "method": args.method,
-             "rtol": args.rtol, "atol": args.atol, "step": args.step}
+             "rtol": args.rtol, "atol": args.atol, "step": args.step,
+             "max_step": args.max_step}
     settings = {**DEFAULTS, **model.simulation,
                 **{k: v for k, v in given.items() if v is not None}}
     problems = check_settings(settings)     # before building anything
@@ -106,7 +110,8 @@ def run(args):
         with _progress_bar(args, model, settings["t_end"]) as progress:
             results = kn.simulate(system, t_end=args.t_end, n_points=args.n_points,
                                   method=args.method, rtol=args.rtol, atol=args.atol,
-                                  step=args.step, jit=args.jit, params=params,
+                                  step=args.step, max_step=args.max_step, jit=args.jit,
+                                  params=params,
                                   max_steps=args.max_steps, time_limit=args.time_limit,
                                   progress=progress, error_estimate=args.error_estimate)
     except kn.SimulationError as exc:
@@ -131,8 +136,10 @@ def run(args):
     code = ("C, cached" if stats.get("jit_cached") else
             f"C, compiled in {stats['jit_seconds']:.2g} s" if "jit_seconds" in stats else
             "C" if stats.get("jit") else "CasADi virtual machine")
-    work = ", ".join(f"{stats[k]} {k.replace('_', ' ')}" for k in ("steps", "rhs_evaluations")
-                     if k in stats)
+    work = ", ".join([f"{stats[k]} {k.replace('_', ' ')}" for k in ("steps", "rhs_evaluations")
+                      if k in stats] + [f"{n} {what}" for what, n in (
+                          ("events", len(stats.get("events", ()))),
+                          ("time events", stats.get("time_events", 0))) if n])
     print(f"simulated t = {t[0]:g} .. {t[-1]:g} s ({len(t)} points) with {results.method} "
           f"({code}{'; ' + work if work else ''}) in {done - compiled:.3g} s wall time "
           f"(build {compiled - start:.3g} s)")

@@ -75,8 +75,9 @@ def methods(args):
     print(f"default: {DEFAULTS['method']}, rtol {DEFAULTS['rtol']:g}, atol {DEFAULTS['atol']:g}")
     for name, method in METHODS.items():
         kind = "fixed step" if method.fixed else "variable step"
+        events = " and ".join(method.events)
         print(f"  {name:<{width}}  {kind:<13}  " + textwrap.fill(
-            method.doc, 88, initial_indent=" " * (width + 19),
+            f"{method.doc}; events: {events}", 88, initial_indent=" " * (width + 19),
             subsequent_indent=" " * (width + 19)).lstrip())
     return 0
 

@@ -388,8 +388,8 @@ def _plain(value):
 
 
 def _table(value, where):
-    """Rows [x, y] of numbers, x strictly increasing, at least two and at most
-    TABLE_ROWS_LIMIT."""
+    """Rows [x, y] of numbers, x increasing (two equal in a row: a step), at least two and
+    at most TABLE_ROWS_LIMIT."""
     if isinstance(value, np.ndarray):
         value = value.tolist()
     if not isinstance(value, (list, tuple)) or len(value) < 2:
@@ -406,9 +406,12 @@ def _table(value, where):
             raise ModelError(f"{where}[{i}]: must be a row [x, y], got {quote(row)}")
         rows.append([check_number(v, f"{where}[{i}][{j}]") for j, v in enumerate(row)])
     for i in range(1, len(rows)):
-        if rows[i][0] <= rows[i - 1][0]:
+        if rows[i][0] < rows[i - 1][0]:
             raise ModelError(f"{where}[{i}]: x must increase, got {rows[i][0]} after "
                              f"{rows[i - 1][0]}")
+        if i >= 2 and rows[i][0] == rows[i - 1][0] == rows[i - 2][0]:
+            raise ModelError(f"{where}[{i}]: x = {rows[i][0]} a third time in a row; two "
+                             f"equal x's are a step, three are not a table")
     return rows
 
 

@@ -8,10 +8,12 @@ Unwired optional inputs read as None. A block that needs the model's own dynamic
 computed-torque controller) overrides ``evaluate``, which is handed them.
 """
 
+import hashlib
+
 import numpy as np
 
 from ..errors import ModelError
-from ..expr import parse
+from ..expr import literal_functions, parse
 from ..util import check_number, quote
 from .base import REQUIRED, TABLE_ROWS_LIMIT, Component, Param, Port, library_attribute
 
@@ -99,6 +101,83 @@ class Sine(PartialBlock, library=LIB):
         return self.offset + ca.if_else(t >= self.start_time, wave, 0)
 
 
+class PartialPeriodic(PartialBlock):
+    """A periodic signal from start_time on, as MSL's periodic sources: ``nperiod`` periods
+    (< 0: without end), ``offset`` before and after. Its edges and kinks are time events."""
+    period = Param(1.0, unit="s", positive=True, doc="Time for one period")
+    nperiod = Param(-1.0, unit="1", doc="Number of periods (< 0: without end)")
+    offset = Param(0.0, doc="Output before start_time (added to it after)")
+    start_time = Param(0.0, unit="s", doc="Start of the first period")
+
+    def wave(self, phase):
+        """The output less the offset, at ``phase`` in [0, period) of a period."""
+        raise NotImplementedError
+
+    def output(self, u, x, t):
+        import casadi as ca
+        tau = t - self.start_time
+        running = tau >= 0
+        n = ca.SX(self.nperiod)
+        last = tau < n * self.period
+        # the phase runs from the start (and stops after the last period): no events of
+        # periods that are not shown
+        phase = ca.fmax(tau, 0)
+        if n.is_constant():
+            running = running * last if float(n) >= 0 else running
+            if float(n) >= 0:
+                phase = ca.fmin(phase, n * self.period)
+        else:
+            running = running * ca.if_else(n < 0, 1, last)
+        return self.offset + running * self.wave(ca.fmod(phase, self.period))
+
+
+class Pulse(PartialPeriodic, library=LIB):
+    """A pulse train as MSL's Blocks.Sources.Pulse: amplitude for the first ``width`` % of
+    each period, 0 for the rest (plus offset)."""
+    amplitude = Param(1.0, doc="Amplitude of the pulses")
+    width = Param(50.0, unit="1", min=0.0, max=100.0, doc="Width of a pulse, % of the period")
+
+    def wave(self, phase):
+        return self.amplitude * (phase < self.width / 100 * self.period)
+
+
+class SawTooth(PartialPeriodic, library=LIB):
+    """A saw tooth as MSL's Blocks.Sources.SawTooth: rising from 0 to amplitude over each
+    period, falling back at once (plus offset)."""
+    amplitude = Param(1.0, doc="Amplitude of the teeth")
+
+    def wave(self, phase):
+        return self.amplitude * phase / self.period
+
+
+class Trapezoid(PartialPeriodic, library=LIB):
+    """A trapezoid train as MSL's Blocks.Sources.Trapezoid: in each period, rising from 0 to
+    amplitude over ``rising``, holding it for ``width``, falling back over ``falling``, 0 for
+    the rest (plus offset)."""
+    amplitude = Param(1.0, doc="Amplitude of the trapezoids")
+    rising = Param(0.0, unit="s", min=0.0, doc="Rising duration")
+    width = Param(0.5, unit="s", min=0.0, doc="Duration at the amplitude")
+    falling = Param(0.0, unit="s", min=0.0, doc="Falling duration")
+
+    def check_values(self, values, place):
+        total = [values[k] for k in ("rising", "width", "falling", "period")]
+        if all(isinstance(v, (int, float)) for v in total) and \
+                sum(total[:3]) > total[3] * (1 + 1e-12):
+            return [f"{place('period')} = {total[3]}: shorter than rising + width + falling "
+                    f"= {sum(total[:3])}"]
+        return []
+
+    def wave(self, phase):
+        import casadi as ca
+        up, hold = self.rising, self.rising + self.width
+        down = hold + self.falling
+        rise = phase / ca.fmax(up, 1e-300)
+        fall = (down - phase) / ca.fmax(self.falling, 1e-300)
+        shape = ca.if_else(phase < up, rise,
+                           ca.if_else(phase < hold, 1, ca.if_else(phase < down, fall, 0)))
+        return self.amplitude * shape
+
+
 class Gain(PartialSISO, library=LIB):
     """y = k u."""
     k = Param(doc="Gain")
@@ -155,9 +234,21 @@ class Limiter(PartialSISO, library=LIB):
 
 class Table(PartialBlock, library=LIB):
     """y interpolated linearly in ``table`` rows [x, y] at u (or at time t when u is not
-    wired), extrapolated linearly from the end rows."""
+    wired), extrapolated linearly from the end rows. Two rows with the same x are a step,
+    as in MSL's CombiTimeTable: the first row's y up to x, the second's from x on.
+
+    Read in time, every breakpoint is a time event (the integration stops there, as MSL's
+    CombiTimeTable's do by default), however long the table; with ``time_events="steps"``
+    only its steps are (MSL's AtDiscontinuities: a long, finely sampled smooth signal,
+    whose kinks the integrator's error control follows, without a restart at each row).
+    Read at a signal of the states, its kinks are taken as they are (as MSL's CombiTable1D)
+    and its steps are state events."""
     u = Port("signal_in", "Abscissa (unwired: time)", optional=True)
-    table = Param(kind="table", doc="Rows [x, y], x increasing (at most 100 000)")
+    table = Param(kind="table", doc="Rows [x, y], x increasing; two rows with the same x "
+                                    "are a step (at most 100 000 rows)")
+    time_events = Param("always", kind="choice", choices=("always", "steps"),
+                        doc="Read in time, the rows that are time events: every one "
+                            "(always) or the steps only (steps)")
     #: a table of up to this many rows is an expression (``kinetwork equations`` prints it);
     #: a longer one a CasADi interpolant, which costs time linear in the rows to build and
     #: compile to C, where the expression's cost grows with their square (10 000 rows:
@@ -169,9 +260,34 @@ class Table(PartialBlock, library=LIB):
         at = t if u["u"] is None else u["u"]
         xs = [row[0] for row in self.table]
         ys = [row[1] for row in self.table]
+        kinks = self.time_events == "always"
         if len(xs) <= self.expression_rows:
-            return ca.pw_lin(at, ca.DM(xs), ca.DM(ys))
-        return ca.interpolant(f"{self.name}_table", "linear", [xs], ys)(at)
+            return piecewise_linear(at, xs, ys, kinks)
+        knots, left, jumps = _steps(xs, ys)
+        # the table less its steps is continuous: an interpolant, the steps added to it
+        name = _interpolant_name(self.name, knots) if kinks else f"{self.name}_table"
+        smooth = ca.interpolant(name, "linear", [knots], left)(at)
+        return smooth + sum((j * (k <= at) for k, j in zip(knots, jumps) if j), ca.SX(0))
+
+
+#: the knots of each long Table's interpolant by its name: read in time, every knot is a
+#: time event (``kinetwork.equations.relations`` finds the interpolant's call in the
+#: equations, and its knots here), as each breakpoint of MSL's CombiTimeTable is
+_KNOTS = {}
+
+
+def _interpolant_name(name, knots):
+    """A name for the interpolant of ``knots`` that no other table's shares (their digest in
+    it), its knots recorded for ``interpolant_knots``."""
+    digest = hashlib.sha1(np.asarray(knots, dtype=float).tobytes()).hexdigest()[:16]
+    full = f"{name}_table_{digest}"
+    _KNOTS[full] = tuple(knots)
+    return full
+
+
+def interpolant_knots(name):
+    """The knots of the Table interpolant called ``name``, or None for any other function."""
+    return _KNOTS.get(name)
 
 
 class Integrator(PartialSISO, library=LIB):
@@ -441,7 +557,47 @@ def _hats(at, grid):
     sum to one): a linear interpolant is their product with the values."""
     import casadi as ca
     eye = np.eye(len(grid))
-    return ca.vertcat(*[ca.pw_lin(at, ca.DM(grid), ca.DM(eye[k])) for k in range(len(grid))])
+    return ca.vertcat(*[piecewise_linear(at, grid, eye[k]) for k in range(len(grid))])
+
+
+def _steps(xs, ys):
+    """(knots, values, jumps) of a table whose equal x's are steps: at each distinct x, the
+    value of the table less the steps before it (continuous), and the step there (0:
+    none)."""
+    knots, left, jumps = [], [], []
+    total = 0.0
+    i = 0
+    while i < len(xs):
+        equal = i + 1 < len(xs) and xs[i + 1] == xs[i]
+        step = ys[i + 1] - ys[i] if equal else 0.0
+        knots.append(xs[i])
+        left.append(ys[i] - total)
+        jumps.append(step)
+        total += step
+        i += 2 if equal else 1
+    return knots, left, jumps
+
+
+def piecewise_linear(at, xs, ys, kinks=True):
+    """The linear interpolation of the rows (xs, ys) at ``at`` (extrapolated linearly from
+    the end segments; two equal x's a step to the second y), as kinks ``fmax(at - x, 0)``
+    and steps ``x <= at``: on time both are time events, on the states the kinks are taken
+    as they are and the steps are state events (``kinetwork.equations.relations``).
+    ``kinks`` False: the kinks built as ``noEvent`` builds them, never events."""
+    import casadi as ca
+    knots, left, jumps = _steps(list(xs), list(ys))
+    fmax = ca.fmax if kinks else literal_functions()["max"]
+    if len(knots) == 1:
+        return ca.SX(left[0]) + jumps[0] * (knots[0] <= at)
+    slopes = [(left[j + 1] - left[j]) / (knots[j + 1] - knots[j]) for j in range(len(knots) - 1)]
+    y = left[0] + slopes[0] * (at - knots[0])
+    for j in range(1, len(knots) - 1):
+        if slopes[j] != slopes[j - 1]:
+            y = y + (slopes[j] - slopes[j - 1]) * fmax(at - knots[j], 0)
+    for k, jump in zip(knots, jumps):
+        if jump:
+            y = y + jump * (k <= at)
+    return y
 
 
 class VectorParam(Param):

@@ -362,7 +362,6 @@ def _symbols(names, suffix):
 
 
 def _speed_units(joint):
-    # looked up on the class: a component's __getattr__ refuses unknown names as a ModelError
     if hasattr(type(joint), "speed_units"):
         return joint.speed_units()
     return ["m/s"] * 3 + ["rad/s"] * 3 if joint.dof == 6 else ["rad/s"] * joint.dof

@@ -21,6 +21,7 @@ from .assemble import assemble
 from .initial import InitialEquations
 from .loops import BAUMGARTE_RATE, formulate, newton
 from .modes import close as close_modes, free_terms
+from .relations import find as find_relations
 
 
 class System:
@@ -388,6 +389,12 @@ class System:
         coords = a.q if eq.q is None else eq.q
         return ca.Function("frame_poses", [a.t, ca.vertcat(eq.x, eq.z), a.p],
                            [ca.densify(ca.substitute(poses, a.q, ca.densify(coords)))])
+
+    @functools.cached_property
+    def relations(self):
+        """Where the equations change their law (``relations.Relations``: time and state
+        events, and the equations held between them), or None; found on first use."""
+        return find_relations(self)
 
     @functools.cached_property
     def damped(self):

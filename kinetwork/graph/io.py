@@ -396,9 +396,10 @@ def _simulation(settings, problems):
         return {}
     found = [Problem(p, path=f"simulation.{cut(str(k))}")
              for k, v in settings.items() if (p := check_setting(k, v))]
-    if not found and "step" in settings and "t_end" in settings:     # what they cost together
-        found = [Problem(p, path="simulation.step")
-                 for p in [check_steps(settings["t_end"], settings["step"])] if p]
+    for key in ("step", "max_step"):                              # what they cost together
+        if not found and key in settings and "t_end" in settings:
+            found = [Problem(p, path=f"simulation.{key}")
+                     for p in [check_steps(settings["t_end"], settings[key], key)] if p]
     problems.extend(found)
     return dict(settings)
 

@@ -3,7 +3,7 @@ by ``simulate``; and the limits of what one run may cost."""
 
 from ..util import finite, quote, suggest
 
-SIMULATION_KEYS = ("t_end", "n_points", "method", "rtol", "atol", "step")
+SIMULATION_KEYS = ("t_end", "n_points", "method", "rtol", "atol", "step", "max_step")
 
 #: the most steps a fixed-step run may take: beyond, a tiny step would run for days
 MAX_STEPS = 10**9
@@ -41,20 +41,23 @@ def check_settings(settings, t_start=0.0):
     problems = [m for k, v in settings.items() if v is not None and (m := check_setting(k, v))]
     if problems:
         return problems
-    t_end, step = settings.get("t_end"), settings.get("step")
-    if t_end is not None and step is not None and t_end > t_start:
-        problem = check_steps(t_end - t_start, step)
-        if problem:
-            problems.append(problem)
+    t_end = settings.get("t_end")
+    for key in ("step", "max_step"):
+        step = settings.get(key)
+        if t_end is not None and step is not None and t_end > t_start:
+            problem = check_steps(t_end - t_start, step, key)
+            if problem:
+                problems.append(problem)
     return problems
 
 
-def check_steps(span, step):
-    """The problem with fixed steps of ``step`` over ``span`` seconds, or None."""
+def check_steps(span, step, key="step"):
+    """The problem with steps of at most ``step`` (the setting ``key``) over ``span``
+    seconds, or None."""
     steps = span / step
     if steps > MAX_STEPS:
-        return (f"simulation.step = {step:g}: {_count(steps)} steps to cover {span:g} s, "
-                f"more than the {_count(MAX_STEPS)} a run may take; use a larger step")
+        return (f"simulation.{key} = {step:g}: {_count(steps)} steps to cover {span:g} s, "
+                f"more than the {_count(MAX_STEPS)} a run may take; use a larger {key}")
     return None
 
 

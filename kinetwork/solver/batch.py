@@ -288,7 +288,7 @@ def _interval_work(plan, template):
     settings."""
     system, settings = plan.system, plan.settings
     key = ("member work", plan.key, settings["rtol"], settings["atol"], settings["step"],
-           plan.grid.tobytes(), bool(template.jit))
+           settings["max_step"], plan.grid.tobytes(), bool(template.jit))
 
     def measure():
         estimate = 4 * FIRST_CHUNK_STEPS * template.instructions

@@ -4,6 +4,10 @@ A ``System`` is not changed by running it: its compiled twins (C code through th
 CasADi integrators' DAE functions, the midpoint rule's step) live here, in a table keyed by the
 System that goes away with it. Building is serialised by one lock, so threads that simulate
 the same System at once build each function once.
+
+The integration functions (``rhs``, ``jacobian``, ``dae``, ``dae_scaled``) are those of the
+equations the integrators see: with relations (``system.relations``), each held at a value
+between events, their parameters [p; r] (``Run.p_solver``); without, the System's own, of p.
 """
 
 import collections
@@ -39,6 +43,11 @@ class Compiled:
     def system(self):
         return self._system()
 
+    @property
+    def held(self):
+        """The equations the integrators see: ``Held`` of the System."""
+        return self._get("held", lambda: Held(self.system))
+
     def _get(self, key, build):
         with _LOCK:
             if key not in self._cache:
@@ -52,19 +61,19 @@ class Compiled:
     def rhs(self, jit=None, jacobian=False):
         """The right-hand side as a Function of (t, x, p): CasADi's SX, or C when ``jit``
         (a dict of options for ``jit.external``: stats, required, deadline, cancelled)."""
-        system = self.system
+        held = self.held
         if not jit:
-            return system.f_rhs
+            return held.f_rhs
         jacobian = jacobian and self.jacobian_small()
         return self._get(("rhs", jacobian),
-                         lambda: self._external(system.f_rhs, jacobian, jit))
+                         lambda: self._external(held.f_rhs, jacobian, jit))
 
     def jacobian(self, jit=None):
         """d(xdot)/dx as a Function of (t, x, p), compiled when small enough."""
-        system = self.system
+        held = self.held
         if not (jit and self.jacobian_small()):
-            return system.jacobian_function()
-        return self._get("jac", lambda: self._external(system.jacobian_function(), False, jit))
+            return held.jacobian_function()
+        return self._get("jac", lambda: self._external(held.jacobian_function(), False, jit))
 
     def outputs(self, jit=None):
         """The probe signals as a Function of (t, x_full, p)."""
@@ -77,12 +86,12 @@ class Compiled:
         """Whether the exact Jacobian is small enough to compile (a Jacobian costs about
         operations x states: one that cannot pass is not even built)."""
         def decide():
-            system = self.system
-            f = system.f_rhs or system.f_dae
+            system, held = self.system, self.held
+            f = held.f_rhs or held.f_dae
             if f.n_instructions() * (system.n_states + system.n_algebraic) > \
                     20 * JACOBIAN_JIT_LIMIT:
                 return False
-            return system.jacobian_function().n_instructions() <= JACOBIAN_JIT_LIMIT
+            return held.jacobian_function().n_instructions() <= JACOBIAN_JIT_LIMIT
         return self._get("jacobian_small", decide)
 
     def dae(self, jit=None, jacobian=False):
@@ -105,8 +114,7 @@ class Compiled:
     def _dae(self, name, scaled, jit, jacobian):
         """``dae`` (t = t0 + tau) or, ``scaled``, ``dae_scaled`` (t = t0 + s dt, the rates
         times dt), each built once per kind."""
-        system = self.system
-        eq, a = system.eq, system.asm
+        system, held = self.system, self.held
         n_extra = 2 if scaled else 1            # t0, and dt when scaled
 
         def clock(tau, extra):
@@ -119,16 +127,16 @@ class Compiled:
             def build_sx():
                 tau, extra = ca.SX.sym("tau"), ca.SX.sym("extra", n_extra)
                 t, factor = clock(tau, extra)
-                return {"x": eq.x, "z": eq.z, "p": ca.vertcat(a.p, extra), "t": tau,
-                        "ode": rates(ca.substitute(eq.ode, a.t, t), factor),
-                        "alg": ca.substitute(eq.alg, a.t, t)}
+                return {"x": held.x, "z": held.z, "p": ca.vertcat(held.p, extra), "t": tau,
+                        "ode": rates(ca.substitute(held.ode, held.t, t), factor),
+                        "alg": ca.substitute(held.alg, held.t, t)}
             return self._get(f"{name}_sx", build_sx)
         exact = jacobian and bool(jit) and self.jacobian_small()
 
         def build():
             tau, x = ca.MX.sym("tau"), ca.MX.sym("x", system.n_states)
             z = ca.MX.sym("z", system.n_algebraic)
-            pt, empty = ca.MX.sym("p", len(system.param_names) + n_extra), ca.MX(0, 1)
+            pt, empty = ca.MX.sym("p", held.p.numel() + n_extra), ca.MX(0, 1)
             t, factor = clock(tau, pt[-n_extra:])
             ode, alg = self._equations(jit, exact, jacobian, t, x, z, pt[:-n_extra])
             return ca.Function(name, [tau, x, z, pt, ca.MX.sym("u", 0)],
@@ -146,13 +154,13 @@ class Compiled:
         over a dense pattern, grew as N^2.5 to set up (24 s per integrator at 1024 links, and a
         run makes two or three; bench/results/study_scaling_setup.md). Hidden, the set-up takes
         0.04 s there and the run is the same to the last bit."""
-        system = self.system
+        held = self.held
         if not newton:
             x = ca.stop_diff(x, 1)
-        if system.n_algebraic:
-            f = self._external(system.f_dae, exact, jit) if jit else system.f_dae
+        if self.system.n_algebraic:
+            f = self._external(held.f_dae, exact, jit) if jit else held.f_dae
             return f(t, x, z, p)
-        return (self.rhs(jit, exact) if jit else system.f_rhs)(t, x, p), ca.MX(0, 1)
+        return (self.rhs(jit, exact) if jit else held.f_rhs)(t, x, p), ca.MX(0, 1)
 
     def _no_newton_vm(self):
         """Whether an integrator without Newton runs in the VM around the SX Function, its
@@ -178,6 +186,24 @@ class Compiled:
     def memo(self, key, build):
         """Anything else a method builds once per System (the midpoint rule's step)."""
         return self._get(("memo", key), build)
+
+
+class Held:
+    """The equations the integrators see, of (t, x, z, p): with relations, each held at a
+    value (``p`` = [model parameters; held values]); without, the System's own."""
+
+    def __init__(self, system):
+        eq, a = system.eq, system.asm
+        self.relations = rel = system.relations
+        self.t, self.x, self.z = a.t, eq.x, eq.z
+        if rel is None:
+            self.p, self.ode, self.alg = a.p, eq.ode, eq.alg
+            self.f_rhs, self.f_dae = system.f_rhs, system.f_dae
+            self.jacobian_function = system.jacobian_function
+        else:
+            self.p, self.ode, self.alg = rel.p, rel.ode, rel.alg
+            self.f_rhs, self.f_dae = rel.f_rhs, rel.f_dae
+            self.jacobian_function = rel.jacobian_function
 
 
 def compiled(system):

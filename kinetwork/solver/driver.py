@@ -47,7 +47,7 @@ from .loopwatch import Partitions, near_singular
 from .methods import METHODS, Failure, Interrupted, choose, shift_times
 
 DEFAULTS = {"t_end": 10.0, "n_points": 1001, "method": "auto", "rtol": 1e-6, "atol": 1e-8,
-            "step": None}
+            "step": None, "max_step": None}
 #: a chunk of a CasADi integration is sized to about this much work (evaluations of the
 #: equations times their instructions: ~1 ns an instruction compiled, ~10 in CasADi's virtual
 #: machine, so 0.1 to 1 s): cancellation, time limits and progress are served between
@@ -96,7 +96,10 @@ class Run:
         self.t_start, self.t_end = float(grid[0]), float(grid[-1])
         self.spacing = float(grid[1] - grid[0])
         self.rtol, self.atol = settings["rtol"], settings["atol"]
+        self.max_step = settings["max_step"]
         self.step = settings["step"]
+        if self.max_step is not None and self.max_step < (self.step or self.spacing):
+            self.step = self.max_step        # a fixed step is a largest step too
         self.steps_per_interval = max(1, math.ceil(self.spacing / (self.step or self.spacing)
                                                    * (1 - 1e-12)))
         self.max_steps = settings["max_steps"]
@@ -110,7 +113,10 @@ class Run:
         self.said = []                  # what the solvers printed
         self.quiet = False              # nothing to watch: one call over the grid
         self.abortable = False          # a signal now aborts the compiled call
-        self.events = None              # friction and stops: events.Events
+        self.events = None              # friction, stops, relations: events.Events
+        #: the parameters of the equations the integrators see (``compiled.Held``): the
+        #: model's, then the values the relations are held at (``switches.py``)
+        self.p_solver = p
 
     # -- what methods use --------------------------------------------------------------------
     @contextlib.contextmanager
@@ -141,8 +147,13 @@ class Run:
     def rate(self, t, X):
         """d(x)/dt at a consistent full state X = (x, z), as IDAS's ``init_xdot``."""
         nx = self.system.n_states
-        rate = self.system.f_dae(t, X[:nx], X[nx:], self.p)[0]
+        rate = self.compiled.held.f_dae(t, X[:nx], X[nx:], self.p_solver)[0]
         return tuple(float(v) for v in np.asarray(rate).ravel())
+
+    def bound(self, t):
+        """The time a method started at t must not step past: the next time event, or the
+        end of the run."""
+        return self.t_end if self.events is None else self.events.bound(t)
 
     def stop_reason(self):
         """Why the run must stop now (cancelled, interrupted, out of time), or None."""
@@ -186,6 +197,17 @@ def _check(system, settings, t_start, max_steps, time_limit):
     if key not in METHODS:
         raise ModelError(f"method {settings['method']!r:.60}: unknown{suggest(key, METHODS)}; "
                          f"methods are {', '.join(METHODS)}")
+    rel = system.relations
+    located = [f"friction or stops ({', '.join(c.name for c in system.modes.comps)})"] \
+        if system.modes is not None else []
+    if rel is not None and len(rel.state):
+        located.append(f"a relation on the states, {rel.text(rel.state[0])}; write it in "
+                       f"noEvent(...) to take it as it is")
+    if located and "state" not in METHODS[key].events:
+        raise ModelError(
+            f"method {settings['method']!r} locates no state events, and "
+            f"{system.model.name!r} has them: {'; '.join(located)}. Use 'auto', a CVODES, "
+            f"IDAS or scipy method, 'rk' or 'collocation'")
     if system.n_algebraic and not METHODS[key].dae:
         raise ModelError(
             f"method {settings['method']!r} integrates ODEs only, and {system.model.name!r} "
@@ -244,16 +266,20 @@ def _integrate(run, method):
                              f"is smaller than the {run.steps_per_interval} steps of "
                              f"{run.step or run.spacing:g} s that the fixed-step method "
                              f"takes"), stats
+    if run.events is not None:
+        # as at the start, with the values held there (auto may try another method after
+        # one that failed, later in the run)
+        run.events.reset()
     try:
         stepper = method.start(run, grid[0], X[0])
     except Failure as failure:
         return np.array(X), failure.reason, stats
-    run.quiet = method.interruptible and run.events is None and \
+    # (time events alone: each call goes to the next of them, the method restarts there)
+    run.quiet = method.interruptible and (run.events is None or not run.events.located) and \
         run.system.f_dependent is None and run.progress is None and run.cancel is None \
         and run.deadline is None
     chunk = n - 1 if method.stepper or run.quiet else _first_chunk(run, method, n - 1)
-    if run.events is not None:
-        run.events.log = []            # of this method (auto may try another after it)
+    if run.events is not None and run.events.located:
         chunk = min(chunk, EVENT_CHUNK)
     k, failure = 0, None
     restart_at = None                   # with events: where the last one left the run
@@ -311,10 +337,12 @@ def _integrate(run, method):
             chunk = n - 1 - k
         elif not method.stepper:
             chunk = _next_chunk(run, m, _work(run, stepper.stats) - work_before, n - 1 - k)
-            chunk = chunk if run.events is None else min(chunk, EVENT_CHUNK)
+            if run.events is not None and run.events.located:
+                chunk = run.events.chunk(chunk, restart_at is not None)
             chunk = parts.limit(chunk)
-        elif run.events is not None:
-            chunk = 1
+        elif run.events is not None and run.events.located:
+            # a stepper goes on between chunks: they bound what an event makes it do again
+            chunk = run.events.chunk(n - 1 - k, restart_at is not None)
     if failure is not None and run.system.f_dependent is not None and \
             run.stop_reason() is None and "singular" not in failure:
         failure += near_singular(run, np.array(X), grid)
@@ -446,6 +474,8 @@ def _restart(run, method, X, restarts, failure):
     """With ``restart=True``: start ``method`` afresh from the last state, if it is sound and
     the restarted run continues it without a jump. Returns whether the run goes on."""
     if not run.restart or len(restarts) >= MAX_RESTARTS or len(X) < 2 or len(X) >= len(run.grid):
+        return False
+    if run.events is not None:      # its trial interval would not look for them
         return False
     system, last, before = run.system, X[-1], X[-2]
     if not np.all(np.isfinite(last)) or \

@@ -7,6 +7,10 @@ tolerance proportional to the global error (``tolerance.py``), the first repetit
 TIGHTER times more accurate than the run, so their difference is the run's error to within
 about 1 / TIGHTER: that difference, the largest over the run, is the estimate of each signal.
 
+The repetitions step at most the output spacing (and 1 / STEPS_SEEN of the run): a run
+whose steps passed over an input that nothing announced (a pulse in ``noEvent``, a smooth
+bump between two steps) differs from them by what it missed, so its estimate is never 0.
+
 The second repetition checks the first. Where the two repetitions differ by more than
 1 / MARGIN of what the run and the first repetition differ by (and by a visible part of the
 motion, SATURATED^2 of its range), the first one is no longer much more accurate than the run,
@@ -35,6 +39,9 @@ SMALL = 0.1
 #: an error this large a fraction of the signal's range over the run has saturated (the run
 #: and its repetitions have parted ways): from there the estimate is only a lower bound
 SATURATED = 0.1
+#: the repetitions of a variable-step run take at least this many steps over it (and step
+#: at most the output spacing): they see what the run's own steps may have passed over
+STEPS_SEEN = 1000
 
 
 def attach(results, again):
@@ -52,8 +59,12 @@ def attach(results, again):
         h = float(settings.get("step") or (results.t[1] - results.t[0]))
         runs = [{"step": h / 2}, {"step": h / 4}]
     else:
-        runs = [{"rtol": settings["rtol"] / TIGHTER ** k, "atol": settings["atol"] / TIGHTER ** k}
-                for k in (1, 2)]
+        t = results.t
+        bound = min(float(t[1] - t[0]) if len(t) > 1 else np.inf,
+                    (settings["t_end"] - settings["t_start"]) / STEPS_SEEN,
+                    settings.get("max_step") or np.inf)
+        runs = [{"rtol": settings["rtol"] / TIGHTER ** k, "atol": settings["atol"] / TIGHTER ** k,
+                 "max_step": bound} for k in (1, 2)]
     tighter = _tighter(results, runs)
     if not tighter[0]:
         note = ("no estimate: the solver's tolerance is at its smallest already "

@@ -164,8 +164,9 @@ class Partitions:
         self.run, self.base = run, base
         self.loops = base.eq.loops if base.f_dependent is not None else None
         # (not with friction or stops: their events restart the method on their own)
+        events = getattr(run, "events", None)
         self.enabled = getattr(run, "repartition", True) and self.loops is not None and \
-            getattr(run, "events", None) is None
+            (events is None or events.modes is None)
         self.segments = [(0, base)]         # (first row, System), in the order met
         self.events = []                    # times of the re-partitions
         self.c0 = None                      # condition number where the partition began
@@ -176,13 +177,16 @@ class Partitions:
         self._use(base)
         run.partitions = self
 
-    def _use(self, system):
+    def _use(self, system, t=None, x=None):
         # compiled to C is the model's own partition only: the others, met for a while, run
         # in CasADi's virtual machine rather than wait for the C compiler
         run = self.run
         run.jit = self.jit if system is self.base else None
+        changed = run.system is not system
         run.system, run.compiled = system, compiled(system)
         run.instructions = (system.f_rhs or system.f_dae).n_instructions()
+        if changed and t is not None and getattr(run, "events", None) is not None:
+            run.events.rebind(t, x)          # its relations, read at the switch
 
     # -- where ------------------------------------------------------------------------------
     def watch(self, X, new, failure):
@@ -311,13 +315,13 @@ class Partitions:
         old, t = run.system, float(run.grid[k])
         new = self.system(formulation, rows, dep)
         row = new.polish(convert(old, new, [t], np.asarray(X[-1])[None, :], run.p), run.p)[0]
-        self._use(new)
+        self._use(new, t, row)
         steps = run.steps_per_interval
         run.steps_per_interval = max(self.steps, CROSSING_STEPS) if crossing else self.steps
         try:
             stepper = (METHODS["rk"] if crossing else method).start(run, t, row)
         except Failure:
-            self._use(old)
+            self._use(old, t, X[-1])
             run.steps_per_interval = steps
             return None
         X.replace_last(row)

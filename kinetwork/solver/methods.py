@@ -37,19 +37,51 @@ class Interrupted(Exception):
 
 
 class Method:
-    """One integration method.
+    """One integration method: what it can do, declared, and ``start``.
 
-    ``fixed`` methods take a step size instead of tolerances; ``newton`` methods iterate with
-    the Jacobian (compiled with the right-hand side under JIT); ``dae`` methods take the
-    algebraic variables of loops; ``stepper`` methods are advanced step by step in Python
-    (the driver reads the clock and the cancel flag at every step); ``interruptible`` ones
-    can be aborted by a signal within an ``advance`` (the driver then gives them long ones).
+    What a method can do is declared by class attributes, which the driver and the events
+    read (never the method's type or its other attributes):
+
+    ``fixed``
+        It takes a step size (``Run.step``, at most ``max_step``) instead of tolerances.
+    ``newton``
+        It iterates with the Jacobian (compiled with the right-hand side under JIT).
+    ``dae``
+        It takes the algebraic variables of loops.
+    ``stepper``
+        It is advanced step by step in Python (the driver reads the clock and the cancel
+        flag at every step).
+    ``interruptible``
+        A signal can abort it within an ``advance`` (the driver then gives it long ones).
+    ``events``
+        The events it takes: "time" (it stops exactly at the instants ``Run.bound`` gives,
+        never stepping past one, and lands on them with fixed steps) and "state" (its
+        states at any trial time can be had, so state events are located on its own
+        integration). A model with events of a kind a method does not take is refused.
+    ``trial_states``
+        Its runs have ``state_at(t)``: the state at any time after the start without
+        advancing, from one integration for every trial time (else a trial time is a new
+        run advanced there).
+
+    ``start(run, t, x)`` returns a run of the method from the full state x at t, with the
+    equations the integrators see (``compiled.Held``, parameters ``run.p_solver``, held at
+    the values they have when it starts), never stepping past ``run.bound(t)``. A run has
+
+    - ``advance(times, exact=False)``: the full states at ``times`` (increasing, after the
+      last time reached), continuing from there. ``exact``: the times are not to be
+      rounded onto the output grid. It raises ``Failure`` holding the rows it reached.
+    - ``stats``: a dict of its counts so far: ``steps`` always; ``rhs_evaluations`` and
+      ``jacobian_evaluations`` where the solver counts them; a fixed-step method also
+      ``step``, its step size. Counters are summed over the runs a run is made of (restarts
+      after events), anything else taken from the last.
     """
     fixed = False
     newton = False
     dae = False
     stepper = False
     interruptible = False
+    events = ("time", "state")
+    trial_states = False
 
     def __init__(self, doc):
         self.doc = doc
@@ -116,6 +148,7 @@ class Casadi(Method):
     """A CasADi integrator plugin: each ``advance`` runs in compiled code, which checks
     Python's signals at every evaluation of the equations."""
     interruptible = True
+    trial_states = True
 
     def __init__(self, plugin, doc, newton=False, fixed=False, dae=False, **options):
         super().__init__(doc)
@@ -131,6 +164,7 @@ class _CasadiRun:
     def __init__(self, method, run, t, x):
         self.method, self.run = method, run
         self.t, self.x = float(t), np.asarray(x, dtype=float)
+        self.p = np.array(run.p_solver, dtype=float)     # the values held from here on
         self.stats = {"steps": 0}
         if method.sundials:
             self.stats.update(rhs_evaluations=0, jacobian_evaluations=0)
@@ -143,6 +177,8 @@ class _CasadiRun:
                             solver_tolerances(m, run.system, run.rtol, run.atol)))
             if run.max_steps:
                 opts["max_num_steps"] = int(run.max_steps)
+            if run.max_step:
+                opts["max_step_size"] = float(run.max_step)
         else:       # fixed steps: counted over the chunk; a blow-up is reported once, below
             opts["show_eval_warnings"] = False
             opts["number_of_finite_elements"] = run.steps_per_interval * len(times)
@@ -176,6 +212,11 @@ class _CasadiRun:
     def advance(self, times, exact=False):
         m, run = self.method, self.run
         nx = run.system.n_states
+        if exact and len(times) == 1 and m.plugin != "idas":
+            # one time off the grid (the next time event): by the integrator of any stretch
+            x = self.state_at(float(times[0]))
+            self.t, self.x = float(times[0]), x
+            return x[None, :]
         opts = self.options(times)
         if m.plugin == "idas":
             # the consistent initial rate is f(t0, x0) (loops: z0 is consistent already):
@@ -193,7 +234,7 @@ class _CasadiRun:
         # interface): a failed or aborted call keeps the rows it reached, and no DM is
         # converted (50 ms for the 256 x 1001 states of a 128-link chain)
         x0, z0 = np.ascontiguousarray(self.x[:nx]), np.ascontiguousarray(self.x[nx:])
-        p = np.append(run.p, self.t)
+        p = np.append(self.p, self.t)
         xf, zf = np.full((len(times), nx), np.nan), np.full((len(times), len(self.x) - nx), np.nan)
         buffer, evaluate = integ.buffer()
         for name, value in (("x0", x0), ("z0", z0), ("p", p)):
@@ -241,7 +282,11 @@ class _CasadiRun:
         event is looked for at (an integrator for each costs ~10 ms of CasADi's set-up)."""
         m, run = self.method, self.run
         if m.plugin == "idas":          # its options hold the state's rate: not reusable
-            return self.advance(np.array([t]), exact=True)[0]
+            fresh = _CasadiRun(m, run, self.t, self.x)      # from the start, every time
+            fresh.p = self.p
+            x = fresh.advance(np.array([t]), exact=True)[0]
+            _add_counts(self.stats, fresh.stats)
+            return x
         nx = run.system.n_states
         opts = self.options([t])
         key = ("stretch", m.plugin, tuple(sorted(opts.items())), bool(run.jit))
@@ -250,14 +295,35 @@ class _CasadiRun:
         try:
             with run.solver_section(self.t):
                 out = integ(x0=self.x[:nx], z0=self.x[nx:],
-                            p=np.concatenate([run.p, [self.t, t - self.t]]))
+                            p=np.concatenate([self.p, [self.t, t - self.t]]))
         except RuntimeError as exc:
             run.said.append(shift_times(solver_words(str(exc)), self.t))
             raise Failure(solver_reason(str(exc))) from None
+        self._count_call(integ)
         x = np.concatenate([np.asarray(out["xf"]).ravel(), np.asarray(out["zf"]).ravel()])
         if not np.all(np.isfinite(x)):
             raise Failure("the state became non-finite (Inf or NaN)")
         return x
+
+
+    def _count_call(self, integ):
+        """Steps and evaluations of the plain call of ``integ`` just made."""
+        if self.method.sundials:
+            with contextlib.suppress(RuntimeError, KeyError):
+                st = integ.stats()
+                self.stats["steps"] += int(st["nsteps"])
+                self.stats["rhs_evaluations"] += int(st["nfevals"])
+                self.stats["jacobian_evaluations"] += int(st["n_call_jacF"])
+        else:
+            self.stats["steps"] += self.run.steps_per_interval
+            self.stats["step"] = self.run.spacing / self.run.steps_per_interval
+
+
+def _add_counts(total, more):
+    """The counters of ``more`` added into ``total``."""
+    for key, value in more.items():
+        if isinstance(value, int) and not isinstance(value, bool):
+            total[key] = total.get(key, 0) + value
 
 
 def _finite_rows(X):
@@ -279,12 +345,14 @@ class Scipy(Method):
     def start(self, run, t, x):
         import scipy.integrate                 # 0.4 s to import: only when asked for
         system = run.system
-        kwargs = {"jac": numeric(run.compiled.jacobian(run.jit), run.p, system.n_states)} \
-            if self.newton else {}
-        fun = numeric(run.compiled.rhs(run.jit), run.p, system.n_states)
+        kwargs = {"jac": numeric(run.compiled.jacobian(run.jit), run.p_solver,
+                                 system.n_states)} if self.newton else {}
+        if run.max_step:
+            kwargs["max_step"] = run.max_step
+        fun = numeric(run.compiled.rhs(run.jit), run.p_solver, system.n_states)
         with np.errstate(all="ignore"):
             solver = getattr(scipy.integrate, self.name)(
-                fun, t, x, run.t_end, rtol=run.rtol, atol=run.atol, **kwargs)
+                fun, t, x, run.bound(t), rtol=run.rtol, atol=run.atol, **kwargs)
         return _ScipyRun(solver, run)
 
 
@@ -310,6 +378,13 @@ class _ScipyRun:
                     dense = solver.dense_output()
                     while len(out) < len(times) and times[len(out)] <= solver.t:
                         out.append(dense(times[len(out)]))
+                    continue
+                if solver.status == "finished":     # at its bound: the time asked is it
+                    if times[len(out)] - solver.t > 1e-13 * max(1.0, abs(solver.t)):
+                        raise Failure(f"asked for t = {times[len(out)]:.17g} s, past the time "
+                                      f"event at {solver.t:.17g} s the method stops at",
+                                      np.array(out).reshape(-1, len(solver.y)))
+                    out.append(np.array(solver.y))
                     continue
                 message = solver.step()
                 in_interval, self.steps = in_interval + 1, self.steps + 1
@@ -338,16 +413,14 @@ class _ScipyRun:
 
 # -- the midpoint rule ------------------------------------------------------------------------
 class MidpointRule(Method):
-    """The implicit midpoint rule in canonical coordinates (``midpoint.py``)."""
+    """The implicit midpoint rule in canonical coordinates (``midpoint.py``). It evaluates
+    the equations at the middle of each step only, so it lands on time events with the
+    equations as they are (no value held), and locates no state event."""
     fixed = True
     newton = True
+    events = ("time",)
 
     def check(self, system):
-        if system.modes is not None:
-            raise ModelError("method 'midpoint' integrates a conservative tree with fixed "
-                             "steps, and this model has friction or stops, whose events it "
-                             "cannot locate: use 'auto', a CVODES, IDAS or scipy method, 'rk' "
-                             "or 'collocation'")
         if system.asm.prescribed:
             raise ModelError("method 'midpoint' integrates a conservative tree in canonical "
                              "coordinates; this model has joints whose motion is prescribed "
@@ -357,6 +430,14 @@ class MidpointRule(Method):
             raise ModelError("method 'midpoint' works in canonical coordinates of a tree of "
                              "angles and distances; this model has kinematic loops or a "
                              "quaternion joint (Spherical, FreeMotion): use 'auto' or 'idas'")
+        tree = [*system.coordinate_names, *system.speed_names]
+        if list(system.state_names) != tree:
+            others = [n for n in system.state_names if n not in tree]
+            raise ModelError(f"method 'midpoint' integrates the joint coordinates and speeds "
+                             f"of a multibody tree; this model has other states too "
+                             f"({', '.join(others[:4])}{', ...' if len(others) > 4 else ''}: "
+                             f"1-D masses and rotors, filters, signal blocks): use 'auto', "
+                             f"'rk' or 'collocation'")
 
     def start(self, run, t, x):
         from .midpoint import Midpoint
@@ -478,11 +559,11 @@ def choose(run, keep=True):
     why = {"stiff": False, "damped": system.damped}
     if system.damped:
         def test():
-            rhs = numeric(run.compiled.rhs(run.jit), run.p, system.n_states)
+            rhs = numeric(run.compiled.rhs(run.jit), run.p_solver, system.n_states)
             return stiffness(rhs, run.t_start, run.t_end, run.x0)
         # once per start, horizon and parameter values: a model run again asks the same
         key = ("stiffness", float(run.t_start), float(run.t_end),
-               np.asarray(run.x0, float).tobytes(), np.asarray(run.p, float).tobytes())
+               np.asarray(run.x0, float).tobytes(), np.asarray(run.p_solver, float).tobytes())
         stiff, sigma, omega = run.compiled.memo(key, test) if keep else test()
         why.update(stiff=bool(stiff), decay_rate=sigma, motion_rate=omega)
     return (["cvodes"] if why["stiff"] else ["cvodes-adams", "cvodes"]), why

@@ -69,8 +69,8 @@ class Plan:
         The output times (increasing, from ``t_start``) instead of ``n_points`` equal
         intervals up to ``t_end``.
     **settings
-        ``t_end``, ``n_points``, ``method``, ``rtol``, ``atol``, ``step`` (not given: the
-        model's ``simulation`` block, then ``DEFAULTS``), and ``t_start``, ``jit``,
+        ``t_end``, ``n_points``, ``method``, ``rtol``, ``atol``, ``step``, ``max_step`` (not
+        given: the model's ``simulation`` block, then ``DEFAULTS``), and ``t_start``, ``jit``,
         ``max_steps``, ``time_limit``, ``restart``, ``repartition`` as ``kn.simulate`` takes
         them.
     """
@@ -170,7 +170,8 @@ class Plan:
         run = Run(self.system, p, x0, self.grid, self.settings, None, cancel, progress,
                   self.restart)
         run.repartition = self.repartition
-        if self.system.modes is not None:
+        if self.system.modes is not None or self.system.relations is not None:
+            # modes consistent with the start, relations' values there, before any method
             run.events = Events(run)
             run.x0 = run.events.start(float(self.grid[0]), run.x0)
         return run
@@ -211,6 +212,7 @@ class Plan:
             stats["solver_output"] = "".join(run.said)
         if run.events is not None:
             stats["events"] = run.events.log
+            stats["time_events"] = run.events.time_events
         stats["jit"] = bool(run.jit) and not stats.get("jit_fallback")
         results = self.results(run, X, p, stats, key, params)
         if failure is not None:
@@ -246,7 +248,8 @@ class Plan:
                        settings={"t_start": self.t_start, "t_end": settings["t_end"],
                                  "n_points": settings["n_points"], "method": key,
                                  "rtol": settings["rtol"], "atol": settings["atol"],
-                                 "step": settings["step"], "jit": stats.get("jit", False),
+                                 "step": settings["step"], "max_step": settings["max_step"],
+                                 "jit": stats.get("jit", False),
                                  "max_steps": settings["max_steps"],
                                  "time_limit": settings["time_limit"],
                                  "restart": self.restart, "params": dict(params or {})},
@@ -302,7 +305,8 @@ class Plan:
 def simulate(model: Model | System, t_end: float | None = None, n_points: int | None = None,
              method: str | None = None, rtol: float | None = None, atol: float | None = None,
              params: Mapping[str, float | str] | None = None, t_start: float = 0.0,
-             step: float | None = None, jit: bool | None = None, max_steps: int | None = None,
+             step: float | None = None, max_step: float | None = None,
+             jit: bool | None = None, max_steps: int | None = None,
              time_limit: float | None = None, progress: Callable[[float], object] | None = None,
              cancel: Callable[[], object] | None = None, restart: bool = False,
              repartition: bool = True, error_estimate: bool = False) -> Results:
@@ -329,6 +333,10 @@ def simulate(model: Model | System, t_end: float | None = None, n_points: int | 
     step : float, optional
         Largest step [s] of the fixed-step methods (``rk``, ``collocation``, ``midpoint``);
         default: the output spacing.
+    max_step : float, optional
+        Largest step [s] of every method: the variable-step ones never step further (an
+        input that no relation announces, a smooth pulse, cannot be stepped over), and a
+        fixed step is at most this long.
     params : dict, optional
         Parameter values for this run, numbers (SI) or numbers with a unit
         (``{"c": "2 N*m/rad"}``, see ``Model.parameter_values``): model parameters (no
@@ -354,7 +362,8 @@ def simulate(model: Model | System, t_end: float | None = None, n_points: int | 
         After a solver failure, start the method afresh from the last state reached (at most
         MAX_RESTARTS times), if that state is sound: finite, the loops closed, and the
         restarted run continuing it without a jump. Each restart is in ``stats["restarts"]``.
-        Off by default: a failure is a SimulationError.
+        Off by default: a failure is a SimulationError. Not with events (friction, stops,
+        relations).
     repartition : bool, optional
         With kinematic loops: where the partition of the speeds into independent and
         dependent ones nears a singular configuration (a dead point of the independent
@@ -380,7 +389,7 @@ def simulate(model: Model | System, t_end: float | None = None, n_points: int | 
         ``err.t_reached``.
     """
     plan = Plan(model, names=list(params or ()), t_end=t_end, n_points=n_points, method=method,
-                rtol=rtol, atol=atol, step=step, t_start=t_start, jit=jit,
+                rtol=rtol, atol=atol, step=step, max_step=max_step, t_start=t_start, jit=jit,
                 max_steps=max_steps, time_limit=time_limit, restart=restart,
                 repartition=repartition)
     return plan.run(params, cancel=cancel, progress=progress, error_estimate=error_estimate)

@@ -21,7 +21,8 @@ from .results import encode
 log = logging.getLogger("kinetwork.studio")
 
 #: what a run's ``settings`` may hold: simulate's arguments of the same names
-SETTINGS = ("t_end", "n_points", "method", "rtol", "atol", "step", "max_steps", "time_limit")
+SETTINGS = ("t_end", "n_points", "method", "rtol", "atol", "step", "max_step", "max_steps",
+            "time_limit")
 #: finished runs kept for polling, and runs going at once (each takes a core)
 KEEP, MAX_RUNNING = 8, 4
 

@@ -415,7 +415,8 @@ def test_gravity_type_round_trips_and_is_checked(tmp_path):
     assert params == {"gravity_type": "point", "mue": 4e14}
     assert kn.load(tmp_path / "m.json").components["ground"].gravity_type == "point"
     with pytest.raises(kn.ModelError, match=r"ground\.gravity_type: must be one of uniform, "
-                                            r"point, got 'pont' \(did you mean 'point'\?\)"):
+                                            r"point, expression, got 'pont' \(did you mean "
+                                            r"'point'\?\)"):
         mb.Ground("ground", gravity_type="pont")
     with pytest.raises(kn.ModelError, match=r"ground\.mue = -1 m\^3/s\^2: must be >= 0"):
         mb.Ground("ground", mue=-1)

@@ -230,3 +230,20 @@ def test_the_five_revolute_loop_runs_through_its_folds():
     assert np.max(np.abs(wrap(ref[early, 0] - th1[early]))) < 5e-5   # IDAS at 1e-8
     assert np.max(np.abs(wrap(ref[:, 0] - th1))) < 1e-3
     assert np.max(np.abs(wrap(ref[:, 1] - th2))) < 1e-3
+
+
+def test_a_loop_with_time_events_re_partitions_with_its_relations():
+    # a torque of 1e-12 N m from 1.2 to 1.25 s (after the first dead point): two time events
+    # met by a re-partitioned System, whose relations the run reads again at the switch
+    m = triple_rocker()
+    m.add(kn.rotational.Torque("kick", tau="if_else(t < 1.2, 0, if_else(t < 1.25, 1e-12, 0))"))
+    m.connect("kick.flange", "A.axis")
+    res = kn.simulate(m, t_end=1.5, n_points=151, rtol=1e-10, atol=1e-10, jit=False)
+    assert res.stats["repartitions"] >= 2 and res.stats["time_events"] == 2
+    assert res.stats["repartition_times"][0] < 1.2
+    crank = res["pA.angle"]
+    th = np.column_stack([crank, crank + res["pB.angle"], res["pD.angle"]])
+    ref = rocker_reference(np.concatenate([th[0], [res["pA.speed"][0],
+                                                   res["pA.speed"][0] + res["pB.speed"][0],
+                                                   res["pD.speed"][0]]]), res.t)
+    assert np.max(np.abs(wrap(ref[:, :3] - th))) < 1e-6

@@ -1,0 +1,160 @@
+"""The relations of a run (``kinetwork.equations.relations``) as events: the values they are
+held at, where those change, and what a change does.
+
+The integrators see the equations with every relation held at a value r (``run.p_solver`` =
+[p; r]). Between time events the nodes on time alone are held at the values they take in
+that stretch of time (read at its middle); the relations on the states are held at the values
+they have where the stretch began. A time event (``schedule.Schedule``) ends a stretch
+exactly at its instant; a state event is where a relation on the states no longer holds the
+value it is held at: its indicator, oriented so that it is positive while the value holds,
+crosses zero (``events.Events`` locates it). At either, the relations are read again there,
+each with the others held, until none changes (Modelica's event iteration), the one whose
+indicator crossed taking its other value; the method starts afresh with the new values. The
+state itself does not jump.
+"""
+
+import numpy as np
+
+from ..equations.system import mapped
+from .compiled import numeric
+from .methods import Failure
+from .schedule import Schedule
+
+#: rounds of the event iteration at most (each relation read with the others held)
+MAX_ITERATIONS = 50
+
+
+class Switches:
+    """The relations of one run as one source of events of ``events.Events``."""
+
+    def __init__(self, events, run, relations):
+        self.events, self.run, self.relations = events, run, relations
+        self.nx = run.system.n_states
+        self.schedule = Schedule(relations, run.p, run.t_start, run.t_end)
+        self.r = np.zeros(relations.n)
+        self.time_events = 0
+        self._calls = {}
+
+    # -- numbers ---------------------------------------------------------------------------
+    def _numeric(self, name):
+        """The Function ``name`` of the relations as a fast callable of (t, full state) at the
+        values held now (made again when they change)."""
+        key = (name, self.r.tobytes())
+        if self._calls.get(name, (None,))[0] != key:
+            f = getattr(self.relations, name)
+            self._calls[name] = (key, numeric(f, np.concatenate([self.run.p, self.r]),
+                                              f.size1_in(1)))
+        return self._calls[name][1]
+
+    def select(self, t, x):
+        """The value each node takes at (t, x), the others held at r."""
+        return self._numeric("f_select")(t, x).ravel()
+
+    def indicators(self, t, x):
+        """(indicator, its rate) of each relation on the states at (t, x): positive while the
+        value it is held at is the one it has."""
+        if not len(self.relations.state):
+            return np.zeros(0), np.zeros(0)
+        table = self._numeric("f_state")(t, x).reshape(-1, 2)
+        g, rate = table[:, 0], table[:, 1]
+        held = self.r[self.relations.state] > 0.5
+        sign = np.where(held, 1.0, -1.0)
+        # held true, a relation ends where g reaches zero (< : g <= 0; <= : g < 0); held
+        # false, where g rises above zero (<: g > 0; <=: g >= 0): all crossings of zero
+        return sign * g, sign * rate
+
+    @property
+    def count(self):
+        """How many indicators: one per relation on the states."""
+        return len(self.relations.state)
+
+    def indicator_rows(self, times, rows):
+        """``indicators`` at each of ``rows`` (at ``times``): two (len(rows), k) arrays."""
+        k = len(self.relations.state)
+        if not k or not len(rows):
+            return np.zeros((len(rows), k)), np.zeros((len(rows), k))
+        f = self.relations.f_state
+        pr = np.concatenate([self.run.p, self.r])
+        table = np.asarray(mapped(f, len(rows))(np.asarray(times, dtype=float)[None, :],
+                                                np.asarray(rows, dtype=float).T, pr))
+        g, rate = table[:, 0::2], table[:, 1::2]       # (k, n) each: columns per row
+        sign = np.where(self.r[self.relations.state] > 0.5, 1.0, -1.0)[None, :]
+        return sign * g.T, sign * rate.T
+
+    def chatter(self, i):
+        """Why events of relation i pile up at one instant, in words."""
+        return (f"the relation {self.relations.text(self.relations.state[i])} chatters: the "
+                f"motion crosses it back at once each time (a Coulomb law written as if_else "
+                f"on a speed, at rest); use a friction element, which sticks, or write the "
+                f"relation in noEvent(...) to integrate it as it is")
+
+    # -- the held values -------------------------------------------------------------------
+    def start(self, t, x):
+        """The values at the start: the time nodes' over the first stretch, the relations'
+        on the states where the run starts."""
+        self._hold_time(t)
+        self._iterate(t, x, None)
+        self._publish()
+        return x
+
+    def bound(self, t):
+        """The first time event after t, or the run's end."""
+        nxt = self.schedule.next(t)
+        return self.run.t_end if nxt is None else nxt
+
+    def next_time(self, t):
+        return self.schedule.next(t)
+
+    def at_time(self, t, x):
+        """At the time event t: the values of the stretch that begins there."""
+        self.time_events += 1
+        self._hold_time(t)
+        self._iterate(t, x, None)
+        self._publish()
+        return x
+
+    def apply(self, t, x, i):
+        """The state relation i (of ``relations.state``) crossed at (t, x): its other value,
+        the others read again there; logged."""
+        k = self.relations.state[i]
+        self.r[k] = 1.0 - self.r[k]
+        self._iterate(t, x, k)
+        self._publish()
+        self.events.log.append({"t": float(t), "component": None,
+                                "kind": "relation true" if self.r[k] > 0.5 else
+                                "relation false", "relation": self.relations.text(k)})
+        return np.asarray(x, dtype=float)
+
+    def _hold_time(self, t):
+        """The time nodes held at their values in the stretch after t (read at its middle,
+        nested ones read again until they agree)."""
+        time = self.relations.time
+        if not len(time):
+            return
+        mid = (t + self.bound(t)) / 2
+        x = np.zeros(self.nx + self.run.system.n_algebraic)
+        for _ in range(len(time) + 1):
+            new = self.select(mid, x)[time]
+            if np.array_equal(new, self.r[time]):
+                return
+            self.r[time] = new
+
+    def _iterate(self, t, x, fixed):
+        """The relations on the states read at (t, x) with the others held, until none
+        changes; ``fixed``: the one that crossed, whose new value stands."""
+        state = self.relations.state
+        if not len(state):
+            return
+        for _ in range(MAX_ITERATIONS):
+            new = self.select(t, x)[state]
+            if fixed is not None:
+                new[list(state).index(fixed)] = self.r[fixed]
+            if np.array_equal(new, self.r[state]):
+                return
+            self.r[state] = new
+        raise Failure(f"the relations do not settle at t = {t:.15g} s (their values change "
+                      f"each other's without end)")
+
+    def _publish(self):
+        """The integrators' parameters with the values now held."""
+        self.run.p_solver = np.concatenate([self.run.p, self.r])
