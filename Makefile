@@ -27,10 +27,13 @@ demo: $(VENV)/.core
 	$(VENV)/bin/kinetwork run models/double_pendulum.json --out $(OUT)/double_pendulum.csv --plot $(OUT)/double_pendulum.png
 	@echo "probe plots written to $(OUT)/"
 
-# two workers (pytest-xdist), each taking whole test files so module fixtures are built once;
-# the browser tests need Debian's Chromium, installed here where it is missing (as root)
+# the front end first: its packages from the lockfile, ESLint (with React's rules of hooks)
+# and the type check, then its unit tests (Vitest); then two pytest workers (pytest-xdist),
+# each taking whole test files so module fixtures are built once; the browser tests need
+# Debian's Chromium, installed here where it is missing (as root)
 test: $(VENV)/.installed
 	@.ci/chromium
+	cd frontend && npm ci --no-audit --no-fund && npm run lint && npm test
 	$(PY) -m pytest -q -n 2 --dist loadfile
 
 # the documentation site in site/, every warning an error (its code blocks run in make test)

@@ -175,6 +175,23 @@ def dumps(model: Model, folder: str | os.PathLike | None = None) -> str:
     return _render(model_to_dict(model, folder), 0) + "\n"
 
 
+def render_json(data: dict) -> str:
+    """A file's top-level object as text in the layout of :func:`dumps`, without reading it as
+    a model: what an editor writes of work the reader would refuse (a required value still
+    empty). Only plain, finite JSON is written.
+
+    Raises
+    ------
+    ModelError
+        A value that is not plain, finite JSON, with its place.
+    """
+    problems = []
+    _plain(data, "", problems)
+    if problems:
+        raise ModelError(problems)
+    return _render(data, 0) + "\n"
+
+
 def save(model: Model, path: str | os.PathLike, overwrite: bool = False) -> None:
     """Write ``model`` to ``path`` under the output policy (``kinetwork.outputs``): atomically
     (a failed save leaves the old file whole), never over a file the model was read from

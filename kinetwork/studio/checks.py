@@ -15,7 +15,7 @@ import os
 import numpy as np
 
 from ..components.base import REGISTRY
-from ..errors import ModelError, KinetworkWarning, Problem
+from ..errors import ModelError, Problem
 from ..graph.io import Context, model_from_dict
 
 log = logging.getLogger("kinetwork.studio")
@@ -25,6 +25,8 @@ LIBRARY_ORDER = ("multibody", "rotational", "translational", "signals", "electri
 #: a model is compiled to list its states only up to this many flat components: the
 #: symbolic build takes about 50 ms for the seed and grows with the model
 COMPILE_LIMIT = 400
+#: problems sent to the page at most (a model of a million broken parts lists the first)
+MAX_PROBLEMS = 200
 GRID_COLUMNS, GRID_DX, GRID_DY = 4, 220, 140
 
 
@@ -90,54 +92,81 @@ def build(data, ctx, validate):
 
 
 def validate(data, ctx):
-    """``{"ok", "problems", "warnings", "summary"}`` of a model file's top-level object.
+    """``{"ok", "problems", "warnings", "summary"}`` of a model file's top-level object:
+    :func:`check`, then :func:`summarize` when the check passes. What the checks warn about
+    (an idealised inertia) is in ``warnings``: problems of severity "warning"."""
+    answer = check(data, ctx)
+    if answer.pop("compile"):
+        more = summarize(data, ctx)
+        if more.get("problems"):
+            return {**answer, "ok": False, "problems": more["problems"], "warnings": []}
+        answer["summary"].update(more["summary"])
+        answer["warnings"] = more["warnings"]
+    return answer
 
-    The model is checked as ``kn.load`` checks it; then compiled (up to COMPILE_LIMIT flat
-    components) to count its degrees of freedom and name its states, so what would refuse
-    to run (a mass matrix singular at the start) is a problem here too. What the checks warn
-    about (an idealised inertia) is in ``warnings``: problems of severity "warning".
-    """
+
+def check(data, ctx):
+    """The checks of ``kn.load`` on a model file's top-level object: ``{"ok", "problems",
+    "warnings", "summary": {"dof", "states", "components"}, "compile"}``, ``compile`` saying
+    whether :func:`summarize` has more to tell (a sound model that is not a definition)."""
     components = data.get("components")
     summary = {"dof": None, "states": None,
                "components": len(components) if isinstance(components, list) else 0}
-    refused = {"ok": False, "warnings": [], "summary": summary}
     try:
         model = build(data, ctx, validate=True)
     except ModelError as exc:
-        return {**refused, "problems": problems_of(exc)}
+        return {"ok": False, "problems": problems_of(exc), "warnings": [],
+                "summary": summary, "compile": False}
     summary["components"] = len(model.components)
-    if model.exposed:      # a definition: wired where it is placed, nothing to count alone
-        return {"ok": True, "problems": [], "warnings": [], "summary": summary}
+    # a definition is wired where it is placed: nothing to count alone
+    return {"ok": True, "problems": [], "warnings": [], "summary": summary,
+            "compile": not model.exposed}
+
+
+def summarize(data, ctx):
+    """What compiling a sound model tells (up to COMPILE_LIMIT flat components): its degrees
+    of freedom and states and what it is accepted with, ``{"summary": {"dof", "states"},
+    "warnings": [...]}``, or ``{"problems": [...]}`` for what would refuse to run (a mass
+    matrix singular at the start)."""
+    out = {"dof": None, "states": None}
     try:
+        model = build(data, ctx, validate=True)
         flat = model.flat()
         topo = flat.validate()
         if len(flat.components) <= COMPILE_LIMIT:
             system = model.compile()
-            summary["dof"], summary["states"] = int(system.dof), list(system.state_names)
+            out["dof"], out["states"] = int(system.dof), list(system.state_names)
         elif not topo.loops:
             free = sum(1 for group in topo.oned if group.kind == "free")
-            summary["dof"] = int(topo.dof + free)
+            out["dof"] = int(topo.dof + free)
     except ModelError as exc:
-        return {**refused, "problems": problems_of(exc)}
-    return {"ok": True, "problems": [], "warnings": [problem(p) for p in topo.warnings],
-            "summary": summary}
+        return {"problems": problems_of(exc)}
+    return {"summary": out, "warnings": [problem(p) for p in topo.warnings[:MAX_PROBLEMS]]}
 
 
 def problems_of(exc):
-    """The problems of a ModelError as the page reads them (``problem``)."""
-    return [problem(p) for p in exc.problems]
+    """The problems of a ModelError as the page reads them (:func:`problem`), the first
+    MAX_PROBLEMS of them and a last one saying how many more there are."""
+    listed = [problem(p) for p in exc.problems[:MAX_PROBLEMS]]
+    if len(exc.problems) > MAX_PROBLEMS:
+        listed.append(problem(f"... and {len(exc.problems) - MAX_PROBLEMS:,} more problems "
+                              f"(the first {MAX_PROBLEMS} are listed)"))
+    return listed
 
 
 def problem(record):
-    """A ``Problem`` as JSON: ``{"message", "component", "port", "parameter", "path", "hint",
-    "severity"}`` (API.md), and the keys the page read before those fields: ``param`` (the
-    parameter of a component of the file itself) and ``connection`` (the index of the wire
-    ``path`` is on)."""
+    """A ``Problem`` as JSON (API.md): ``{"message", "component", "port", "parameter",
+    "path", "hint", "severity"}``; ``reason``, what is wrong without the place, for the page
+    to say it in the user's words (``mass1.mass: must be >= 0 (got -1 kg)``); and the keys
+    the page read before those fields: ``param`` (the parameter of a component of the file
+    itself) and ``connection`` (the index of the wire ``path`` is on). The place is read
+    from the fields only; a plain string is a problem with no place."""
     out = Problem.of(record).to_dict()
     path = out["path"] or ""
-    own = path.startswith("components[")
-    out["param"] = out["parameter"] if own else None
+    out["param"] = out["parameter"] if path.startswith("components[") else None
     out["connection"] = _index(path, "connections[")
+    rest = _after_place(out)
+    out["reason"] = None if rest is None else _reason(rest)
     return out
 
 
@@ -147,6 +176,41 @@ def _index(path, head):
         return None
     digits = path[len(head):].partition("]")[0]
     return int(digits) if digits.isdigit() else None
+
+
+def _after_place(out):
+    """The message after the place its fields name, when the message names that place as
+    the library writes it (``components[3] "mass1" params.mass``, ``connections[2]``,
+    ``mass1.frame_a``), else None: the page then shows the whole message."""
+    message, path = out["message"], out["path"] or ""
+    local = path[max(path.rfind("components["), path.rfind("connections["), 0):]
+    places = []
+    index = _index(local, "components[")
+    if index is not None and out["component"]:
+        head = f'components[{index}] "{out["component"]}"'
+        if out["parameter"]:
+            places.append(f"{head} params.{out['parameter']}")
+        places.append(head)
+    wire = _index(local, "connections[")
+    if wire is not None:
+        places.append(f"connections[{wire}]")
+    if out["component"] and out["port"]:
+        places.append(f"{out['component']}.{out['port']}")
+    for place in places:
+        at = message.find(place)
+        if at >= 0:
+            return message[at + len(place):]
+    return None
+
+
+def _reason(rest):
+    """What is wrong, from the text after a place: ``" = -1 kg: must be >= 0"`` is
+    ``"must be >= 0 (got -1 kg)"``."""
+    rest = rest.strip()
+    if rest.startswith("= ") and ": " in rest:
+        value, _, what = rest[2:].partition(": ")
+        return f"{what} (got {value})"
+    return rest.lstrip(":").strip() or None
 
 
 # -- layout ------------------------------------------------------------------------------------

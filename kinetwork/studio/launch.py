@@ -40,7 +40,10 @@ def cli_studio(args):
     print(f"kinetwork studio: files in {root}\n  {url}\n(Ctrl-C stops it)", flush=True)
     if not getattr(args, "no_browser", False):
         _open_browser(url)
-    server = uvicorn.Server(uvicorn.Config(app, log_level="warning", lifespan="on"))
+    # Ctrl-C stops at once: requests still open get half a second (the work they wait on is
+    # in child processes, ended with them), not for ever
+    server = uvicorn.Server(uvicorn.Config(app, log_level="warning", lifespan="on",
+                                           timeout_graceful_shutdown=0.5))
     try:
         server.run(sockets=[sock])
     except KeyboardInterrupt:       # uvicorn shuts down, then raises the signal it caught

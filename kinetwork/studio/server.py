@@ -1,31 +1,38 @@
 """The studio's HTTP server: the API of ``API.md`` over kinetwork, and the built front end.
 
 ``create_app(root, token)`` gives an ASGI app (FastAPI). Every ``/api`` route checks the
-session token; files are read and written only inside ``root``; a model is checked by the
-checker of ``kn.load`` and written by kinetwork's writer; runs go in worker threads. Answers
-are JSON, a refusal ``{"error", "problems"}`` with 400, 403, 404 or 409, never a traceback.
+session token; files are read and written only inside ``root``, special files (FIFOs,
+devices) never opened, a save refused when the file changed since the page read it. Whatever
+reads a model the page sent (check, lay out, write, run, sweep, linearise) runs in a child
+process (``jobs``), with a time limit, so no request holds up another and SIGINT stops the
+server at once. Answers are JSON, a refusal ``{"error", "problems"}`` with 400, 403, 404,
+409 or 503, never a traceback.
 """
 
+import asyncio
 import contextlib
 import json
 import logging
 import os
 import pathlib
 import secrets
+import time
 
 from fastapi import APIRouter, Depends, FastAPI, Request
 from fastapi.exceptions import RequestValidationError
 from fastapi.responses import FileResponse, HTMLResponse, JSONResponse, Response
+from starlette.concurrency import run_in_threadpool
 from starlette.exceptions import HTTPException
 
 from ..errors import ModelError
-from ..graph.io import FORMAT, MAX_FILE_SIZE, load, loads
+from ..graph.io import FORMAT, MAX_FILE_SIZE, load
 from ..graph.writer import dumps
 from ..schema import schema
-from ..util import atomic_write
-from . import checks, files
-from .files import StudioError
-from .runs import Runs, check_settings, encode
+from . import checks, files, jobs, work
+from .facts import facts
+from .files import Conflict, StudioError
+from .results import encode
+from .runs import Runs, check_settings
 
 log = logging.getLogger("kinetwork.studio")
 
@@ -33,6 +40,14 @@ STATIC = pathlib.Path(__file__).resolve().parent / "static"
 TOKEN_HEADER = "X-Kinetwork-Token"
 #: the largest request body: a model file's limit, and room for its JSON around it
 MAX_BODY = 2 * MAX_FILE_SIZE
+#: seconds a check (validate, layout, the text of a save) may take before it is stopped; the
+#: compilation validate does to count states (a model that checks: its answer waits for it,
+#: or goes without the counts); and a linearisation (it may simulate up to its time)
+CHECK_LIMIT, SUMMARY_LIMIT, LINEARIZE_LIMIT = 15.0, 30.0, 120.0
+#: checks in child processes at once; more wait their turn (up to their time limit)
+MAX_CHECKS = 4
+#: the longest a poll of a run waits for it to end
+MAX_WAIT = 2.0
 
 
 class StudioJSON(JSONResponse):
@@ -43,7 +58,7 @@ class StudioJSON(JSONResponse):
         return encode(content)
 
 
-def create_app(root, token, library=None, model=None):
+def create_app(root, token, library=None, model=None, static=None):
     """The studio as an ASGI app.
 
     Parameters
@@ -59,6 +74,9 @@ def create_app(root, token, library=None, model=None):
     model : str, optional
         The model file the studio was started with (relative to ``root``, or absolute inside
         it); ``GET /api/files`` names it as ``open``.
+    static : str or os.PathLike, optional
+        The folder of the built page to serve (default: the package's ``static``); the
+        end-to-end tests serve their own build, with its test hook.
 
     Returns
     -------
@@ -76,8 +94,11 @@ def create_app(root, token, library=None, model=None):
         except StudioError as exc:
             raise ModelError(exc.message) from None
 
+    static = pathlib.Path(static) if static is not None else STATIC
+
     @contextlib.asynccontextmanager
     async def lifespan(app):
+        jobs.warm_up()
         yield
         studio.runs.stop_all()
 
@@ -91,7 +112,7 @@ def create_app(root, token, library=None, model=None):
 
     @app.get("/", dependencies=[Depends(studio.check_token)], include_in_schema=False)
     def page():
-        index = STATIC / "index.html"
+        index = static / "index.html"
         if index.is_file():
             return FileResponse(index, headers={"Cache-Control": "no-store"})
         return HTMLResponse(PLACEHOLDER)
@@ -100,7 +121,9 @@ def create_app(root, token, library=None, model=None):
     def asset(name: str):
         # no token: the page's scripts and styles are the same for everyone; only the built
         # files are served, and nothing the path could reach outside their folder
-        folder = os.path.realpath(STATIC / "assets")
+        if "\x00" in name or len(name) > 255:       # realpath raises on a NUL
+            raise StudioError(404, f"no asset {name!r:.80}")
+        folder = os.path.realpath(static / "assets")
         path = os.path.realpath(os.path.join(folder, name))
         if os.path.commonpath([path, folder]) != folder or not os.path.isfile(path):
             raise StudioError(404, f"no asset {name!r:.80}")
@@ -116,6 +139,40 @@ class _Studio:
         self.root, self.token, self.library = root, token, library
         self.open = None
         self.runs = Runs()
+        self._checks = None
+
+    async def call(self, fn, *args, limit=CHECK_LIMIT, what="checking the model"):
+        """``fn(*args, channel)`` in a child process, awaited (at most MAX_CHECKS at once).
+
+        Raises
+        ------
+        StudioError
+            503 when it took longer than ``limit`` seconds (the child is ended), or waited
+            that long for its turn; 500 when the child failed.
+        """
+        if self._checks is None:
+            self._checks = asyncio.Semaphore(MAX_CHECKS)
+        try:
+            await asyncio.wait_for(self._checks.acquire(), limit)
+        except asyncio.TimeoutError:
+            raise StudioError(503, f"{what}: the studio is busy with {MAX_CHECKS} other "
+                                   f"checks; try again") from None
+        try:
+            child = jobs.Child(fn, args)
+            return await child.answer_async(limit)
+        except jobs.TimeLimit:
+            raise StudioError(503, f"{what} took longer than {limit:g} s and was stopped: "
+                                   f"something in it makes too much work (a unit or an "
+                                   f"expression raised to huge powers, a subsystem placing "
+                                   f"itself many times over?)") from None
+        except jobs.ChildError as exc:
+            if exc.kind == "ModelError":
+                raise StudioError(400, exc.text) from None
+            log.error("%s failed in its worker: %s", what, exc)
+            raise StudioError(500, f"{what} failed: internal error ({exc.kind}); the "
+                                   f"server's log has the details") from None
+        finally:
+            self._checks.release()
 
     def check_token(self, request: Request):
         given = request.headers.get(TOKEN_HEADER) or request.query_params.get("token") or ""
@@ -124,8 +181,9 @@ class _Studio:
             raise StudioError(403, "missing or wrong token: open the address that "
                                    "`kinetwork studio` printed")
 
-    def context(self, real_path=None):
-        return checks.context(checks.folder_of(self.root, real_path), self.library)
+    def folder(self, real_path=None):
+        """The folder a model's definitions are found in (its file's, or the root)."""
+        return checks.folder_of(self.root, real_path)
 
     def model_path(self, body):
         """The real path of the body's optional ``path`` (None when not given)."""
@@ -141,6 +199,10 @@ def _routes(api, studio):
     @api.get("/schema")
     def model_schema():
         return StudioJSON(schema())
+
+    @api.get("/facts")
+    def studio_facts():
+        return StudioJSON(facts())
 
     @api.get("/files")
     def list_files():
@@ -158,47 +220,148 @@ def _routes(api, studio):
         if example is not None:
             return StudioJSON(_open_example(example, studio))
         real, rel = files.confine(studio.root, path)
-        text = files.read_text(real, rel)
-        return StudioJSON({"path": rel, "text": text,
+        raw = files.read_bytes(real, rel)
+        text = files.decode(raw, rel)
+        return StudioJSON({"path": rel, "text": text, "version": files.version_of(raw),
                            "model": files.parse_model_text(text, rel)})
 
     @api.post("/validate")
-    def validate(body: dict = Depends(_body)):
+    async def validate(body: dict = Depends(_body)):
         _keys(body, "validate", required=("model",), optional=("path",))
         data = _model(body)
-        return StudioJSON(checks.validate(data, studio.context(studio.model_path(body))))
+        folder = studio.folder(studio.model_path(body))
+        try:
+            answer = await studio.call(work.check, data, folder, studio.library)
+        except StudioError as exc:
+            if exc.status != 503:
+                raise
+            return StudioJSON({"ok": False, "summary": None, "warnings": [],
+                               "problems": [checks.problem(exc.message)]})
+        if answer.pop("compile"):
+            try:
+                more = await studio.call(work.summarize, data, folder, studio.library,
+                                         limit=SUMMARY_LIMIT, what="counting the states")
+            except StudioError as exc:      # too long to count: the check's answer stands
+                if exc.status != 503:
+                    raise
+                more = {"summary": {}, "warnings": []}
+            if more.get("problems"):
+                answer.update(ok=False, problems=more["problems"])
+            else:
+                answer["summary"].update(more["summary"])
+                answer["warnings"] = more["warnings"]
+        return StudioJSON(answer)
 
     @api.post("/save")
-    def save(body: dict = Depends(_body)):
-        _keys(body, "save", required=("path", "model"), optional=("text",))
-        return StudioJSON(_save(studio, body))
+    async def save(body: dict = Depends(_body)):
+        _keys(body, "save", required=("path", "model"), optional=("text", "base"))
+        return StudioJSON(await _save(studio, body))
+
+    @api.post("/autosave")
+    async def autosave(body: dict = Depends(_body)):
+        _keys(body, "autosave", required=("model",), optional=("path", "base", "session"))
+        rel = _rel_or_none(studio, body.get("path"))
+        base, session = _base(body), body.get("session")
+        if session is not None and (not isinstance(session, str) or len(session) > 100):
+            raise StudioError(400, "session: a string naming the page's session, or null")
+        await run_in_threadpool(files.write_recovery, studio.root, rel, _model(body), base,
+                                session)
+        return StudioJSON({"ok": True})
+
+    @api.get("/recovery")
+    def recovery(path: str = None):
+        rel = _rel_or_none(studio, path)
+        return StudioJSON({"recovery": files.read_recovery(studio.root, rel)})
+
+    @api.post("/recovery/discard")
+    def discard(body: dict = Depends(_body)):
+        _keys(body, "recovery/discard", required=(), optional=("path",))
+        files.discard_recovery(studio.root, _rel_or_none(studio, body.get("path")))
+        return StudioJSON({"ok": True})
 
     @api.post("/layout")
-    def layout(body: dict = Depends(_body)):
+    async def layout(body: dict = Depends(_body)):
         _keys(body, "layout", required=("model",), optional=("path",))
         data = _model(body)
-        try:
-            model = checks.build(data, studio.context(studio.model_path(body)), validate=False)
-        except ModelError as exc:
-            raise StudioError(400, "the model cannot be read", checks.problems_of(exc))
-        return StudioJSON({"layout": checks.layout(model)})
+        answer = await studio.call(work.layout, data, studio.folder(studio.model_path(body)),
+                                   studio.library, what="laying out the model")
+        if "problems" in answer:
+            raise StudioError(400, "the model cannot be read", answer["problems"])
+        return StudioJSON(answer)
 
     @api.post("/run")
     def run(body: dict = Depends(_body)):
         _keys(body, "run", required=("model",), optional=("settings", "path"))
         data = _model(body)
         settings = check_settings(body.get("settings"))
-        started = studio.runs.start(data, settings, studio.context(studio.model_path(body)))
+        started = studio.runs.start("run", data, settings, studio.folder(studio.model_path(body)),
+                                    studio.library)
         return StudioJSON({"run": started.id})
 
     @api.get("/run/{run_id}")
-    def poll(run_id: str):
-        return Response(studio.runs.get(run_id).body(), media_type="application/json")
+    async def poll(run_id: str, wait: float = 0.0):
+        return Response(await _waited(studio.runs.get(run_id, "run"), wait),
+                        media_type="application/json")
 
     @api.post("/run/{run_id}/cancel")
     def cancel(run_id: str):
-        studio.runs.get(run_id).cancel.set()
+        studio.runs.get(run_id, "run").cancel()
         return StudioJSON({"ok": True})
+
+    @api.post("/sweep")
+    def sweep(body: dict = Depends(_body)):
+        _keys(body, "sweep", required=("model", "sweep"), optional=("path",))
+        data = _model(body)
+        if not isinstance(body["sweep"], dict):
+            raise StudioError(400, "sweep: must be an object {kind, grid} or {kind, "
+                                   "distributions, n, seed}")
+        started = studio.runs.start("sweep", data, body["sweep"],
+                                    studio.folder(studio.model_path(body)), studio.library)
+        return StudioJSON({"sweep": started.id})
+
+    @api.get("/sweep/{sweep_id}")
+    async def poll_sweep(sweep_id: str, wait: float = 0.0):
+        return Response(await _waited(studio.runs.get(sweep_id, "sweep"), wait),
+                        media_type="application/json")
+
+    @api.post("/sweep/{sweep_id}/cancel")
+    def cancel_sweep(sweep_id: str):
+        studio.runs.get(sweep_id, "sweep").cancel()
+        return StudioJSON({"ok": True})
+
+    @api.post("/linearize")
+    async def linearize(body: dict = Depends(_body)):
+        _keys(body, "linearize", required=("model",),
+              optional=("path", "at", "inputs", "outputs"))
+        data = _model(body)
+        spec = {k: body.get(k) for k in ("at", "inputs", "outputs")}
+        return StudioJSON(await studio.call(work.linearize, data, spec,
+                                            studio.folder(studio.model_path(body)),
+                                            studio.library, limit=LINEARIZE_LIMIT,
+                                            what="linearising the model"))
+
+
+async def _waited(job, wait):
+    """A job's answer, once it has ended or ``wait`` seconds (at most MAX_WAIT) have passed:
+    a page polling with a wait hears of the end at once."""
+    if not (0.0 <= wait <= MAX_WAIT):
+        raise StudioError(400, f"wait: seconds from 0 to {MAX_WAIT:g}, got {wait!r:.40}")
+    end = time.monotonic() + wait
+    while job.state == "running" and job.cancel_at is None and time.monotonic() < end:
+        await asyncio.sleep(0.01)
+    return job.body()
+
+
+def _rel_or_none(studio, path):
+    """A path of the API in canonical form, or None for none."""
+    return None if path is None else files.confine(studio.root, path)[1]
+
+
+def _base(body):
+    base = body.get("base")
+    if base is not None and (not isinstance(base, str) or len(base) > 200):
+        raise StudioError(400, "base: the version the page opened (a string), or null")
+    return base
 
 
 def _open_example(name, studio):
@@ -212,77 +375,32 @@ def _open_example(name, studio):
     if data.get("version") == 2:
         text = dumps(load(path, validate=False))      # folder=None: every definition inline
         data = files.parse_model_text(text, f"example {name}")
-    return {"path": None, "text": text, "model": data}
+    return {"path": None, "text": text, "version": None, "model": data}
 
 
-def _save(studio, body):
+async def _save(studio, body):
     """Write a model file: the text the page opened when the model is that text unchanged
-    (byte for byte), else kinetwork's canonical text of the model. Either way the text is
-    read back as ``kn.load`` would (without the wiring checks, so work in progress saves)
-    before the old file is replaced, atomically."""
+    (byte for byte), else kinetwork's canonical text of the model, or, for a model the
+    reader refuses (work in progress), the model as it is, with its problems. Written only
+    if the file is still the version the page's model was based on, atomically."""
     real, rel = files.confine(studio.root, body["path"])
     data, text = _model(body), body.get("text")
+    base = _base(body) if "base" in body else files.UNCHECKED
     if text is not None and not isinstance(text, str):
         raise StudioError(400, "save: text must be a string or null")
+    if data.get("format") != FORMAT:
+        raise StudioError(400, f"save: the model must be a kinetwork model file's object "
+                               f"(\"format\": \"{FORMAT}\")")
     if os.path.isdir(real):
         raise StudioError(400, f"{rel}: a folder, not a model file")
     if not os.path.isdir(os.path.dirname(real)):
         raise StudioError(400, f"{rel}: the folder {os.path.dirname(rel) or '.'} does not exist")
-    if os.path.exists(real):
-        _check_overwrite(real, rel)
-    ctx = studio.context(real)
-    unchanged = text is not None and _same(_json_or_none(text), data)
-    try:
-        if unchanged:
-            loads(text, validate=False, library=studio.library, folder=os.path.dirname(real))
-            written = text
-
-            def write(tmp):
-                with open(tmp, "wb") as fh:
-                    fh.write(written.encode("utf-8"))
-            atomic_write(real, write)
-        else:
-            model = checks.build(data, ctx, validate=False)
-            model.save(real)
-            written = files.read_text(real, rel)
-    except ModelError as exc:
-        raise StudioError(400, f"{rel}: not saved: the model cannot be written as a file",
-                          checks.problems_of(exc)) from None
-    except OSError as exc:
-        raise StudioError(400, f"{rel}: not saved: {exc.strerror or exc}") from None
-    return {"ok": True, "bytes": len(written.encode("utf-8")), "text": written}
-
-
-def _check_overwrite(real, rel):
-    """A file already there is replaced only when it is a kinetwork model file."""
-    try:
-        data = json.loads(files.read_text(real, rel))
-    except (StudioError, ValueError, RecursionError):
-        data = None
-    if not isinstance(data, dict) or data.get("format") != FORMAT:
-        raise StudioError(409, f"{rel}: exists and is not a kinetwork model file; not "
-                               f"overwritten (save under another name)")
-
-
-def _same(a, b):
-    """JSON values equal as the page sees them: 1 and 1.0 alike (JavaScript has one number
-    type), but true and 1 not, nor "1" and 1."""
-    if isinstance(a, bool) or isinstance(b, bool):
-        return type(a) is type(b) and a == b
-    if isinstance(a, (int, float)) and isinstance(b, (int, float)):
-        return a == b
-    if isinstance(a, dict) and isinstance(b, dict):
-        return list(a) == list(b) and all(_same(a[k], b[k]) for k in a)
-    if isinstance(a, list) and isinstance(b, list):
-        return len(a) == len(b) and all(_same(x, y) for x, y in zip(a, b))
-    return type(a) is type(b) and a == b
-
-
-def _json_or_none(text):
-    try:
-        return json.loads(text)
-    except (ValueError, RecursionError):
-        return None
+    rendered = await studio.call(work.render, data, text, os.path.dirname(real),
+                                 studio.library, what=f"{rel}: writing the model")
+    version = await run_in_threadpool(files.write_model, real, rel, rendered["text"], base)
+    await run_in_threadpool(files.discard_recovery, studio.root, rel)
+    return {"ok": True, "bytes": len(rendered["text"].encode("utf-8")), "text": rendered["text"],
+            "version": version, "problems": rendered["problems"]}
 
 
 # -- requests and refusals ---------------------------------------------------------------------
@@ -324,8 +442,10 @@ def _model(body):
 def _handlers(app):
     @app.exception_handler(StudioError)
     async def refused(request, exc):
-        return StudioJSON({"error": exc.message, "problems": exc.problems},
-                          status_code=exc.status)
+        answer = {"error": exc.message, "problems": exc.problems}
+        if isinstance(exc, Conflict):
+            answer["conflict"] = {"version": exc.version}
+        return StudioJSON(answer, status_code=exc.status)
 
     @app.exception_handler(HTTPException)
     async def http_error(request, exc):

@@ -1,15 +1,22 @@
 """Fixtures of the studio's end-to-end tests: the real server (uvicorn in a thread, on a free
-port, over a copy of the example models) and Debian's Chromium driven by Playwright.
+port, over a copy of the example models) serving a test build of the page, and Debian's
+Chromium driven by Playwright.
+
+The page the tests drive is the studio's own, built with its test hook (``window.__kinetwork``,
+which the studio's shipped build does not have): ``vite build --mode e2e`` into a folder of
+the test session, from ``frontend/`` (``npm ci`` first when its packages are not installed).
 
 Nothing here is autouse, so the server's own tests (test_server.py) are untouched. The
-fixtures fail, saying why, when Chromium, Playwright, FastAPI/uvicorn or the built front end
-is missing (``browser_missing`` in tests/conftest.py: skipped only when asked).
+fixtures fail, saying why, when Chromium, Playwright, FastAPI/uvicorn or Node is missing
+(``browser_missing`` in tests/browser.py: skipped only when asked).
 """
 
+import fcntl
 import os
 import pathlib
 import shutil
 import socket
+import subprocess
 import threading
 import time
 
@@ -17,8 +24,8 @@ import pytest
 from browser import browser_missing
 
 REPO = pathlib.Path(__file__).resolve().parents[2]
+FRONTEND = REPO / "frontend"
 CHROMIUM = "/usr/bin/chromium"
-STATIC_INDEX = REPO / "kinetwork" / "studio" / "static" / "index.html"
 E2E_TOKEN = "e2e-token-0123456789abcdef"
 VIEWPORT = {"width": 1600, "height": 1000}
 
@@ -34,10 +41,38 @@ def _why_not():
         except ImportError:
             return f"{what} is not installed (the studio extras: pip install fastapi uvicorn " \
                    f"playwright)"
-    if not STATIC_INDEX.exists():
-        return "the studio's front end is not built (cd frontend && npm ci && npm run " \
-               "build:studio)"
+    if shutil.which("npm") is None or shutil.which("node") is None:
+        return "Node and npm are needed to build the studio's test page (apt-get install nodejs npm)"
     return None
+
+
+def npm_installed():
+    """``frontend/node_modules`` from the lockfile (``npm ci``, once, whichever test process
+    gets there first)."""
+    with open(FRONTEND / "package-lock.json") as lock:
+        fcntl.flock(lock, fcntl.LOCK_EX)        # one npm ci at a time, between test workers
+        try:
+            if not (FRONTEND / "node_modules" / ".bin" / "vite").exists():
+                subprocess.run(["npm", "ci", "--no-audit", "--no-fund"], cwd=FRONTEND,
+                               check=True, capture_output=True, text=True, timeout=900)
+        finally:
+            fcntl.flock(lock, fcntl.LOCK_UN)
+
+
+@pytest.fixture(scope="session")
+def test_page(tmp_path_factory):
+    """The studio's page built with its test hook, in a folder of this test session."""
+    why = _why_not()
+    if why:
+        browser_missing(why)
+    npm_installed()
+    out = tmp_path_factory.mktemp("studio-e2e-build")
+    done = subprocess.run([str(FRONTEND / "node_modules" / ".bin" / "vite"), "build",
+                           "--mode", "e2e", "--outDir", str(out), "--emptyOutDir",
+                           "--logLevel", "warn"], cwd=FRONTEND, capture_output=True, text=True,
+                          timeout=600)
+    assert done.returncode == 0, f"the test build of the studio failed:\n{done.stderr}"
+    return out
 
 
 class Studio:
@@ -53,12 +88,9 @@ class Studio:
 
 
 @pytest.fixture
-def studio(tmp_path):
+def studio(tmp_path, test_page):
     """The studio's server over a folder holding a copy of models/ (so saving touches no
-    file of the repository)."""
-    why = _why_not()
-    if why:
-        browser_missing(why)
+    file of the repository), serving the test build of the page."""
     import uvicorn
 
     from kinetwork.studio.server import create_app
@@ -69,8 +101,8 @@ def studio(tmp_path):
     sock.bind(("127.0.0.1", 0))
     sock.listen(64)
     port = sock.getsockname()[1]
-    server = uvicorn.Server(uvicorn.Config(create_app(tmp_path, E2E_TOKEN), log_level="warning",
-                                           ws="none", lifespan="on"))
+    server = uvicorn.Server(uvicorn.Config(create_app(tmp_path, E2E_TOKEN, static=test_page),
+                                           log_level="warning", ws="none", lifespan="on"))
     thread = threading.Thread(target=server.run, kwargs={"sockets": [sock]}, daemon=True)
     thread.start()
     end = time.monotonic() + 30

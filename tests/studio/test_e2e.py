@@ -8,125 +8,17 @@ the studio's extras are missing.
 """
 
 import json
-import os
 import pathlib
-import tempfile
-import time
 
 import numpy as np
 
 import kinetwork as kn
+from tests.studio.helpers import (IMAGES, RUN_TIMEOUT, K, center, deselect, open_file, open_studio,
+                                  place, run, select, set_field, tid, wait_validated, wire)
 
 REPO = pathlib.Path(__file__).resolve().parents[2]
 SEED = "models/double_pendulum.json"
 MODEL_FILES = sorted(p.relative_to(REPO).as_posix() for p in (REPO / "models").rglob("*.json"))
-#: where the screenshots go: a folder of the test run, unless KINETWORK_SCREENSHOTS names
-#: one (`KINETWORK_SCREENSHOTS=docs/images pytest tests/studio/test_e2e.py` refreshes the
-#: README's); a test run never rewrites files of the repository
-IMAGES = pathlib.Path(os.environ.get("KINETWORK_SCREENSHOTS")
-                      or pathlib.Path(tempfile.gettempdir()) / "kinetwork-screenshots")
-RUN_TIMEOUT = 240_000          # ms: EngineV6 compiles for ~30 s on a busy 2-core machine
-
-
-# -- helpers -----------------------------------------------------------------------------------
-def tid(name):
-    return f'[data-testid="{name}"]'
-
-
-def K(page, expr):
-    """Evaluate ``expr`` on the studio's testing hook (window.__kinetwork as K)."""
-    return page.evaluate(f"() => {{ const K = window.__kinetwork; return ({expr}); }}")
-
-
-def open_studio(page, studio, **query):
-    """Load the page; the seconds from navigation to the palette being ready."""
-    t0 = time.perf_counter()
-    page.goto(studio.url(**query))
-    page.wait_for_selector(f'{tid("palette")}[data-ready="1"]')
-    return time.perf_counter() - t0
-
-
-def wait_validated(page):
-    """Wait for the debounced validation of the current document to answer."""
-    page.wait_for_function("() => window.__kinetwork.validated")
-
-
-def center(page, selector):
-    box = page.locator(selector).bounding_box()
-    assert box, f"{selector} is not on screen"
-    return box["x"] + box["width"] / 2, box["y"] + box["height"] / 2
-
-
-def place(page, type_, name, x, y):
-    """Drag ``type_`` from the palette onto the canvas, its block's top-left corner at
-    (x, y) of the canvas (screen pixels), and name it ``name`` in the parameter panel."""
-    before = K(page, "K.doc.components.length")
-    page.locator(tid(f"palette-{type_}")).scroll_into_view_if_needed()
-    page.drag_and_drop(tid(f"palette-{type_}"), tid("canvas"),
-                       target_position={"x": x + 58, "y": y + 32})
-    page.wait_for_function(f"() => window.__kinetwork.doc.components.length === {before + 1}")
-    fresh = K(page, "K.doc.components[K.doc.components.length - 1].name")
-    page.wait_for_function(f"() => window.__kinetwork.selection.join() === {json.dumps(fresh)}")
-    if fresh != name:
-        field = page.locator(tid("param-name"))
-        field.fill(name)
-        field.press("Enter")
-    page.wait_for_selector(tid(f"node-{name}"))
-    return fresh
-
-
-def wire(page, a, b):
-    """Drag with the mouse from port ``a`` ("comp.port") to port ``b``."""
-    (ca, pa), (cb, pb) = a.split("."), b.split(".")
-    x1, y1 = center(page, tid(f"handle-{ca}-{pa}"))
-    x2, y2 = center(page, tid(f"handle-{cb}-{pb}"))
-    page.mouse.move(x1, y1)
-    page.mouse.down()
-    page.mouse.move((x1 + x2) / 2, (y1 + y2) / 2 + 7, steps=6)
-    page.mouse.move(x2, y2, steps=6)
-    page.mouse.up()
-
-
-def select(page, name):
-    """Select one block by clicking its name."""
-    page.locator(f'{tid(f"node-{name}")} .kn-block-name').click()
-    page.wait_for_function(f"() => window.__kinetwork.selection.join() === {json.dumps(name)}")
-
-
-def deselect(page):
-    box = page.locator(tid("canvas")).bounding_box()
-    page.mouse.click(box["x"] + box["width"] - 60, box["y"] + 20)
-    page.wait_for_function("() => window.__kinetwork.selection.length === 0")
-
-
-def set_field(page, testid, text):
-    field = page.locator(tid(testid))
-    field.fill(text)
-    field.press("Enter")
-
-
-def open_file(page, path):
-    """Open ``path`` through the Open dialog's file list; wait for its blocks."""
-    page.click(tid("open"))
-    page.click(tid(f"file-{path}"))
-    page.wait_for_selector(tid("open-dialog"), state="detached")
-    page.wait_for_function(f"() => window.__kinetwork.file.path === {json.dumps(path)}")
-    for comp in K(page, "K.doc.components.map(c => c.name)"):
-        page.wait_for_selector(tid(f"node-{comp}"))
-
-
-def run(page, timeout=RUN_TIMEOUT):
-    """Press Run, wait for the run to end; its final state."""
-    n = K(page, "(K.runs || []).length ? K.runs[0].n : 0")
-    page.click(tid("run"))
-    page.wait_for_function(
-        "() => { const s = window.__kinetwork.runState; return s && s.state !== 'running' "
-        "&& s.state !== 'starting'; }", timeout=timeout)
-    state = K(page, "K.runState.state")
-    if state == "done":
-        page.wait_for_function(f"() => window.__kinetwork.runs.length && "
-                               f"window.__kinetwork.runs[0].n > {n}")
-    return state
 
 
 def seed_results():
@@ -519,7 +411,7 @@ def test_runs_overlay_cancel_and_the_3d_view_follows_the_plot_cursor(page, studi
     page.click(tid("run"))
     page.wait_for_function("() => window.__kinetwork.runState && "
                            "window.__kinetwork.runState.state === 'running' && "
-                           "window.__kinetwork.runState.id")
+                           "window.__kinetwork.runState.progress > 0")    # integrating
     page.click(tid("cancel"))
     page.wait_for_function("() => window.__kinetwork.runState.state === 'cancelled'",
                            timeout=RUN_TIMEOUT)

@@ -23,7 +23,7 @@ with warnings.catch_warnings():
 
 import kinetwork as kn
 from kinetwork.components.base import REGISTRY
-from kinetwork.studio import launch, runs
+from kinetwork.studio import checks, launch, results
 from kinetwork.studio.server import TOKEN_HEADER, create_app
 
 MODELS = pathlib.Path(__file__).resolve().parents[2] / "models"
@@ -97,6 +97,10 @@ def test_the_page_needs_the_token_and_assets_do_not(root):
     # no token asked of assets: a missing one is a 404, never a 403
     assert c.get("/assets/missing.js").status_code == 404
     assert c.get("/assets/../server.py").status_code == 404
+    # a NUL or an endless name is no asset, never a 500
+    assert c.get("/assets/%00").status_code == 404
+    assert c.get("/assets/a%00.js").status_code == 404
+    assert c.get("/assets/" + "a" * 5000 + ".js").status_code == 404
 
 
 # -- palette, schema, files, examples ------------------------------------------------------------
@@ -164,9 +168,11 @@ def test_open_then_save_unchanged_is_byte_identical(client, root, name, verbatim
     assert opened["path"] == path and opened["text"] == before.decode()
     model = json.loads(json.dumps(opened["model"]))       # as the page holds it
     answer = client.post("/api/save", json={"path": path, "model": model,
-                                            "text": opened["text"] if verbatim else None})
+                                            "text": opened["text"] if verbatim else None,
+                                            "base": opened["version"]})
     assert answer.status_code == 200, answer.json()
-    assert answer.json() == {"ok": True, "bytes": len(before), "text": before.decode()}
+    assert answer.json() == {"ok": True, "bytes": len(before), "text": before.decode(),
+                             "version": opened["version"], "problems": []}
     assert (root / path).read_bytes() == before
 
 
@@ -190,21 +196,41 @@ def test_save_keeps_a_half_built_model(client, root):
     assert kn.load(root / "wip.json", validate=False).connections == []
 
 
-@pytest.mark.parametrize("change", [
-    lambda d: d["components"].append({"name": "x", "type": "multibody.Nope"}),
-    lambda d: d.__setitem__("version", 99),
-    lambda d: d.__setitem__("layout", {"nobody": {"x": 0}}),
-    lambda d: d.__setitem__("simulation", {"t_end": -1}),
-], ids=["unknown type", "version", "layout", "settings"])
-def test_save_never_writes_what_is_not_a_model(client, root, change):
-    before = (root / SEED).read_bytes()
+@pytest.mark.parametrize("change, where", [
+    (lambda d: d["components"].append({"name": "x", "type": "multibody.Nope"}), "unknown type"),
+    (lambda d: d["components"][4]["params"].pop("mass"), "a value is required"),
+    (lambda d: d["components"][4]["params"].update(mass="m1 +"), "cannot parse"),
+    (lambda d: d.__setitem__("layout", {"nobody": {"x": 0}}), "layout.nobody"),
+    (lambda d: d.__setitem__("simulation", {"t_end": -1}), "t_end"),
+], ids=["unknown type", "required value empty", "half-typed expression", "layout",
+        "settings"])
+def test_unfinished_work_saves_as_it_is_and_its_problems_come_back(client, root, change,
+                                                                     where):
+    """Work in progress that the reader refuses is written as it is (never lost), with its
+    problems in the answer; kn.load lists them; opened again it is the same model."""
     data = seed(client)
     change(data)
-    for text in (None, json.dumps(data)):
-        answer = client.post("/api/save", json={"path": SEED, "model": data, "text": text})
-        assert answer.status_code == 400 and answer.json()["problems"]
-        assert (root / SEED).read_bytes() == before
+    answer = client.post("/api/save", json={"path": "models/wip.json", "model": data})
+    assert answer.status_code == 200, answer.json()
+    assert any(where in p["message"] for p in answer.json()["problems"])
+    assert json.loads((root / "models" / "wip.json").read_text()) == data
+    assert (root / "models" / "wip.json").read_text() == answer.json()["text"]
+    with pytest.raises(kn.ModelError, match=where.split()[0]):
+        kn.load(root / "models" / "wip.json")
+    opened = client.get("/api/open", params={"path": "models/wip.json"}).json()
+    assert opened["model"] == data
+    problems = client.post("/api/validate", json={"model": opened["model"]}).json()["problems"]
+    assert any(where in p["message"] for p in problems)
     assert not [p for p in (root / "models").iterdir() if p.name.endswith(".tmp")]
+
+
+@pytest.mark.parametrize("model", [{"components": []}, {"format": "other"}],
+                         ids=["no format", "another format"])
+def test_save_never_writes_what_is_not_a_model_file(client, root, model):
+    before = (root / SEED).read_bytes()
+    answer = client.post("/api/save", json={"path": SEED, "model": model})
+    assert answer.status_code == 400 and "format" in answer.json()["error"]
+    assert (root / SEED).read_bytes() == before
 
 
 def test_save_does_not_overwrite_other_json_files(client, root):
@@ -295,7 +321,7 @@ def test_validate_sends_the_fields_of_each_problem_and_its_warnings(client):
     index = [c["name"] for c in data["components"]].index("mass1")
     problem = next(p for p in answer["problems"] if p["component"] == "mass1")
     assert set(problem) == {"message", "component", "port", "parameter", "path", "hint",
-                            "severity", "param", "connection"}
+                            "severity", "reason", "param", "connection"}
     assert (problem["parameter"], problem["path"], problem["severity"]) == \
         ("mass", f"components[{index}].params.mass", "error")
     assert problem["param"] == "mass" and answer["warnings"] == []
@@ -352,30 +378,44 @@ def test_a_run_gives_what_kn_simulate_gives(client, root):
         ("probe1", "angle", "shoulder.axis")
 
 
-def test_results_carry_the_animation_or_null_without_its_module(client, monkeypatch):
+def test_results_carry_the_animation(client):
     settings = {"t_end": 0.5, "n_points": 6}
     answer = wait(client, client.post("/api/run", json={"model": seed(client),
                                                         "settings": settings}).json()["run"])
     animation = answer["results"]["animation"]
     assert animation["format"] == "kinetwork.animation" and animation["frames"]
-    assert len(animation["t"]) == 6
+    assert len(animation["t"]) == 6 and answer["results"]["animation_note"] is None
+
+
+def test_without_the_animation_module_results_say_why_there_is_no_3d_view(root, monkeypatch):
+    model = kn.load(root / SEED)
+    res = kn.simulate(model, t_end=0.5, n_points=6)
     monkeypatch.setitem(sys.modules, "kinetwork.animation", None)     # not importable
-    answer = wait(client, client.post("/api/run", json={"model": seed(client),
-                                                        "settings": settings}).json()["run"])
-    assert answer["state"] == "done" and answer["results"]["animation"] is None
+    out = results.results_json(res, model)
+    assert out["animation"] is None and "not installed" in out["animation_note"]
 
 
-def test_a_dense_run_is_resampled_for_the_animation(client, monkeypatch):
-    monkeypatch.setattr(runs, "MAX_FRAMES", 50)
-    answer = wait(client, client.post("/api/run", json={"model": seed(client), "settings": {
-        "t_end": 2.0, "n_points": 201}}).json()["run"])
-    assert len(answer["results"]["t"]) == 201
-    assert len(answer["results"]["animation"]["t"]) == 50
+def test_a_dense_run_is_resampled_for_the_animation(root, monkeypatch):
+    monkeypatch.setattr(results, "MAX_FRAMES", 50)
+    model = kn.load(root / SEED)
+    out = results.results_json(kn.simulate(model, t_end=2.0, n_points=201), model)
+    assert len(out["t"]) == 201 and len(out["animation"]["t"]) == 50
 
 
-def test_layout_without_the_diagram_module_is_a_grid(client, monkeypatch):
+@pytest.mark.parametrize("name", ["msl_friction.json", "robot_r3/OneAxis.json"])
+def test_a_1d_model_runs_and_says_the_3d_view_has_nothing_to_show(client, name, caplog):
+    data = client.get("/api/open", params={"path": f"models/{name}"}).json()["model"]
+    answer = wait(client, client.post("/api/run", json={"model": data, "settings": {
+        "n_points": 11, "t_end": 0.1}, "path": f"models/{name}"}).json()["run"])
+    assert answer["state"] == "done", answer["error"]
+    assert answer["results"]["animation"] is None
+    assert answer["results"]["animation_note"] == results.NO_SCENE
+    assert not [r for r in caplog.records if r.levelname in ("WARNING", "ERROR")]
+
+
+def test_layout_without_the_diagram_module_is_a_grid(root, monkeypatch):
     monkeypatch.setitem(sys.modules, "kinetwork.diagram", None)
-    layout = client.post("/api/layout", json={"model": seed(client)}).json()["layout"]
+    layout = checks.layout(kn.load(root / SEED))
     assert len({(p["x"], p["y"]) for p in layout.values()}) == len(layout) == 9
 
 

@@ -15,7 +15,7 @@ function start() {
     return;
   }
   const animation = JSON.parse(node.textContent);
-  window.kinetworkPlayer = createViewer(root, animation, { controls: true, autoplay: true });
+  /** @type {any} */ (window).kinetworkPlayer = createViewer(root, animation, { controls: true, autoplay: true });
 }
 
 if (document.readyState === "loading") document.addEventListener("DOMContentLoaded", start);

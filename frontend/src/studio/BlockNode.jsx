@@ -2,17 +2,21 @@
 // (coloured by domain, as Modelica draws connectors), and what validation says about it.
 import { memo } from "react";
 import { Handle, Position } from "@xyflow/react";
-import { DOMAIN_COLORS, portSide } from "./model.js";
+import { DOMAIN_COLORS, portSide, rotatedSide } from "./model.js";
+import { blockText } from "./problems.js";
 import { TypeIcon } from "./icons.jsx";
 
 const POS = { left: Position.Left, right: Position.Right, top: Position.Top, bottom: Position.Bottom };
 export const BLOCK_W = 116;
 const PORT_STEP = 20;
 
-/** Where each port goes: {port, side, offset (0..1 along the side)}; the block's height. */
-export function blockGeometry(ports) {
+/**
+ * Where each port goes: {port, side, offset (0..1 along the side)}; the block's height. A
+ * block turned by ``rotation`` degrees has its ports on the sides turned with it.
+ */
+export function blockGeometry(ports, rotation = 0) {
   const sides = { left: [], right: [], top: [], bottom: [] };
-  for (const p of ports) sides[p.side || portSide(p.name, p.domain, ports)].push(p);
+  for (const p of ports) sides[rotatedSide(p.side || portSide(p.name, p.domain, ports), rotation)].push(p);
   const tall = Math.max(sides.left.length, sides.right.length);
   const height = Math.max(64, tall * PORT_STEP + 24);
   const out = [];
@@ -28,9 +32,9 @@ function shortType(type, subsystem) {
 }
 
 function BlockNode({ data, selected }) {
-  const { name, type, info, problems, subsystem, unknown } = data;
+  const { name, type, info, problems, subsystem, unknown, rotation } = data;
   const ports = info ? info.ports : data.ports || [];
-  const { handles, height } = blockGeometry(ports);
+  const { handles, height } = blockGeometry(ports, rotation);
   const bad = problems && problems.length > 0;
   const cls = ["kn-block", selected ? "selected" : "", bad ? "bad" : "", subsystem ? "subsystem" : "", unknown ? "unknown" : ""]
     .filter(Boolean)
@@ -41,7 +45,14 @@ function BlockNode({ data, selected }) {
       <div className="kn-block-icon">
         <TypeIcon type={type} subsystem={subsystem} />
       </div>
-      <div className="kn-block-type">{shortType(type, subsystem)}</div>
+      {bad ? (
+        // what is wrong, inside the block: it covers no neighbour (the whole text on hover)
+        <div className="kn-block-msg" data-testid={`node-msg-${name}`} title={problems.map((p) => p.text).join("\n")}>
+          {blockText(problems[0])}
+        </div>
+      ) : (
+        <div className="kn-block-type">{shortType(type, subsystem)}</div>
+      )}
       {handles.map(({ port, side, offset }) => {
         const color = DOMAIN_COLORS[port.domain] || "#888";
         const along = `${offset * 100}%`;
@@ -62,14 +73,8 @@ function BlockNode({ data, selected }) {
         );
       })}
       {bad && (
-        <div className="kn-block-badge" data-testid={`node-bad-${name}`} title={problems.map((p) => p.message).join("\n")}>
+        <div className="kn-block-badge" data-testid={`node-bad-${name}`} title={problems.map((p) => p.text).join("\n")}>
           {problems.length}
-        </div>
-      )}
-      {bad && (
-        <div className="kn-block-msg" data-testid={`node-msg-${name}`} title={problems.map((p) => p.message).join("\n")}>
-          {problems[0].message}
-          {problems.length > 1 ? ` (+${problems.length - 1})` : ""}
         </div>
       )}
     </div>

@@ -1,133 +1,129 @@
 // The diagram: React Flow in loose connection mode (any port to any port; the domain rule
-// decides), blocks placed from the palette by drag and drop, positions committed on drop.
+// decides), blocks placed from the palette by drag and drop. The document says where blocks
+// are and what is selected; while the mouse drags, React Flow's positions are shown, and the
+// drop commits them to the model (one undo step).
 import { useCallback, useEffect, useMemo, useRef, useState } from "react";
-import {
-  Background,
-  ConnectionMode,
-  Controls,
-  MiniMap,
-  ReactFlow,
-  applyEdgeChanges,
-  applyNodeChanges,
-  useNodesInitialized,
-  useReactFlow,
-} from "@xyflow/react";
+import { Background, ConnectionMode, Controls, MiniMap, ReactFlow, useNodesInitialized, useReactFlow, useStoreApi } from "@xyflow/react";
 import BlockNode from "./BlockNode.jsx";
 import PortNode from "./PortNode.jsx";
 import { GRID, SCALE } from "./model.js";
+import { studio, useStudio } from "./store.js";
+import { edgeData } from "./hooks/useEditing.js";
 
 const nodeTypes = { block: BlockNode, extport: PortNode };
 export const DRAG_MIME = "application/x-kinetwork-type";
+/** A right button released this close to where it went down opens the menu (else it panned). */
+const CLICK_SLOP = 5;
 
-export default function Canvas({
-  nodesIn,
-  edgesIn,
-  selectRequest,
-  fitRequest,
-  placed,
-  checkConnection,
-  onConnectPorts,
-  onRefused,
-  onMoved,
-  onDelete,
-  onDropType,
-  onOpenNode,
-  onSelection,
-}) {
-  const [nodes, setNodes] = useState([]);
-  const [edges, setEdges] = useState([]);
-  const dragging = useRef(false);
-  const applied = useRef(null);
+function sameList(a, b) {
+  return a.length === b.length && a.every((x, i) => x === b[i]);
+}
+
+/**
+ * @param {{nodes: any[], edges: any[], placed: boolean, edit: import("./hooks/useEditing.js").Edit}} props
+ */
+export default function Canvas({ nodes: nodesIn, edges: edgesIn, placed, edit }) {
   const flow = useReactFlow();
+  const rf = useStoreApi();
+  const selection = useStudio((s) => s.selection);
+  const selectedEdges = useStudio((s) => s.selectedEdges);
+  const fitRequest = useStudio((s) => s.fitRequest);
+  // what React Flow holds while the mouse works: positions being dragged, measured sizes
+  const [dragPos, setDragPos] = useState({});
+  const [measured, setMeasured] = useState({});
 
-  // the document's nodes, keeping what React Flow holds of its own (selection, a drag)
-  useEffect(() => {
-    setNodes((prev) => {
-      const old = new Map(prev.map((n) => [n.id, n]));
-      // a request to select is applied once; after that, React Flow's selection holds
-      const fresh = selectRequest && selectRequest !== applied.current;
-      applied.current = selectRequest;
-      const want = fresh ? new Set(selectRequest.names) : null;
-      return nodesIn.map((n) => {
-        const o = old.get(n.id);
-        const selected = want ? want.has(n.id) : o ? !!o.selected : false;
-        const position = dragging.current && o ? o.position : n.position;
-        return o && o.measured ? { ...n, position, selected, measured: o.measured } : { ...n, position, selected };
-      });
+  const nodes = useMemo(() => {
+    const chosen = new Set(selection);
+    return nodesIn.map((n) => {
+      const out = { ...n, selected: chosen.has(n.id), position: dragPos[n.id] || n.position };
+      return measured[n.id] ? { ...out, measured: measured[n.id] } : out;
     });
-  }, [nodesIn, selectRequest]);
+  }, [nodesIn, selection, dragPos, measured]);
 
+  const edges = useMemo(() => {
+    const chosen = new Set(selectedEdges);
+    return edgesIn.map((e) => (chosen.has(e.id) ? { ...e, selected: true } : e));
+  }, [edgesIn, selectedEdges]);
+
+  // a selection set by the studio (not by a box): React Flow's box over the last one goes,
+  // or it would take the clicks (a double-click on a block made a subsystem did nothing)
+  const own = useRef(false);
   useEffect(() => {
-    setEdges((prev) => {
-      const old = new Map(prev.map((e) => [e.id, e]));
-      return edgesIn.map((e) => ({ ...e, selected: old.has(e.id) ? !!old.get(e.id).selected : false }));
-    });
-  }, [edgesIn]);
+    if (own.current) own.current = false;
+    else rf.setState({ nodesSelectionActive: false });
+  }, [selection, rf]);
+
+  const onNodesChange = useCallback((changes) => {
+    let drag = null;
+    let sizes = null;
+    let picked = null;
+    for (const c of changes) {
+      if (c.type === "position" && c.position) (drag = drag || {})[c.id] = c.position;
+      else if (c.type === "dimensions" && c.dimensions) (sizes = sizes || {})[c.id] = c.dimensions;
+      else if (c.type === "select") (picked = picked || new Map()).set(c.id, c.selected);
+    }
+    if (drag) setDragPos((d) => ({ ...d, ...drag }));
+    if (sizes) setMeasured((m) => ({ ...m, ...sizes }));
+    if (picked) {
+      const now = studio().selection;
+      const next = [...now.filter((id) => picked.get(id) !== false), ...[...picked].filter(([id, on]) => on && !now.includes(id)).map(([id]) => id)];
+      if (!sameList(now, next)) {
+        own.current = true;
+        studio().select(next, studio().selectedEdges);
+      }
+    }
+  }, []);
+
+  const onEdgesChange = useCallback((changes) => {
+    const picked = changes.filter((c) => c.type === "select");
+    if (!picked.length) return;
+    const now = studio().selectedEdges;
+    const on = new Set(now);
+    for (const c of picked) {
+      if (c.selected) on.add(c.id);
+      else on.delete(c.id);
+    }
+    const next = [...on];
+    if (!sameList(now, next)) {
+      own.current = true;
+      studio().select(studio().selection, next);
+    }
+  }, []);
+
+  const onNodeDragStop = useCallback(
+    (_event, _node, dragged) => {
+      const moved = {};
+      for (const n of dragged || []) moved[n.id] = { x: Math.round(n.position.x / SCALE), y: Math.round(n.position.y / SCALE) };
+      edit.moved(moved);
+      setDragPos({});
+    },
+    [edit],
+  );
 
   // fit the view to a model just opened, once its blocks are measured
   const initialized = useNodesInitialized();
-  const pendingFit = useRef(0);
+  const fitted = useRef(0);
   useEffect(() => {
-    if (fitRequest) pendingFit.current = fitRequest;
-  }, [fitRequest]);
-  useEffect(() => {
-    if (!pendingFit.current || !initialized || !nodes.length || !placed) return undefined;
-    if (nodes.length !== nodesIn.length || nodes.some((n, i) => n.id !== nodesIn[i].id)) return undefined;
+    if (!fitRequest || fitted.current === fitRequest || !initialized || !nodes.length || !placed) return undefined;
     const id = requestAnimationFrame(() => {
       flow.fitView({ padding: 0.15, maxZoom: 1.1, duration: 0 });
-      pendingFit.current = 0;
+      fitted.current = fitRequest;
     });
     return () => cancelAnimationFrame(id);
-  }, [fitRequest, initialized, nodes, nodesIn, placed, flow]);
+  }, [fitRequest, initialized, nodes, placed, flow]);
 
-  const onNodesChange = useCallback((changes) => {
-    setNodes((ns) => applyNodeChanges(changes, ns));
-  }, []);
-  const onEdgesChange = useCallback((changes) => setEdges((es) => applyEdgeChanges(changes, es)), []);
-
-  const onNodeDragStart = useCallback(() => {
-    dragging.current = true;
-  }, []);
-  const onNodeDragStop = useCallback(
-    (_event, _node, dragged) => {
-      dragging.current = false;
-      const moved = {};
-      for (const n of dragged || []) {
-        moved[n.id] = { x: Math.round(n.position.x / SCALE), y: Math.round(n.position.y / SCALE) };
-      }
-      onMoved(moved);
-    },
-    [onMoved],
-  );
-
-  const isValidConnection = useCallback(
-    (c) => checkConnection(`${c.source}.${c.sourceHandle}`, `${c.target}.${c.targetHandle}`) === null,
-    [checkConnection],
-  );
-  const onConnect = useCallback(
-    (c) => onConnectPorts(`${c.source}.${c.sourceHandle}`, `${c.target}.${c.targetHandle}`),
-    [onConnectPorts],
-  );
+  const isValidConnection = useCallback((c) => edit.checkConnection(`${c.source}.${c.sourceHandle}`, `${c.target}.${c.targetHandle}`) === null, [edit]);
+  const onConnect = useCallback((c) => edit.connect(`${c.source}.${c.sourceHandle}`, `${c.target}.${c.targetHandle}`), [edit]);
   const onConnectEnd = useCallback(
     (_event, state) => {
       if (!state || state.isValid !== false || !state.toHandle || !state.fromHandle) return;
       const a = `${state.fromHandle.nodeId}.${state.fromHandle.id}`;
       const b = `${state.toHandle.nodeId}.${state.toHandle.id}`;
       if (a === b) return; // a click on a handle
-      const why = checkConnection(a, b);
-      if (why) onRefused(why);
+      const why = edit.checkConnection(a, b);
+      if (why) studio().toast(why);
     },
-    [checkConnection, onRefused],
-  );
-
-  const onDeleteCb = useCallback(
-    ({ nodes: ns, edges: es }) => onDelete(ns.map((n) => n.id), es.map((e) => e.data)),
-    [onDelete],
-  );
-
-  const onSelectionChange = useCallback(
-    ({ nodes: ns, edges: es }) => onSelection(ns.map((n) => n.id), es.map((e) => e.data)),
-    [onSelection],
+    [edit],
   );
 
   const onDragOver = useCallback((e) => {
@@ -142,32 +138,70 @@ export default function Canvas({
       if (!type) return;
       e.preventDefault();
       const p = flow.screenToFlowPosition({ x: e.clientX, y: e.clientY });
-      onDropType(type, { x: p.x - 58, y: p.y - 32 });
+      edit.place(type, { x: p.x - 58, y: p.y - 32 });
     },
-    [flow, onDropType],
+    [flow, edit],
   );
 
-  const onNodeDoubleClick = useCallback((_e, node) => onOpenNode(node.id), [onOpenNode]);
+  // the pointer's place, where Ctrl+V pastes
+  const onMouseMove = useCallback(
+    (e) => {
+      const p = flow.screenToFlowPosition({ x: e.clientX, y: e.clientY });
+      studio().setPointer({ x: p.x / SCALE, y: p.y / SCALE });
+    },
+    [flow],
+  );
+  const onMouseLeave = useCallback(() => studio().setPointer(null), []);
+
+  // the right-click menu: opened on a click of the right button, not after it panned
+  const rightDown = useRef(null);
+  const onMouseDownCapture = useCallback((e) => {
+    if (e.button === 2) rightDown.current = { x: e.clientX, y: e.clientY };
+  }, []);
+  const openMenu = useCallback((e, target) => {
+    e.preventDefault();
+    const down = rightDown.current;
+    if (down && Math.hypot(e.clientX - down.x, e.clientY - down.y) > CLICK_SLOP) return;
+    const p = flow.screenToFlowPosition({ x: e.clientX, y: e.clientY });
+    if (target.kind === "node" && !studio().selection.includes(target.id)) studio().select([target.id]);
+    studio().setMenu({ x: e.clientX, y: e.clientY, at: { x: p.x / SCALE, y: p.y / SCALE }, target });
+  }, [flow]);
+  const onNodeContextMenu = useCallback((e, node) => openMenu(e, { kind: node.type === "extport" ? "port" : "node", id: node.id }), [openMenu]);
+  const onPaneContextMenu = useCallback((e) => openMenu(e, { kind: "pane" }), [openMenu]);
+  const onSelectionContextMenu = useCallback((e) => openMenu(e, { kind: "selection" }), [openMenu]);
+  const onEdgeContextMenu = useCallback((e, edge) => openMenu(e, { kind: "edge", id: edge.id, data: edgeData(edge.id) }), [openMenu]);
+  const onPaneClick = useCallback(() => studio().setMenu(null), []);
+
+  const onNodeDoubleClick = useCallback((_e, node) => edit.open(node.id), [edit]);
 
   const defaultEdgeOptions = useMemo(() => ({ type: "smoothstep", pathOptions: { borderRadius: 6 } }), []);
 
   return (
-    <div className="kn-canvas" data-testid="canvas" onDragOver={onDragOver} onDrop={onDrop}>
+    <div
+      className="kn-canvas"
+      data-testid="canvas"
+      onDragOver={onDragOver}
+      onDrop={onDrop}
+      onMouseMove={onMouseMove}
+      onMouseLeave={onMouseLeave}
+      onMouseDownCapture={onMouseDownCapture}
+    >
       <ReactFlow
         nodes={nodes}
         edges={edges}
         nodeTypes={nodeTypes}
         onNodesChange={onNodesChange}
         onEdgesChange={onEdgesChange}
-        onNodeDragStart={onNodeDragStart}
         onNodeDragStop={onNodeDragStop}
         onConnect={onConnect}
         onConnectEnd={onConnectEnd}
         isValidConnection={isValidConnection}
-        onDelete={onDeleteCb}
-        onSelectionChange={onSelectionChange}
         onNodeDoubleClick={onNodeDoubleClick}
-        onPaneContextMenu={(e) => e.preventDefault()}
+        onNodeContextMenu={onNodeContextMenu}
+        onPaneContextMenu={onPaneContextMenu}
+        onSelectionContextMenu={onSelectionContextMenu}
+        onEdgeContextMenu={onEdgeContextMenu}
+        onPaneClick={onPaneClick}
         connectionMode={ConnectionMode.Loose}
         defaultEdgeOptions={defaultEdgeOptions}
         snapToGrid
@@ -177,6 +211,7 @@ export default function Canvas({
         selectionKeyCode={null}
         multiSelectionKeyCode={["Meta", "Control", "Shift"]}
         deleteKeyCode={null}
+        disableKeyboardA11y
         zoomOnDoubleClick={false}
         minZoom={0.1}
         maxZoom={3}
@@ -185,7 +220,7 @@ export default function Canvas({
       >
         <Background gap={GRID * 2} size={1} color="#d4d8de" />
         <Controls showInteractive={false} />
-        <MiniMap pannable zoomable nodeStrokeWidth={2} nodeColor={(n) => (n.data.problems && n.data.problems.length ? "#e05555" : "#c9ced6")} style={{ width: 140, height: 90 }} />
+        <MiniMap pannable zoomable nodeStrokeWidth={2} nodeColor={(n) => (/** @type {any} */ (n.data).problems?.length ? "#e05555" : "#c9ced6")} style={{ width: 140, height: 90 }} />
       </ReactFlow>
     </div>
   );

@@ -1,4 +1,5 @@
-// Modal dialogs: Open (the root's model files and the shipped examples) and a one-line prompt.
+// Modal dialogs: Open (the root's model files and the shipped examples), a one-line prompt,
+// and a choice among a few buttons (unsaved changes, a file changed on disk, a recovery).
 import { useEffect, useRef, useState } from "react";
 import { api } from "./api.js";
 
@@ -21,7 +22,7 @@ function Modal({ title, onClose, children, testid }) {
   );
 }
 
-export function OpenDialog({ onOpen, onClose, dirty }) {
+export function OpenDialog({ onOpen, onClose }) {
   const [files, setFiles] = useState(null);
   const [root, setRoot] = useState("");
   const [examples, setExamples] = useState(null);
@@ -34,7 +35,6 @@ export function OpenDialog({ onOpen, onClose, dirty }) {
   const f = filter.toLowerCase();
   return (
     <Modal title="Open a model" onClose={onClose} testid="open-dialog">
-      {dirty ? <div className="kn-warn">The model has unsaved changes: opening another discards them.</div> : null}
       <input className="kn-input" autoFocus placeholder="Filter…" value={filter} onChange={(e) => setFilter(e.target.value)} data-testid="open-filter" />
       {error ? <div className="kn-problem">{error}</div> : null}
       <div className="kn-open-cols">
@@ -83,6 +83,22 @@ export function PromptDialog({ title, label, value, onOk, onClose, testid }) {
       <div className="kn-modal-buttons">
         <button className="kn-btn" onClick={onClose}>Cancel</button>
         <button className="kn-btn kn-primary" data-testid="prompt-ok" onClick={() => onOk(text)}>OK</button>
+      </div>
+    </Modal>
+  );
+}
+
+/** A question and its answers as buttons; Escape or a click outside is no answer (null). */
+export function ChoiceDialog({ title, message, choices, resolve, testid }) {
+  return (
+    <Modal title={title} onClose={() => resolve(null)} testid={testid || "choice-dialog"}>
+      <div className="kn-choice-message">{message}</div>
+      <div className="kn-modal-buttons">
+        {choices.map((c) => (
+          <button key={c.id} className={`kn-btn ${c.primary ? "kn-primary" : ""}`} data-testid={`choice-${c.id}`} autoFocus={!!c.primary} onClick={() => resolve(c.id)}>
+            {c.label}
+          </button>
+        ))}
       </div>
     </Modal>
   );

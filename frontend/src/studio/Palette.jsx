@@ -3,25 +3,13 @@
 // (or the last clicked) is described below the list: doc, ports, parameters with units.
 import { useMemo, useState } from "react";
 import { TypeIcon, LIBRARY_COLORS } from "./icons.jsx";
-import { DOMAIN_COLORS, formatValue } from "./model.js";
+import { DOMAIN_COLORS } from "./model.js";
+import { formatValue } from "./values.js";
 import { DRAG_MIME } from "./Canvas.jsx";
+import { search } from "./search.js";
 
 function firstLine(doc) {
   return String(doc || "").trim().split("\n")[0];
-}
-
-/** A doc's first sentence: what a search looks in, beside names. */
-function firstSentence(doc) {
-  const line = firstLine(doc);
-  const m = /\.(\s|$)/.exec(line);
-  return m ? line.slice(0, m.index + 1) : line;
-}
-
-function matches(t, q) {
-  if (!q) return true;
-  // the type's name, the first sentence of its doc and its parameters' names
-  const hay = `${t.type} ${firstSentence(t.doc)} ${(t.params || []).map((p) => p.name).join(" ")}`.toLowerCase();
-  return q.toLowerCase().split(/\s+/).every((w) => hay.includes(w));
 }
 
 export function TypeInfoCard({ info }) {
@@ -76,23 +64,27 @@ export function TypeInfoCard({ info }) {
   );
 }
 
+/**
+ * @param {{palette: any, definitions: any[], onAdd: (type: string) => void}} props
+ */
 export default function Palette({ palette, definitions, onAdd }) {
   const [query, setQuery] = useState("");
   const [shown, setShown] = useState(null);
   const [collapsed, setCollapsed] = useState({});
+  // the libraries; while searching, one list of what matches, best first
   const libs = useMemo(() => {
     if (!palette) return [];
-    const out = palette.libraries.map((lib) => ({ name: lib.name, types: lib.types.filter((t) => matches(t, query)) }));
-    if (definitions && definitions.length) {
-      out.push({ name: "subsystems", types: definitions.filter((t) => matches(t, query)), subsystem: true });
-    }
-    return out.filter((l) => l.types.length);
+    const all = palette.libraries.map((lib) => ({ name: lib.name, types: lib.types }));
+    if (definitions && definitions.length) all.push({ name: "subsystems", types: definitions, subsystem: true });
+    if (!query.trim()) return all;
+    const subsystems = new Set((definitions || []).map((d) => d.type));
+    const found = search(all.flatMap((l) => l.types), query);
+    return found.length ? [{ name: "matches", types: found, ranked: true, subsystems }] : [];
   }, [palette, definitions, query]);
-
   const info = shown && ((palette && palette.types[shown]) || (definitions || []).find((d) => d.type === shown));
 
   return (
-    <div className="kn-palette" data-testid="palette" data-ready={palette ? "1" : "0"}>
+    <div className="kn-palette" data-testid="palette" data-ready={palette ? "1" : "0"} data-query={query}>
       <input
         className="kn-search"
         type="search"
@@ -103,11 +95,13 @@ export default function Palette({ palette, definitions, onAdd }) {
       />
       <div className="kn-palette-list">
         {!palette && <div className="kn-muted kn-pad">Loading the palette…</div>}
+        {palette && query.trim() && !libs.length ? <div className="kn-muted kn-pad" data-testid="palette-none">Nothing matches “{query.trim()}”.</div> : null}
         {libs.map((lib) => (
           <div key={lib.name} className="kn-lib">
             <div
               className="kn-lib-name"
               style={{ borderLeftColor: LIBRARY_COLORS[lib.subsystem ? "subsystem" : lib.name] || "#888" }}
+              data-testid={`palette-lib-${lib.name}`}
               onClick={() => setCollapsed((c) => ({ ...c, [lib.name]: !c[lib.name] }))}
             >
               <span>{collapsed[lib.name] && !query ? "▸" : "▾"}</span> {lib.name}
@@ -131,9 +125,12 @@ export default function Palette({ palette, definitions, onAdd }) {
                     .map((p) => `${p.name}${p.unit ? ` [${p.unit}]` : ""}${p.doc ? `: ${p.doc}` : ""}`)
                     .join("\n")}`}
                 >
-                  <TypeIcon type={t.type} subsystem={lib.subsystem} size={0.75} />
+                  <TypeIcon type={t.type} subsystem={lib.subsystem || (lib.subsystems && lib.subsystems.has(t.type))} size={0.75} />
                   <div className="kn-palette-text">
-                    <div className="kn-palette-type">{t.type.split(".").pop()}</div>
+                    <div className="kn-palette-type">
+                      {t.type.split(".").pop()}
+                      {lib.ranked && t.type.includes(".") ? <span className="kn-muted kn-small"> {t.type.split(".")[0]}</span> : null}
+                    </div>
                     <div className="kn-palette-doc">{firstLine(t.doc)}</div>
                   </div>
                 </div>

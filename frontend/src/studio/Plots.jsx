@@ -1,13 +1,16 @@
 // Probe plots (uPlot): one panel per probe quantity of the last run, chosen by chips; the
-// last few runs overlaid (older ones dashed and faded); drag to zoom (all panels follow),
+// last few runs overlaid (older ones dashed and faded), each named by what differed; a
+// sweep's members overlaid, each named by its values; drag to zoom (all panels follow),
 // double-click to zoom out; the cursor shows values and moves the 3-D view in time.
 import { useEffect, useMemo, useRef, useState } from "react";
 import uPlot from "uplot";
 import "uplot/dist/uPlot.min.css";
+import { OVERLAY } from "./hooks/useRun.js";
+import { memberLabel } from "./runs.js";
+import { TESTING, trace } from "./testing.js";
 
 const COLORS = ["#1f77b4", "#d62728", "#2ca02c", "#9467bd", "#ff7f0e", "#17becf", "#8c564b", "#e377c2", "#7f7f7f"];
 const AXES = ["x", "y", "z"];
-export const OVERLAY = 3;
 
 function components(sig) {
   // a signal's columns: scalars one, vectors (3,) x y z, matrices flattened
@@ -35,55 +38,74 @@ function fmt(v) {
   return v.toFixed(4);
 }
 
-function shortName(name) {
-  // "probe1.angle" -> "probe1"; "upper.p1.angle" -> "upper.p1"
+/** The probe a signal is of ("probe1", "upper.p1"): its descriptor's, sent by the server. */
+function probeOf(sig, name) {
+  if (sig && sig.probe) return sig.probe;
   const i = name.lastIndexOf(".");
   return i < 0 ? name : name.slice(0, i);
 }
 
-export function quantityOf(name) {
+/** The quantity a signal records ("angle"): its descriptor's, sent by the server. */
+export function quantityOf(sig, name) {
+  if (sig && sig.quantity) return sig.quantity;
   const i = name.lastIndexOf(".");
   return i < 0 ? name : name.slice(i + 1);
 }
 
+/**
+ * The curves a run entry draws: one for a run, one per member for a sweep (members that
+ * have results), each with its name.
+ */
+export function sourcesOf(entry) {
+  if (entry.kind === "sweep") {
+    return (entry.members || []).filter((m) => m.results && m.results.t.length).map((m) => ({ results: m.results, label: memberLabel(m) || `member ${m.index}` }));
+  }
+  return [{ results: entry.results, label: entry.label || `run ${entry.n}` }];
+}
+
 /** uPlot's data and series for the signals ``names`` of the last runs (latest first). */
 function buildData(names, runs) {
-  const t0 = runs[0].results.t;
+  const sources = runs.slice(0, OVERLAY).flatMap((run, r) => sourcesOf(run).map((src, m) => ({ ...src, r, m, sweep: run.kind === "sweep" })));
+  const t0 = sources[0].results.t;
   const series = [{ label: "t [s]", value: (u, v) => (v == null ? "–" : v.toFixed(3)) }];
   const tables = [];
   const columns = {};
   let unit = "";
-  runs.slice(0, OVERLAY).forEach((run, r) => {
-    let color = 0;
+  let color = 0;
+  for (const src of sources) {
+    // a signal has its colour in every run; a sweep's members each their own
+    if (!src.sweep || src.m === 0) color = 0;
     for (const name of names) {
-      const sig = run.results.signals.find((s) => s.name === name);
+      const sig = src.results.signals.find((s) => s.name === name);
       const { cols, labels } = sig ? components(sig) : { cols: [], labels: [] };
       if (sig && !unit) unit = sig.unit || "";
       cols.forEach((col, k) => {
         const c = COLORS[color++ % COLORS.length];
-        const label = names.length > 1 ? `${shortName(name)}${labels[k] ? ` ${labels[k]}` : ""}` : labels[k] || quantityOf(name);
+        const label = names.length > 1 ? `${probeOf(sig, name)}${labels[k] ? ` ${labels[k]}` : ""}` : labels[k] || quantityOf(sig, name);
+        const older = src.r > 0;
         series.push({
-          label: `${label}${r ? ` (run ${run.n})` : ""}`,
-          stroke: r ? `${c}66` : c,
-          width: r ? 1 : 1.6,
-          dash: r ? [5, 4] : undefined,
+          label: sources.length > 1 ? `${label} · ${src.label}` : label,
+          stroke: older ? `${c}66` : c,
+          width: older ? 1 : 1.6,
+          dash: older ? [5, 4] : undefined,
           value: (u, v) => fmt(v),
           points: { show: false },
           spanGaps: true,
         });
-        if (r === 0) (columns[name] = columns[name] || []).push(tables.length + 1);
-        tables.push({ t: run.results.t, y: col });
+        if (src.r === 0 && src.m === 0) (columns[name] = columns[name] || []).push(tables.length + 1);
+        tables.push({ t: src.results.t, y: col });
       });
-      if (!sig && r === 0) columns[name] = [];
+      if (!sig && src.r === 0 && src.m === 0) columns[name] = [];
     }
-  });
+  }
   let data;
   if (tables.every((tb) => sameGrid(tb.t, t0))) {
     data = [t0, ...tables.map((tb) => tb.y)];
   } else {
     data = uPlot.join(tables.map((tb) => [tb.t, tb.y]));
   }
-  const latestCount = Object.values(columns).reduce((a, c) => a + c.length, 0);
+  const latest = sources.filter((src) => src.r === 0).length;
+  const latestCount = Object.values(columns).reduce((a, c) => a + c.length, 0) * latest;
   return { series, data, unit, columns, latestCount };
 }
 
@@ -131,18 +153,19 @@ function Panel({ title, names, runs, bus, width, height }) {
     plotRef.current = u;
     // the legend lists the latest run; older runs are drawn dashed (named in the header)
     u.root.querySelectorAll(".u-legend .u-series").forEach((row, i) => {
-      if (i > built.latestCount) row.style.display = "none";
+      if (i > built.latestCount) /** @type {HTMLElement} */ (row).style.display = "none";
     });
     bus.plots.add(u);
-    // what is drawn, for tests: per signal, t and its columns of the latest run
-    const K = (window.__kinetwork = window.__kinetwork || {});
-    K.plotted = K.plotted || {};
-    for (const [name, idx] of Object.entries(built.columns)) K.plotted[name] = [built.data[0], ...idx.map((i) => built.data[i])];
-    K.plottedSeries = K.plottedSeries || {};
-    K.plottedSeries[title] = built.series.length - 1;
+    if (TESTING) {
+      // what is drawn: per signal, t and its columns of the latest run
+      for (const [name, idx] of Object.entries(built.columns)) trace.plotted[name] = [built.data[0], ...idx.map((i) => built.data[i])];
+      trace.plottedSeries[title] = built.series.length - 1;
+    }
     return () => {
-      for (const name of Object.keys(built.columns)) delete K.plotted[name];
-      delete K.plottedSeries[title];
+      if (TESTING) {
+        for (const name of Object.keys(built.columns)) delete trace.plotted[name];
+        delete trace.plottedSeries[title];
+      }
       bus.plots.delete(u);
       u.destroy();
       plotRef.current = null;
@@ -166,12 +189,16 @@ function fmt0(v) {
   return String(+v.toPrecision(6));
 }
 
-export function makeBus() {
+/**
+ * What the plots share: their uPlot instances (zoom and cursor move together) and the time.
+ * @param {(t: number) => void} cursor called when the user moves a plot's cursor to time t
+ */
+export function makeBus(cursor) {
   return {
     plots: new Set(),
     silent: false,
     zooming: false,
-    cursor: () => {},
+    cursor,
     // the 3-D view playing: the plots' cursors follow at most ten times a second (moving a
     // uPlot cursor redraws its legend: at every frame it would halve the 3-D frame rate)
     pending: null,
@@ -185,7 +212,7 @@ export function makeBus() {
       }, 100);
     },
     setTime(t) {
-      window.__kinetwork.plotTime = t;
+      if (TESTING) trace.plotTime = t;
       this.silent = true;
       try {
         for (const u of this.plots) {
@@ -215,20 +242,22 @@ export default function Plots({ runs, bus, running, progress, status }) {
     return () => ro.disconnect();
   }, []);
   const latest = runs[0];
-  const names = useMemo(() => (latest ? latest.results.signals.map((s) => s.name) : []), [latest]);
+  const signals = useMemo(() => (latest ? sourcesOf(latest)[0].results.signals : []), [latest]);
+  const names = useMemo(() => signals.map((s) => s.name), [signals]);
   // panels: one per quantity (every probe's angle together, as the seed paper plots them),
   // or one per signal
   const panels = useMemo(() => {
     const shown = names.filter((n) => !hidden.has(n));
     if (!byQuantity) return shown.map((n) => ({ title: n, names: [n] }));
     const groups = new Map();
+    const byName = new Map(signals.map((s) => [s.name, s]));
     for (const n of shown) {
-      const q = quantityOf(n);
+      const q = quantityOf(byName.get(n), n);
       if (!groups.has(q)) groups.set(q, []);
       groups.get(q).push(n);
     }
     return [...groups].map(([q, ns]) => ({ title: q, names: ns }));
-  }, [names, hidden, byQuantity]);
+  }, [signals, names, hidden, byQuantity]);
   const cols = width > 1000 ? 3 : width > 500 ? 2 : 1;
   const panelWidth = Math.floor((width - 12 * cols) / cols) - 8;
   // the panels fill the height they have (a title and a legend around each plot)
@@ -239,10 +268,11 @@ export default function Plots({ runs, bus, running, progress, status }) {
       <div className="kn-plots-head">
         <span className="kn-panel-title-inline">Probes</span>
         {latest ? (
-          <span className="kn-muted kn-small kn-runinfo">
-            run {latest.n}
-            {latest.state !== "done" ? ` (${latest.state})` : ""} · {latest.results.t.length} points
-            {runs.length > 1 ? ` · dashed: run ${runs.slice(1, OVERLAY).map((r) => r.n).join(", ")}` : ""}
+          <span className="kn-muted kn-small kn-runinfo" data-testid="plot-runs">
+            <b>{latest.label}</b>
+            {latest.kind !== "sweep" ? ` · ${latest.results.t.length} points` : ""}
+            {latest.kind !== "sweep" && latest.results.partial ? ` · partial, to t = ${Number(latest.results.partial.t_reached).toPrecision(4)} s` : ""}
+            {runs.length > 1 ? ` · dashed: ${runs.slice(1, OVERLAY).map((r) => r.label).join("; ")}` : ""}
           </span>
         ) : null}
         {latest ? (

@@ -1,6 +1,12 @@
-// What validation (and the last run) says is wrong, each on the place it names: a click
-// goes to the block (opening the definition it is in).
-export default function Problems({ places, ok, count, onGo }) {
+// What validation (and the last run) says is wrong, in the user's words, each on the place it
+// names: a click goes to the block (opening the definition it is in).
+import { whereOf } from "./problems.js";
+
+/**
+ * @param {{places: import("./problems.js").Place[], ok: boolean | null, onGo: (p: any) => void}} props
+ */
+export default function Problems({ places, ok, onGo }) {
+  const count = places.length;
   return (
     <div className="kn-problems" data-testid="problems" data-count={count}>
       <div className="kn-panel-title">
@@ -12,13 +18,14 @@ export default function Problems({ places, ok, count, onGo }) {
           <div className="kn-muted kn-pad">{ok ? "The model is valid." : ok === null ? "Checking…" : "No problems reported."}</div>
         ) : (
           places.map((p, i) => (
-            <div key={i} className="kn-problem-item" data-testid="problem" onClick={() => onGo(p)} title="show it">
+            <div key={i} className={`kn-problem-item ${p.severity}`} data-testid="problem" onClick={() => onGo(p)} title={p.hint ? `${p.message}\n\n${p.hint}` : p.message}>
               <span className="kn-problem-where">
                 {p.run ? "run · " : ""}
                 {p.scope ? `${p.scope} › ` : ""}
-                {p.component || (p.connection !== null ? `connection ${p.connection}` : "model")}
+                {whereOf(p) || "model"}
               </span>
-              <span className="kn-problem-msg">{p.message}</span>
+              <span className="kn-problem-msg">{p.reason || p.text}</span>
+              {p.hint ? <span className="kn-problem-hint">{p.hint}</span> : null}
             </div>
           ))
         )}

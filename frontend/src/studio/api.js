@@ -27,8 +27,8 @@ async function call(method, path, body) {
   } catch (err) {
     throw new ApiError(`the studio server does not answer (${err.message}): is kinetwork studio still running?`, 0, null);
   }
-  let data = null;
   const text = await res.text();
+  let data;
   try {
     data = text ? JSON.parse(text) : null;
   } catch {
@@ -45,14 +45,24 @@ const q = encodeURIComponent;
 
 export const api = {
   palette: () => call("GET", "api/palette"),
+  facts: () => call("GET", "api/facts"),
   files: () => call("GET", "api/files"),
   examples: () => call("GET", "api/examples"),
   openPath: (path) => call("GET", `api/open?path=${q(path)}`),
   openExample: (name) => call("GET", `api/open?example=${q(name)}`),
   validate: (model, path) => call("POST", "api/validate", { model, path: path || null }),
-  save: (path, model, text) => call("POST", "api/save", { path, model, text }),
+  /** ``base``: the version of the file the model was based on (null: a new file). */
+  save: (path, model, text, base) => call("POST", "api/save", { path, model, text, base: base ?? null }),
+  autosave: (path, model, base, session) => call("POST", "api/autosave", { path: path || null, model, base: base ?? null, session }),
+  recovery: (path) => call("GET", path ? `api/recovery?path=${q(path)}` : "api/recovery"),
+  discardRecovery: (path) => call("POST", "api/recovery/discard", { path: path || null }),
   run: (model, settings, path) => call("POST", "api/run", { model, settings, path: path || null }),
-  runStatus: (id) => call("GET", `api/run/${q(id)}`),
-  cancel: (id) => call("POST", `api/run/${q(id)}/cancel`),
+  /** A run's state; ``wait``: seconds to wait for its end before answering. */
+  runStatus: (id, wait = 0) => call("GET", `api/run/${q(id)}?wait=${wait}`),
+  sweep: (model, sweep, path) => call("POST", "api/sweep", { model, sweep, path: path || null }),
+  sweepStatus: (id, wait = 0) => call("GET", `api/sweep/${q(id)}?wait=${wait}`),
+  /** Cancel run or sweep ``id`` (``kind`` "run" or "sweep"). */
+  cancel: (kind, id) => call("POST", `api/${kind === "sweep" ? "sweep" : "run"}/${q(id)}/cancel`),
+  linearize: (model, spec, path) => call("POST", "api/linearize", { model, ...spec, path: path || null }),
   layout: (model, path) => call("POST", "api/layout", { model, path: path || null }),
 };

@@ -1,6 +1,7 @@
 // Small schematic icons of the component types, in the spirit of the Modelica libraries'
 // diagrams: drawn in a 48 x 28 box, stroked in the library's colour.
 
+/** @type {import("react").SVGProps<SVGSVGElement>} */
 const S = { fill: "none", strokeWidth: 1.6, strokeLinecap: "round", strokeLinejoin: "round" };
 
 function Zigzag({ y = 14, x0 = 6, x1 = 42 }) {

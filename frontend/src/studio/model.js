@@ -17,8 +17,15 @@ export const GRID = 15; // snap grid in pixels (10 layout units)
 
 const SIGNALS = new Set(["signal_in", "signal_out"]);
 
-/** Why two ports cannot be wired (kn's Model.connect), or null when they can. */
-export function connectProblem(a, b, connections) {
+/**
+ * Why two ports cannot be wired, or null when they can: kn's Model.connect (same domain,
+ * not twice) and, given ``domainOf``, the signal rule of its validation (one source a signal).
+ * @param {{path: string, domain: string}} a
+ * @param {{path: string, domain: string}} b
+ * @param {string[][]} connections
+ * @param {(path: string) => string | null} [domainOf]
+ */
+export function connectProblem(a, b, connections, domainOf) {
   if (a.path === b.path) return `cannot connect ${a.path} to itself`;
   const da = a.domain;
   const db = b.domain;
@@ -31,7 +38,42 @@ export function connectProblem(a, b, connections) {
       return `${a.path} and ${b.path} are already connected`;
     }
   }
+  if (signals && domainOf) return signalSourceProblem(a.path, b.path, connections, domainOf);
   return null;
+}
+
+/** The ports wired together with ``path`` (its connection set), ``path`` included. */
+export function connectedSet(path, connections) {
+  const seen = new Set([path]);
+  const todo = [path];
+  while (todo.length) {
+    const p = todo.pop();
+    for (const [x, y] of connections || []) {
+      const other = x === p ? y : y === p ? x : null;
+      if (other !== null && !seen.has(other)) {
+        seen.add(other);
+        todo.push(other);
+      }
+    }
+  }
+  return seen;
+}
+
+/**
+ * Why wiring signal ports ``a`` and ``b`` would give a signal two sources (kn's rule: a
+ * signal connection set has exactly one output), or null.
+ * @param {(path: string) => string | null} domainOf
+ */
+export function signalSourceProblem(a, b, connections, domainOf) {
+  const outsOf = (p) => [...connectedSet(p, connections)].filter((q) => domainOf(q) === "signal_out");
+  const outA = outsOf(a);
+  const outB = outsOf(b);
+  if (!outA.length || !outB.length) return null;
+  if (domainOf(a) === "signal_out" && domainOf(b) === "signal_out") {
+    return `cannot connect ${a} to ${b}: both are signal outputs, and a signal has exactly one source`;
+  }
+  const [inPort, fed, other] = domainOf(a) === "signal_out" ? [b, outB[0], a] : [a, outA[0], b];
+  return `cannot connect ${other} to ${inPort}: ${inPort} is fed by ${fed} already, and a signal has exactly one source`;
 }
 
 /** Which side of a block a port sits on: left, right, top or bottom. */
@@ -172,6 +214,29 @@ export function resolveScope(scopes, ctx) {
     cur = { body: r.body, ctx: r.ctx, res: r };
   }
   return cur;
+}
+
+/**
+ * The document with ``fn`` applied to the body of the scope at the end of ``scopes`` (the
+ * model itself when there is none). Every definition on the way is made inline, so the edit
+ * is the one used; the document is unchanged when a scope cannot be resolved.
+ * @param {any} doc
+ * @param {string[]} scopes
+ * @param {{palette: any, docPath: string | null, defCache: any}} ctx
+ * @param {(body: any) => any} fn
+ */
+export function editInScope(doc, scopes, ctx, fn) {
+  if (!scopes.length) return fn(doc);
+  let c = { ...ctx, doc };
+  let out = doc;
+  for (let i = 0; i < scopes.length; i++) {
+    const r = resolveDef(scopes[i], c);
+    if (!r || !r.body) return doc;
+    if (i === scopes.length - 1) out = updateDefinition(out, ctx.docPath, scopes[i], r, fn);
+    else if (r.src.kind === "file") out = updateDefinition(out, ctx.docPath, scopes[i], r, (x) => x);
+    c = r.ctx;
+  }
+  return out;
 }
 
 const BODY_KEYS = ["description", "parameters", "ports", "components", "connections", "layout"];
@@ -341,68 +406,77 @@ export function setParam(body, cname, key, value) {
   };
 }
 
-// -- values: numbers, expressions, vectors ---------------------------------------------------
-
-/** A parameter value as text in an input: 1.5, "-L1/2" as -L1/2, [0, "-L1", 0] as [0, -L1, 0]. */
-export function formatValue(v) {
-  if (v === undefined || v === null) return "";
-  if (typeof v === "string") return v;
-  if (Array.isArray(v)) return `[${v.map(formatValue).join(", ")}]`;
-  if (typeof v === "number") return formatNumber(v);
-  return JSON.stringify(v);
+/** The components named, moved by (dx, dy) layout units from where they are shown. */
+export function moveComponents(body, names, dx, dy, positionOf) {
+  const layout = { ...(body.layout || {}) };
+  for (const n of names) {
+    const p = positionOf(n);
+    if (!p) continue;
+    layout[n] = { ...(layout[n] || {}), x: Math.round(p.x + dx), y: Math.round(p.y + dy) };
+  }
+  return { ...body, layout };
 }
 
-export function formatNumber(x) {
-  if (!Number.isFinite(x)) return String(x);
-  const a = Math.abs(x);
-  // the shortest text that reads back as the same number; 1e-06 rather than 0.000001
-  if (a !== 0 && (a < 1e-4 || a >= 1e15)) return x.toExponential();
-  return String(x);
+/** Components placed at ``moved`` (name -> {x, y}), keeping the rest of their layout entry. */
+export function placeComponents(body, moved) {
+  const old = body.layout || {};
+  const layout = { ...old };
+  let changed = false;
+  for (const [k, v] of Object.entries(moved)) {
+    if (old[k] && old[k].x === v.x && old[k].y === v.y) continue;
+    layout[k] = { ...(old[k] || {}), x: v.x, y: v.y };
+    changed = true;
+  }
+  return changed ? { ...body, layout } : body;
+}
+
+/** A block turned a quarter to the right: ``layout[name].rotation`` 0, 90, 180 or 270. */
+export function rotateComponent(body, name, positionOf) {
+  const old = (body.layout || {})[name] || positionOf(name) || { x: 0, y: 0 };
+  const rotation = (((old.rotation || 0) + 90) % 360 + 360) % 360;
+  const entry = { ...old, rotation };
+  if (!rotation) delete entry.rotation;
+  return { ...body, layout: { ...(body.layout || {}), [name]: entry } };
+}
+
+/** The side a port is drawn on once its block is turned by ``rotation`` degrees. */
+export function rotatedSide(side, rotation) {
+  const order = ["left", "top", "right", "bottom"];
+  const turns = Math.round(((rotation || 0) % 360 + 360) % 360 / 90);
+  const i = order.indexOf(side);
+  return i < 0 ? side : order[(i + turns) % 4];
 }
 
 /**
- * Text typed into a parameter field -> a file value: "" -> undefined (the default), a number,
- * an expression string, or a (nested) list of those for "[a, b, c]".
+ * A copy of components (with the wires among them) renamed to fresh names of ``body``, their
+ * top-left corner at ``at`` (layout units) or, without it, beside the originals, below them.
+ * @returns {{body: any, names: string[]}}
  */
-export function parseValue(text) {
-  const s = String(text).trim();
-  if (s === "") return undefined;
-  if (s.startsWith("[")) {
-    const items = splitList(s);
-    if (items) return items.map(parseValue).map((x) => (x === undefined ? 0 : x));
+export function pasteComponents(body, clip, at) {
+  const taken = takenNames(body);
+  const rename = {};
+  for (const c of clip.components) {
+    const n = freshName(c.name, taken);
+    taken.add(n);
+    rename[c.name] = n;
   }
-  if (s === "true") return true;
-  if (s === "false") return false;
-  if (/^[-+]?(\d+\.?\d*|\.\d+)([eE][-+]?\d+)?$/.test(s)) return Number(s);
-  return s;
-}
-
-function splitList(s) {
-  if (!s.endsWith("]")) return null;
-  const inner = s.slice(1, -1);
-  const items = [];
-  let depth = 0;
-  let cur = "";
-  for (const ch of inner) {
-    if (ch === "[" || ch === "(") depth++;
-    if (ch === "]" || ch === ")") depth--;
-    if (ch === "," && depth === 0) {
-      items.push(cur);
-      cur = "";
-    } else cur += ch;
-  }
-  if (cur.trim() !== "" || items.length) items.push(cur);
-  return items.map((x) => x.trim());
-}
-
-/** The identifiers an expression (or a nested value) mentions. */
-export function identifiers(value, out = new Set()) {
-  if (typeof value === "string") {
-    for (const m of value.matchAll(/[A-Za-z_][A-Za-z0-9_]*/g)) out.add(m[0]);
-  } else if (Array.isArray(value)) {
-    for (const v of value) identifiers(v, out);
-  }
-  return out;
+  const pts = clip.components.map((c) => clip.positions[c.name] || { x: 0, y: 0 });
+  const minX = Math.min(...pts.map((p) => p.x));
+  const minY = Math.min(...pts.map((p) => p.y));
+  const maxY = Math.max(...pts.map((p) => p.y));
+  const origin = at || { x: minX, y: maxY + 90 };
+  const re = (ref) => {
+    const [c, p] = String(ref).split(".");
+    return `${rename[c]}.${p}`;
+  };
+  let next = body;
+  clip.components.forEach((c, i) => {
+    const p = { x: Math.round((origin.x + pts[i].x - minX) / 10) * 10, y: Math.round((origin.y + pts[i].y - minY) / 10) * 10 };
+    const rotation = clip.rotations && clip.rotations[c.name];
+    next = addComponent(next, { ...clone(c), name: rename[c.name] }, rotation ? { ...p, rotation } : p);
+  });
+  next = { ...next, connections: [...(next.connections || []), ...clip.connections.map(([a, b]) => [re(a), re(b)])] };
+  return { body: next, names: Object.values(rename) };
 }
 
 // -- layout ---------------------------------------------------------------------------------

@@ -1,15 +1,16 @@
 // "Make subsystem": selected components of a scope become a new definition, placed once
 // where they were, with a port exposed for each of their ports wired across the selection.
-import { clone, identifiers, freshName, IDENT } from "./model.js";
+import { clone, freshName, IDENT } from "./model.js";
+import { identifiers } from "./values.js";
 
 /**
- * @param body   the scope's body (components, connections, layout, parameters)
- * @param names  the selected component names
- * @param defName the new definition's name (its type in the file)
- * @param instName the instance's name
- * @param positions name -> {x, y} (layout units) of every component as shown
- * @returns {body, definition}: the scope with the instance in place of the selection, and
- *   the definition's inline body.
+ * @param {any} body the scope's body (components, connections, layout, parameters)
+ * @param {string[]} names the selected component names
+ * @param {string} defName the new definition's name (its type in the file)
+ * @param {string} instName the instance's name
+ * @param {Record<string, {x: number, y: number}>} positions name -> {x, y} (layout units) of every component as shown
+ * @returns {{body: any, definition: any}} the scope with the instance in place of the
+ *   selection, and the definition's inline body.
  */
 export function makeSubsystem(body, names, defName, instName, positions) {
   const inside = new Set(names);

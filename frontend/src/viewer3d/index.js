@@ -63,7 +63,7 @@ export function createViewer(element, animation, options = {}) {
   const frameAxes = [];
   const ground = animation.shapes.find(s => s.kind === "grid");
   for (const shape of animation.shapes) {
-    const object = build(shape, data.scale);
+    const object = build(shape);
     if (!object) continue;
     if (shape.kind === "rod" || shape.kind === "spring") {
       scene.add(object);
@@ -359,7 +359,7 @@ function material(color) {
 
 // The three.js object of one shape, in the coordinates of its frame (or, between two
 // frames, a unit along y that `stretch` places).
-function build(shape, scale) {
+function build(shape) {
   const kind = shape.kind;
   if (kind === "box" || kind === "cylinder" || kind === "sphere") {
     const { length, width, height } = shape;

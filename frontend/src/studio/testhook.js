@@ -1,0 +1,47 @@
+// window.__kinetwork: the end-to-end tests' view of the store (getters, always current) and
+// a few handles (the 3-D viewer, the plots' time). Installed by main.jsx in test builds only.
+import { trace } from "./testing.js";
+
+/** @param {import("zustand").StoreApi<any>} store */
+export function installTestHook(store) {
+  const K = {};
+  const get = () => store.getState();
+  const view = {
+    doc: () => get().hist.present,
+    file: () => get().file,
+    dirty: () => get().isDirty(),
+    validation: () => get().validation,
+    validated: () => get().validation.doc === get().hist.present,
+    runState: () => get().run,
+    runs: () => get().runs,
+    scopes: () => get().scopes,
+    selection: () => get().selection,
+    dialog: () => get().dialog,
+    history: () => ({ past: get().hist.past.length, future: get().hist.future.length }),
+    timings: () => trace.timings,
+    lastRun: () => trace.lastRun,
+    plotted: () => trace.plotted,
+    plottedSeries: () => trace.plottedSeries,
+    cursorTime: () => trace.cursorTime,
+  };
+  for (const [key, read] of Object.entries(view)) Object.defineProperty(K, key, { get: read, enumerable: true });
+  Object.defineProperty(K, "lastSave", {
+    get: () => trace.lastSave,
+    set: (v) => {
+      trace.lastSave = v;
+    },
+  });
+  Object.defineProperty(K, "plotTime", {
+    get: () => trace.plotTime,
+    set: (v) => {
+      trace.plotTime = v;
+    },
+  });
+  K.store = store;
+  K.viewer = () => trace.viewer;
+  K.setTime = (t) => {
+    if (trace.bus) trace.bus.setTime(t);
+    if (trace.viewer) trace.viewer.setTime(t);
+  };
+  /** @type {any} */ (window).__kinetwork = K;
+}

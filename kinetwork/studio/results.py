@@ -1,0 +1,101 @@
+"""Results as the page reads them: the time grid, every probe signal with its descriptor, the
+3-D animation (or why there is none), and where a partial run stopped; encoded as compact
+JSON with non-finite numbers as null."""
+
+import json
+import logging
+import math
+
+import numpy as np
+
+from .checks import plain
+
+log = logging.getLogger("kinetwork.studio")
+
+#: the most time samples of a run's 3-D animation: a denser run is resampled (the viewer
+#: interpolates between samples), or the poses of a large scene would be tens of MB of JSON
+MAX_FRAMES = 1000
+#: what the 3-D view says of a model without multibody parts
+NO_SCENE = "This model has no multibody parts (it is 1-D only): there is nothing to show in 3-D."
+
+
+def results_json(res, model=None):
+    """Results as the page reads them: the time grid and every probe signal, values nested
+    with n_points first, non-finite values null; and the 3-D animation when it can be made,
+    else ``animation_note`` says why."""
+    anim, note = animation(res, model)
+    return {
+        "t": finite_list(res.t),
+        "signals": [{"name": name, "unit": sig.unit, "shape": list(sig.shape),
+                     "probe": sig.probe, "quantity": sig.quantity, "port": sig.target,
+                     "values": finite_list(res[name])} for name, sig in res.signals.items()],
+        "animation": anim,
+        "animation_note": note,
+        "partial": plain(res.partial),
+    }
+
+
+def finite_list(values):
+    a = np.asarray(values, dtype=float)
+    good = np.isfinite(a)
+    if good.all():
+        return a.tolist()
+    out = a.astype(object)
+    out[~good] = None
+    return out.tolist()
+
+
+def has_scene(model):
+    """Whether a model has anything the 3-D view draws: a multibody frame."""
+    if model is None:
+        return True
+    flat = model.flat() if hasattr(model, "flat") else model
+    return any(port.domain == "frame" for comp in flat.components.values()
+               for port in type(comp).ports.values())
+
+
+def animation(res, model=None):
+    """``(animation_data(res), None)`` for the results of ``model``, or ``(None, why)``
+    when the scene has nothing to show or cannot be made."""
+    if not has_scene(model):
+        return None, NO_SCENE
+    try:
+        from ..animation import animation_data
+    except ImportError:
+        return None, "The 3-D view is not installed with this kinetwork."
+    try:
+        n, span = len(res.t), float(res.t[-1] - res.t[0]) if len(res.t) else 0.0
+        fps = (MAX_FRAMES - 1) / span if n > MAX_FRAMES and span > 0 else None
+        return animation_data(res, fps=fps, model=model), None
+    except Exception as exc:      # noqa: BLE001 -- the plots are worth showing without it
+        log.warning("no 3-D view for these results: %s: %s", type(exc).__name__, exc)
+        return None, f"The 3-D view could not be made for this model ({type(exc).__name__})."
+
+
+def encode(content):
+    """JSON bytes as the page reads them: compact, numpy values as lists, NaN and infinities
+    null (JSON has none, and a model file or partial results may hold them)."""
+    try:
+        text = json.dumps(content, allow_nan=False, separators=(",", ":"), default=_numpy)
+    except ValueError:
+        text = json.dumps(_finite(content), allow_nan=False, separators=(",", ":"),
+                          default=_numpy)
+    return text.encode("utf-8")
+
+
+def _numpy(value):
+    if hasattr(value, "tolist"):
+        return value.tolist()
+    raise TypeError(f"{type(value).__name__} is not JSON")
+
+
+def _finite(value):
+    if isinstance(value, float):
+        return value if math.isfinite(value) else None
+    if hasattr(value, "tolist"):
+        value = value.tolist()
+    if isinstance(value, dict):
+        return {k: _finite(v) for k, v in value.items()}
+    if isinstance(value, (list, tuple)):
+        return [_finite(v) for v in value]
+    return value
