@@ -28,7 +28,7 @@ def test_pivoted_qr_is_lapacks_within_the_rank(shape, rank):
         _, r, piv = scipy.linalg.qr(a, pivoting=True, mode="economic")
         want = np.abs(np.diag(r))
         assert sorted(order.tolist()) == list(range(shape[1]))
-        assert np.array_equal(order[:rank], piv[:rank])
+        assert order[:rank].tolist() == piv[:rank].tolist()   # integer column indices
         np.testing.assert_allclose(diag[:rank], want[:rank], rtol=1e-12)
         assert np.all(diag[rank:] <= 1e-12 * want[0])
 
