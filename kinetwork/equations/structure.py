@@ -112,29 +112,25 @@ def singular_parts(inc, n_unknowns, owner):
     for e, row in enumerate(inc):
         for v in row:
             readers[v].append(e)
-    over, seen = set(), set()
-    todo = [e for e in range(len(inc)) if e not in matched_eq]
-    while todo:
-        e = todo.pop()
-        if e in over:
-            continue
-        over.add(e)
-        for v in inc[e]:
-            if v not in seen and v in owner:
-                seen.add(v)
-                todo.append(owner[v])
-    under, seen_eq = set(), set()
-    todo = [v for v in range(n_unknowns) if v not in owner]
-    while todo:
-        v = todo.pop()
-        if v in under:
-            continue
-        under.add(v)
-        for e in readers[v]:
-            if e not in seen_eq and e in matched_eq:
-                seen_eq.add(e)
-                todo.append(matched_eq[e])
+    over = _alternating([e for e in range(len(inc)) if e not in matched_eq], inc, owner)
+    under = _alternating([v for v in range(n_unknowns) if v not in owner], readers, matched_eq)
     return sorted(over), sorted(under)
+
+
+def _alternating(starts, neighbours, partner):
+    """What alternating paths reach from ``starts``: a node, its ``neighbours`` on the other
+    side, the node each of those is matched to (``partner``), and so on."""
+    reached, seen, todo = set(), set(), list(starts)
+    while todo:
+        a = todo.pop()
+        if a in reached:
+            continue
+        reached.add(a)
+        for b in neighbours[a]:
+            if b not in seen and b in partner:
+                seen.add(b)
+                todo.append(partner[b])
+    return reached
 
 
 @dataclass
