@@ -204,6 +204,7 @@ class PartialPowerSensor(PartialRigid):
     reads the flow into it, its speed and their product, the power flowing from flange_a to
     flange_b, each on the output port ``outputs`` names for it."""
     quantity = "flow"
+    power = Port("signal_out", "Power from flange_a to flange_b [W]", optional=True)
     #: output port -> what it carries: "flow", "speed" or "power"
     outputs = {}
 

@@ -90,7 +90,6 @@ class PowerSensor(PartialPowerSensor, library=LIB):
     """The power flowing from flange_a to flange_b, flange_a.tau * der(flange_a.phi), as the
     signal ``power`` (MSL's Rotational.Sensors.PowerSensor); wire it in series."""
     domain = LIB
-    power = Port("signal_out", "Power from flange_a to flange_b [W]", optional=True)
     outputs = {"power": "power"}
 
 
@@ -99,7 +98,6 @@ class MultiSensor(PartialPowerSensor, library=LIB):
     from flange_a to flange_b, tau * w (``power``), as MSL's Rotational.Sensors.MultiSensor;
     wire it in series."""
     domain = LIB
-    power = Port("signal_out", "Power from flange_a to flange_b [W]", optional=True)
     w = Port("signal_out", "Speed of the flanges [rad/s]", optional=True)
     tau = Port("signal_out", "Torque into flange_a [N*m]", optional=True)
     outputs = {"power": "power", "w": "speed", "tau": "flow"}

@@ -103,7 +103,6 @@ class PowerSensor(PartialPowerSensor, library=LIB):
     """The power flowing from flange_a to flange_b, flange_a.f * der(flange_a.s), as the
     signal ``power`` (MSL's Translational.Sensors.PowerSensor); wire it in series."""
     domain = LIB
-    power = Port("signal_out", "Power from flange_a to flange_b [W]", optional=True)
     outputs = {"power": "power"}
 
 
@@ -112,7 +111,6 @@ class MultiSensor(PartialPowerSensor, library=LIB):
     from flange_a to flange_b, f * v (``power``), as MSL's Translational.Sensors.MultiSensor;
     wire it in series."""
     domain = LIB
-    power = Port("signal_out", "Power from flange_a to flange_b [W]", optional=True)
     f = Port("signal_out", "Force into flange_a [N]", optional=True)
     v = Port("signal_out", "Velocity of the flanges [m/s]", optional=True)
     outputs = {"power": "power", "f": "flow", "v": "speed"}
