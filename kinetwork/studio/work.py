@@ -34,6 +34,16 @@ def _ctx(folder, library):
     return checks.context(folder, library)
 
 
+def _runnable(data, folder, library, verb):
+    """The model of ``data``, validated; a subsystem definition (a model exposing ports) is
+    refused: it runs only where it is placed."""
+    model = checks.build(data, _ctx(folder, library), validate=True)
+    if model.exposed:
+        raise ModelError(f"this model is a subsystem definition (it exposes ports): place it "
+                         f"in a model to {verb} it")
+    return model
+
+
 def check(data, folder, library, channel):
     """``checks.check`` of the model: ``{"ok", "problems", "summary", "compile"}``."""
     channel.enter("checking")
@@ -88,10 +98,7 @@ def run(data, settings, folder, library, channel):
     model, phase = None, "checking"
     try:
         channel.enter("checking")
-        model = checks.build(data, _ctx(folder, library), validate=True)
-        if model.exposed:
-            raise ModelError("this model is a subsystem definition (it exposes ports): place "
-                             "it in a model to run it")
+        model = _runnable(data, folder, library, "run")
         sim = {**DEFAULTS, **model.simulation, **settings}
         n_points, t_end = sim.get("n_points"), sim.get("t_end")
         _check_size(n_points, 1, 1, beyond=True)
@@ -167,10 +174,7 @@ def sweep(data, spec, folder, library, channel):
     model = None
     try:
         channel.enter("checking")
-        model = checks.build(data, _ctx(folder, library), validate=True)
-        if model.exposed:
-            raise ModelError("this model is a subsystem definition (it exposes ports): place "
-                             "it in a model to sweep it")
+        model = _runnable(data, folder, library, "sweep")
         kind, names, members = _sweep_spec(spec)
         sim = {**DEFAULTS, **model.simulation}
         _check_size(sim.get("n_points"), 1, members, beyond=True)
@@ -298,10 +302,7 @@ def linearize(data, spec, folder, library, channel):
     frequency response of every input to every output (a Bode plot)."""
     from ..analysis.linear import linearize as linearise
     channel.enter("checking")
-    model = checks.build(data, _ctx(folder, library), validate=True)
-    if model.exposed:
-        raise ModelError("this model is a subsystem definition (it exposes ports): place it in "
-                         "a model to linearise it")
+    model = _runnable(data, folder, library, "linearise")
     at = spec.get("at")
     if at is not None and (isinstance(at, bool) or not isinstance(at, (int, float))
                            or not math.isfinite(at) or at < 0):
