@@ -331,6 +331,15 @@ def catching_signals(flag):
 
 
 # -- writing -------------------------------------------------------------------------------------
+def filler(data):
+    """The ``fill`` of :func:`write` (and ``util.atomic_write``) that writes the bytes
+    ``data``."""
+    def fill(tmp):
+        with open(tmp, "wb") as fh:
+            fh.write(data)
+    return fill
+
+
 def write(path, fill, kind=None, *, what=None, reads=(), force=False, stop=None,
           cooperative=False, mode=0o666):
     """Write a file under the policy: :func:`check`, then ``fill`` writes a temporary file

@@ -13,7 +13,7 @@ from typing import TYPE_CHECKING
 
 from ..components.base import _NAME, REGISTRY
 from ..errors import ModelError
-from ..outputs import check, model_files, write
+from ..outputs import check, filler, model_files, write
 from ..util import finite
 from .initial import check_initial
 from .settings import check_setting
@@ -219,10 +219,7 @@ def save(model: Model, path: str | os.PathLike, overwrite: bool = False) -> None
     folder = os.path.dirname(os.path.abspath(os.fspath(path)))
     text = dumps(model, folder).encode("utf-8")   # every refusal before the disk is touched
 
-    def fill(tmp):
-        with open(tmp, "wb") as fh:
-            fh.write(text)
-    write(path, fill, "model", reads=reads, force=overwrite)
+    write(path, filler(text), "model", reads=reads, force=overwrite)
 
 
 def _render(value, level):

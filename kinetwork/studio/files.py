@@ -15,6 +15,7 @@ import re
 import stat
 
 from ..graph.io import FORMAT, MAX_FILE_SIZE
+from ..outputs import filler
 from ..util import atomic_write
 
 #: model files are JSON: the studio opens and writes nothing else
@@ -211,11 +212,8 @@ def write_model(real, rel, text, base):
                            f"under another name", now)
         data = text.encode("utf-8")
 
-        def write(tmp):
-            with open(tmp, "wb") as fh:
-                fh.write(data)
         try:
-            atomic_write(real, write)
+            atomic_write(real, filler(data))
         except OSError as exc:
             raise StudioError(400, f"{rel}: not saved: {exc.strerror or exc}") from None
         return version_of(data)
@@ -274,11 +272,8 @@ def write_recovery(root, rel, model, base, session=None):
     if len(data) > MAX_FILE_SIZE:
         raise StudioError(400, "the model is too large to keep a recovery of")
 
-    def write(tmp):
-        with open(tmp, "wb") as fh:
-            fh.write(data)
     try:
-        atomic_write(path, write)
+        atomic_write(path, filler(data))
     except OSError as exc:
         raise StudioError(400, f"no recovery kept: {exc.strerror or exc}") from None
 

@@ -4,7 +4,7 @@ import os
 
 from ..errors import ModelError
 from ..graph.io import dumps
-from ..outputs import check, write
+from ..outputs import check, filler, write
 from .load import from_urdf
 
 
@@ -18,11 +18,8 @@ def cli_import(args):
                       limits=not getattr(args, "no_limits", False))
     text = dumps(model, os.path.dirname(os.path.abspath(args.out))).encode("utf-8")
 
-    def fill(tmp):
-        with open(tmp, "wb") as fh:
-            fh.write(text)
     try:
-        write(args.out, fill, "model", what="-o", reads=reads, force=force)
+        write(args.out, filler(text), "model", what="-o", reads=reads, force=force)
     except OSError as exc:
         raise ModelError(f"cannot write {args.out}: {exc.strerror or exc}") from None
     parts = model.components.values()
