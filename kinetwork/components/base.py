@@ -369,6 +369,12 @@ def library_attribute(library):
     return __getattr__
 
 
+class NoSuchAttribute(ModelError, AttributeError):
+    """A component's misspelt port or parameter: a ModelError for the user, and an
+    AttributeError for Python's protocol (``hasattr``, ``getattr`` with a default), so that
+    asking whether a component has something never raises."""
+
+
 @functools.lru_cache(maxsize=4096)
 def _is_quantity(text):
     """Whether ``text`` is a quantity ("5 mm") rather than an expression ("L/2"): it does not
@@ -599,9 +605,9 @@ class Component:
         if key.startswith("_"):
             raise AttributeError(key)
         close = suggest(key, [*self.ports, *self.params])
-        raise ModelError(f"{type(self).__name__} {self.name!r} has no port or parameter "
-                         f"{key!r}{close}; ports: {', '.join(self.ports)}",
-                         component=self.name, hint=hint(close))
+        raise NoSuchAttribute(f"{type(self).__name__} {self.name!r} has no port or parameter "
+                              f"{key!r}{close}; ports: {', '.join(self.ports)}",
+                              component=self.name, hint=hint(close))
 
     def port_ref(self, name):
         """The ``PortRef`` called ``name``; a ModelError suggesting close names otherwise."""

@@ -120,6 +120,10 @@ def test_a_misspelt_port_or_parameter_is_named_with_a_suggestion():
         body.frame_b
     with pytest.raises(kn.ModelError, match=r"has no port 'fram_a' \(did you mean"):
         body.port_ref("fram_a")
+    # Python's own questions get Python's answers: hasattr and getattr with a default do not
+    # raise (a Spherical joint has no speed_units; asking built nothing before)
+    joint = kn.multibody.Spherical("j")
+    assert not hasattr(joint, "speed_units") and getattr(joint, "frame_b2", None) is None
 
 
 def test_bound_gives_a_copy_reading_other_values():
