@@ -110,7 +110,7 @@ def shown(code):
     out = []
     for number, text in enumerate(code.splitlines(), 1):
         m = PRINTED.match(text)
-        expected = _literal(m.group("comment")) if m else None
+        expected, _ = _literal(m.group("comment")) if m else (None, None)
         if expected is not None and _single(m.group("arg")):
             text = (f"{m.group('indent')}_shown({m.group('arg')}, "
                     f"{m.group('comment')!r})")
@@ -127,16 +127,16 @@ def _single(arg):
 
 
 def _literal(comment):
-    """The value a comment starts with (before a ``:`` of prose), or None."""
-    for head in (comment, comment.split(":")[0]):
+    """(the value a comment starts with, before a ``:`` of prose; its text), or (None, None)."""
+    for head in (comment.strip(), comment.split(":")[0].strip()):
         try:
-            value = ast.literal_eval(head.strip())
+            value = ast.literal_eval(head)
         except (ValueError, SyntaxError, TypeError, MemoryError, RecursionError):
             continue
         # "..." stands for the rest of a list; anywhere else it is prose ({"t": ..., })
         inner = value[:-1] if isinstance(value, (list, tuple)) and value else value
-        return None if _elided(inner) else value
-    return None
+        return (None, None) if _elided(inner) else (value, head)
+    return None, None
 
 
 def _elided(value):
@@ -151,10 +151,8 @@ def _elided(value):
 
 def _shown(value, comment):
     print(value)
-    expected = _literal(comment)
-    head = comment.split(":")[0].strip() if _literal(comment.split(":")[0]) is not None \
-        else comment.strip()
-    assert _same(value, expected, head), f"printed {value!r}; the docs say # {comment}"
+    expected, text = _literal(comment)
+    assert _same(value, expected, text), f"printed {value!r}; the docs say # {comment}"
 
 
 def _same(value, expected, text):
