@@ -73,8 +73,8 @@ class System:
                                  [ca.densify(eq.ode), ca.densify(eq.alg)],
                                  ["t", "x", "z", "p"], ["ode", "alg"])
         self.signals = [sig.described() for sig in asm.signals]
-        self.probe_targets = {probe.name: _as_wired(model, probe.name, target.path)
-                              for probe, target in self.topology.probes}
+        self.probe_targets = _as_wired(model, {probe.name: target.path
+                                               for probe, target in self.topology.probes})
         # signals are written in the assembly's coordinates, speeds, their rates and the
         # multipliers; the formulation says what those are in the states (x, z)
         coords = asm.q if eq.q is None else eq.q
@@ -612,15 +612,17 @@ def _dense(sparsity, values):
     return out
 
 
-def _as_wired(model, probe, target):
-    """The port a probe reads as the user wired it: ``motor.p``, not the flat model's
-    ``motor.Ra.p`` inside an aggregate or a subsystem (names the user never wrote)."""
+def _as_wired(model, targets):
+    """{probe: the port it reads as the user wired it}: ``motor.p``, not the flat model's
+    ``motor.Ra.p`` inside an aggregate or a subsystem (names the user never wrote);
+    ``targets`` gives the flat model's, kept where the user's model does not say."""
     source = getattr(model, "_source", None)
-    if source is None or probe not in source.components:
-        return target
-    mine = f"{probe}.port"
+    if source is None:
+        return targets
+    other_end = {}                     # a port -> the other end of its first connection
     for a, b in source.connections:
-        ends = (str(getattr(a, "path", a)), str(getattr(b, "path", b)))
-        if mine in ends:
-            return ends[1] if ends[0] == mine else ends[0]
-    return target
+        a, b = str(getattr(a, "path", a)), str(getattr(b, "path", b))
+        other_end.setdefault(a, b)
+        other_end.setdefault(b, a)
+    return {probe: other_end.get(f"{probe}.port", target)
+            if probe in source.components else target for probe, target in targets.items()}
