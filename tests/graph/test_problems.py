@@ -188,7 +188,12 @@ def test_the_studio_reads_fields_and_holds_no_regular_expression_over_messages()
                           path="components[3].params.mass"))
     assert out == {"message": "x", "component": "mass1", "port": None, "parameter": "mass",
                    "path": "components[3].params.mass", "hint": None, "severity": "error",
-                   "param": "mass", "connection": None}
+                   "param": "mass", "connection": None, "reason": None}
+    # the reason is the text after the place the fields name, in the page's words
+    placed = problem(Problem('components[3] "mass1" params.mass = -1 kg: must be >= 0',
+                             component="mass1", parameter="mass",
+                             path="components[3].params.mass"))
+    assert placed["reason"] == "must be >= 0 (got -1 kg)"
     assert problem(Problem("y", path="connections[12][1]"))["connection"] == 12
     # a message shaped like a place, with no fields, is not read for one
     assert problem('components[3] "mass1" params.mass: x')["component"] is None

@@ -152,6 +152,7 @@ def test_sigint_stops_the_server_while_a_check_is_under_way(root):
     proc = subprocess.Popen([sys.executable, "-m", "kinetwork", "studio", "--no-browser"],
                             cwd=root, stdout=subprocess.PIPE, stderr=subprocess.STDOUT,
                             text=True, env=env)
+    client = None
     try:
         url = None
         for _ in range(200):
@@ -164,9 +165,10 @@ def test_sigint_stops_the_server_while_a_check_is_under_way(root):
         token = query.split("token=")[1].split("&")[0]
         client = httpx.Client(base_url=base, headers={TOKEN_HEADER: token}, timeout=60)
         data = client.get("/api/open", params={"path": SEED}).json()["model"]
-        threading.Thread(target=lambda: _quietly(client.post, "/api/validate",
-                                                 json={"model": with_mass(data, TOWER)}),
-                         daemon=True).start()
+        check = threading.Thread(target=lambda: _quietly(client.post, "/api/validate",
+                                                         json={"model": with_mass(data, TOWER)}),
+                                 daemon=True)
+        check.start()
         run_id = client.post("/api/run", json={"model": data, "settings": {
             "t_end": 1e6, "n_points": 100001, "rtol": 1e-12}}).json()["run"]
         time.sleep(1.0)
@@ -177,11 +179,14 @@ def test_sigint_stops_the_server_while_a_check_is_under_way(root):
               f"{time.monotonic() - sent:.2f} s (exit code {code})")
         assert code == 0
         assert run_id
+        check.join(60)                           # the check's request ended with the server
     finally:
         if proc.poll() is None:
             proc.kill()
             proc.wait()
         proc.stdout.close()
+        if client is not None:                   # its sockets closed here, not at some later gc
+            client.close()
 
 
 def _quietly(call, *args, **kwargs):
