@@ -96,12 +96,8 @@ class Schedule:
         grid = np.linspace(self.t_start, self.t_end, SCAN + 1)
         args = np.asarray(mapped(f, len(grid))(grid[None, :], p)[0], dtype=float).ravel()
         level = _position(args, knots)
-        out = []
-        for a in range(len(grid) - 1):
-            out.extend(_crossings(at, grid[a], grid[a + 1], level[a], level[a + 1], True,
-                                  brentq))
-            self._count(len(out))
-        return out
+        return self._located([(at, grid[a], grid[a + 1], level[a], level[a + 1], True)
+                              for a in range(len(grid) - 1)], brentq)
 
     def _scan(self, f, p, k, others, levels, values, known):
         """The switches of the nodes ``others`` (not affine in t), on SCAN points and the
@@ -112,7 +108,7 @@ class Schedule:
                           [t for t in known if self.t_start < t < self.t_end])
         table = np.asarray(mapped(f, len(grid))(grid[None, :], p), dtype=float)
         table = table.reshape(k, len(grid), 2)        # (k, 2n): [g, rate] per time
-        out = []
+        spans = []                  # (indicator, ta, tb, ga, gb, level): monotone pieces
         for j in others:
             g, rate = table[j, :, 0], table[j, :, 1]
             level = levels[j]
@@ -134,15 +130,35 @@ class Schedule:
                     except ValueError:              # the rate does not change sign there
                         pass
                 ends.append((t1, g1))
-                for (ta, ga), (tb, gb) in zip(ends, ends[1:]):
-                    out.extend(_crossings(at, ta, tb, ga, gb, level, brentq))
-                self._count(len(out))
+                spans.extend((at, ta, tb, ga, gb, level)
+                             for (ta, ga), (tb, gb) in zip(ends, ends[1:]))
+        return self._located(spans, brentq)
+
+    def _located(self, spans, brentq):
+        """The crossings of monotone pieces ``(indicator, ta, tb, ga, gb, level)``, counted
+        from their ends' values first: a count beyond MAX_TIME_EVENTS is refused before a
+        single one is located (a 1e-8 s period over 1 s: at once, not after a million
+        root finds)."""
+        self._count(sum(_n_crossings(ga, gb, level) for _, _, _, ga, gb, level in spans))
+        out = []
+        for at, ta, tb, ga, gb, level in spans:
+            out.extend(_crossings(at, ta, tb, ga, gb, level, brentq))
         return out
 
     def next(self, t):
         """The first time event after t (beyond the same instant), or None."""
         i = np.searchsorted(self.times, t + _gap(t), side="right")
         return float(self.times[i]) if i < len(self.times) else None
+
+
+def _n_crossings(ga, gb, level):
+    """How many crossings ``_crossings`` finds between ends of values ga and gb."""
+    if not level:
+        return int(ga == 0.0 or ga * gb < 0)
+    if not (np.isfinite(ga) and np.isfinite(gb)):
+        return 0
+    low, high = sorted((ga, gb))
+    return max(0, math.ceil(high) - 1 - math.floor(low))
 
 
 def _crossings(at, ta, tb, ga, gb, level, brentq):

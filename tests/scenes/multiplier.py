@@ -16,6 +16,7 @@ only at the integrator's tolerance, which the tests check.
 
 import warnings
 
+import casadi as ca
 import numpy as np
 import sympy as sp
 from scipy.integrate import solve_ivp
@@ -35,40 +36,45 @@ def unit(v):
 
 class Mechanism:
     """Coordinates ``q`` (sympy symbols), bodies, constraints g(q) = 0 and extra generalized
-    forces Q(q, qd); gravity along ``gravity`` (world)."""
+    forces Q(q, qd); gravity along ``gravity`` (world).
+
+    The scene is written in sympy; the derivatives (Jacobians, rates) are taken by CasADi's
+    SX, a second symbolic engine with no part of kinetwork in it: sympy's own differentiation
+    and common-subexpression pass took 40-120 s on a spatial four-bar, CasADi's takes
+    milliseconds, with the same equations."""
 
     def __init__(self, q, bodies, constraints=(), forces=None, gravity=(0, -9.81, 0)):
         self.q = list(q)
         n = len(self.q)
         self.qd = sp.symbols(f"qd0:{n}")
-        qd = sp.Matrix(self.qd)
-        qv = sp.Matrix(self.q)
-        g = sp.Matrix(gravity)
-        M, h, Q = sp.zeros(n, n), sp.zeros(n, 1), sp.zeros(n, 1)
+        qv, qd = ca.SX.sym("q", n), ca.SX.sym("qd", n)
+        sx = _to_sx(self.q + list(self.qd), ca.vertcat(qv, qd))
+        g = ca.DM(gravity)
+        M, h, Q = ca.SX(n, n), ca.SX(n, 1), ca.SX(n, 1)
 
         def rate(expr):
-            return expr.jacobian(qv) * qd
+            return ca.reshape(ca.jtimes(ca.vec(expr), qv, qd), *expr.shape)
         for mass, inertia, R, c in bodies:
-            I = sp.Matrix(inertia)
-            Jc = c.jacobian(qv)
-            dR = sp.Matrix(3, 3, lambda i, j: rate(sp.Matrix([R[i, j]]))[0])
-            W = R.T * dR
-            w = sp.Matrix([W[2, 1], W[0, 2], W[1, 0]])         # body axes
-            Jw = w.jacobian(qd)
-            M += mass * Jc.T * Jc + Jw.T * I * Jw
-            h += mass * Jc.T * rate(Jc * qd) + Jw.T * (I * rate(Jw * qd) + w.cross(I * w))
-            Q += mass * Jc.T * g
+            I = ca.DM(np.array(sp.Matrix(inertia), dtype=float))
+            R, c = sx(R), sx(c)
+            Jc = ca.jacobian(c, qv)
+            W = R.T @ rate(R)
+            w = ca.vertcat(W[2, 1], W[0, 2], W[1, 0])           # body axes
+            Jw = ca.jacobian(w, qd)
+            M += mass * Jc.T @ Jc + Jw.T @ I @ Jw
+            h += mass * Jc.T @ rate(Jc @ qd) + Jw.T @ (I @ rate(Jw @ qd)
+                                                         + ca.cross(w, I @ w))
+            Q += mass * Jc.T @ g
         if forces is not None:
-            Q += sp.Matrix(forces)
-        phi = sp.Matrix(list(constraints)) if constraints else sp.zeros(0, 1)
-        G = phi.jacobian(qv) if constraints else sp.zeros(0, n)
-        Gd = rate(G * qd) if constraints else sp.zeros(0, 1)
-        args = (self.q, self.qd)
-        self.f_M = sp.lambdify(args, M, "numpy", cse=True)
-        self.f_rest = sp.lambdify(args, Q - h, "numpy", cse=True)
-        self.f_G = sp.lambdify(args, G, "numpy")
-        self.f_Gd = sp.lambdify(args, Gd, "numpy")
-        self.f_phi = sp.lambdify([self.q], phi, "numpy")
+            Q += sx(sp.Matrix(forces))
+        phi = sx(sp.Matrix(list(constraints))) if constraints else ca.SX(0, 1)
+        G = ca.jacobian(phi, qv)
+        Gd = rate(G @ qd)
+        self.f_M = ca.Function("M", [qv, qd], [M])
+        self.f_rest = ca.Function("rest", [qv, qd], [Q - h])
+        self.f_G = ca.Function("G", [qv, qd], [G])
+        self.f_Gd = ca.Function("Gd", [qv, qd], [Gd])
+        self.f_phi = ca.Function("phi", [qv], [phi])
         self.m = len(constraints)
 
     def accelerations(self, q, qd):
@@ -116,3 +122,19 @@ class Mechanism:
     def drift(self, Q):
         return max(np.max(np.abs(np.array(self.f_phi(q), dtype=float)), initial=0.0)
                    for q in Q)
+
+
+def _to_sx(symbols, values):
+    """A function taking a sympy matrix (or expression) in ``symbols`` to CasADi SX, the
+    symbols replaced by the entries of ``values``."""
+    functions = {"sin": ca.sin, "cos": ca.cos, "tan": ca.tan, "sqrt": ca.sqrt,
+                 "atan2": ca.atan2, "exp": ca.exp, "log": ca.log, "Abs": ca.fabs}
+    entries = [values[i] for i in range(values.shape[0])]
+
+    def sx(expr):
+        matrix = sp.Matrix(expr) if not isinstance(expr, sp.MatrixBase) else expr
+        f = sp.lambdify(symbols, list(matrix), modules=[functions, "math"])
+        out = f(*entries)
+        return ca.reshape(ca.vertcat(*[ca.SX(v) for v in out]), matrix.shape[1],
+                          matrix.shape[0]).T
+    return sx
