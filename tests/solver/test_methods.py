@@ -43,7 +43,7 @@ def test_buffered_callable_survives_garbage_collection(system):
     fast = numeric(system.f_rhs, p, system.n_states)
     jac = numeric(system.jacobian_function(), p, system.n_states)
     rng = np.random.default_rng(1)
-    for _ in range(50):
+    for _ in range(10):          # a full collection is ~0.4 s in a suite's process
         junk = [np.full(64, np.nan) for _ in range(200)]      # reuse freed memory
         del junk
         gc.collect()

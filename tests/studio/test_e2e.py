@@ -11,6 +11,7 @@ import json
 import pathlib
 
 import numpy as np
+import pytest
 
 import kinetwork as kn
 from tests.studio.helpers import (IMAGES, RUN_TIMEOUT, K, center, deselect, open_file, open_studio,
@@ -126,11 +127,22 @@ def test_build_the_seed_by_mouse_and_run_it_as_kn_simulate(page, studio):
 
 
 # -- 2. every example: render and run ------------------------------------------------------------
+#: the examples run from the page as well as opened: one of each kind the page shows after a
+#: run (bodies in 3-D, a loop, 1-D drives, a circuit, signal blocks, subsystems, a chain of
+#: point masses, a subsystem definition refused); every example is simulated and plotted by
+#: tests/test_models.py, and run to its plot in the page here costs ~1-6 s each
+RUN_IN_PAGE = {SEED, "models/fourbar1.json", "models/drive_train.json",
+               "models/chua_circuit.json", "models/arm_pid.json", "models/robot/arm_axes.json",
+               "models/point_gravity_with_point_masses.json", "models/engine_v6/Cylinder.json",
+               "models/line_force_with_two_masses.json"}
+
+
 def test_every_example_model_opens_renders_and_runs(page, studio, monkeypatch):
     # each runs briefly (the copies in the studio's folder) and without the C compiler (the
     # server runs in this process): opening, drawing and running are what is checked here;
     # their numbers, and the compiled code, are checked elsewhere
     monkeypatch.setenv("KINETWORK_JIT", "0")
+    assert RUN_IN_PAGE <= set(MODEL_FILES)
     for path in MODEL_FILES:
         data = json.loads((studio.root / path).read_text())
         if data.get("simulation"):
@@ -148,6 +160,9 @@ def test_every_example_model_opens_renders_and_runs(page, studio, monkeypatch):
         open_file(page, path)
         wait_validated(page)
         assert K(page, "K.validation.ok"), (path, K(page, "K.validation.problems"))
+        assert not page.errors, (path, page.errors)
+        if path not in RUN_IN_PAGE:
+            continue
         data = json.loads((studio.root / path).read_text())
         state = run(page)
         if "ports" in data:          # a subsystem definition: placed in a model, it runs
@@ -421,6 +436,7 @@ def test_runs_overlay_cancel_and_the_3d_view_follows_the_plot_cursor(page, studi
     assert not page.errors, page.errors
 
 
+@pytest.mark.bench
 def test_measure_load_run_and_3d_frame_rate(page, studio, record_property):
     """The numbers of the report (not asserted: timings never go in a test): the studio's
     load (navigation to the palette ready), Run to plotted results for the seed, and the 3-D

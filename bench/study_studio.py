@@ -1,0 +1,43 @@
+"""The studio's speed in headless Chromium: its load (navigation to the palette ready), Run
+to plotted results for the seed (median of 3, compiled), and the 3-D view's frame rate for a
+32-link chain. The measurement is the browser test marked ``bench`` in
+tests/studio/test_e2e.py (the suite leaves it out: timings never go in a test); this runs it
+and writes ``results/studio.md`` from the figures it records.
+
+Run: ``python bench/study_studio.py [--quick]`` (needs the test extras and Debian's Chromium).
+"""
+
+import subprocess
+import sys
+import xml.etree.ElementTree as ET
+
+from common import HERE, RESULTS, machine
+
+TEST = "tests/studio/test_e2e.py::test_measure_load_run_and_3d_frame_rate"
+
+
+def main():
+    RESULTS.mkdir(exist_ok=True)
+    report = RESULTS / "studio_junit.xml"
+    code = subprocess.call([sys.executable, "-m", "pytest", "-q", "-s", "-m", "bench",
+                            "-p", "no:cacheprovider", "-o", "junit_family=xunit1", TEST,
+                            f"--junitxml={report}"],
+                           cwd=HERE.parent)
+    if code:
+        sys.exit(f"the studio's measurement failed (pytest exit code {code})")
+    figures = {p.get("name"): float(p.get("value"))
+               for p in ET.parse(report).getroot().iter("property")}
+    report.unlink()
+    (RESULTS / "studio.md").write_text(
+        "# The studio in headless Chromium\n\n"
+        f"{machine()}.\n\n"
+        "| measure | value |\n| --- | ---: |\n"
+        f"| load, navigation to the palette ready (median of 3) | {figures['load_s']:.2f} s |\n"
+        f"| seed: Run to plotted results (median of 3, compiled) | "
+        f"{figures['run_to_plot_s']:.2f} s |\n"
+        f"| 3-D view of a 32-link chain, playing | {figures['chain32_fps']:.1f} frames/s |\n")
+    print((RESULTS / "studio.md").read_text())
+
+
+if __name__ == "__main__":
+    main()
