@@ -7,6 +7,28 @@ import pytest
 from browser import browser_missing
 from scenes import double_pendulum
 
+#: the files that take longest (seconds of one run on 2 cores, 2026-11-28), longest first:
+#: pytest-xdist's ``--dist loadfile`` hands files out in collection order, so these go first
+#: and the short ones fill in around them, instead of one worker finishing a long file alone
+#: while the other waits (longest-first scheduling; a stale figure only costs balance)
+LONG_FILES = {
+    "studio/test_e2e.py": 145, "studio/test_e2e_editing.py": 77, "scenes/test_engine_flat.py": 48,
+    "studio/test_server.py": 47, "test_models.py": 46, "test_docs.py": 42,
+    "studio/test_e2e_work.py": 41, "studio/test_e2e_analysis.py": 39, "graph/test_fuzz.py": 30,
+    "solver/test_time_events.py": 27, "solver/test_stability.py": 23,
+    "test_entry_points.py": 23, "fmu/test_export.py": 22, "test_first_answer.py": 21,
+    "equations/test_loops.py": 21, "equations/test_point_mass_chains.py": 21,
+}
+
+
+def pytest_collection_modifyitems(items):
+    """The long files first, longest first; each file's tests keep their order."""
+    def weight(item):
+        path = item.path.as_posix()
+        return next((-w for name, w in LONG_FILES.items() if path.endswith("tests/" + name)), 0)
+    items.sort(key=weight)             # stable: files stay whole, in their order otherwise
+
+
 @pytest.fixture(autouse=True, scope="session")
 def jit_cache(tmp_path_factory):
     """Compiled models go to a folder of this test run, not to the user's cache."""
