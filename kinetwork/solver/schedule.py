@@ -72,11 +72,9 @@ class Schedule:
             return []
         if not level:
             return [self.t_start - g0 / rate]
-        g1 = g0 + rate * (self.t_end - self.t_start)
-        low, high = sorted((g0, g1))
-        first, last = math.floor(low) + 1, math.ceil(high) - 1
-        self._count(last - first + 1)
-        return list(self.t_start + (np.arange(first, last + 1) - g0) / rate)
+        wholes = _wholes(g0, g0 + rate * (self.t_end - self.t_start))
+        self._count(len(wholes))
+        return list(self.t_start + (np.arange(wholes.start, wholes.stop) - g0) / rate)
 
     def _table(self, f, affine, knots, p):
         """Where the argument of a long Table read in time (``f``: (t, p) -> (argument,
@@ -151,14 +149,20 @@ class Schedule:
         return float(self.times[i]) if i < len(self.times) else None
 
 
+def _wholes(a, b):
+    """The whole numbers strictly between a and b (in either order), as a range: counted
+    without being listed."""
+    low, high = sorted((a, b))
+    return range(math.floor(low) + 1, math.ceil(high))
+
+
 def _n_crossings(ga, gb, level):
     """How many crossings ``_crossings`` finds between ends of values ga and gb."""
     if not level:
         return int(ga == 0.0 or ga * gb < 0)
     if not (np.isfinite(ga) and np.isfinite(gb)):
         return 0
-    low, high = sorted((ga, gb))
-    return max(0, math.ceil(high) - 1 - math.floor(low))
+    return len(_wholes(ga, gb))
 
 
 def _crossings(at, ta, tb, ga, gb, level, brentq):
@@ -171,10 +175,8 @@ def _crossings(at, ta, tb, ga, gb, level, brentq):
             return [brentq(at, ta, tb, xtol=1e-15, rtol=4 * np.finfo(float).eps,
                            maxiter=200)]
         return []
-    low, high = sorted((ga, gb))
-    first, last = math.floor(low) + 1, math.ceil(high) - 1
     found = []
-    for whole in range(first, last + 1):
+    for whole in _wholes(ga, gb):
         found.append(brentq(lambda t, w=whole: at(t, shift=w), ta, tb, xtol=1e-15,
                             rtol=4 * np.finfo(float).eps, maxiter=200))
     return found
