@@ -15,13 +15,12 @@ import fcntl
 import os
 import pathlib
 import shutil
-import socket
 import subprocess
-import threading
-import time
 
 import pytest
 from browser import browser_missing
+
+from tests.studio.helpers import serving
 
 REPO = pathlib.Path(__file__).resolve().parents[2]
 FRONTEND = REPO / "frontend"
@@ -91,30 +90,18 @@ class Studio:
 def studio(tmp_path, test_page):
     """The studio's server over a folder holding a copy of models/ (so saving touches no
     file of the repository), serving the test build of the page."""
-    import uvicorn
-
     from kinetwork.studio.server import create_app
 
     shutil.copytree(REPO / "models", tmp_path / "models")
-    sock = socket.socket(socket.AF_INET, socket.SOCK_STREAM)
-    sock.setsockopt(socket.SOL_SOCKET, socket.SO_REUSEADDR, 1)
-    sock.bind(("127.0.0.1", 0))
-    sock.listen(64)
-    port = sock.getsockname()[1]
-    server = uvicorn.Server(uvicorn.Config(create_app(tmp_path, E2E_TOKEN, static=test_page),
-                                           log_level="warning", ws="none", lifespan="on"))
-    thread = threading.Thread(target=server.run, kwargs={"sockets": [sock]}, daemon=True)
-    thread.start()
-    end = time.monotonic() + 30
-    while not server.started and time.monotonic() < end:
-        time.sleep(0.02)
-    assert server.started, "the studio's server did not start"
-    try:
+    with serving(create_app(tmp_path, E2E_TOKEN, static=test_page)) as port:
         yield Studio(tmp_path, port)
-    finally:
-        server.should_exit = True
-        thread.join(30)
-        sock.close()
+
+
+@pytest.fixture
+def root(tmp_path):
+    """A studio folder holding a copy of the example models."""
+    shutil.copytree(REPO / "models", tmp_path / "models")
+    return tmp_path
 
 
 @pytest.fixture

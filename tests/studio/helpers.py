@@ -1,10 +1,12 @@
 """What the studio's end-to-end tests do with the page: real mouse and keyboard events, and
 waits on the page's state (the test build's window.__kinetwork), never on time."""
 
+import contextlib
 import json
 import os
 import pathlib
 import tempfile
+import threading
 import time
 
 RUN_TIMEOUT = 240_000          # ms: EngineV6 compiles for ~30 s on a busy 2-core machine
@@ -13,6 +15,31 @@ RUN_TIMEOUT = 240_000          # ms: EngineV6 compiles for ~30 s on a busy 2-cor
 #: run never rewrites files of the repository
 IMAGES = pathlib.Path(os.environ.get("KINETWORK_SCREENSHOTS")
                       or pathlib.Path(tempfile.gettempdir()) / "kinetwork-screenshots")
+
+
+@contextlib.contextmanager
+def serving(app):
+    """``app`` served over HTTP by uvicorn in a thread, on a free local port (a socket held
+    from the start, as ``kinetwork studio`` holds it): yields the port; on the way out the
+    server is asked to exit, must stop within 30 s, and its socket is closed."""
+    import uvicorn
+
+    from kinetwork.studio import launch
+    sock = launch._listen(None)
+    server = uvicorn.Server(uvicorn.Config(app, log_level="warning", ws="none", lifespan="on"))
+    thread = threading.Thread(target=server.run, kwargs={"sockets": [sock]}, daemon=True)
+    thread.start()
+    try:
+        end = time.monotonic() + 30
+        while not server.started and time.monotonic() < end:
+            time.sleep(0.02)
+        assert server.started, "the studio's server did not start"
+        yield sock.getsockname()[1]
+    finally:
+        server.should_exit = True
+        thread.join(30)
+        sock.close()
+    assert not thread.is_alive(), "the studio's server did not stop"
 
 
 def screenshot(page, name):

@@ -6,7 +6,6 @@ shipped page has no test hook (window.__kinetwork is in the tests' own build onl
 ESLint, the type check and the Vitest unit tests of the front end run in ``make test``
 (``cd frontend && npm ci && npm run lint && npm test``)."""
 
-import pathlib
 import shutil
 import subprocess
 

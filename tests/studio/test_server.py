@@ -5,9 +5,7 @@ files byte for byte, and runs that end as kn.simulate ends (done, failed, cancel
 import json
 import os
 import pathlib
-import shutil
 import sys
-import threading
 import time
 import types
 import warnings
@@ -25,18 +23,12 @@ import kinetwork as kn
 from kinetwork.components.base import REGISTRY
 from kinetwork.studio import checks, launch, results
 from kinetwork.studio.server import TOKEN_HEADER, create_app
+from tests.studio.helpers import serving
 
 MODELS = pathlib.Path(__file__).resolve().parents[2] / "models"
 MODEL_FILES = sorted(p.relative_to(MODELS).as_posix() for p in MODELS.rglob("*.json"))
 TOKEN = "test-token-0123456789"
 SEED = "models/double_pendulum.json"
-
-
-@pytest.fixture
-def root(tmp_path):
-    """A studio folder holding a copy of the example models."""
-    shutil.copytree(MODELS, tmp_path / "models")
-    return tmp_path
 
 
 @pytest.fixture
@@ -567,27 +559,13 @@ def test_bad_settings_fail_the_run_with_a_message(client, settings):
 
 # -- the real server and the command -------------------------------------------------------------
 def test_the_server_answers_over_http(root):
-    sock = launch._listen(None)
-    port = sock.getsockname()[1]
-    server = uvicorn.Server(uvicorn.Config(create_app(root, TOKEN), log_level="warning",
-                                           ws="none", lifespan="on"))
-    thread = threading.Thread(target=server.run, kwargs={"sockets": [sock]}, daemon=True)
-    thread.start()
-    try:
-        end = time.monotonic() + 20
-        while not server.started and time.monotonic() < end:
-            time.sleep(0.02)
+    with serving(create_app(root, TOKEN)) as port:        # and stops when asked
         base = f"http://127.0.0.1:{port}"
         answer = httpx.get(f"{base}/api/palette", headers={TOKEN_HEADER: TOKEN}, timeout=20)
         assert answer.status_code == 200
         assert {t["type"] for lib in answer.json()["libraries"] for t in lib["types"]} == \
             set(REGISTRY)
         assert httpx.get(f"{base}/api/palette", timeout=20).status_code == 403
-    finally:
-        server.should_exit = True
-        thread.join(20)
-        sock.close()
-    assert not thread.is_alive()
 
 
 def test_cli_studio_prints_the_address_and_serves_the_folder(root, monkeypatch, capsys):

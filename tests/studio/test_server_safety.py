@@ -10,7 +10,6 @@ while a check is still going) and that nothing hangs (a generous timeout, printe
 import json
 import os
 import pathlib
-import shutil
 import signal
 import subprocess
 import sys
@@ -19,13 +18,12 @@ import time
 
 import httpx
 import pytest
-import uvicorn
 
 import kinetwork as kn
-from kinetwork.studio import files, launch
+from kinetwork.studio import files
 from kinetwork.studio.server import TOKEN_HEADER, create_app
+from tests.studio.helpers import serving
 
-MODELS = pathlib.Path(__file__).resolve().parents[2] / "models"
 TOKEN = "safety-token-0123456789"
 SEED = "models/double_pendulum.json"
 #: a unit whose exponent is a tower: checking it is unbounded work without a bound
@@ -33,32 +31,12 @@ TOWER = "1 kg^100^100^100"
 
 
 @pytest.fixture
-def root(tmp_path):
-    shutil.copytree(MODELS, tmp_path / "models")
-    return tmp_path
-
-
-@pytest.fixture
 def live(root):
     """The studio over HTTP (uvicorn in a thread), and an httpx client of it."""
-    sock = launch._listen(None)
-    port = sock.getsockname()[1]
-    server = uvicorn.Server(uvicorn.Config(create_app(root, TOKEN), log_level="warning",
-                                           ws="none", lifespan="on"))
-    thread = threading.Thread(target=server.run, kwargs={"sockets": [sock]}, daemon=True)
-    thread.start()
-    end = time.monotonic() + 30
-    while not server.started and time.monotonic() < end:
-        time.sleep(0.02)
-    client = httpx.Client(base_url=f"http://127.0.0.1:{port}", headers={TOKEN_HEADER: TOKEN},
-                          timeout=120)
-    try:
+    with serving(create_app(root, TOKEN)) as port, \
+            httpx.Client(base_url=f"http://127.0.0.1:{port}", headers={TOKEN_HEADER: TOKEN},
+                         timeout=120) as client:
         yield client
-    finally:
-        client.close()
-        server.should_exit = True
-        thread.join(30)
-        sock.close()
 
 
 def seed(client):
