@@ -45,7 +45,7 @@ from .capture import SOLVER_LOCK, solver_output
 from .compiled import compiled
 from .events import EVENT_CHUNK
 from .loopwatch import Partitions, near_singular
-from .methods import METHODS, Failure, Interrupted, choose, shift_times
+from .methods import LOOK, METHODS, Failure, Interrupted, choose, shift_times
 
 DEFAULTS = {"t_end": 10.0, "n_points": 1001, "method": "auto", "rtol": 1e-6, "atol": 1e-8,
             "step": None, "max_step": None}
@@ -64,6 +64,13 @@ CHUNK_GROWTH = 16
 #: over 6e6 output times took 4 s and stopping it only comes between calls (a signal aborts
 #: a call, not the building), and work counts miss the cost of the outputs themselves
 MAX_CHUNK = 2**16
+#: seconds between looks at the time limit and cancel= within a compiled call
+TICK = 0.1
+#: seconds of a run after which auto's Adams is stopped to look whether the model became
+#: stiff (then BDF takes over), and again after twice the time since the start each time
+STALL_LOOK = 2.0
+#: Adams steps projected for a run beyond which a look asks whether they are held by stability
+STALL_STEPS = 1e6
 #: restarts after a failure, with ``restart=True``, at most
 MAX_RESTARTS = 3
 #: a restarted run must keep the loops closed to this (m, or rotation-matrix entries)
@@ -126,6 +133,11 @@ class Run:
         self.said = []                  # what the solvers printed
         self.quiet = False              # nothing to watch: one call over the grid
         self.abortable = False          # a signal now aborts the compiled call
+        #: auto's Adams watched for a stall (``_stalled``): the perf_counter of its next look
+        #: within a compiled call, doubling the time since the start after each, or None
+        self.stall_look = None
+        self.watched = False            # auto: its Adams may be looked at (the tick is set)
+        self.stall_due = False          # set by the tick that aborted a call to look
         self.events = None              # friction, stops, relations: events.Events
         #: the parameters of the equations the integrators see (``compiled.Held``): the
         #: model's, then the values the relations are held at (``switches.py``)
@@ -142,7 +154,8 @@ class Run:
             with SOLVER_LOCK, solver_output(_sink()) as box:
                 yield
         finally:                        # a failing solver's words are the ones wanted
-            if box is not None and box["text"].strip() and self.signal is None:
+            if box is not None and box["text"].strip() and self.signal is None \
+                    and not self.stall_due and self.stop_reason() is None:
                 self.said.append(shift_times(box["text"], t0))
 
     @contextlib.contextmanager
@@ -265,12 +278,52 @@ def _auto(run, stats):
     names, why = choose(run)
     stats.update(why)
     for i, name in enumerate(names):
+        watch = name == "cvodes-adams" and i < len(names) - 1 and run.events is None
+        run.stall_look = time.perf_counter() + STALL_LOOK if watch else None
         X, failure, method_stats = _integrate(run, METHODS[name])
+        run.stall_look = None
         if failure is None or i == len(names) - 1 or run.stop_reason() is not None:
             stats.update(method_stats)
             return X, failure, name
         stats["adams_failure"] = failure
+        if isinstance(failure, Stalled):
+            stats["switched"] = {"from": name, "to": names[i + 1], "at": failure.t,
+                                 "why": str(failure)}
     raise AssertionError("unreachable")
+
+
+class Stalled(str):
+    """Why auto's Adams gave way to BDF mid-run (a str, as every failure's reason is, with
+    the time ``t`` it was found at)."""
+
+    def __new__(cls, t, step, projected, rate, decay):
+        self = super().__new__(cls, (
+            f"Adams stalled at t = {t:g} s: its steps ({step:.3g} s on average, "
+            f"{projected:.3g} projected for the run) are held by the stability of a mode "
+            f"of rate {rate:.3g}/s that decays at {decay:.3g}/s, not by accuracy; BDF took "
+            f"over from the start"))
+        self.t = float(t)
+        return self
+
+
+def _stalled(run, t, x, steps):
+    """After a look at a long Adams call that took ``steps`` steps to ``t``: a ``Stalled``
+    reason when the evidence says Adams cannot finish in reasonable work (more than
+    STALL_STEPS projected for the run, its mean step held by the stability of a fast mode
+    that decays, ``methods.stability_held``), else None (Adams goes on)."""
+    from .compiled import numeric
+    from .methods import stability_held
+    t = float(t)
+    if t <= run.t_start or steps <= 0:
+        return None
+    step = (t - run.t_start) / steps
+    projected = steps * (run.t_end - run.t_start) / (t - run.t_start)
+    if projected <= STALL_STEPS:
+        return None
+    rhs = numeric(run.compiled.rhs(run.jit), run.p_solver, run.system.n_states)
+    held, rate, decay = stability_held(rhs, t, run.t_end, np.asarray(x)[:run.system.n_states],
+                                       step)
+    return Stalled(t, step, projected, rate, decay) if held else None
 
 
 def _integrate(run, method):
@@ -324,7 +377,7 @@ def _integrate(run, method):
             new = exc.states if exc.states is not None else np.zeros((0, len(X[0])))
             failure = exc.reason
             if not len(new) and m > 1 and not method.stepper and run.events is None \
-                    and run.stop_reason() is None:
+                    and run.stop_reason() is None and failure != LOOK:
                 # CasADi keeps nothing of a failed call: go again an output at a time,
                 # to keep every output before the failure (and stop there all the same)
                 new, failure = _piecewise(run, method, grid[k], X[-1], times, failure)
@@ -342,6 +395,18 @@ def _integrate(run, method):
         k = len(X) - 1
         if run.progress is not None and len(new):
             run.progress(float(grid[k]))
+        if failure == LOOK:          # auto's Adams ran long: stalled? (else it goes on)
+            failure = _stalled(run, grid[k], X[-1],
+                               stats.get("steps", 0) + stepper.stats.get("steps", 0))
+            if failure is None and k < n - 1:
+                stats = _merge(stats, stepper.stats)
+                try:
+                    stepper = method.start(run, grid[k], X[-1])
+                except Failure as exc:
+                    failure = exc.reason
+                else:
+                    chunk = min(n - 1 - k, MAX_CHUNK) if run.quiet else max(1, chunk)
+                    continue
         if turn is not None and run.stop_reason() is None:
             switched = parts.switch(method, X, turn)
             if switched is not None:       # the loops re-partitioned: on from there
@@ -585,17 +650,40 @@ def _running(run):
         if run.abortable:           # raised in CasADi's check for signals: the call stops
             run.abortable = False
             raise Interrupted
-    saved = {}
+    def tick(signum, frame):
+        if not run.abortable:
+            return
+        # not abortable while it looks: a tick arriving within this one (cancel= may wait on
+        # a lock, as the studio's Event does) returns at once instead of taking it again
+        run.abortable = False
+        now = time.perf_counter()
+        due = run.stall_look is not None and now > run.stall_look
+        if due or run.stop_reason() is not None:
+            if due:
+                run.stall_due = True
+                run.stall_look = now + 2 * (now - run.started)
+            raise Interrupted
+        run.abortable = True
+    saved, timer = {}, None
     # through the C module under ``signal``: its Python wrapper turns each handler into an
     # enum at 60 us a call (0.25 ms of a run that takes 3 ms)
-    for sig in (signal.SIGINT, signal.SIGTERM):
+    for sig, handler in ((signal.SIGINT, stop), (signal.SIGTERM, stop)):
         try:
-            saved[sig] = _signal.signal(sig, stop)
+            saved[sig] = _signal.signal(sig, handler)
         except (ValueError, OSError):     # not settable here (an embedded interpreter)
             pass
+    if run.deadline is not None or run.cancel is not None or run.watched:
+        # the time limit and cancel= are looked at every TICK s within a compiled call as
+        # well: a chunk sized for a fraction of a second can take minutes (a stiff model
+        # under Adams takes 100x the steps the chunk was sized for)
+        with contextlib.suppress(ValueError, OSError):
+            saved[signal.SIGALRM] = _signal.signal(signal.SIGALRM, tick)
+            timer = signal.setitimer(signal.ITIMER_REAL, TICK, TICK)
     try:
         yield
     finally:
+        if timer is not None:             # the caller's own timer, as it was
+            signal.setitimer(signal.ITIMER_REAL, *timer)
         for sig, handler in saved.items():
             _signal.signal(sig, handler)
 

@@ -32,6 +32,10 @@ class Failure(Exception):
         self.states = states
 
 
+#: the reason of a call aborted to look whether auto's Adams stalls (``driver._stalled``)
+LOOK = "looking whether the model became stiff"
+
+
 class Interrupted(Exception):
     """Raised by the driver's signal handler to abort a compiled call (``Run.interruptible``)."""
 
@@ -273,8 +277,12 @@ class _CasadiRun:
         reached = X[:_finite_rows(X)]
         self._count(buffer, len(reached) if failed is not None else len(times))
         if failed is not None:
-            if run.signal is not None:          # aborted by the signal: no solver failure
-                raise Failure(run.stop_reason(), reached)
+            stop = run.stop_reason()
+            if stop is not None:        # aborted by a signal, the time limit or cancel=
+                raise Failure(stop, reached)
+            if run.stall_due:           # aborted to look at the model (auto's stall watch)
+                run.stall_due = False
+                raise Failure(LOOK, reached)
             run.said.append(shift_times(solver_words(str(failed)), self.t))
             raise Failure(solver_reason(str(failed)), reached)
         if len(reached) < len(X):
@@ -558,6 +566,30 @@ def stiffness(rhs, t_start, t_end, x0):
     omega = float(max(0.0, np.max(lam.real), np.max(np.abs(lam.imag))))
     stiff = sigma * (t_end - t_start) > STIFF_HORIZON_STEPS and sigma > STIFF_RATIO * omega
     return stiff, sigma, omega
+
+
+#: a mean step times the fastest mode's rate below this: the step is held by stability (the
+#: stability regions of CVODES's Adams orders reach about 0.2 to 2 along the axes)
+STABILITY_HELD = 3.0
+
+
+def stability_held(rhs, t, t_end, x, step):
+    """Whether a variable-step explicit or Adams method taking steps of ``step`` at (t, x) is
+    held there by the stability of a mode rather than by accuracy: the fastest mode of the
+    Jacobian (rate |λ|) has step |λ| < STABILITY_HELD, and it decays within what remains of
+    the run (-Re λ (t_end - t) > STIFF_HORIZON_STEPS: gone early, not a motion the solution
+    follows). The evidence behind auto's switch from a stalled Adams to BDF.
+
+    Returns (held, |λ|, -Re λ) of that mode."""
+    J = _jacobian_fd(rhs, t, x)
+    with np.errstate(all="ignore"):
+        lam = np.linalg.eigvals(J) if J.size and np.all(np.isfinite(J)) else np.zeros(0)
+    if lam.size == 0 or not np.all(np.isfinite(lam)):
+        return False, 0.0, 0.0
+    fastest = lam[np.argmax(np.abs(lam))]
+    rate, decay = float(abs(fastest)), float(-fastest.real)
+    held = step * rate < STABILITY_HELD and decay * (t_end - t) > STIFF_HORIZON_STEPS
+    return held, rate, decay
 
 
 def choose(run, keep=True):
