@@ -214,16 +214,23 @@ def measure_sweep(system, reference, names, rtol, size):
     return float(np.max(np.abs(got - reference))), wall, member.method.item()
 
 
-def sweep_main(args, rtols):
-    """``--sweep``: simulate and sweeps of 1, 4 and 64 side by side."""
+def compiled_scenes(names):
+    """(name, System, reference states on the study's grid, extract) of each scene, its C
+    code built before anything is timed."""
     t = np.linspace(0.0, T_END, N_POINTS)
-    rows = []
-    started = time.perf_counter()
-    for name in args.scenes:
+    for name in names:
         build, reference, extract = SCENES[name]
         system = build()
         ref = reference(t)
         kn.simulate(system, t_end=0.1, n_points=3, jit=True)          # JIT: untimed
+        yield name, system, ref, extract
+
+
+def sweep_main(args, rtols):
+    """``--sweep``: simulate and sweeps of 1, 4 and 64 side by side."""
+    rows = []
+    started = time.perf_counter()
+    for name, system, ref, extract in compiled_scenes(args.scenes):
         kn.sample(system, {GRAVITY: [-9.81]}, n=1, t_end=0.1, n_points=3, jit=True,
                   progress=False)                                      # the twin's too
         sizes = [b for b in BATCHES if b <= 4 or name not in ONE_BY_ONE]
@@ -314,14 +321,9 @@ def main():
         return sweep_rewrite(rtols)
     if args.sweep:
         return sweep_main(args, rtols)
-    t = np.linspace(0.0, T_END, N_POINTS)
     rows = []
     started = time.perf_counter()
-    for name in args.scenes:
-        build, reference, extract = SCENES[name]
-        system = build()
-        ref = reference(t)
-        kn.simulate(system, t_end=0.1, n_points=3, jit=True)          # JIT: untimed
+    for name, system, ref, extract in compiled_scenes(args.scenes):
         for rtol in rtols:
             row = {"scene": name, "rtol": rtol}
             for label, enabled in (("before", False), ("after", True)):
