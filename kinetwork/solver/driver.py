@@ -42,10 +42,11 @@ from ..errors import ModelError
 from ..graph.settings import check_output, check_settings
 from ..util import quote, suggest
 from .capture import SOLVER_LOCK, solver_output
-from .compiled import compiled
+from .compiled import compiled, numeric
 from .events import EVENT_CHUNK
 from .loopwatch import Partitions, near_singular
-from .methods import LOOK, METHODS, Failure, Interrupted, choose, shift_times
+from .methods import (LOOK, METHODS, Failure, Interrupted, choose, shift_times,
+                      stability_held)
 
 DEFAULTS = {"t_end": 10.0, "n_points": 1001, "method": "auto", "rtol": 1e-6, "atol": 1e-8,
             "step": None, "max_step": None}
@@ -169,6 +170,11 @@ class Run:
             yield
         finally:
             self.abortable = False
+
+    def rhs(self):
+        """The right-hand side as a fast Python callable ``(t, x) -> xdot`` of the values the
+        integrators see (scipy's methods, the stiffness tests)."""
+        return numeric(self.compiled.rhs(self.jit), self.p_solver, self.system.n_states)
 
     def rate(self, t, X):
         """d(x)/dt at a consistent full state X = (x, z), as IDAS's ``init_xdot``."""
@@ -311,8 +317,6 @@ def _stalled(run, t, x, steps):
     reason when the evidence says Adams cannot finish in reasonable work (more than
     STALL_STEPS projected for the run, its mean step held by the stability of a fast mode
     that decays, ``methods.stability_held``), else None (Adams goes on)."""
-    from .compiled import numeric
-    from .methods import stability_held
     t = float(t)
     if t <= run.t_start or steps <= 0:
         return None
@@ -320,8 +324,7 @@ def _stalled(run, t, x, steps):
     projected = steps * (run.t_end - run.t_start) / (t - run.t_start)
     if projected <= STALL_STEPS:
         return None
-    rhs = numeric(run.compiled.rhs(run.jit), run.p_solver, run.system.n_states)
-    held, rate, decay = stability_held(rhs, t, run.t_end, np.asarray(x)[:run.system.n_states],
+    held, rate, decay = stability_held(run.rhs(), t, run.t_end, np.asarray(x)[:run.system.n_states],
                                        step)
     return Stalled(t, step, projected, rate, decay) if held else None
 

@@ -377,7 +377,7 @@ class Scipy(Method):
                                  system.n_states)} if self.newton else {}
         if run.max_step:
             kwargs["max_step"] = run.max_step
-        fun = numeric(run.compiled.rhs(run.jit), run.p_solver, system.n_states)
+        fun = run.rhs()
         with np.errstate(all="ignore"):
             solver = getattr(scipy.integrate, self.name)(
                 fun, t, x, run.bound(t), rtol=run.rtol, atol=run.atol, **kwargs)
@@ -611,8 +611,7 @@ def choose(run, keep=True):
     why = {"stiff": False, "damped": system.damped}
     if system.damped:
         def test():
-            rhs = numeric(run.compiled.rhs(run.jit), run.p_solver, system.n_states)
-            return stiffness(rhs, run.t_start, run.t_end, run.x0)
+            return stiffness(run.rhs(), run.t_start, run.t_end, run.x0)
         # once per start, horizon and parameter values: a model run again asks the same
         key = ("stiffness", float(run.t_start), float(run.t_end),
                np.asarray(run.x0, float).tobytes(), np.asarray(run.p_solver, float).tobytes())
