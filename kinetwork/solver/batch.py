@@ -276,7 +276,9 @@ def _method(plan, template, p, x0):
     is not one a map runs."""
     if plan.key != "auto":
         return plan.key
-    template.p, template.x0 = p, x0
+    # the member's own values, also where the stiffness test reads them (p_solver)
+    template.p = template.p_solver = p
+    template.x0 = x0
     names, _ = plan.methods(template, keep=False)
     method = METHODS[names[0]]
     return names[0] if getattr(method, "plugin", None) in MAPPED else None

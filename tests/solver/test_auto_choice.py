@@ -97,3 +97,18 @@ def test_cancel_stops_a_long_compiled_call():
     assert 0 < caught.value.t_reached < 100.0
     assert time.perf_counter() - start < 60.0
     assert math.isfinite(caught.value.results.t[-1])
+
+
+def test_each_member_of_a_sweep_is_tested_with_its_own_parameters():
+    """The batch's stiffness test read the first member's parameters for every member: the
+    heavily damped member (c = 80, d = 1e6: decays at 5e5/s, creeps at 8e-5/s) ran Adams when
+    it came second. Each member's method follows its own values, in either order, as
+    ``simulate`` chooses it."""
+    model = kn.load(MODELS / "prismatic_spring.json")
+    model.parameters["d"] = 1e6
+    alone = {c: kn.simulate(model, params={"c": c}, t_end=0.05).method for c in (80.0, 1e12)}
+    assert alone[80.0] == "cvodes"
+    for order in ([80.0, 1e12], [1e12, 80.0]):
+        ds = kn.sweep(model, {"c": order}, t_end=0.05, progress=False, workers=1)
+        assert ds.status.values.tolist() == ["ok", "ok"]
+        assert ds.method.values.tolist() == [alone[c] for c in order], order
