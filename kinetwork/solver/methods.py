@@ -568,17 +568,23 @@ def stiffness(rhs, t_start, t_end, x0):
     return stiff, sigma, omega
 
 
-#: a mean step times the fastest mode's rate below this: the step is held by stability (the
-#: stability regions of CVODES's Adams orders reach about 0.2 to 2 along the axes)
-STABILITY_HELD = 3.0
+#: a mean step times the fastest mode's rate in this band: the step is held by that mode's
+#: stability (the stability regions of CVODES's Adams orders reach about 0.2 to 2 along the
+#: axes); far below it, the step is held by accuracy (a tight rtol), not by that mode
+STABILITY_HELD = (0.1, 3.0)
+#: the decay rate of that mode at least this fraction of its rate (within 72.5 degrees of
+#: the negative real axis): BDF of orders up to 4 is stable on it at any step, as it is not on
+#: a lightly damped ringing (the seed at rest after a long run), where BDF would do no better
+BDF_WEDGE = 0.3
 
 
 def stability_held(rhs, t, t_end, x, step):
     """Whether a variable-step explicit or Adams method taking steps of ``step`` at (t, x) is
-    held there by the stability of a mode rather than by accuracy: the fastest mode of the
-    Jacobian (rate |λ|) has step |λ| < STABILITY_HELD, and it decays within what remains of
+    held there by the stability of a mode that BDF steps over: the fastest mode of the
+    Jacobian (rate |λ|) has step |λ| within STABILITY_HELD, it decays within what remains of
     the run (-Re λ (t_end - t) > STIFF_HORIZON_STEPS: gone early, not a motion the solution
-    follows). The evidence behind auto's switch from a stalled Adams to BDF.
+    follows), and within BDF's stable wedge (-Re λ >= BDF_WEDGE |λ|). The evidence behind
+    auto's switch from a stalled Adams to BDF.
 
     Returns (held, |λ|, -Re λ) of that mode."""
     J = _jacobian_fd(rhs, t, x)
@@ -588,7 +594,9 @@ def stability_held(rhs, t, t_end, x, step):
         return False, 0.0, 0.0
     fastest = lam[np.argmax(np.abs(lam))]
     rate, decay = float(abs(fastest)), float(-fastest.real)
-    held = step * rate < STABILITY_HELD and decay * (t_end - t) > STIFF_HORIZON_STEPS
+    low, high = STABILITY_HELD
+    held = low <= step * rate < high and decay >= BDF_WEDGE * rate and \
+        decay * (t_end - t) > STIFF_HORIZON_STEPS
     return held, rate, decay
 
 
