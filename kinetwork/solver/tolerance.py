@@ -52,6 +52,11 @@ RUN_STEPS = 10_000_000
 #: SUNDIALS' own budget per output interval (its mxstep), at the tolerances asked: what an
 #: output interval may take at least, however short
 MXSTEP = 10_000
+#: at most this many steps for any run or interval (SUNDIALS counts them in a C long), and a
+#: horizon counted as at most this many HORIZONs (1e300 s asked: no overflow; the floor and
+#: the time limit bound such a run anyway)
+MOST_STEPS = 10**15
+LONGEST = 1e30
 
 
 def solver_tolerances(method, system, rtol, atol, horizon=HORIZON):
@@ -76,7 +81,7 @@ def tightening(method, system, horizon=HORIZON):
     adams = method.options.get("linear_multistep_method") == "adams"
     name = "cvodes-adams" if adams else method.plugin
     factor = TIGHTEN.get((name, _closes_loops(system)), 1.0)
-    return factor * max(1.0, abs(float(horizon)) / HORIZON) ** 2
+    return factor * _length(horizon) ** 2
 
 
 def step_budget(method, system, horizon, interval=None):
@@ -90,11 +95,16 @@ def step_budget(method, system, horizon, interval=None):
     point where the steps shrink to nothing), whatever the grid; the run's total is the
     driver's to count."""
     growth = tightening(method, system, horizon) ** 0.2
-    length = max(1.0, abs(float(horizon)) / HORIZON)
+    run = RUN_STEPS * _length(horizon)
     if interval is None:
-        return int(RUN_STEPS * length * growth)
-    share = RUN_STEPS * abs(float(interval)) / HORIZON
-    return int(min(max(MXSTEP, share), RUN_STEPS * length) * growth)
+        return int(min(run * growth, MOST_STEPS))
+    share = RUN_STEPS * min(abs(float(interval)) / HORIZON, LONGEST)
+    return int(min(min(max(MXSTEP, share), run) * growth, MOST_STEPS))
+
+
+def _length(horizon):
+    """The length of a run in HORIZONs, at least one and at most LONGEST."""
+    return min(max(1.0, abs(float(horizon)) / HORIZON), LONGEST)
 
 
 def _closes_loops(system):
