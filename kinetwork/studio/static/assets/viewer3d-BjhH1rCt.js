@@ -4228,13 +4228,13 @@ void main() {
 .kn-viewer canvas{display:block}
 .kn-viewer-title{position:absolute;top:8px;left:12px;font-weight:600;color:#555;pointer-events:none}
 .kn-viewer-note{padding:2em;color:#a33}
-.kn-viewer-bar{position:absolute;left:0;right:0;bottom:0;display:flex;align-items:center;gap:8px;
-  padding:6px 10px;background:#fff;border-top:1px solid #dde0e4}
+.kn-viewer-bar{position:absolute;left:0;right:0;bottom:0;display:flex;flex-wrap:wrap;align-items:center;
+  gap:4px 8px;padding:6px 10px;background:#fff;border-top:1px solid #dde0e4}
 .kn-viewer-bar button{font:inherit;padding:2px 8px;border:1px solid #c8ccd2;border-radius:4px;
   background:#fff;cursor:pointer;min-width:2.2em}
 .kn-viewer-bar button.kn-play{width:2.8em}
 .kn-viewer-bar button:hover{background:#eef1f5}
 .kn-viewer-bar button.kn-on{background:#dbe8fb;border-color:#8fb3e6}
-.kn-viewer-bar input[type=range]{flex:1;min-width:80px}
+.kn-viewer-bar input[type=range]{flex:1 1 60px;min-width:60px}
 .kn-viewer-bar select{font:inherit}
 .kn-time{font-variant-numeric:tabular-nums;white-space:nowrap}`,document.head.appendChild(e)}export{tu as createViewer};
