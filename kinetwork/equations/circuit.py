@@ -145,7 +145,7 @@ class Circuit:
             bound = self.b.bound[c.name]
             for k, (x, rate) in enumerate(zip(view.x, bound.rates(view))):
                 key = _start_key(c, k)
-                dae.candidate(Candidate(x, self.b.net.names[self.b._at(x)], c, key,
+                dae.candidate(Candidate(x, self.b.net.names[self.b.index_of(x)], c, key,
                                         bound.initial()[k]), rate, c)
         return dae
 
@@ -177,7 +177,7 @@ class Circuit:
     def _view(self, comp, knowns):
         b = self.b
         bound = b.bound[comp.name]
-        x = [b._state(f"{comp.name}.{label}", unit, start, 0) for label, unit, start in
+        x = [b.add_state(f"{comp.name}.{label}", unit, start, 0) for label, unit, start in
              zip(bound.state_labels, bound.state_units, bound.initial())]
         u = self.sources.get(comp.name)
         if u is not None:
@@ -306,7 +306,7 @@ class Circuit:
             if cand.group is not None:
                 self.coupled[cand.group.index].acc = rate
             elif cand not in demoted:
-                b.net.rate[b._at(cand.x)] = rate
+                b.net.rate[b.index_of(cand.x)] = rate
         kept = [dae.candidates[i] for i in reduced.states]
         self._check_starts(dae, reduced, kept, demoted, [sub(v) for v in ca.vertsplit(vd)])
         for cand, v in zip(demoted, ca.vertsplit(vd)):
@@ -402,7 +402,7 @@ class Circuit:
     def _drop(self, x):
         """Take the state ``x`` out of the network: a constraint gives its value."""
         net = self.b.net
-        at = self.b._at(x)
+        at = self.b.index_of(x)
         for seq in (net.x, net.rate, net.start, net.names, net.units):
             del seq[at]
 
