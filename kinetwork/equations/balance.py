@@ -17,6 +17,8 @@ from .records import Hybrid, position_label, state_units
 
 
 def mechanics(builder):
+    """The mechanics, at its place in the order of the blocks: sources' flows, motions' drives,
+    the trains riding on housings, then every group's balance."""
     flows(builder, "source")
     for m in builder.motions:
         u = blockflow.inputs(builder, m.source).get("u")
@@ -46,6 +48,8 @@ def apply_drive(builder, motion, torque):
 
 
 def flows(builder, role):
+    """The flows of every element of ``role`` (compliant, source) from its flanges' positions
+    and speeds (and, for a source, its signal input)."""
     net = builder.net
     flow = net.flow
     for comp in builder.model.components.values():
@@ -84,16 +88,9 @@ def hybrid(builder, comp, b, refs):
                                   refs else None, refs[b.side_b], u))
 
 
-def applied(builder, s, roles=("compliant", "source"), exclude=()):
-    """Flows into the non-rigid elements at a connection set (compliant, sources; with
-    ``prescribed`` in ``roles``, motion sources too), but those of ``exclude``."""
-    return sum((builder.net.flow.get(r, 0) for r in builder.topo.sets[s]
-                if r.component.role in roles and r.component.name not in exclude),
-               ca.SX(0))
-
-
 def generalized(builder, group, roles=("compliant", "source"), exclude=()):
-    return sum((-builder.kt[s] * applied(builder, s, roles, exclude) for s, _, _ in group.sets),
+    """The generalized force on the group's coordinate of the flows applied at its sets."""
+    return sum((-builder.kt[s] * builder.applied(s, roles, exclude) for s, _, _ in group.sets),
                ca.SX(0))
 
 
@@ -125,6 +122,7 @@ def virtual(builder, group, gen):
 
 
 def speed_index(builder, group):
+    """The index of the speed of the joint whose coordinate a "joint" group follows."""
     joint = group.definer.component
     return builder.uindex[joint.name][joint.coordinate_ports[group.definer.name]]
 
@@ -152,6 +150,8 @@ def balance(builder, group):
 
 
 def massless(builder, group, gen):
+    """A massless group's speed (one first-order state, a damper on it) or position (springs
+    only) solved from its balance ``gen`` = 0, linear in them."""
     theta, w, a = builder.coord[group.index]
     builder.net.no_acceleration.update(s for s, _, _ in group.sets)
     where = ", ".join(r.path for s, _, _ in group.sets for r in builder.topo.sets[s])
@@ -182,7 +182,7 @@ def rigid_flows(builder, group):
     """Kirchhoff at every set of the group, leaves first: the flow into a rigid element at
     its far side balances what is beyond; its law gives the near side."""
     flow = builder.net.flow
-    beyond = {s: applied(builder, s, ("compliant", "source", "prescribed"))
+    beyond = {s: builder.applied(s, ("compliant", "source", "prescribed"))
               + supports.reactions(builder, s) for s, _, _ in group.sets}
     for s, parent, element in reversed(group.sets):
         if parent is None:

@@ -21,6 +21,7 @@ MECHANICS = "the mechanics"
 
 
 def block_states(builder):
+    """The states of the signal blocks, with their starts."""
     for comp in builder.model.components.values():
         if comp.role == "block" and comp.n_states:
             b = builder.bound[comp.name]
@@ -114,11 +115,13 @@ def algebraic_loop(builder, names):
 
 
 def massless_at(builder, ref):
+    """Whether the port ``ref`` is on a massless group (no acceleration there)."""
     group = builder.group_of.get(builder.topo.set_of[ref])
     return group is not None and group.kind == "massless"
 
 
 def block_rates(builder):
+    """The rates of the signal blocks' states, once every signal is known."""
     for name, xs in builder.block_x.items():
         comp = builder.model.components[name]
         rates = builder.bound[name].rates(inputs(builder, comp), xs, builder.t)

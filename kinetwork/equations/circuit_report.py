@@ -43,6 +43,7 @@ def label(circuit, z, unknowns):
 
 
 def summary(circuit, dae, reduced, solved):
+    """The line on what structural analysis made of the circuits (``Network.circuit``)."""
     loops = [n for n in solved.sizes if n > 1]
     out = (f"circuits: {len(circuit.potential)} node potentials and {len(circuit.current)} "
            f"pin currents in {len(solved.sizes)} blocks"

@@ -90,6 +90,8 @@ def projected(loops, x, zg, ode, keep_q, dep_q, ind, sub, u_full, udot, udot_i, 
 
 
 def equations_of(loops, formulation, rate):
+    """The Equations of a model with loops in ``formulation`` (partition, projected,
+    baumgarte at ``rate``), on the closure rows and speed partition of ``loops``."""
     asm = loops.asm
     q, u = asm.q, asm.u
     nv = u.shape[0]
@@ -233,4 +235,5 @@ def take_rows(m, index):
 
 
 def take_cols(m, index):
+    """Columns ``index`` of an SX matrix: SX(rows, 0) when there are none."""
     return m[:, index] if index else ca.SX(m.shape[0], 0)

@@ -21,6 +21,8 @@ def closed(r):
 
 
 def gauss_newton(loops, q, p, rows=None, free=None):
+    """Gauss-Newton with least-squares steps on the closure (its ``rows``, in the ``free``
+    coordinates), backtracking on |residual|: (q, residual) where it stops."""
     free = loops.free if free is None else free
     pick = (lambda r: r) if rows is None else (lambda r: r[rows])
     q = q.copy()

@@ -225,6 +225,7 @@ class _Builder:
         self.coord[group.index] = (theta, w, a)
 
     def add_state(self, name, unit, start, rate, at=None):
+        """A new state of the network (its symbol), at position ``at`` (default: last)."""
         x = ca.SX.sym(name.replace(".", "_"))
         at = len(self.net.x) if at is None else at
         self.net.x.insert(at, x)
@@ -233,6 +234,13 @@ class _Builder:
         self.net.names.insert(at, name)
         self.net.units.insert(at, unit)
         return x
+
+    def applied(self, s, roles=("compliant", "source"), exclude=()):
+        """Flows into the non-rigid elements at a connection set (compliant, sources; with
+        ``prescribed`` in ``roles``, motion sources too), but those of ``exclude``."""
+        return sum((self.net.flow.get(r, 0) for r in self.topo.sets[s]
+                    if r.component.role in roles and r.component.name not in exclude),
+                   ca.SX(0))
 
     def index_of(self, x):
         """Position of the state symbol ``x`` (by identity: SX == builds an expression)."""
