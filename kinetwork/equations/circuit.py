@@ -326,7 +326,7 @@ class Circuit:
                               for k in solved.kept]
             net.loops_kept.append(owners)
         # the rates of the sources' signals are needed only where a constraint was
-        # differentiated through a source (the network finds them: ``_input_rates``)
+        # differentiated through a source (the network finds them: ``derivatives.input_rates``)
         used = ca.vertcat(*self.potential.values(), *self.current.values(),
                           *b.net.rate, *b.net.alg_res,
                           *[c.acc for c in self.coupled.values()])

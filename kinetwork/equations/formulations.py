@@ -107,7 +107,7 @@ def equations_of(loops, formulation, rate):
     T[ind, :] = ca.SX.eye(len(ind))
     if dep:
         T[dep, :] = -ca.solve(JD, JI)
-    # u = T u_I + s: the prescribed speeds (symbols until ``_prescribe``) and what the
+    # u = T u_I + s: the prescribed speeds (symbols until ``loops._prescribe``) and what the
     # dependent ones do to follow them
     s_vel = ca.SX.zeros(nv)
     acc_P = ca.vertcat(*[m.acc for m in asm.prescribed.values()])

@@ -174,8 +174,8 @@ def _parse(text, source):
 
 def _count(data, source):
     """Refuse a model whose lists of components or connections (at the top or in an inline
-    definition) are longer than a model may have, as ``_components`` and ``_connections``
-    would, before the file is read again object by object."""
+    definition) are longer than a model may have, as reading its ``sections`` would, before
+    the file is read again object by object."""
     if not isinstance(data, dict):
         return
     bodies = [("", data)]
