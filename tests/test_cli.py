@@ -273,7 +273,9 @@ def seed_file_long(tmp_path):
     return path
 
 
-def test_progress_bar_goes_to_stderr(seed_file, capfd):
+def test_progress_bar_goes_to_stderr(seed_file, capfd, monkeypatch):
+    from kinetwork.solver import progress
+    monkeypatch.setattr(progress, "DELAY", 0.0)      # this run is shorter than the delay
     assert main(["run", str(seed_file), "--progress", "--t-end", "5"]) == 0
     captured = capfd.readouterr()
     assert "t = " in captured.err and "%" in captured.err      # the bar

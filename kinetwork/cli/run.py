@@ -3,7 +3,6 @@ probe plots; what a failed or stopped run computed is written all the same."""
 
 import argparse
 import contextlib
-import os
 import sys
 import time
 
@@ -123,7 +122,7 @@ def run(args):
     # the limit counts from the run (its C compilation included) to the last output written
     deadline = None if args.time_limit is None else time.monotonic() + args.time_limit
     try:
-        with _progress_bar(args, model, settings["t_end"]) as progress:
+        with _progress_bar(args, model, 0.0, settings["t_end"]) as progress:
             results = kn.simulate(system, t_end=args.t_end, n_points=args.n_points,
                                   method=args.method, rtol=args.rtol, atol=args.atol,
                                   step=args.step, max_step=args.max_step, jit=args.jit,
@@ -233,21 +232,13 @@ def _save_plot(args, results, path, title):
 
 
 @contextlib.contextmanager
-def _progress_bar(args, model, t_end):
-    """A tqdm bar on stderr while the run goes, or None. It writes to a duplicate of the
-    terminal's descriptor: the integrators' own output is captured meanwhile."""
+def _progress_bar(args, model, t_start, t_end):
+    """A tqdm bar on stderr while the run goes (``solver.progress``), or None."""
     show = args.progress if args.progress is not None else \
         (not args.quiet and sys.stderr.isatty())
     if not show:
         yield None
         return
-    from tqdm import tqdm
-    terminal = os.fdopen(os.dup(sys.stderr.fileno()), "w")
-    bar = tqdm(total=round(t_end, 9), file=terminal, unit="s", desc=f"{model.name}",
-               bar_format="{desc}: {percentage:3.0f}%|{bar}| t = {n:.3g} of {total:g} s "
-                          "[{elapsed}<{remaining}]", leave=False)
-    try:
-        yield lambda t: bar.update(max(0.0, t - bar.n))
-    finally:
-        bar.close()
-        terminal.close()
+    from ..solver.progress import progress_bar
+    with progress_bar(t_start, t_end, desc=model.name) as report:
+        yield report
