@@ -78,7 +78,9 @@ def add(sub):
 
 
 def run(args):
-    outputs = [("--out", args.out, "csv"), ("--plot", args.plot, plot_kind(args.plot or ""))]
+    from ..solver.csvio import sidecar
+    outputs = [("--out", args.out, "csv"), ("--plot", args.plot, plot_kind(args.plot or "")),
+               ("--out's sidecar", args.out and sidecar(args.out), "meta")]
     try:                                # by name, before anything is read or run
         check_all(outputs, [("the model file", args.model)], args.force)
     except OutputRefused as exc:
@@ -201,7 +203,7 @@ def _outputs(args, results, title, deadline=None, stopped=False):
             flag.cut = why
             if not quiet:
                 rows = f"{len(results.t)} points" if why is None else \
-                    f"the first rows ({why}: cut short, said on its last line)"
+                    f"the first rows ({why}: cut short, said in its sidecar)"
                 print(f"wrote {rows} x {len(results.column_names())} columns to {args.out}")
         if args.plot:
             why = flag()
