@@ -32,7 +32,7 @@ from ..expr import parse
 from ..graph.model import evaluate
 from ..util import quote, suggest
 from .compiled import compiled
-from .driver import CHUNK_WORK, FIRST_CHUNK_STEPS, _finite_start, _work
+from .driver import CHUNK_WORK, FIRST_CHUNK_STEPS, _finite_start, _work, look_budget
 from .methods import METHODS, Casadi, Failure, _CasadiRun
 
 #: members of one mapped call at most
@@ -328,6 +328,10 @@ def _mapped(plan, template, key, call, out, workers, stop):
     X = np.empty((b, len(grid), nx))
     X[:, 0] = np.array([x0 for _, _, x0 in call])
     P = np.array([p for _, p, _ in call])
+    # auto's Adams under its look budget, as in a run: a member it stalls on fails the call
+    # within that budget, and runs on its own through Plan.run, which looks and switches
+    template.look_steps = look_budget(template) \
+        if plan.key == "auto" and key == "cvodes-adams" else None
     k = 0
     while k < len(grid) - 1:
         if k and stop():

@@ -72,6 +72,10 @@ TICK = 0.1
 STALL_LOOK = 2.0
 #: Adams steps projected for a run beyond which a look asks whether they are held by stability
 STALL_STEPS = 1e6
+#: auto's Adams is also stopped to look when one output interval takes more steps than
+#: STALL_STEPS spread over the run's intervals, and at least this many: a step budget, so the
+#: look needs no signal and works in any thread (a sweep's mapped members, a Dask worker)
+LOOK_STEPS = 500
 #: restarts after a failure, with ``restart=True``, at most
 MAX_RESTARTS = 3
 #: a restarted run must keep the loops closed to this (m, or rotation-matrix entries)
@@ -139,6 +143,10 @@ class Run:
         self.stall_look = None
         self.watched = False            # auto: its Adams may be looked at (the tick is set)
         self.stall_due = False          # set by the tick that aborted a call to look
+        #: auto's Adams watched by a step budget per output interval (``look_budget``), and
+        #: the time its budget ran out at (set by the method whose call it stopped)
+        self.look_steps = None
+        self.look_hit = None
         self.events = None              # friction, stops, relations: events.Events
         #: the parameters of the equations the integrators see (``compiled.Held``): the
         #: model's, then the values the relations are held at (``switches.py``)
@@ -286,8 +294,9 @@ def _auto(run, stats):
     for i, name in enumerate(names):
         watch = name == "cvodes-adams" and i < len(names) - 1 and run.events is None
         run.stall_look = time.perf_counter() + STALL_LOOK if watch else None
+        run.look_steps = look_budget(run) if watch else None
         X, failure, method_stats = _integrate(run, METHODS[name])
-        run.stall_look = None
+        run.stall_look = run.look_steps = None
         if failure is None or i == len(names) - 1 or run.stop_reason() is not None:
             stats.update(method_stats)
             return X, failure, name
@@ -312,21 +321,38 @@ class Stalled(str):
         return self
 
 
+def look_budget(run):
+    """The steps of one output interval after which auto's Adams is stopped to look whether
+    it stalls: STALL_STEPS spread over the run's intervals, at least LOOK_STEPS."""
+    intervals = max(1, len(run.grid) - 1)
+    return max(LOOK_STEPS, math.ceil(STALL_STEPS / intervals))
+
+
 def _stalled(run, t, x, steps):
-    """After a look at a long Adams call that took ``steps`` steps to ``t``: a ``Stalled``
-    reason when the evidence says Adams cannot finish in reasonable work (more than
-    STALL_STEPS projected for the run, its mean step held by the stability of a fast mode
-    that decays, ``methods.stability_held``), else None (Adams goes on)."""
-    t = float(t)
-    if t <= run.t_start or steps <= 0:
-        return None
-    step = (t - run.t_start) / steps
-    projected = steps * (run.t_end - run.t_start) / (t - run.t_start)
+    """After a look at a long Adams call that took ``steps`` steps to the output ``t``
+    (state ``x``): a ``Stalled`` reason when the evidence says Adams cannot finish in
+    reasonable work (more than STALL_STEPS projected for the run, its mean step held by the
+    stability of a fast mode that decays, ``methods.stability_held``), else None (Adams goes
+    on). A look by the step budget (``look_budget``) takes the mean step of the interval whose
+    budget ran out, and the rest of the run goes on under the run's own budget."""
+    t, hit = float(t), run.look_hit
+    run.look_hit = None
+    if hit is not None:
+        budget, run.look_steps = run.look_steps, None
+        step = (hit - t) / budget
+        if step <= 0:
+            return None
+        projected = steps + (run.t_end - hit) / step
+    else:
+        if t <= run.t_start or steps <= 0:
+            return None
+        step = (t - run.t_start) / steps
+        projected = steps * (run.t_end - run.t_start) / (t - run.t_start)
     if projected <= STALL_STEPS:
         return None
-    held, rate, decay = stability_held(run.rhs(), t, run.t_end, np.asarray(x)[:run.system.n_states],
-                                       step)
-    return Stalled(t, step, projected, rate, decay) if held else None
+    held, rate, decay = stability_held(run.rhs(), t, run.t_end,
+                                       np.asarray(x)[:run.system.n_states], step)
+    return Stalled(max(t, hit or t), step, projected, rate, decay) if held else None
 
 
 def _integrate(run, method):

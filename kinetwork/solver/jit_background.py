@@ -17,12 +17,13 @@ import sys
 import casadi as ca
 
 from . import jit
+from .jit_build import exit_on
 from .jit_tiers import BACKGROUND_TIMEOUT, NICE, failed_marker
 
 
 def main(argv):
     # stopped (SIGTERM): its compilers stopped and its build folder removed on the way out
-    signal.signal(signal.SIGTERM, lambda signum, frame: sys.exit(128 + signum))
+    signal.signal(signal.SIGTERM, exit_on)
     job = pathlib.Path(argv[0])
     spec = json.loads((job / "job.json").read_text())
     functions = [ca.Function.deserialize((job / f"f{i}.casadi").read_text())

@@ -17,6 +17,7 @@ import pathlib
 import signal
 import stat
 import subprocess
+import sys
 import tempfile
 import time
 
@@ -32,6 +33,35 @@ class Unavailable(ModelError):
     def __init__(self, kind, message):
         super().__init__(message)
         self.kind = kind
+
+
+class _Starting:
+    """Whether a compiler is being started and recorded now, and the stop signal that came
+    meanwhile: a builder's exit (``exit_on``) waits for the record, so no compiler it started
+    outlives it unstopped."""
+    active = False
+    pending = None
+
+
+@contextlib.contextmanager
+def _starting():
+    _Starting.active = True
+    try:
+        yield
+    finally:
+        _Starting.active = False
+        if _Starting.pending is not None:
+            signum, _Starting.pending = _Starting.pending, None
+            sys.exit(128 + signum)
+
+
+def exit_on(signum, frame):
+    """A stop signal's handler in a builder process: exit (its compilers stopped and its
+    folder removed on the way out), once the compiler being started, if one is, is recorded."""
+    if _Starting.active:
+        _Starting.pending = signum
+    else:
+        sys.exit(128 + signum)
 
 
 def stop_reason(deadline, cancelled):
@@ -139,7 +169,7 @@ def _compile(jobs, work, deadline, cancelled, limit):
         while (waiting or running) and failed is None:
             while waiting and len(running) < cores():
                 i, command = waiting.pop(0)
-                with open(work / f"stderr{i:05d}", "wb") as said:
+                with open(work / f"stderr{i:05d}", "wb") as said, _starting():
                     try:
                         running.append(subprocess.Popen(
                             command, cwd=work, stdin=subprocess.DEVNULL, stdout=said,

@@ -139,6 +139,16 @@ def solver_words(message):
     return last[:300] + "\n" if last else ""
 
 
+def _budget_hit(said):
+    """The time at which a SUNDIALS call ran out of its step budget, from what it printed
+    (``At t = ..., mxstep steps taken``), or None."""
+    found = re.search(r"At t\s*=\s*([-+0-9.eE]+)", said)
+    try:
+        return float(found.group(1)) if found else None
+    except ValueError:
+        return None
+
+
 def solver_reason(message):
     """A CasADi integrator's error in plain words."""
     for flag, words in SUNDIALS_FLAGS.items():
@@ -191,6 +201,8 @@ class _CasadiRun:
                 opts["max_num_steps"] = int(run.max_steps)
             if run.max_step:
                 opts["max_step_size"] = float(run.max_step)
+            if run.look_steps is not None and run.look_steps < opts["max_num_steps"]:
+                opts["max_num_steps"] = run.look_steps      # auto's look: driver.look_budget
         else:       # fixed steps: counted over the chunk; a blow-up is reported once, below
             opts["show_eval_warnings"] = False
             opts["number_of_finite_elements"] = run.steps_per_interval * len(times)
@@ -282,6 +294,13 @@ class _CasadiRun:
                 raise Failure(stop, reached)
             if run.stall_due:           # aborted to look at the model (auto's stall watch)
                 run.stall_due = False
+                raise Failure(LOOK, reached)
+            if opts.get("max_num_steps") == run.look_steps and "TOO_MUCH_WORK" in str(failed):
+                # auto's look budget ran out: the driver looks. Where, CVODES printed (its
+                # words, not the run's); else, at most the next output time
+                said = run.said.pop() if run.said and "mxstep" in run.said[-1] else ""
+                hit = _budget_hit(said)
+                run.look_hit = hit if hit is not None else float(times[len(reached)])
                 raise Failure(LOOK, reached)
             run.said.append(shift_times(solver_words(str(failed)), self.t))
             raise Failure(solver_reason(str(failed)), reached)

@@ -112,3 +112,28 @@ def test_each_member_of_a_sweep_is_tested_with_its_own_parameters():
         ds = kn.sweep(model, {"c": order}, t_end=0.05, progress=False, workers=1)
         assert ds.status.values.tolist() == ["ok", "ok"]
         assert ds.method.values.tolist() == [alone[c] for c in order], order
+
+
+def test_adams_gives_way_in_a_thread_and_in_a_sweep_member_too():
+    """The look at a running Adams is a step budget per output interval, not only a timer
+    signal (which Python delivers to the main thread alone): a run started in another thread
+    and a sweep's thread-mapped member switch as a run in the main thread does. Before, the
+    member ran Adams to the end (1.3e7 steps, 80 s) and the thread's run likewise."""
+    import threading
+
+    model = kn.load(MODELS / "prismatic_spring.json")
+    main = kn.simulate(model, params=HARD)
+    box = {}
+    worker = threading.Thread(target=lambda: box.update(res=kn.simulate(model, params=HARD)))
+    worker.start()
+    worker.join()
+    res = box["res"]
+    assert res.stats["switched"]["to"] == "cvodes" and res.method == "cvodes"
+    np.testing.assert_allclose(res.states, main.states, rtol=1e-9, atol=1e-15)
+    model.parameters["d"] = HARD["d"]
+    ds = kn.sweep(model, {"c": [80.0, HARD["c"]]}, progress=False, workers=2)
+    assert ds.status.values.tolist() == ["ok", "ok"]
+    assert ds.method.values.tolist() == ["cvodes", "cvodes"]
+    member = ds.sel(c=HARD["c"])
+    np.testing.assert_allclose(member["slider.q"].values, main.states[:, 0], rtol=1e-6,
+                               atol=1e-15)
