@@ -185,7 +185,7 @@ def _outputs(args, results, title, deadline=None, stopped=False):
 
     The time limit covers writing too; once it has passed, or after the run was ``stopped``
     (a signal), the outputs get WRITE_GRACE seconds more. The CSV stops between blocks of
-    rows, keeping the rows written and a last line saying where; a plot is drawn whole or
+    rows, keeping the rows written, its sidecar saying where; a plot is drawn whole or
     not at all."""
     quiet = getattr(args, "quiet", False)
     now = time.monotonic()
