@@ -74,38 +74,76 @@ class PortRef:
 
 #: what other tools (Modelica's MSL, Simscape, MapleSim) call a component kinetwork has under
 #: another name, looked up by the name after the library
-ELSEWHERE = {"World": "multibody.Ground", "Body": "multibody.RigidBody",
-             "RigidTransform": "multibody.FixedRotation", "Translation": "multibody.FixedTranslation",
-             "Rotation": "multibody.FixedRotation", "RevoluteJoint": "multibody.Revolute",
-             "PrismaticJoint": "multibody.Prismatic", "SphericalJoint": "multibody.Spherical",
-             "Gear": "rotational.IdealGear", "Motor": "electrical.DCMotor",
-             "Capacitance": "electrical.Capacitor", "Inductance": "electrical.Inductor",
-             "Resistance": "electrical.Resistor", "Source": "signals.Constant"}
+#: what other tools call a kinetwork type: a name, or "lib.Name" where the library decides
+#: (MSL's MultiBody ``Fixed`` is a fixed frame, its Rotational ``Fixed`` a fixed flange)
+ELSEWHERE = {"World": ["multibody.Ground"], "Body": ["multibody.RigidBody"],
+             "RigidTransform": ["multibody.FixedRotation"],
+             "Translation": ["multibody.FixedTranslation"],
+             "Rotation": ["multibody.FixedRotation"], "RevoluteJoint": ["multibody.Revolute"],
+             "PrismaticJoint": ["multibody.Prismatic"], "SphericalJoint": ["multibody.Spherical"],
+             "Gear": ["rotational.IdealGear"], "Motor": ["electrical.DCMotor"],
+             "Capacitance": ["electrical.Capacitor"], "Inductance": ["electrical.Inductor"],
+             "Resistance": ["electrical.Resistor"], "Source": ["signals.Constant"],
+             "PointGravity": ["multibody.Ground"], "Fixed": ["multibody.Ground"],
+             "multibody.Fixed": ["multibody.Ground"],
+             "rotational.Ground": ["rotational.Fixed"],
+             "translational.Ground": ["translational.Fixed"],
+             "multibody.Mass": ["multibody.PointMass", "translational.Mass"],
+             "multibody.Inertia": ["multibody.RigidBody", "rotational.Inertia"],
+             "ConstantTorque": ["rotational.Torque"], "TorqueSource": ["rotational.Torque"],
+             "ForceSource": ["translational.Force"], "ConstantForce": ["translational.Force"],
+             "ConstantVoltage": ["electrical.VoltageSource"],
+             "SineVoltage": ["electrical.VoltageSource"],
+             "StepVoltage": ["electrical.VoltageSource"],
+             "ConstantCurrent": ["electrical.CurrentSource"],
+             "LimPID": ["signals.PID"], "PI": ["signals.PID"], "Feedback": ["signals.Add"],
+             "Sensor": ["Probe"], "PositionSensor": ["translational.PositionSensor"]}
+
+
+def type_suggestions(kind):
+    """The types the unknown component type ``kind`` ("lib.Name") may stand for, best first:
+    what other tools call it (``multibody.World``: multibody.Ground), the same name in the
+    other libraries (``rotational.Mass``: translational.Mass), else the closest names."""
+    name = str(kind).rpartition(".")[2]
+    found = [k for k in ELSEWHERE.get(str(kind), []) + ELSEWHERE.get(name, [])
+             if k in REGISTRY and k != kind]
+    found += sorted(k for k in REGISTRY if k.rpartition(".")[2].lower() == name.lower()
+                    and k != kind)
+    found = list(dict.fromkeys(found))
+    if not found:
+        import difflib                  # here: the command line starts without it
+        found = difflib.get_close_matches(str(kind)[:100], list(REGISTRY), n=1)
+    return found[:3]
 
 
 def type_suggestion(kind):
-    """' (did you mean ...?)' for the unknown component type ``kind`` ("lib.Name"): the same
-    name in the other libraries (``rotational.Mass``: translational.Mass), the kinetwork name
-    of what other tools call it (``multibody.World``: multibody.Ground), else the closest
-    names; '' if none."""
-    name = str(kind).rpartition(".")[2]
-    same = sorted(k for k in REGISTRY if k.rpartition(".")[2].lower() == name.lower()
-                  and k != kind)
-    if not same and ELSEWHERE.get(name) in REGISTRY:
-        same = [ELSEWHERE[name]]
-    if same:
-        return f" (did you mean {' or '.join(repr(k) for k in same[:3])}?)"
-    return suggest(kind, REGISTRY)
+    """' (did you mean ...?)' for the unknown component type ``kind`` (see
+    ``type_suggestions``); '' if none."""
+    found = type_suggestions(kind)
+    return f" (did you mean {' or '.join(repr(k) for k in found)}?)" if found else ""
+
+
+class NoSuchComponent(AttributeError):
+    """``kn.multibody.World``: no such component type in that library. An AttributeError
+    (``hasattr`` and ``getattr`` with a default keep working) whose message says what it may
+    be, across libraries; ``library``, ``name`` and ``suggestions`` hold the same as data."""
+
+    def __init__(self, library, name):
+        self.library, self.name = library, name
+        self.suggestions = type_suggestions(f"{library}.{name}")
+        close = f" (did you mean {' or '.join(repr(k) for k in self.suggestions)}?)" \
+            if self.suggestions else ""
+        super().__init__(f"kinetwork.{library} has no component {quote(name)}{close}")
 
 
 def library_attribute(library):
-    """The ``__getattr__`` of a library's module: an unknown component is an AttributeError
-    that says what it may be (``kn.multibody.World``: did you mean 'multibody.Ground'?)."""
+    """The ``__getattr__`` of a library's module: an unknown component is a
+    ``NoSuchComponent`` that says what it may be (``kn.multibody.World``: did you mean
+    'multibody.Ground'?)."""
     def __getattr__(name):
         if name.startswith("__"):
             raise AttributeError(name)
-        raise AttributeError(f"kinetwork.{library} has no component {name!r}"
-                             f"{type_suggestion(f'{library}.{name}')}")
+        raise NoSuchComponent(library, name)
     return __getattr__
 
 

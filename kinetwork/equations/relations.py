@@ -75,6 +75,9 @@ class Relations:
     f_state : casadi.Function
         (t, [x; z], [p; r]) -> (k, 2): each state relation's indicator g (the relation
         holds where g > 0, ``<=``: g >= 0) and its rate along the held equations.
+    f_level : casadi.Function
+        (t, [x; z], [p; r]) -> (k,): the indicators g alone, without the equations their
+        rates read (what locating a crossing evaluates, many times).
     f_time : casadi.Function
         (t, p) -> (k, 2): each time node's indicator (a relation, min, max: zero where it
         switches; abs, sign: its argument; floor, ceil, fmod: the argument whose whole
@@ -91,6 +94,7 @@ class Relations:
     p: ca.SX
     f_select: ca.Function
     f_state: ca.Function
+    f_level: ca.Function
     f_time: ca.Function
 
     @property
@@ -252,6 +256,8 @@ def find(system):
                              [ca.densify(select)]),
         f_state=ca.Function("relation_indicators", [t, ca.vertcat(x, z), pr],
                             [ca.densify(ca.horzcat(g_state, rate))]),
+        f_level=ca.Function("relation_levels", [t, ca.vertcat(x, z), pr],
+                            [ca.densify(g_state)]),
         f_time=ca.Function("time_indicators", [t, p],
                            [ca.densify(ca.horzcat(g_time, d_time))]))
     out._symbols = (t, x, z)

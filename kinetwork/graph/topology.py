@@ -195,7 +195,8 @@ def _probes(model, graph, probes, problems):
         asked = probe.quantities if probe.quantities is not None else list(allowed)
         for q in asked:
             if q not in allowed:
-                problems.append(model.problem(f"{q!r} is not a quantity of a "
+                article = "an" if target.domain[0] in "aeiou" else "a"
+                problems.append(model.problem(f"{q!r} is not a quantity of {article} "
                                               f"{target.domain} port ({target.path}); choose "
                                               f"from {', '.join(allowed)}", probe,
                                               "quantities"))

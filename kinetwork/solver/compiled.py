@@ -82,6 +82,15 @@ class Compiled:
             return system.f_out
         return self._get("outputs", lambda: self._external(system.f_out, False, jit))
 
+    def relations(self, name, jit=None):
+        """The Function ``name`` of the System's relations (``equations.relations``:
+        f_state, f_level, f_select), compiled when ``jit``: the indicators' rates read the
+        whole equations, and locating an event evaluates them many times."""
+        f = getattr(self.system.relations, name)
+        if not jit:
+            return f
+        return self._get(("relations", name), lambda: self._external(f, False, jit))
+
     def jacobian_small(self):
         """Whether the exact Jacobian is small enough to compile (a Jacobian costs about
         operations x states: one that cannot pass is not even built)."""

@@ -92,6 +92,10 @@ class Events:
         parts = [s.indicators(t, x) for s in self.sources]
         return (np.concatenate([p[0] for p in parts]), np.concatenate([p[1] for p in parts]))
 
+    def levels(self, t, x):
+        """The indicators of every source at (t, x), without their rates."""
+        return np.concatenate([s.levels(t, x) for s in self.sources])
+
     def _which(self, i):
         """(source, index in it) of indicator i."""
         for source in self.sources:
@@ -245,7 +249,7 @@ class Events:
             return cache[t]
 
         def g(t, i):
-            return self.indicators(t, state(t))[0][i]
+            return self.levels(t, state(t))[i]
 
         best = None
         for i in dipped:

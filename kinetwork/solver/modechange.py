@@ -52,6 +52,10 @@ class ModeChanges:
         table = self.values(t, x)
         return table[:, 0], table[:, RATE]
 
+    def levels(self, t, x):
+        """The indicators of ``indicators`` alone."""
+        return self.values(t, x)[:, 0]
+
     def indicator_rows(self, times, rows):
         """``indicators`` at each of ``rows`` (at ``times``): two (len(rows), k) arrays."""
         k = len(self.modes.comps)

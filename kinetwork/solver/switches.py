@@ -41,10 +41,16 @@ class Switches:
         values held now (made again when they change)."""
         key = (name, self.r.tobytes())
         if self._calls.get(name, (None,))[0] != key:
-            f = getattr(self.relations, name)
+            f = self._function(name)
             self._calls[name] = (key, numeric(f, np.concatenate([self.run.p, self.r]),
                                               f.size1_in(1)))
         return self._calls[name][1]
+
+    def _function(self, name):
+        """The relations' Function ``name``, compiled as the run's equations are."""
+        if self.relations is self.run.system.relations:
+            return self.run.compiled.relations(name, self.run.jit)
+        return getattr(self.relations, name)          # another System's (re-partitioned)
 
     def select(self, t, x):
         """The value each node takes at (t, x), the others held at r."""
@@ -63,6 +69,14 @@ class Switches:
         # false, where g rises above zero (<: g > 0; <=: g >= 0): all crossings of zero
         return sign * g, sign * rate
 
+    def levels(self, t, x):
+        """The indicators of ``indicators`` alone, without their rates (which read the whole
+        equations): what locating a crossing evaluates."""
+        if not len(self.relations.state):
+            return np.zeros(0)
+        sign = np.where(self.r[self.relations.state] > 0.5, 1.0, -1.0)
+        return sign * self._numeric("f_level")(t, x).ravel()
+
     @property
     def count(self):
         """How many indicators: one per relation on the states."""
@@ -73,7 +87,7 @@ class Switches:
         k = len(self.relations.state)
         if not k or not len(rows):
             return np.zeros((len(rows), k)), np.zeros((len(rows), k))
-        f = self.relations.f_state
+        f = self._function("f_state")
         pr = np.concatenate([self.run.p, self.r])
         table = np.asarray(mapped(f, len(rows))(np.asarray(times, dtype=float)[None, :],
                                                 np.asarray(rows, dtype=float).T, pr))
