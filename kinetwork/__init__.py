@@ -43,6 +43,7 @@ _LAZY = {
     "simulate": ("solver.plan", "simulate"),
     "METHODS": ("solver.methods", "METHODS"),
     "Results": ("solver.results", "Results"),
+    "read_csv": ("solver.csvio", "read_csv"),
     "schema": ("schema", None),       # the module, callable: kn.schema()
     "from_urdf": ("urdf", "from_urdf"),
     "examples": ("examples", None),

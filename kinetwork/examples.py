@@ -9,6 +9,7 @@ the definition files it places with it.
 >>> model = kn.load(kn.examples.path("double_pendulum"))
 """
 
+import difflib
 import functools
 import json
 import os
@@ -72,6 +73,28 @@ def path(name):
     if key in known:
         return known[key]
     raise ModelError(f"{name}: no such example ({_suggest(key, known)})")
+
+
+def data(name):
+    """The file ``name`` shipped beside the examples that is no model: a robot's URDF
+    (``"robots/industrial_arm.urdf"``), for the docs and a first try of ``kn.from_urdf``.
+
+    Raises
+    ------
+    ModelError
+        No such file there; the message lists the files that are.
+    """
+    root = folder()
+    shipped = {} if root is None else {
+        f.relative_to(root).as_posix(): f for f in sorted(root.rglob("*"))
+        if f.is_file() and f.suffix != SUFFIX and not any(
+            part.startswith(".") or part in _SKIPPED for part in f.relative_to(root).parts)}
+    if str(name) in shipped:
+        return shipped[str(name)]
+    close = difflib.get_close_matches(str(name), shipped, n=3, cutoff=0.5)
+    hint = f"did you mean {' or '.join(close)}?" if close else \
+        f"there are: {', '.join(shipped) or 'none'}"
+    raise ModelError(f"{name}: no such file beside the examples ({hint})")
 
 
 def copy(name, destination="."):

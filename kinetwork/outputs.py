@@ -46,7 +46,7 @@ KINDS = {
     "model": "a kinetwork model file", "json": "JSON", "csv": "a CSV table",
     "netcdf": "a NetCDF file", "png": "a PNG image", "gif": "a GIF", "mp4": "an MP4 video",
     "pdf": "a PDF", "svg": "an SVG drawing", "html": "an HTML page", "urdf": "a URDF robot",
-    "xml": "XML", "jpeg": "a JPEG image", "tiff": "a TIFF image", "webp": "a WebP image",
+    "meta": "a results sidecar (kinetwork.results)", "xml": "XML", "jpeg": "a JPEG image", "tiff": "a TIFF image", "webp": "a WebP image",
     "ps": "a PostScript file", "text": "text", "binary": "binary data", "library":
     "a compiled library", "empty": "nothing (an empty file)",
 }
@@ -121,7 +121,9 @@ def sniff(head):
     stripped = text.lstrip()
     lower = stripped[:400].lower()
     if stripped.startswith(("{", "[")):
-        return "model" if '"kinetwork.model"' in text else "json"
+        if '"kinetwork.model"' in text:
+            return "model"
+        return "meta" if '"kinetwork.results"' in text else "json"
     if stripped.startswith("<"):
         if lower.startswith(("<!doctype html", "<html")):
             return "html"

@@ -158,10 +158,10 @@ def test_a_model_holds_at_most_max_components(monkeypatch):
 
 
 def test_a_file_with_too_many_components_is_refused_before_any_is_built(monkeypatch):
-    import kinetwork.graph.io as io
-    monkeypatch.setattr(io, "MAX_COMPONENTS", 50)
+    import kinetwork.graph.sections as sections         # reads a file's components
+    monkeypatch.setattr(sections, "MAX_COMPONENTS", 50)
     built = []
-    monkeypatch.setattr(io, "_component", lambda *args: built.append(1))
+    monkeypatch.setattr(sections, "_component", lambda *args: built.append(1))
     text = json.dumps({"format": "kinetwork.model", "version": 1, "name": "many",
                        "components": [{"name": f"c{i}", "type": "Probe"} for i in range(51)]})
     with pytest.raises(kn.ModelError, match="51 entries, more than the 50"):

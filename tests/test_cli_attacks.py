@@ -16,6 +16,7 @@ import pytest
 from conftest import double_pendulum
 from test_cli_safety import no_compiler, no_traceback  # noqa: F401  (a fixture)
 
+import kinetwork as kn
 from kinetwork.cli import main
 
 URDF = pathlib.Path(__file__).parent / "data" / "planar_arm.urdf"
@@ -150,11 +151,12 @@ def test_sigterm_while_a_large_csv_is_written_keeps_the_rows_written(tmp_path):
     assert "Traceback" not in err and "interrupted by SIGTERM" in err
     lines = out.read_text().splitlines()
     assert lines[0].startswith("t,probe1.angle")
-    assert lines[-1].startswith("# partial: the writing stopped after t = ") and \
-        "(interrupted by SIGTERM); the run reached t = 10.0 s" in lines[-1]
-    rows = np.loadtxt(out, comments="#", delimiter=",", skiprows=1, ndmin=2)
+    table = kn.read_csv(out)
+    assert table.cut["reason"] == "interrupted by SIGTERM" and table.cut["t_reached"] == 10.0
+    assert table.cut["rows"] == len(table.t) and table.cut["t_written"] == table.t[-1]
+    rows = np.loadtxt(out, delimiter=",", skiprows=1, ndmin=2)
     assert 0 < len(rows) < 1_000_000 and np.all(np.diff(rows[:, 0]) > 0)
-    assert sorted(os.listdir(tmp_path)) == ["dp.json", "out.csv"]
+    assert sorted(os.listdir(tmp_path)) == ["dp.json", "out.csv", "out.meta.json"]
 
 
 def test_the_time_limit_covers_the_probe_signals_and_the_writing(tmp_path, capsys):
@@ -168,9 +170,10 @@ def test_the_time_limit_covers_the_probe_signals_and_the_writing(tmp_path, capsy
     captured = capsys.readouterr()
     assert "the time limit" in captured.err and no_traceback(captured)
     lines = out.read_text().splitlines()
-    assert lines[-1].startswith("# partial: ") and "the time limit" in lines[-1]
-    assert len(lines) - 2 < 2_000_000
-    assert sorted(os.listdir(tmp_path)) == ["dp.json", "out.csv"]
+    table = kn.read_csv(out)
+    assert "the time limit" in (table.partial or table.cut)["reason"]
+    assert len(lines) - 1 < 2_000_000
+    assert sorted(os.listdir(tmp_path)) == ["dp.json", "out.csv", "out.meta.json"]
 
 
 # -- inputs -------------------------------------------------------------------------------------

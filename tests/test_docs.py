@@ -1,11 +1,14 @@
 """Every code block of the README and the documentation runs, so the docs cannot rot.
 
-A page's ``python`` blocks run in order in one namespace, in a fresh folder holding a copy of
-``models/`` (as a reader who cloned the repository, or ran ``kinetwork examples copy``, has).
-Setup a reader need not see goes in an HTML comment right before a block:
+The blocks run against an installed wheel, not the checkout (``tests/test_docs_installed.py``
+builds it, installs it in a fresh virtual environment and calls :func:`run_pages` there): a
+page's blocks run in order in one namespace, in a fresh empty folder outside the checkout, so
+the models they load (``kn.load("fourbar")``) and the files they read come from the installed
+package. Setup a reader need not see goes in an HTML comment right before a block (run before
+``sh`` blocks too):
 
     <!-- setup
-    model = kn.load("models/fourbar.json")
+    model = kn.load("fourbar")
     -->
 
 ``sh`` blocks run their ``kinetwork ...`` lines through the CLI's ``main`` and must exit 0
@@ -27,7 +30,6 @@ import os
 import pathlib
 import re
 import shlex
-import shutil
 import warnings
 
 import matplotlib
@@ -53,17 +55,8 @@ def page_id(page):
     return page.relative_to(ROOT).as_posix()
 
 
-@pytest.fixture
-def reader_folder(tmp_path, monkeypatch):
-    shutil.copytree(ROOT / "models", tmp_path / "models")
-    shutil.copytree(ROOT / "tests" / "data", tmp_path / "data")
-    shutil.copy(ROOT / "tests" / "data" / "industrial_arm.urdf", tmp_path / "robot.urdf")
-    monkeypatch.chdir(tmp_path)
-    return tmp_path
-
-
-@pytest.mark.parametrize("page", [p for p in PAGES if blocks(p)], ids=page_id)
-def test_page_runs(page, reader_folder):
+def run_page(page):
+    """Run every block of ``page`` in order, in one namespace, in the current folder."""
     import matplotlib.pyplot as plt
 
     from kinetwork.cli import main
@@ -78,6 +71,8 @@ def test_page_runs(page, reader_folder):
                 exec(compile(source, page_id(page), "exec"), scope)  # our own docs
             plt.close("all")
         elif lang in ("sh", "bash", "console"):
+            if setup:                       # files the commands read (a robot, measured data)
+                exec(compile(setup, page_id(page), "exec"), scope)   # our own docs
             for command in _commands(code):
                 expected = int(EXITS.search(command).group(1)) if EXITS.search(command) else 0
                 argv = shlex.split(command, comments=True)[1:]
@@ -100,6 +95,28 @@ def test_page_runs(page, reader_folder):
             if data.get("format") == "kinetwork.model":
                 import kinetwork as kn
                 kn.loads(code)
+
+
+def run_pages(folder):
+    """Run every page that has blocks, each in a fresh subfolder of ``folder``:
+    ``{"ran": [pages], "failures": {page: the error's text}}``. What ``tests/test_docs_installed.py`` runs in a
+    virtual environment holding only the wheel."""
+    import tempfile
+    import traceback
+    failures, ran = {}, []
+    home = os.getcwd()
+    for page in [p for p in PAGES if blocks(p)]:
+        ran.append(page_id(page))
+        os.chdir(tempfile.mkdtemp(prefix=page.stem + "-", dir=folder))
+        try:
+            run_page(page)
+        except BaseException as exc:                 # every page's failure, not the first
+            if isinstance(exc, KeyboardInterrupt):
+                raise
+            failures[page_id(page)] = "".join(traceback.format_exception(exc))[-4000:]
+        finally:
+            os.chdir(home)
+    return {"ran": ran, "failures": failures}
 
 
 PRINTED = re.compile(r"^(?P<indent>\s*)print\((?P<arg>.+)\)\s*#\s*(?P<comment>.+)$")

@@ -1,5 +1,5 @@
 // The document model: the wiring rules of kn's Model.connect and its signal check, names,
-// renames that follow the wires, removal with the wires, moves, rotation, paste, values as
+// renames that follow the wires, removal with the wires, moves, rotation, flips, paste, values as
 // typed, scopes of definitions.
 import { describe, expect, it } from "vitest";
 import {
@@ -17,6 +17,8 @@ import {
   resolveScope,
   rotateComponent,
   rotatedSide,
+  flipComponent,
+  placedSide,
   shapeProblem,
   signalSourceProblem,
 } from "../src/studio/model.js";
@@ -104,6 +106,16 @@ describe("positions", () => {
     }
     expect(sides).toEqual(["top", "right", "bottom", "left"]);
     expect(body.layout.mass1).toEqual(seed.layout.mass1);
+  });
+
+  it("flips a block left to right, in its own frame before it turns, and back", () => {
+    const flipped = flipComponent(seed, "mass1", pos(seed));
+    expect(/** @type {any} */ (flipped.layout.mass1).flip).toBe(true);
+    expect(placedSide("left", 0, true)).toBe("right");
+    expect(placedSide("top", 0, true)).toBe("top");
+    // mirrored, then a quarter turn: its left port goes to the right, then to the bottom
+    expect(placedSide("left", 90, true)).toBe("bottom");
+    expect(flipComponent(flipped, "mass1", pos(flipped)).layout.mass1).toEqual(seed.layout.mass1);
   });
 
   it("pastes copies with fresh names and their own wires, at the place asked", () => {

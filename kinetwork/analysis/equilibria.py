@@ -15,6 +15,8 @@ from ..solver.plan import lifted_model
 from ..util import quote, suggest
 from .channels import plant
 
+#: values a REPL echo of an Equilibrium shows before "... (n more)"
+REPR_VALUES = 8
 #: System -> {free parameter positions: the residual and its Jacobians' Function}
 _RESIDUALS = weakref.WeakKeyDictionary()
 
@@ -34,9 +36,11 @@ class Equilibrium:
         self.undetermined = undetermined
 
     def __repr__(self):
-        shown = ", ".join(f"{k} = {v:.6g}" for k, v in
-                          [*self.state.items(), *self.inputs.items(), *self.params.items()])
-        return f"<Equilibrium {shown}>"
+        # a REPL echo stays a line or two: a robot's 42 states are summarised, not listed
+        values = [*self.inputs.items(), *self.params.items(), *self.state.items()]
+        shown = ", ".join(f"{k} = {v:.6g}" for k, v in values[:REPR_VALUES])
+        more = f", ... ({len(values) - REPR_VALUES} more)" if len(values) > REPR_VALUES else ""
+        return f"<Equilibrium {shown}{more}>"
 
 
 def equilibrium(model, at=None, inputs=(), free=(), fix=None, params=None, t=0.0,

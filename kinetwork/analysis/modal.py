@@ -11,6 +11,9 @@ from ..errors import ModelError
 from ..util import quote, suggest
 from .linear import Linearization, linearize
 
+#: entries of a mode shape a REPL echo of a Mode shows (the largest)
+REPR_SHAPE = 4
+
 
 @dataclass
 class Mode:
@@ -35,7 +38,13 @@ class Mode:
         return self.damped_frequency > 0
 
     def __repr__(self):
-        shape = ", ".join(f"{k}: {_short(v)}" for k, v in self.shape.items())
+        # the largest entries of the shape, in joint order: a robot's mode stays one line
+        items = list(self.shape.items())
+        largest = sorted(range(len(items)), key=lambda i: -abs(items[i][1]))[:REPR_SHAPE]
+        shape = ", ".join(f"{k}: {_short(v)}" for i, (k, v) in enumerate(items)
+                          if i in largest)
+        if len(items) > REPR_SHAPE:
+            shape += f", ... ({len(items) - REPR_SHAPE} smaller)"
         return (f"<Mode {self.frequency:.6g} rad/s ({self.hz:.4g} Hz), damping "
                 f"{self.damping:.4g}; {shape}>")
 

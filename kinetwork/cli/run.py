@@ -3,7 +3,6 @@ probe plots; what a failed or stopped run computed is written all the same."""
 
 import argparse
 import contextlib
-import os
 import sys
 import time
 
@@ -79,7 +78,9 @@ def add(sub):
 
 
 def run(args):
-    outputs = [("--out", args.out, "csv"), ("--plot", args.plot, plot_kind(args.plot or ""))]
+    from ..solver.csvio import sidecar
+    outputs = [("--out", args.out, "csv"), ("--plot", args.plot, plot_kind(args.plot or "")),
+               ("--out's sidecar", args.out and sidecar(args.out), "meta")]
     try:                                # by name, before anything is read or run
         check_all(outputs, [("the model file", args.model)], args.force)
     except OutputRefused as exc:
@@ -123,7 +124,7 @@ def run(args):
     # the limit counts from the run (its C compilation included) to the last output written
     deadline = None if args.time_limit is None else time.monotonic() + args.time_limit
     try:
-        with _progress_bar(args, model, settings["t_end"]) as progress:
+        with _progress_bar(args, model, 0.0, settings["t_end"]) as progress:
             results = kn.simulate(system, t_end=args.t_end, n_points=args.n_points,
                                   method=args.method, rtol=args.rtol, atol=args.atol,
                                   step=args.step, max_step=args.max_step, jit=args.jit,
@@ -184,7 +185,7 @@ def _outputs(args, results, title, deadline=None, stopped=False):
 
     The time limit covers writing too; once it has passed, or after the run was ``stopped``
     (a signal), the outputs get WRITE_GRACE seconds more. The CSV stops between blocks of
-    rows, keeping the rows written and a last line saying where; a plot is drawn whole or
+    rows, keeping the rows written, its sidecar saying where; a plot is drawn whole or
     not at all."""
     quiet = getattr(args, "quiet", False)
     now = time.monotonic()
@@ -202,7 +203,7 @@ def _outputs(args, results, title, deadline=None, stopped=False):
             flag.cut = why
             if not quiet:
                 rows = f"{len(results.t)} points" if why is None else \
-                    f"the first rows ({why}: cut short, said on its last line)"
+                    f"the first rows ({why}: cut short, said in its sidecar)"
                 print(f"wrote {rows} x {len(results.column_names())} columns to {args.out}")
         if args.plot:
             why = flag()
@@ -233,21 +234,13 @@ def _save_plot(args, results, path, title):
 
 
 @contextlib.contextmanager
-def _progress_bar(args, model, t_end):
-    """A tqdm bar on stderr while the run goes, or None. It writes to a duplicate of the
-    terminal's descriptor: the integrators' own output is captured meanwhile."""
+def _progress_bar(args, model, t_start, t_end):
+    """A tqdm bar on stderr while the run goes (``solver.progress``), or None."""
     show = args.progress if args.progress is not None else \
         (not args.quiet and sys.stderr.isatty())
     if not show:
         yield None
         return
-    from tqdm import tqdm
-    terminal = os.fdopen(os.dup(sys.stderr.fileno()), "w")
-    bar = tqdm(total=round(t_end, 9), file=terminal, unit="s", desc=f"{model.name}",
-               bar_format="{desc}: {percentage:3.0f}%|{bar}| t = {n:.3g} of {total:g} s "
-                          "[{elapsed}<{remaining}]", leave=False)
-    try:
-        yield lambda t: bar.update(max(0.0, t - bar.n))
-    finally:
-        bar.close()
-        terminal.close()
+    from ..solver.progress import progress_bar
+    with progress_bar(t_start, t_end, desc=model.name) as report:
+        yield report

@@ -1,6 +1,6 @@
 """Component libraries; each module is one library of the file format's ``type`` names."""
 
-from . import electrical, multibody, rolling, rotational, signals, translational
+from . import electrical, multibody, rolling, rotational, signals, tables, translational
 from .base import REGISTRY, Component, Param, Port, PortRef
 from .probe import Probe
 

@@ -398,7 +398,7 @@ class FreeMotion(PartialJoint, library=MB):
     FreeMotion) moves them without turning: no body it carries has rotational inertia, so its
     orientation is not a state. Its coordinates are then r only, its speeds v, frame_b keeps
     the orientation angles0 gives (MSL's unit rotation by default) and w0, if given, must be
-    zero (``graph/topology.py`` finds it).
+    zero (``graph/tree.py`` finds it).
     """
     nq = 7
     #: True while frame_b carries only point masses (set with each model's topology)

@@ -30,6 +30,7 @@ import networkx as nx
 import numpy as np
 
 from ..errors import ModelError, Problem
+from . import circuit_report
 from .circuit_dae import Candidate, Dae, couple
 from .blocks import solve_blocks
 from .structure import Singular, reduce_index
@@ -101,7 +102,7 @@ class Circuit:
             # in parallel: with the rotors' balances they may not be
             moving = self._moving([dae.equations[e] for e in exc.equations])
             if not moving:
-                raise self._refusal(exc, dae) from None
+                raise circuit_report.refusal(self, exc, dae) from None
         if moving:
             # a constraint reaches the speed of rotors (or masses) the EMFs turn: their
             # balances join the system, their speeds among its candidate states
@@ -109,12 +110,12 @@ class Circuit:
             try:
                 reduced = self._reduce(dae)
             except Singular as exc:
-                raise self._refusal(exc, dae) from None
+                raise circuit_report.refusal(self, exc, dae) from None
         try:
             solved = solve_blocks(reduced.equations, reduced.unknowns, self._regular,
                                   self._sample)
         except Singular as exc:
-            raise self._refusal(exc, dae, reduced) from None
+            raise circuit_report.refusal(self, exc, dae, reduced) from None
         self._apply(dae, reduced, solved, sets)
         return self
 
@@ -145,7 +146,7 @@ class Circuit:
             bound = self.b.bound[c.name]
             for k, (x, rate) in enumerate(zip(view.x, bound.rates(view))):
                 key = _start_key(c, k)
-                dae.candidate(Candidate(x, self.b.net.names[self.b._at(x)], c, key,
+                dae.candidate(Candidate(x, self.b.net.names[self.b.index_of(x)], c, key,
                                         bound.initial()[k]), rate, c)
         return dae
 
@@ -177,7 +178,7 @@ class Circuit:
     def _view(self, comp, knowns):
         b = self.b
         bound = b.bound[comp.name]
-        x = [b._state(f"{comp.name}.{label}", unit, start, 0) for label, unit, start in
+        x = [b.add_state(f"{comp.name}.{label}", unit, start, 0) for label, unit, start in
              zip(bound.state_labels, bound.state_units, bound.initial())]
         u = self.sources.get(comp.name)
         if u is not None:
@@ -306,7 +307,7 @@ class Circuit:
             if cand.group is not None:
                 self.coupled[cand.group.index].acc = rate
             elif cand not in demoted:
-                b.net.rate[b._at(cand.x)] = rate
+                b.net.rate[b.index_of(cand.x)] = rate
         kept = [dae.candidates[i] for i in reduced.states]
         self._check_starts(dae, reduced, kept, demoted, [sub(v) for v in ca.vertsplit(vd)])
         for cand, v in zip(demoted, ca.vertsplit(vd)):
@@ -319,18 +320,19 @@ class Circuit:
                 ca.depends_on(r, k) for r in solved.residuals for k in solved.kept)})
             net.alg_z += solved.kept
             net.alg_res += [sub(r) for r in solved.residuals]
-            net.alg_names += [self._label(k, dae.unknowns) for k in solved.kept]
+            net.alg_names += [circuit_report.label(self, k, dae.unknowns)
+                              for k in solved.kept]
             net.alg_units += ["V" if k.name().startswith("v") else "A"
                               for k in solved.kept]
             net.loops_kept.append(owners)
         # the rates of the sources' signals are needed only where a constraint was
-        # differentiated through a source (the network finds them: ``_input_rates``)
+        # differentiated through a source (the network finds them: ``derivatives.input_rates``)
         used = ca.vertcat(*self.potential.values(), *self.current.values(),
                           *b.net.rate, *b.net.alg_res,
                           *[c.acc for c in self.coupled.values()])
         self.input_rates = {du: s for du, s in self.input_rates.items()
                             if ca.depends_on(used, du)}
-        self.summary = self._summary(dae, reduced, solved)
+        self.summary = circuit_report.summary(self, dae, reduced, solved)
 
     def _knowns(self):
         """The function putting the EMF speeds in, and their derivatives where a
@@ -357,7 +359,8 @@ class Circuit:
         xs = ca.vertcat(*[c.x for c in kept])
         starts = ca.vertcat(*[self._at_values(ca.SX(c.start)) for c in kept])
         for cand, v in zip(demoted, values):
-            self.demoted[cand.name] = self._why(dae, reduced, cand, v, kept)
+            self.demoted[cand.name] = circuit_report.why_demoted(self, dae, reduced, cand, v,
+                                                                 kept)
             if cand.key not in cand.comp.given:
                 continue
             at0 = self._at_values(ca.substitute(v, self.b.t, ca.SX(0)))
@@ -381,91 +384,12 @@ class Circuit:
         if problems:
             raise ModelError(problems)
 
-    def _why(self, dae, reduced, cand, value, kept):
-        """What fixes a demoted state: the kept states and the sources its value follows
-        from, and the components of the constraint (the laws differentiated in the step
-        that found it, with the components of those states), grounds left out."""
-        symbols = {x.element_hash() for x in ca.symvar(value)}
-        reads = [c for c in kept if c.x.element_hash() in symbols]
-        group = {c.comp.name for c in reads} | {cand.comp.name}
-        for eqs in reduced.constraints:
-            if any(ca.depends_on(dae.equations[e], cand.x) for e in eqs):
-                group |= {dae.owners[e].name for e in eqs if dae.owners[e] is not None}
-        group = [name for name in self.model.components if name in group
-                 and self.model.components[name].type_name != "electrical.Ground"]
-        driven = [name for name in group if getattr(
-            type(self.model.components[name]), "reference_key", None)]
-        follows = ", ".join([c.name for c in reads] + [f"the source {n}" for n in driven])
-        return f"follows from {follows or 'the sources'} through the constraint of " \
-               f"{', '.join(group)}"
-
     def _drop(self, x):
         """Take the state ``x`` out of the network: a constraint gives its value."""
         net = self.b.net
-        at = self.b._at(x)
+        at = self.b.index_of(x)
         for seq in (net.x, net.rate, net.start, net.names, net.units):
             del seq[at]
-
-    def _label(self, z, unknowns):
-        """A short name of an unknown kept as an algebraic variable: ``D1.p.v`` for the
-        potential at a set holding pin D1.p, ``D1.p.i`` for a pin's current."""
-        for s, v in zip(sorted(self.potential), unknowns):
-            if v.element_hash() == z.element_hash():
-                first = next(r for r in self.topo.sets[s] if r.component.role != "probe")
-                return f"{first.path}.v"
-        for ref, v in zip(self.current, unknowns[len(self.potential):]):
-            if v.element_hash() == z.element_hash():
-                return f"{ref.path}.i"
-        return z.name()
-
-    def _summary(self, dae, reduced, solved):
-        loops = [n for n in solved.sizes if n > 1]
-        out = (f"circuits: {len(self.potential)} node potentials and {len(self.current)} "
-               f"pin currents in {len(solved.sizes)} blocks"
-               + ("" if solved.kept else " solved symbolically")
-               + (f" (linear loops of {', '.join(map(str, loops))})" if loops else "")
-               + f", {len(reduced.states)} states")
-        if self.coupled:
-            out += ("; with the rotors (masses) the EMFs turn: "
-                    + ", ".join(c.candidate.name for c in self.coupled.values()))
-        if reduced.demoted:
-            out += (f"; index reduction (Pantelides, dummy derivatives): "
-                    f"{len(reduced.constraints)} constraints differentiated, "
-                    f"{', '.join(self.demoted)} demoted to algebraic")
-        if solved.kept:
-            out += (f"; {solved.nonlinear} nonlinear blocks, {len(solved.kept)} algebraic "
-                    f"variables")
-        return out
-
-    def _refusal(self, exc, dae, reduced=None):
-        """The ModelError of a circuit that cannot be solved: the components whose laws
-        over-determine it and the unknowns left undetermined, each sorted."""
-        eqs = exc.equations if reduced is None else sorted({reduced.origin[e]
-                                                            for e in exc.equations})
-        comps = sorted({dae.owners[e].name for e in eqs if dae.owners[e] is not None})
-        kcl = any(dae.owners[e] is None for e in eqs)
-        lost = [dae.described(v if reduced is None else reduced.base[v][0])
-                for v in exc.unknowns]
-        what = (", ".join(comps) or "the circuit") + (
-            " and Kirchhoff's current law" if kcl and comps else "")
-        if exc.reason:
-            reason = exc.reason
-            if "rest_g" in reason:
-                reason = ("it needs the derivative of the forces on a rotor the circuit "
-                          "constrains (a constraint of the mechanism's accelerations)")
-            return ModelError(f"circuit: the equations of {what} cannot be solved: {reason}"
-                              + (f"; undetermined: {', '.join(lost)}" if lost else ""),
-                              **self._fields_of(comps))
-        return ModelError(
-            f"circuit: the equations of {what} constrain their unknowns twice and leave "
-            f"{', '.join(lost) or 'nothing'} undetermined: the circuit is structurally "
-            f"singular (two voltage sources in parallel, a loop of voltage sources, a current "
-            f"source in series with another, an open current source, an ideal op-amp with "
-            f"no feedback)", **self._fields_of(comps))
-
-    def _fields_of(self, names):
-        """The fields of a refusal naming components ``names``: the first one's (sorted)."""
-        return self.model.fields(self.model.components[names[0]]) if names else {}
 
     # -- what the network reads -------------------------------------------------------------
     def output(self, comp):

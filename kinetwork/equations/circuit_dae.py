@@ -17,6 +17,7 @@ from dataclasses import dataclass, field
 import casadi as ca
 
 from ..errors import ModelError
+from . import balance
 
 
 @dataclass(eq=False)
@@ -114,9 +115,9 @@ def couple(circuit, dae, emfs):
                 if b.group_of.get(s) is group:
                     torque += -b.kt[s] * f
         key = type(first).speed0.name            # "w0" or "v0"
-        cand = Candidate(w, b.net.names[b._at(w)], first, key,
-                         b.net.start[b._at(w)], group=group)
-        dae.candidate(cand, (rest + torque) / b.group_inertia(group), first)
+        cand = Candidate(w, b.net.names[b.index_of(w)], first, key,
+                         b.net.start[b.index_of(w)], group=group)
+        dae.candidate(cand, (rest + torque) / balance.group_inertia(b, group), first)
         dae.knowns.append((rest, None))
         circuit.coupled[index] = Coupled(rest, [c.name for c in turning], cand)
     return dae

@@ -13,6 +13,9 @@ does not converge fast, or lands away from its prediction (another branch), is h
 cannot be closed (the asked point beyond where the mechanism assembles, or a change point
 where the dependent coordinates stop following) is refused naming the loop and the residual
 left, and how far along the way the walk got.
+
+The closure at given states is here too: the algebraic variables polished onto it
+(``polish``), its residual, and where an assembly closed in closed form turns singular.
 """
 
 import weakref
@@ -21,6 +24,7 @@ import casadi as ca
 import numpy as np
 
 from ..errors import ModelError
+from .pointwise import mapped, pointwise
 
 #: the closure counts as closed below this (m, and rotation-matrix entries)
 CLOSED = 1e-10
@@ -138,6 +142,53 @@ class Closer:
                f"{', '.join(sys.algebraic_names)} stop following there)" if singular else "")
             + f"; at the asked point a residual of {by_loop.get(bad, left):.3g} (m, or "
               f"rotation-matrix entries) is left: the mechanism does not assemble there")
+
+
+def polish(system, X, p, t=None):
+    """Full states X (n_points, n_states + n_algebraic) with the algebraic variables
+    (dependent coordinates) Newton-corrected onto the closure to machine precision: the
+    integrator solves them only to its tolerance. Equations that read time (a diode's
+    circuit driven by a source in t) are polished at the times ``t`` of the rows, and
+    not at all without them."""
+    if not system.n_algebraic or not len(X):
+        return X
+    timed = ca.depends_on(system.eq.alg, system.asm.t)
+    if timed and t is None:
+        return X
+    times = np.zeros(len(X)) if t is None else np.asarray(t, dtype=float)
+    Z = pointwise(system._f_polish, X, p, times[:, None])[0]
+    out = np.array(X, dtype=float)
+    ok = np.all(np.isfinite(Z), axis=1)
+    out[ok, system.n_states:] = Z[ok]
+    return out
+
+
+def closure_residual(system, X, p):
+    """Largest |closure residual| of the kept loop equations at each row of full states X
+    (``System.constraint_residual_p``); zeros for a model without loops."""
+    X = np.atleast_2d(np.asarray(X, dtype=float))
+    if system.eq.residual is None:
+        return np.zeros(len(X))
+    return pointwise(system._f_residual, X, p)[0].ravel()
+
+
+def assembly_singular(system, times, X, p, margin=0.0):
+    """(row, messages): the first row of full states X (at ``times``) at which an
+    assembly that closes its loop in closed form is at (or past, or within ``margin``
+    of) a singular position, and what is singular there; (None, []) where none is."""
+    if system.f_assembly_checks is None or not len(X):
+        return None, []
+    X = np.atleast_2d(np.asarray(X, dtype=float))
+    values = np.asarray(mapped(system.f_assembly_checks, len(X))(
+        np.atleast_1d(times)[None, :], X.T, p)).T
+    with np.errstate(invalid="ignore"):
+        bad = ~(values > margin)
+    rows = np.nonzero(bad.any(axis=1))[0]
+    if not len(rows):
+        return None, []
+    return int(rows[0]), [f"{name} {'is at' if not margin else 'nears'} a singular "
+                          f"position of its loop: {what}" for (name, what), b in
+                          zip(system.assembly_check_names, bad[rows[0]]) if b]
 
 
 def _norm(g):

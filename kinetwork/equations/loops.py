@@ -51,97 +51,21 @@ four-bar whose crank is driven) is still integrated by IDAS, which solves its ot
 at every step.
 """
 
-import itertools
-import math
-from dataclasses import dataclass
-
 import casadi as ca
 import numpy as np
 
 from ..errors import ModelError
 from ..util import quiet, summary
-from . import loopstart
+from . import loopclose, loopstart, partitioning
+from .formulations import Equations, equations_of, newton, take_rows
+from .loopclose import CLOSED
 from .newton_euler import aba, rnea
 
-def _pivoted_qr(a):
-    """The QR factorisation of ``a`` with column pivoting (Businger-Golub: at each step the
-    column of largest remaining norm, the first of equals): (|diagonal of R|, column order).
-
-    numpy has no pivoted QR and scipy.linalg costs 0.3 s to import in every process that
-    builds a loop; the matrices here are a few dozen rows and columns.
-    """
-    r = np.array(a, dtype=float)
-    m, n = r.shape
-    order = np.arange(n)
-    diag = np.zeros(min(m, n))
-    for k in range(min(m, n)):
-        norms = np.sqrt(np.einsum("ij,ij->j", r[k:, k:], r[k:, k:]))
-        j = k + int(np.argmax(norms))
-        if j != k:
-            r[:, [k, j]] = r[:, [j, k]]
-            order[[k, j]] = order[[j, k]]
-        diag[k] = norms[j - k]
-        if diag[k] == 0.0:
-            break                      # what remains is zero
-        v = r[k:, k].copy()
-        v[0] += math.copysign(diag[k], v[0])
-        v /= np.linalg.norm(v)
-        r[k:, k:] -= 2.0 * np.outer(v, v @ r[k:, k:])
-    return diag, order
-
+__all__ = ["BAUMGARTE_RATE", "FORMULATIONS", "Equations", "formulate", "newton"]
 
 FORMULATIONS = ("partition", "projected", "baumgarte")
-#: Newton steps of the projected formulation (from a start within the integrator's tolerance
-#: of the closure, two already reach round-off)
-PROJECTION_STEPS = 3
-#: rate [1/s] at which the projected formulation's carried starts follow the projection
-PROJECTION_PULL = 1.0
 #: Baumgarte's stabilisation rate a [1/s] by default
 BAUMGARTE_RATE = 10.0
-#: a closure residual below this (m, and rotation-matrix entries) counts as closed
-CLOSED = 1e-10
-#: starts of the assembly search where Gauss-Newton stalls: the guesses, then perturbed ones
-SEARCH_STARTS = 24
-#: singular values below this fraction of the largest mark redundant closure equations
-RANK_TOL = 1e-8
-#: a re-partition compares every choice of dependent speeds when there are at most this many
-#: (a planar five-bar: 10); beyond, it takes the pivoted-QR choice
-PARTITION_CHOICES = 200
-
-
-@dataclass
-class Equations:
-    """What is integrated: differential states x, algebraic variables z, and how the joint
-    coordinates q, speeds u and accelerations udot read from them (all SX in x, z, t, p)."""
-    x: ca.SX
-    z: ca.SX
-    ode: ca.SX
-    alg: ca.SX
-    state_names: list
-    state_units: list
-    algebraic_names: list
-    algebraic_units: list
-    u: ca.SX
-    udot: ca.SX
-    formulation: str
-    note: str = ""
-    loop_rows: int = 0              # independent closure equations kept
-    loop_redundant: int = 0         # closure equations dropped as redundant
-    initial: object = None          # p -> (x0, z0) numpy
-    residual: ca.SX = None          # kept closure equations, in q
-    lam: ca.SX = None               # multiplier of every closure row (0 for dropped ones)
-    q: ca.SX = None                 # coordinates, where they are not the states themselves
-    #: the closure's Jacobian in the dependent speeds (in q): the partition holds while it is
-    #: regular; where it turns singular the mechanism folds flat or locks
-    dependent_jacobian: ca.SX = None
-    dependent_names: list = None    # the dependent speeds, by name
-    prescribed: int = 0             # joint speeds a motion source gives (no states)
-    clock: int = None               # index of the state ``time``, when there is one
-    #: the kept closure rows and the dependent speeds, by index (``_Loops.partitions_at``
-    #: chooses others where this partition turns singular)
-    partition: tuple = None
-    loops: object = None            # the _Loops that made these equations
-    rate: float = None              # Baumgarte's rate, as the formulation was built
 
 
 def formulate(asm, topo, values, formulation="partition", rate=BAUMGARTE_RATE,
@@ -259,9 +183,9 @@ def _hybrid(asm, given):
         return np.concatenate([np.where(given, q0, 0.0)[keep_q], u0[ind]]), np.zeros(0)
     names = [asm.coordinate_names[k] for k in keep_q] + [asm.speed_names[k] for k in ind]
     units = [asm.coordinate_units[k] for k in keep_q] + [asm.speed_units[k] for k in ind]
-    eq = Equations(ca.vertcat(_rows(q, keep_q), _rows(u, ind)), ca.SX(0, 1),
-                   ca.vertcat(_rows(asm.qdot, keep_q), _rows(udot, ind)), ca.SX(0, 1), names,
-                   units, [], [], u, udot, "hybrid",
+    eq = Equations(ca.vertcat(take_rows(q, keep_q), take_rows(u, ind)), ca.SX(0, 1),
+                   ca.vertcat(take_rows(asm.qdot, keep_q), take_rows(udot, ind)), ca.SX(0, 1),
+                   names, units, [], [], u, udot, "hybrid",
                    "hybrid dynamics (the articulated-body algorithm with the prescribed "
                    "accelerations given)", initial=initial, lam=drive)
     return _prescribe(asm, eq, loops=False)
@@ -350,7 +274,8 @@ class _Loops:
             self.rows, self.dep = (sorted(int(i) for i in part) for part in partition)
             return
         q0 = self.close(p_nom)
-        self.rows, self.dep = self._partition(np.asarray(self.f_J(q0, p_nom)), loop_coords)
+        self.rows, self.dep = partitioning.choose(self, np.asarray(self.f_J(q0, p_nom)),
+                                                   loop_coords)
         loopstart.branch(self, q0, p_nom)
 
     # -- consistent initial configuration ---------------------------------------------------
@@ -366,9 +291,9 @@ class _Loops:
         itself."""
         q0, _ = self.f_start(p)
         start = np.asarray(q0, dtype=float).ravel()
-        q, r = self._gauss_newton(start, p)
-        if not self._closed(r):
-            q, r = self._search(start, p, q, r)
+        q, r = loopclose.gauss_newton(self, start, p)
+        if not loopclose.closed(r):
+            q, r = loopclose.search(self, start, p, q, r)
         worst = np.max(np.abs(r), initial=0.0)
         n_closure = self.phi.shape[0]
         if np.isfinite(worst) and worst > CLOSED and \
@@ -381,7 +306,8 @@ class _Loops:
                 by_loop[i] = max(by_loop.get(i, 0.0), v)
             # a loop stalled with a failing one is not blamed: only those that cannot
             # close even alone (or, if each closes alone, those left open together)
-            alone = {i: self._alone(i, start, p) for i, v in by_loop.items() if v > CLOSED}
+            alone = {i: loopclose.alone(self, i, start, p) for i, v in by_loop.items()
+                     if v > CLOSED}
             bad = [i for i, ok in alone.items() if not ok] or list(alone)
             # the coordinates each loop's closure depends on, for the given ones it names
             uses = np.asarray(ca.DM(ca.jacobian(self.phi, self.asm.q).sparsity(), 1))
@@ -400,389 +326,13 @@ class _Loops:
             raise ModelError(msgs)
         return q
 
-    def _closed(self, r):
-        return bool(np.isfinite(r).all()) and np.max(np.abs(r), initial=0.0) < CLOSED * 1e-2
-
-    def _gauss_newton(self, q, p, rows=None, free=None):
-        free = self.free if free is None else free
-        pick = (lambda r: r) if rows is None else (lambda r: r[rows])
-        q = q.copy()
-        r = pick(np.asarray(self.f_phi(q, p)).ravel())
-        for _ in range(100):
-            if self._closed(r):
-                break
-            J = np.asarray(self.f_jac(q, p))
-            J = J[:, [self.free.index(i) for i in free]]
-            J = J if rows is None else J[rows]
-            step = np.linalg.lstsq(J, -r, rcond=None)[0] if free else np.zeros(0)
-            for scale in (1.0, 0.5, 0.25, 0.1, 0.01):        # backtrack on |residual|
-                trial = q.copy()
-                trial[free] += scale * step
-                r_trial = pick(np.asarray(self.f_phi(trial, p)).ravel())
-                if np.linalg.norm(r_trial) < np.linalg.norm(r):
-                    q, r = trial, r_trial
-                    break
-            else:
-                break
-        return q, r
-
-    def _search(self, start, p, q_best, r_best, rows=None, free=None):
-        """Levenberg-Marquardt from the start and from SEARCH_STARTS perturbed starts
-        (deterministic); the closing assembly nearest the start, else the best fit."""
-        from scipy.optimize import least_squares
-        free = self.free if free is None else free
-        if not free:
-            return q_best, r_best
-        pick = (lambda r: r) if rows is None else (lambda r: r[rows])
-        cols = [self.free.index(i) for i in free]
-
-        def residual(z):
-            q = start.copy()
-            q[free] = z
-            return pick(np.asarray(self.f_phi(q, p)).ravel())
-
-        def jacobian(z):
-            q = start.copy()
-            q[free] = z
-            J = np.asarray(self.f_jac(q, p))[:, cols]
-            return J if rows is None else J[rows]
-        rng = np.random.default_rng(0)
-        scale = np.where(np.array(self.asm.coordinate_units)[free] == "m",
-                         max(1.0, np.max(np.abs(start[free]), initial=0.0)), np.pi)
-        found = []
-        for k in range(SEARCH_STARTS):
-            z0 = start[free] + (0 if k == 0 else rng.uniform(-1, 1, len(free)) * scale)
-            try:
-                fit = least_squares(residual, z0, jac=jacobian, method="lm", xtol=1e-15,
-                                    ftol=1e-15, gtol=1e-15, max_nfev=200 * (len(free) + 1))
-            except (ValueError, np.linalg.LinAlgError):
-                continue
-            q = start.copy()
-            q[free] = fit.x
-            q, r = self._gauss_newton(q, p, rows, free)          # polish to round-off
-            if self._closed(r):
-                # an angle as the turn nearest its guess (q0_guess 0: in (-pi, pi])
-                q[free] = start[free] + _wrapped(q[free] - start[free], scale)
-                found.append((np.linalg.norm(q[free] - start[free]), k, q, r))
-                if k == 0:
-                    break
-            elif np.linalg.norm(r) < np.linalg.norm(r_best):
-                q_best, r_best = q, r
-        if found:
-            _, _, q, r = min(found, key=lambda f: f[:2])
-            return q, r
-        return q_best, r_best
-
-    def _alone(self, loop, start, p):
-        """Whether loop ``loop`` closes by itself (its rows, the free coordinates in it)."""
-        rows = [k for k, i in enumerate(self.owner) if i == loop]
-        pattern = np.asarray(ca.DM(self.f_jac.sparsity_out(0), 1))[rows]
-        free = [i for c, i in enumerate(self.free) if pattern[:, c].any()]
-        q, r = self._gauss_newton(start, p, rows, free)
-        if not self._closed(r):
-            q, r = self._search(start, p, q, r, rows, free)
-        return self._closed(r)
-
-    # -- independent equations and the speed partition ------------------------------------------
-    def _partition(self, J, loop_coords):
-        asm = self.asm
-        names = self.asm.coordinate_names
-        if J.size == 0:
-            return [], []
-        s = np.linalg.svd(J, compute_uv=False)
-        rank = int(np.sum(s > RANK_TOL * max(s[0], 1.0)))
-        _, piv = _pivoted_qr(J.T)
-        rows = sorted(piv[:rank].tolist())
-        Jr = J[rows]
-        # speeds that may be dependent: of regular loop coordinates; preference tiers
-        cut_joints = {c.component.name for c, _ in asm.cuts}
-        tiers = [[], [], []]
-        for k in sorted(loop_coords):
-            if not asm.regular[k]:
-                continue
-            speed = asm.speed_of[k]
-            if speed in asm.prescribed:      # its motion is given: neither kind
-                continue
-            if asm.given[k] or asm.u_given[speed]:
-                tiers[2].append(speed)
-            elif names[k].rsplit(".", 1)[0] in cut_joints:
-                tiers[0].append(speed)
-            else:
-                tiers[1].append(speed)
-        dep = []
-        basis = np.zeros((rank, 0))
-        for tier in tiers:
-            if len(dep) == rank or not tier:
-                continue
-            cols = Jr[:, tier]
-            if basis.shape[1]:                 # what the chosen columns do not reach yet
-                Qb, _ = np.linalg.qr(basis)
-                cols = cols - Qb @ (Qb.T @ cols)
-            diag, piv = _pivoted_qr(cols)
-            for j, d in zip(piv, diag):
-                if len(dep) == rank or d <= RANK_TOL * max(np.abs(Jr).max(), 1.0):
-                    break
-                dep.append(tier[j])
-                basis = np.column_stack([basis, Jr[:, tier[j]]])
-        if len(dep) < rank:
-            quaternion = sorted({n.rsplit(".", 1)[0] for k, n in enumerate(names)
-                                 if k in loop_coords and not asm.regular[k]})
-            loops = "; ".join(", ".join(c.loop) for c, _ in asm.cuts)
-            driven = sorted({f"{m.joint} (by {m.source})" for m in asm.prescribed.values()
-                             if m.coordinate in loop_coords})
-            raise ModelError(
-                f"kinematic loop through {loops}: its closure fixes {rank} speeds but only "
-                f"{len(dep)} joint angles or distances on the loop can follow it"
-                + (f"; the ball or free joint(s) {', '.join(quaternion)} on the loop must be "
-                   f"the cut joint (mark one cut=True), or be replaced by a Universal joint"
-                   if quaternion else "")
-                + (f"; the prescribed joint(s) {', '.join(driven)} cannot follow it: "
-                   f"their motions fight each other through the loop (drive fewer joints)"
-                   if driven else ""))
-        return rows, sorted(dep)
-
-    def candidates(self):
-        """The speeds that may be dependent: of the regular coordinates on a loop, less the
-        prescribed ones."""
-        asm = self.asm
-        return sorted(asm.speed_of[k] for k in self.loop_coords
-                      if asm.regular[k] and asm.speed_of[k] not in asm.prescribed)
-
     def partitions_at(self, q, p):
-        """The partitions possible at the configuration ``q``: (health, choices), or None
-        where the closure has lost rank.
-
-        ``health`` is the ratio of the smallest to the largest singular value of the kept
-        closure rows' Jacobian in the candidate speeds: it goes to zero at a change point,
-        where two branches of the mechanism's configurations cross (a rhombus folding
-        flat) and no partition is regular. ``choices`` are (rows, dependent speeds,
-        condition number of the Jacobian in them, quality): the rows by pivoted QR as at
-        the start, every choice of as many candidate speeds as rows (or, beyond
-        PARTITION_CHOICES of them, the pivoted-QR one); quality is the smallest singular
-        value of the rows of the independent speeds in an orthonormal basis of the
-        closure's null space (the tangent of the configurations): how well the independent
-        coordinates describe the motion, through a change point too."""
-        J = np.asarray(self.f_J(q, p), dtype=float)
-        if not np.all(np.isfinite(J)):
-            return None
-        s = np.linalg.svd(J, compute_uv=False)
-        rank = int(np.sum(s > RANK_TOL * max(s[0], 1.0))) if s.size else 0
-        if rank < len(self.rows):
-            return None
-        _, piv = _pivoted_qr(J.T)
-        rows = sorted(piv[:rank].tolist())
-        cand = self.candidates()
-        Jc = J[rows][:, cand]
-        _, sc, vt = np.linalg.svd(Jc)
-        health = float(sc[-1] / sc[0]) if sc.size and sc[0] > 0 else 0.0
-        N = vt[rank:].T                              # null space, one row per candidate
-        if math.comb(len(cand), rank) <= PARTITION_CHOICES:
-            choices = itertools.combinations(range(len(cand)), rank)
-        else:
-            _, piv = _pivoted_qr(Jc)
-            choices = [sorted(piv[:rank].tolist())]
-        out = []
-        for dep in choices:
-            ind = [j for j in range(len(cand)) if j not in dep]
-            quality = np.linalg.svd(N[ind], compute_uv=False)[-1] if ind else 1.0
-            out.append((rows, [cand[j] for j in dep], condition(Jc[:, list(dep)]),
-                        float(quality)))
-        return health, out
-
-    # -- the equations --------------------------------------------------------------------------
-    def _projected(self, x, zg, ode, keep_q, dep_q, ind, sub, u_full, udot, udot_i, phi, lam,
-                   initial, note_rows):
-        """The ``projected`` formulation: an ODE whose dependent coordinates are carried as
-        states only as the start of a Newton projection onto the closure in every
-        evaluation; the dynamics see the projected values, so they hold the closure to
-        round-off, while any ODE method (Adams, DOP853, ...) can integrate them."""
-        asm = self.asm
-        q = asm.q
-        zs = newton(phi, zg)
-        star = lambda e: ca.substitute(e, zg, zs)        # noqa: E731
-        rate_dep = star(sub(_rows(asm.qdot, dep_q))) + PROJECTION_PULL * (zs - zg)
-        x = ca.vertcat(_rows(q, keep_q), zg, _rows(asm.u, ind))
-        ode = ca.vertcat(star(sub(_rows(asm.qdot, keep_q))), rate_dep, star(sub(udot_i)))
-        qn, un = asm.coordinate_names, asm.speed_names
-        qu, uu = asm.coordinate_units, asm.speed_units
-        names = [qn[k] for k in keep_q] + [qn[k] for k in dep_q] + [un[k] for k in ind]
-        units = [qu[k] for k in keep_q] + [qu[k] for k in dep_q] + [uu[k] for k in ind]
-        note = (f"kinematic loops, projected formulation: {x.shape[0]} states for {len(ind)} "
-                f"degree{'s' * (len(ind) != 1)} of freedom; the {len(dep_q)} dependent coordinates are states only to "
-                f"start a Newton projection onto {note_rows} in every evaluation (an ODE that "
-                f"holds the closure to round-off)")
-        out = Equations(x, ca.SX(0, 1), ode, ca.SX(0, 1), names, units, [], [],
-                        star(u_full), star(sub(udot)), "projected", note, len(self.rows),
-                        self.phi.shape[0] - len(self.rows), initial, star(phi),
-                        star(sub(lam)))
-        out.q = ca.substitute(q, zg, zs)
-        out.dependent_jacobian = star(self.JD)
-        out.dependent_names = [un[k] for k in self.dep]
-        return out
-
+        """The partitions possible at the configuration ``q`` (``partitioning``)."""
+        return partitioning.partitions_at(self, q, p)
 
     def equations(self, formulation, rate):
-        eq = self._equations(formulation, rate)
+        """The Equations of the loops in ``formulation`` (``formulations.equations_of``),
+        with the partition they were built on."""
+        eq = equations_of(self, formulation, rate)
         eq.partition, eq.loops, eq.rate = (list(self.rows), list(self.dep)), self, rate
         return eq
-
-    def _equations(self, formulation, rate):
-        asm = self.asm
-        q, u = asm.q, asm.u
-        nv = u.shape[0]
-        dep = self.dep
-        # prescribed speeds P are neither independent nor dependent: their motion is given
-        P = list(asm.prescribed)
-        ind = [k for k in range(nv) if k not in set(dep) | set(P)]
-        phi = _rows(self.phi, self.rows)
-        J = _rows(self.J, self.rows)
-        JD, JI, JP = _cols(J, dep), _cols(J, ind), _cols(J, P)
-        self.JD = JD
-        T = ca.SX.zeros(nv, len(ind))
-        T[ind, :] = ca.SX.eye(len(ind))
-        if dep:
-            T[dep, :] = -ca.solve(JD, JI)
-        # u = T u_I + s: the prescribed speeds (symbols until ``_prescribe``) and what the
-        # dependent ones do to follow them
-        s_vel = ca.SX.zeros(nv)
-        acc_P = ca.vertcat(*[m.acc for m in asm.prescribed.values()])
-        if P:
-            s_vel[P] = u[P]
-            if dep:
-                s_vel[dep] = -ca.solve(JD, JP @ u[P])
-        c = ca.jtimes(J @ u, q, asm.qdot)             # (dJ/dt) u
-        if formulation == "baumgarte":
-            c = c + 2 * rate * (J @ u) + rate ** 2 * phi
-        g = ca.SX.zeros(nv)
-        if P:
-            g[P] = acc_P
-        if dep:
-            g[dep] = -ca.solve(JD, c + JP @ acc_P if P else c)
-        a_grav = ca.vertcat(ca.SX.zeros(3), -asm.gravity)
-        M = asm.mass_matrix()
-        bias = rnea(asm.bodies, u, ca.SX.zeros(nv), a_grav) - asm.Q
-        Mr = T.T @ M @ T
-        udot_i = ca.solve(Mr, -T.T @ (bias + M @ g))
-        udot = T @ udot_i + g
-        # multipliers: J^T lam = M udot + bias, exactly solvable as J has independent rows;
-        # with prescribed speeds, J^T lam + E_P drive = M udot + bias (E_P: their columns of
-        # the identity), as exactly: no combination of closure rows acts on them alone, or
-        # the partition would have failed
-        lam = ca.SX.zeros(self.phi.shape[0])
-        if P:
-            A = ca.horzcat(J.T, ca.SX.eye(nv)[:, P])
-            both = ca.solve(A.T @ A, A.T @ (M @ udot + bias))
-            if self.rows:
-                lam[self.rows] = both[:len(self.rows)]
-            lam = ca.vertcat(lam, both[len(self.rows):])
-        elif self.rows:
-            lam[self.rows] = ca.solve(J @ J.T, J @ (M @ udot + bias))
-        dep_q = [k for k, v in asm.speed_of.items() if v in set(dep)]
-        Pq = {m.coordinate for m in asm.prescribed.values()}
-        qnames, unames = asm.coordinate_names, asm.speed_names
-        qunits, uunits = asm.coordinate_units, asm.speed_units
-        note_rows = (f"{len(self.rows)} independent closure equations"
-                     + (f" ({self.phi.shape[0] - len(self.rows)} redundant dropped)"
-                        if self.phi.shape[0] > len(self.rows) else ""))
-        start = self.f_start
-        rows = self.rows
-        if formulation == "baumgarte":
-            u_i = ca.SX.sym("u_i", len(ind))
-            f_u = ca.Function("u_start", [q, u_i, asm.p], [ca.substitute(
-                T @ u_i + s_vel, _rows(u, P), _rows(asm.u_start, P))])
-            all_q = [k for k in range(q.shape[0]) if k not in Pq]
-            all_u = [k for k in range(nv) if k not in set(P)]
-
-            def initial(p):
-                qc = self.close(p)
-                _, u0 = start(p)
-                u0 = loopstart.speeds(self, qc, np.asarray(u0, dtype=float).ravel(), p)
-                un = np.asarray(f_u(qc, u0[ind], p))
-                return np.concatenate([qc[all_q], un.ravel()[all_u]]), np.zeros(0)
-            note = (f"kinematic loops, Baumgarte formulation: all {len(all_q)} coordinates "
-                    f"and {len(all_u)} speeds are states ({len(ind)} degrees of freedom; "
-                    f"{note_rows}, stabilised at rate {rate:g}/s)")
-            return Equations(ca.vertcat(_rows(q, all_q), _rows(u, all_u)), ca.SX(0, 1),
-                             ca.vertcat(_rows(asm.qdot, all_q), _rows(udot, all_u)),
-                             ca.SX(0, 1), [qnames[k] for k in all_q] + [unames[k] for k in all_u],
-                             [qunits[k] for k in all_q] + [uunits[k] for k in all_u], [], [], u,
-                             udot, "baumgarte", note, len(rows), self.phi.shape[0] - len(rows),
-                             initial, phi, lam, dependent_jacobian=JD,
-                             dependent_names=[unames[k] for k in dep])
-        keep_q = [k for k in range(q.shape[0]) if k not in set(dep_q) | Pq]
-        u_full = ca.densify(T @ _rows(u, ind) + s_vel)
-        sub = lambda e: ca.substitute(e, u, u_full)     # noqa: E731
-        x = ca.vertcat(_rows(q, keep_q), _rows(u, ind))
-        z = _rows(q, dep_q)
-        ode = ca.vertcat(sub(_rows(asm.qdot, keep_q)), sub(udot_i))
-
-        def initial(p, projected=False):
-            qc = self.close(p)
-            _, u0 = start(p)
-            u0 = np.asarray(u0, dtype=float).ravel()
-            u_dep_given = [k for k in dep if asm.u_given[k] and u0[k] != 0]
-            if u_dep_given:
-                raise ModelError(
-                    f"qd0 of {', '.join(unames[k] for k in u_dep_given)}: this speed is "
-                    f"fixed by the loop closure (it is a dependent coordinate); give the "
-                    f"initial speed of an independent coordinate "
-                    f"({', '.join(unames[k] for k in ind)}) instead")
-            u0 = loopstart.speeds(self, qc, u0, p)
-            if projected:
-                return np.concatenate([qc[keep_q], qc[dep_q], u0[ind]]), np.zeros(0)
-            return np.concatenate([qc[keep_q], u0[ind]]), qc[dep_q]
-        if formulation == "projected" and dep:
-            return self._projected(x, z, ode, keep_q, dep_q, ind, sub, u_full, udot, udot_i,
-                                   phi, lam, lambda p: initial(p, True), note_rows)
-        if not dep:
-            note = ("kinematic loops closed by rigid parts or by a free joint: they fix no "
-                    "coordinate, so the states are those of the tree")
-        else:
-            note = ""
-        note = note or (f"kinematic loops, coordinate partitioning: {len(keep_q) + len(ind)} "
-                f"differential states for {len(ind)} degrees of freedom"
-                + (" (a quaternion has 4 coordinates for 3 speeds)"
-                   if len(keep_q) > len(ind) else "")
-                + f"; {len(dep_q)} dependent coordinates ({', '.join(qnames[k] for k in dep_q)})"
-                f" are algebraic variables solved from {note_rows} at every step")
-        return Equations(x, z, ode, phi, [qnames[k] for k in keep_q] + [unames[k] for k in ind],
-                         [qunits[k] for k in keep_q] + [uunits[k] for k in ind],
-                         [qnames[k] for k in dep_q], [qunits[k] for k in dep_q],
-                         u_full, sub(udot), "partition", note, len(rows),
-                         self.phi.shape[0] - len(rows), initial, phi, sub(lam),
-                         dependent_jacobian=JD if dep else None,
-                         dependent_names=[unames[k] for k in dep])
-
-
-
-def condition(A):
-    """The 2-norm condition number of a square matrix (inf when singular)."""
-    if not A.size:
-        return 1.0
-    s = np.linalg.svd(A, compute_uv=False)
-    return float(s[0] / s[-1]) if s[-1] > 0 else np.inf
-
-
-def _wrapped(d, scale):
-    """Differences of coordinates, angles (scale pi) taken modulo 2 pi."""
-    angle = scale == np.pi
-    return np.where(angle, (d + np.pi) % (2 * np.pi) - np.pi, d)
-
-
-def newton(residual, z, steps=PROJECTION_STEPS):
-    """``z`` after ``steps`` Newton steps on ``residual(z) = 0``, written out in SX."""
-    jac = ca.jacobian(residual, z)
-    out = z
-    for _ in range(steps):
-        out = out - ca.solve(ca.substitute(jac, z, out), ca.substitute(residual, z, out))
-    return out
-
-
-def _rows(m, index):
-    """Rows ``index`` of an SX matrix: SX(0, columns) when there are none (CasADi's own
-    indexing of a 1 x 1 matrix by an empty list gives 1 x 0)."""
-    return m[index, :] if index else ca.SX(0, m.shape[1])
-
-
-def _cols(m, index):
-    return m[:, index] if index else ca.SX(m.shape[0], 0)

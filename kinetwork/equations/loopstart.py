@@ -17,6 +17,7 @@ import numpy as np
 
 from ..errors import AssemblyBranchWarning, ModelError
 from ..spatial import vee
+from . import loopclose
 
 #: a start condition counts as met below this (m, m/s, rad/s, rotation-matrix entries)
 MET = 1e-9
@@ -122,8 +123,8 @@ def branch(loops, q, p):
         for _ in range(SEARCH_STARTS):
             trial = q.copy()
             trial[free] = start[free] + rng.uniform(-1, 1, len(free)) * scale
-            found, r = loops._gauss_newton(trial, p, rows, free)
-            if not loops._closed(r):
+            found, r = loopclose.gauss_newton(loops, trial, p, rows, free)
+            if not loopclose.closed(r):
                 continue
             z = found[free]
             theirs = off(z)

@@ -31,7 +31,7 @@ from dataclasses import dataclass
 import casadi as ca
 import numpy as np
 
-from ..components.signals import interpolant_knots
+from ..components.tables import interpolant_knots
 from ..errors import ModelError
 
 RELATIONS = (ca.OP_LT, ca.OP_LE)
@@ -61,7 +61,7 @@ class Relations:
         Per time node: its indicator is affine in t (its instants are found in closed form).
     tables : list
         The long Tables read in time, whose knots are time events of no node (their
-        interpolants', ``kinetwork.components.signals.interpolant_knots``): per table,
+        interpolants', ``kinetwork.components.tables.interpolant_knots``): per table,
         (the Function (t, p) -> (its argument, that argument's time derivative), whether
         that argument is affine in t, the knots, increasing).
     reading : list

@@ -52,7 +52,7 @@ def free(builder):
             given = _given(group, attr)
             if given:
                 symbol = coord[which]
-                builder.net.start[builder._at(symbol)] = _solved_for(builder, given[0], which,
+                builder.net.start[builder.index_of(symbol)] = _solved_for(builder, given[0], which,
                                                                      symbol, attr)
 
 

@@ -90,7 +90,7 @@ def solve(builder, cluster):
                 residual += builder.bound[e.name].inertia() * a * ca.jacobian(pos, theta).T
     for s in sets:
         pos = builder.kin[s][0]
-        residual += ca.jacobian(pos, theta).T * builder._applied(s)
+        residual += ca.jacobian(pos, theta).T * builder.applied(s)
     A = ca.jacobian(residual, acc)
     rest = ca.substitute(residual, acc, ca.SX.zeros(acc.shape[0]))
     solved = -rest / A if len(coords) == 1 else -ca.solve(A, rest)

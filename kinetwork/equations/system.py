@@ -16,12 +16,18 @@ import numpy as np
 
 from ..errors import ModelError
 from . import junctions
+from . import closing
 from .closing import closer
 from .assemble import assemble
 from .initial import InitialEquations
 from .loops import BAUMGARTE_RATE, formulate, newton
 from .modes import close as close_modes, free_terms
+from .pointwise import mapped, pointwise
+from .regularity import OVERFLOW, check_mass_matrix, overflow_message  # noqa: F401
 from .relations import find as find_relations
+
+# mapped, pointwise, OVERFLOW and overflow_message are imported from here by the solver
+__all__ = ["OVERFLOW", "System", "mapped", "overflow_message", "pointwise"]
 
 
 class System:
@@ -75,38 +81,18 @@ class System:
         self.signals = [sig.described() for sig in asm.signals]
         self.probe_targets = _as_wired(model, {probe.name: target.path
                                                for probe, target in self.topology.probes})
-        # signals are written in the assembly's coordinates, speeds, their rates and the
-        # multipliers; the formulation says what those are in the states (x, z)
-        coords = asm.q if eq.q is None else eq.q
-        values_in_states = ca.densify(ca.vertcat(coords, eq.u, eq.udot, eq.lam))
-        kinematics = ca.vertcat(asm.q, asm.u, asm.udot, asm.lam)
-        if self.modes is not None:      # what friction and stops hold with
-            values_in_states = ca.vertcat(values_in_states, self.modes.F_solution)
-            kinematics = ca.vertcat(kinematics, self.modes.F)
-        outs = [ca.substitute(sig.flat(), kinematics, values_in_states) for sig in asm.signals]
-        # outputs read the whole state: differential, then algebraic
-        # dense: CasADi's buffer interface writes the values into a plain array
-        self.f_out = ca.Function("outputs", [asm.t, ca.vertcat(eq.x, eq.z), asm.p],
-                                 [ca.densify(ca.vertcat(*outs)) if outs else ca.SX(0, 1)])
-        jd = eq.dependent_jacobian
-        #: the closure's Jacobian in the dependent speeds, of the full state (None: no loop
-        #: whose partition can turn singular)
-        self.f_dependent = None if jd is None or jd.numel() == 0 else ca.Function(
-            "dependent_jacobian", [ca.vertcat(eq.x, eq.z), asm.p],
-            [ca.densify(ca.substitute(jd, asm.q, ca.densify(coords)))])
+        self.f_out, self.f_dependent, self.f_assembly_checks = _readouts(asm, eq, self.modes)
+        #: f_dependent: the closure's Jacobian in the dependent speeds, of the full state
+        #: (None: no loop whose partition can turn singular); f_assembly_checks: what stays
+        #: positive away from the singular positions of assemblies that close their loops in
+        #: closed form, of the full state (None: no assembly)
         self.dependent_names = eq.dependent_names or []
         checks = asm.placed.checks if asm.placed is not None else []
-        #: what stays positive away from the singular positions of assemblies that close
-        #: their loops in closed form, of the full state (None: no assembly)
-        self.f_assembly_checks = None if not checks else ca.Function(
-            "assembly_checks", [asm.t, ca.vertcat(eq.x, eq.z), asm.p],
-            [ca.densify(ca.substitute(ca.vertcat(*[c for c, _, _ in checks]), asm.q,
-                                      ca.densify(coords)))])
         #: (assembly, what is singular) of each check
         self.assembly_check_names = [(name, what) for _, name, what in checks]
         if self.formulation in ("tree", "hybrid") and self.speed_names and \
                 not self.n_algebraic:
-            self._check_mass_matrix()
+            check_mass_matrix(self)
         elif partition is None:  # initial values that contradict the loops: refused now
             self.initial_full_p(self.param_vector())
         self._z_last = None
@@ -129,37 +115,6 @@ class System:
                 from None
         return _system_from_text, (text, *self._compiled_as)
 
-    def _check_mass_matrix(self):
-        """Refuse a mass matrix that is singular at the initial state (a joint that moves no
-        mass or inertia: a chain of bodies with zero mass, a slider carrying nothing, a free
-        body with no inertia about an axis), naming the joints it cannot accelerate, rather
-        than integrating NaNs or, worse, zeros (``_singular_directions``). Of a model with
-        prescribed joints, the mass matrix of the others."""
-        p = self.param_vector()
-        x0 = self.initial_full_p(p)[0]
-        # M column by column as inverse dynamics of unit accelerations (no speed, no
-        # gravity): an O(n) expression, where CRBA's would be O(n^2) to build
-        a, n = self.asm, len(self.speed_names)
-        acc = ca.SX.sym("acc", n)
-        f = ca.Function("M_columns", [a.q, acc, a.p], [a.mass_times(acc)])
-        q0 = x0[:len(self.coordinate_names)] if self.eq.q is None else \
-            np.asarray(ca.Function("q0", [a.t, self._x, a.p], [self.eq.q])(0, x0, p)).ravel()
-        free = [k for k in range(n) if k not in a.prescribed]
-        M = np.asarray(f.map(n)(q0, np.eye(n), p))[np.ix_(free, free)]
-        if not free:
-            return
-        if not np.all(np.isfinite(M)):
-            raise ModelError(overflow_message(self.model, "the mass matrix", p,
-                                              self.param_names))
-        involved = [self.speed_names[free[k]] for k in _singular_directions(M)]
-        if not involved:
-            return
-        joints = list(dict.fromkeys(n.rsplit(".", 1)[0] for n in involved))
-        raise ModelError(f"the mass matrix is singular at the initial state: "
-                         f"{', '.join(joints)} move(s) no mass or inertia in the direction of "
-                         f"{', '.join(involved)} (give the bodies they carry mass or inertia, "
-                         f"or lock the joint)", **self._fields_of(joints[0]))
-
     def _fields_of(self, name):
         """The fields of a Problem about component ``name`` of the model (none if it is no
         component of it)."""
@@ -168,21 +123,8 @@ class System:
 
     def polish(self, X, p, t=None):
         """Full states X (n_points, n_states + n_algebraic) with the algebraic variables
-        (dependent coordinates) Newton-corrected onto the closure to machine precision: the
-        integrator solves them only to its tolerance. Equations that read time (a diode's
-        circuit driven by a source in t) are polished at the times ``t`` of the rows, and
-        not at all without them."""
-        if not self.n_algebraic or not len(X):
-            return X
-        timed = ca.depends_on(self.eq.alg, self.asm.t)
-        if timed and t is None:
-            return X
-        times = np.zeros(len(X)) if t is None else np.asarray(t, dtype=float)
-        Z = pointwise(self._f_polish, X, p, times[:, None])[0]
-        out = np.array(X, dtype=float)
-        ok = np.all(np.isfinite(Z), axis=1)
-        out[ok, self.n_states:] = Z[ok]
-        return out
+        Newton-corrected onto the closure to machine precision (``closing.polish``)."""
+        return closing.polish(self, X, p, t)
 
     @functools.cached_property
     def _f_polish(self):
@@ -217,28 +159,12 @@ class System:
 
     def constraint_residual_p(self, X, p):
         """``constraint_residual`` for a parameter vector already checked."""
-        X = np.atleast_2d(np.asarray(X, dtype=float))
-        if self.eq.residual is None:
-            return np.zeros(len(X))
-        return pointwise(self._f_residual, X, p)[0].ravel()
+        return closing.closure_residual(self, X, p)
 
     def assembly_singular(self, times, X, p, margin=0.0):
-        """(row, messages): the first row of full states X (at ``times``) at which an
-        assembly that closes its loop in closed form is at (or past, or within ``margin``
-        of) a singular position, and what is singular there; (None, []) where none is."""
-        if self.f_assembly_checks is None or not len(X):
-            return None, []
-        X = np.atleast_2d(np.asarray(X, dtype=float))
-        values = np.asarray(mapped(self.f_assembly_checks, len(X))(
-            np.atleast_1d(times)[None, :], X.T, p)).T
-        with np.errstate(invalid="ignore"):
-            bad = ~(values > margin)
-        rows = np.nonzero(bad.any(axis=1))[0]
-        if not len(rows):
-            return None, []
-        return int(rows[0]), [f"{name} {'is at' if not margin else 'nears'} a singular "
-                              f"position of its loop: {what}" for (name, what), b in
-                              zip(self.assembly_check_names, bad[rows[0]]) if b]
+        """(row, messages): the first row of full states X at which an assembly that closes
+        its loop in closed form is at (or near) a singular position (``closing``)."""
+        return closing.assembly_singular(self, times, X, p, margin)
 
     @functools.cached_property
     def _f_residual(self):
@@ -483,135 +409,38 @@ class System:
                 f"{len(self.signal_names)} signals>")
 
 
-#: a joint whose articulated inertia (what it still moves with the joints beyond it free) is
-#: below this fraction of its own inertia (what it moves with them locked), times the
-#: number of joints, is taken as moving nothing: round-off in the factorisation is about
-#: eps per joint, where a 1024-link point-mass chain's first joint keeps 3e-9 of its own
-PIVOT_FLOOR = 64 * np.finfo(float).eps
-
-
-def _singular_directions(M):
-    """The indices of the speeds that the mass matrix ``M`` cannot accelerate (empty when it
-    is positive definite).
-
-    The test is a Cholesky factorisation of M with each joint's diagonal scaled to one,
-    eliminating the last joints first: on a tree whose joints come parents first, its pivots
-    are the articulated inertias of the articulated-body algorithm, each relative to the
-    joint's own (1 for a leaf; ~3/N^3 for the first joint of an N-link point-mass chain).
-    A singular M has a zero pivot; a regular one has none, however wide its eigenvalues
-    spread: the condition number of a chain's M in relative coordinates grows as N^4, and a
-    bound on the smallest eigenvalue relative to the largest refused point-mass chains from
-    192 links, which pinocchio and MuJoCo run. A joint with no inertia at all is named as
-    it is; otherwise the directions of the scaled M's eigenvalues at the floor."""
-    sym = (M + M.T) / 2
-    n, d = len(sym), np.diag(sym)
-    zero = [k for k in range(n) if not d[k] > 0]
-    if zero:
-        return zero
-    s = 1 / np.sqrt(d)
-    scaled = sym * s[:, None] * s[None, :]
-    floor = PIVOT_FLOOR * n
-    try:
-        pivots = np.diag(np.linalg.cholesky(scaled[::-1, ::-1])) ** 2
-        if np.min(pivots) > floor:
-            return []
-    except np.linalg.LinAlgError:
-        pass
-    values, vectors = np.linalg.eigh(scaled)
-    null = vectors[:, values <= max(floor, values[0])]
-    return [k for k in range(n) if np.max(np.abs(null[k])) > 1e-3]
-
-
-#: a number beyond this in the state or its rate at the start is taken as an overflow to come
-#: (its square is beyond double precision): no physical model has one
-OVERFLOW = 1e150
-
-
-def overflow_message(model, what, p, names):
-    """Why a model whose numbers overflow double precision is refused, naming the largest
-    parameter values."""
-    big = sorted(zip(names, np.asarray(p, dtype=float)), key=lambda kv: -abs(kv[1]))[:3]
-    return (f"{what} of {model.name!r} is not finite or beyond {OVERFLOW:g} at the initial "
-            f"state: a number overflows double precision there (or a division by zero); check "
-            f"the parameters" + (f" (largest: {', '.join(f'{k} = {v:g}' for k, v in big)})"
-                                 if big else "") + " and the initial values")
+def _readouts(asm, eq, modes):
+    """The Functions that read the full state (differential, then algebraic): the probe
+    signals, the closure's Jacobian in the dependent speeds and the assemblies' checks
+    (None where there is nothing to read)."""
+    # signals are written in the assembly's coordinates, speeds, their rates and the
+    # multipliers; the formulation says what those are in the states (x, z)
+    coords = asm.q if eq.q is None else eq.q
+    values_in_states = ca.densify(ca.vertcat(coords, eq.u, eq.udot, eq.lam))
+    kinematics = ca.vertcat(asm.q, asm.u, asm.udot, asm.lam)
+    if modes is not None:      # what friction and stops hold with
+        values_in_states = ca.vertcat(values_in_states, modes.F_solution)
+        kinematics = ca.vertcat(kinematics, modes.F)
+    outs = [ca.substitute(sig.flat(), kinematics, values_in_states) for sig in asm.signals]
+    # dense: CasADi's buffer interface writes the values into a plain array
+    f_out = ca.Function("outputs", [asm.t, ca.vertcat(eq.x, eq.z), asm.p],
+                        [ca.densify(ca.vertcat(*outs)) if outs else ca.SX(0, 1)])
+    jd = eq.dependent_jacobian
+    f_dependent = None if jd is None or jd.numel() == 0 else ca.Function(
+        "dependent_jacobian", [ca.vertcat(eq.x, eq.z), asm.p],
+        [ca.densify(ca.substitute(jd, asm.q, ca.densify(coords)))])
+    checks = asm.placed.checks if asm.placed is not None else []
+    f_checks = None if not checks else ca.Function(
+        "assembly_checks", [asm.t, ca.vertcat(eq.x, eq.z), asm.p],
+        [ca.densify(ca.substitute(ca.vertcat(*[c for c, _, _ in checks]), asm.q,
+                                  ca.densify(coords)))])
+    return f_out, f_dependent, f_checks
 
 
 def _system_from_text(text, loops, baumgarte_rate):
     """The System a pickle holds (``System.__reduce__``): its model read and compiled."""
     from ..graph.io import loads
     return loads(text).compile(loops=loops, baumgarte_rate=baumgarte_rate)
-#: points per call of ``pointwise``: a map over every point of a long run cost more to make
-#: than to evaluate (1e6 points: 14 s to make, 19 s to call with its DM conversions, 8 s to
-#: read back, against 0.3 s to evaluate)
-POINTS_PER_CALL = 4096
-
-
-@functools.lru_cache(maxsize=64)
-def _mapped(f, n, shared):
-    """``f`` mapped over ``n`` points, the inputs ``shared`` the same for all; made once per
-    Function, size and sharing (making it costs ~0.5 ms)."""
-    return f.map(f"{f.name()}_points", "serial", n, list(shared), [])
-
-
-@functools.lru_cache(maxsize=64)
-def mapped(f, n):
-    """``f.map(n)``, made once per Function and size (making it costs ~0.5 ms): for callers
-    that read the call's return status themselves (``solver.batch``)."""
-    return f.map(n)
-
-
-def pointwise(f, *args):
-    """Each output of ``f`` at every point: one array (n_points, numel) per output, each
-    row the output at that point flattened column-major.
-
-    An argument is an array of one row per point (2-D: (n_points, nnz of the input)), or
-    one value for all (1-D, its nnz). ``f`` runs over POINTS_PER_CALL points per call of
-    its map, through ``Function.buffer`` straight from and into numpy arrays (no DM)."""
-    rows = [np.ascontiguousarray(a, dtype=float) if np.ndim(a) == 2 else None for a in args]
-    n = next(len(r) for r in rows if r is not None)
-    shared = tuple(i for i, r in enumerate(rows) if r is None)
-    fixed = [None if r is not None else np.ascontiguousarray(np.ravel(a), dtype=float)
-             for r, a in zip(rows, args)]
-    outs = [np.zeros((n, f.nnz_out(j))) for j in range(f.n_out())]
-    size = min(n, POINTS_PER_CALL)
-    if size:
-        F = _mapped(f, size, shared)
-        buf, trigger = F.buffer()
-        for i, value in enumerate(fixed):
-            if value is not None:
-                buf.set_arg(i, memoryview(value))
-        for k in range(0, n, size):
-            m = min(size, n - k)
-            # the last call's missing points repeat its last one; CasADi keeps raw
-            # pointers: the arrays are kept alive (``blocks``, ``out``) until it has run
-            blocks = [None if r is None else r[k:k + size] if m == size else
-                      np.concatenate([r[k:], np.repeat(r[-1:], size - m, axis=0)])
-                      for r in rows]
-            for i, block in enumerate(blocks):
-                if block is not None:
-                    buf.set_arg(i, memoryview(block))
-            out = [o[k:k + size] if m == size else np.zeros((size, o.shape[1]))
-                   for o in outs]
-            for j, o in enumerate(out):
-                buf.set_res(j, memoryview(o))
-            trigger()
-            if m < size:
-                for o, partial in zip(outs, out):
-                    o[k:] = partial[:m]
-    return [_dense(f.sparsity_out(j), o) for j, o in enumerate(outs)]
-
-
-def _dense(sparsity, values):
-    """Rows of nonzeros of ``sparsity`` as rows of its dense, column-major entries."""
-    if sparsity.is_dense():
-        return values
-    rows, cols = sparsity.get_triplet()
-    out = np.zeros((len(values), sparsity.numel()))
-    out[:, np.asarray(rows) + sparsity.size1() * np.asarray(cols)] = values
-    return out
-
-
 def _as_wired(model, targets):
     """{probe: the port it reads as the user wired it}: ``motor.p``, not the flat model's
     ``motor.Ra.p`` inside an aggregate or a subsystem (names the user never wrote);

@@ -15,7 +15,7 @@ from ..components.base import ANY, Component, PortRef
 from ..util import hint, quote, suggest
 from . import quantities
 from .subsystem import (MAX_COMPONENTS, MAX_CONNECTIONS, Subsystem, check_placement,
-                        check_port_name, definitions, flatten, has_subsystems)
+                        check_port_name, definitions, flatten, has_subsystems, user_names)
 from .writer import save
 from ..errors import ModelError, Problem
 from ..expr import CONSTANTS, FUNCTIONS, parse
@@ -363,7 +363,11 @@ class Model:
         loading a file and compiling it validate once."""
         from .topology import analyze
         if has_subsystems(self):
-            return self.flat().validate()
+            flat = self.flat()
+            try:
+                return flat.validate()
+            except ModelError as exc:             # in the user's names, not the flat ones
+                raise user_names(exc, flat) from None
         key, values = self.content_key(), (dict(self.parameters), dict(self.parameter_text))
         if self._validated is not None and self._validated[:2] == (key, values):
             return self._validated[2]
@@ -387,7 +391,11 @@ class Model:
         flat: states, signals and parameters are named by path (``"cyl1.slide.q"``).
         """
         if has_subsystems(self):
-            return self.flat().compile(loops, baumgarte_rate)
+            flat = self.flat()
+            try:
+                return flat.compile(loops, baumgarte_rate)
+            except ModelError as exc:             # in the user's names, not the flat ones
+                raise user_names(exc, flat) from None
         key = (self.content_key(), loops, baumgarte_rate)
         with _compile_lock:
             if key not in self._compiled:

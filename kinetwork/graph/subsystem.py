@@ -14,6 +14,7 @@ feeding it changes it without a new compilation.
 """
 
 import copy
+import re
 
 import networkx as nx
 
@@ -201,6 +202,17 @@ class _Flat:
             self.expanded[id(comp)] = (comp, comp.expand())
         return self.expanded[id(comp)][1]
 
+    def alias(self, inner, path, shown):
+        """Record the user's names of aggregate ``path``'s parts (``flat.aliases``): its
+        exposed ports (``motor.Ra.p`` is ``motor.p``) and its inner parts (``motor.Ra``, shown
+        ``motor/Ra``, is ``motor``), so that no message names a part the user never placed."""
+        aliases = self.flat.__dict__.setdefault("aliases", {})
+        for name, ref in inner.exposed.items():
+            aliases[f"{path}.{ref.path}"] = f"{path}.{name}"
+        for name in inner.components:
+            aliases[f"{shown}/{name}"] = shown
+            aliases[f"{path}.{name}"] = path
+
     def walk(self, m, prefix, scope, display, depth, entry=None):
         """Add ``m``'s components under ``prefix``; ``scope`` maps m's parameter names to
         their text in flat names; ``entry`` is the file path of the top model's component
@@ -215,7 +227,9 @@ class _Flat:
                           shown + "/", depth + 1, at)
                 continue
             if _aggregate(comp):          # its parts take its parameters' own words
-                self.walk(self.expansion(comp), path + ".", scope, shown + "/", depth + 1, at)
+                inner = self.expansion(comp)
+                self.alias(inner, path, shown)
+                self.walk(inner, path + ".", scope, shown + "/", depth + 1, at)
                 continue
             if at is not None:
                 self.flat.paths[path] = at
@@ -399,6 +413,37 @@ def flatten(model):
     if walker.problems:
         raise ModelError(walker.problems)
     return flat
+
+
+def user_names(error, flat):
+    """``error`` (a ModelError about the flat model ``flat``) in the user's names: the
+    exposed ports and inner parts of aggregates (a ``DCMotor``'s resistor ``Ra``) named as the
+    aggregate and its own ports (``flat.aliases``); the error itself when there are none."""
+    aliases = getattr(flat, "aliases", None)
+    if not aliases or not isinstance(error, ModelError):
+        return error
+    pattern = re.compile(r"(?<![\w./])(" + "|".join(
+        re.escape(k) for k in sorted(aliases, key=len, reverse=True)) + r")(?![\w/])")
+
+    def words(text):
+        return pattern.sub(lambda m: aliases[m.group(1)], text) if text else text
+
+    problems = []
+    for problem in error.problems:
+        fields = {k: getattr(problem, k, None) for k in ("component", "port", "parameter",
+                                                         "path", "hint", "severity")}
+        component, port = fields["component"], fields["port"]
+        if component in aliases:
+            exposed = aliases.get(f"{component}.{port}") if port else None
+            fields["component"] = aliases[component]
+            fields["port"] = exposed.rpartition(".")[2] if exposed else port
+        fields["hint"] = words(fields["hint"])
+        problems.append(Problem(words(problem.message), **{
+            k: v for k, v in fields.items() if v is not None}))
+    renamed = type(error).__new__(type(error))
+    renamed.__dict__.update(error.__dict__)
+    ModelError.__init__(renamed, problems, count=error.count)
+    return renamed
 
 
 def _read_signals(value, prefix):

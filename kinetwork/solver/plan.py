@@ -43,6 +43,7 @@ from .driver import (DEFAULTS, Run, _assembly_watch, _auto, _check, _check_finit
                      _integrate, _probe_outputs, _running, output_values)
 from .events import Events
 from .methods import METHODS, Casadi, _CasadiRun, choose
+from .progress import progress_bar
 from .results import Results
 
 if TYPE_CHECKING:                     # annotations only
@@ -329,7 +330,8 @@ def simulate(model: Model | System, t_end: float | None = None, n_points: int | 
              params: Mapping[str, float | str] | None = None, t_start: float = 0.0,
              step: float | None = None, max_step: float | None = None,
              jit: bool | None = None, max_steps: int | None = None,
-             time_limit: float | None = None, progress: Callable[[float], object] | None = None,
+             time_limit: float | None = None,
+             progress: bool | Callable[[float], object] | None = None,
              cancel: Callable[[], object] | None = None, restart: bool = False,
              repartition: bool = True, error_estimate: bool = False) -> Results:
     """Integrate ``model`` (a Model or a compiled System) and record its probes.
@@ -377,8 +379,9 @@ def simulate(model: Model | System, t_end: float | None = None, n_points: int | 
         it): a run that takes more stops with a SimulationError.
     time_limit : float, optional
         Wall-clock limit [s] of the run, compilation included.
-    progress : callable, optional
-        Called with the simulated time reached, now and then.
+    progress : bool or callable, optional
+        True: a tqdm progress bar on stderr, drawn once the run has lasted a second (a quick
+        run shows none). A callable: called with the simulated time reached, now and then.
     cancel : callable, optional
         Called now and then; a true answer stops the run (a SimulationError holding what was
         computed). SIGINT and SIGTERM stop a run in the main thread the same way.
@@ -417,8 +420,13 @@ def simulate(model: Model | System, t_end: float | None = None, n_points: int | 
                 rtol=rtol, atol=atol, step=step, max_step=max_step, t_start=t_start, jit=jit,
                 max_steps=max_steps, time_limit=time_limit, restart=restart,
                 repartition=repartition)
-    return plan.run(params, cancel=cancel, progress=progress, error_estimate=error_estimate,
-                    started=entered)
+    if progress is True:
+        name = getattr(model, "name", None) or "simulate"
+        with progress_bar(plan.grid[0], plan.grid[-1], desc=name) as report:
+            return plan.run(params, cancel=cancel, progress=report,
+                            error_estimate=error_estimate, started=entered)
+    return plan.run(params, cancel=cancel, progress=progress or None,
+                    error_estimate=error_estimate, started=entered)
 
 
 # -- resolving parameter names ----------------------------------------------------------------

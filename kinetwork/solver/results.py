@@ -8,7 +8,9 @@ guessing a shape from a size.
 from __future__ import annotations
 
 import csv
+import hashlib
 import io
+import json
 import os
 from collections.abc import Callable, Sequence
 from typing import TYPE_CHECKING, Any
@@ -171,67 +173,72 @@ class Results:
 
     def to_csv(self, path: str | os.PathLike, overwrite: bool = False,
                cancel: Callable[[], object] | None = None, stop: Any = None) -> str | None:
-        """Write t and every probe signal as CSV with a header row, under the output policy
-        (``kinetwork.outputs``): atomically (a failed write leaves an old file whole), never
-        over the model file these results came from, a special file or a folder, nor over
-        a file that is not a CSV table unless ``overwrite``.
+        """Write t and every probe signal as a CSV table (a header row, then numbers only)
+        and its sidecar ``x.meta.json`` (units, settings, how the run ended: see
+        ``kinetwork.solver.csvio``; ``kn.read_csv`` reads both back), under the output policy
+        (``kinetwork.outputs``): each atomically (a failed write leaves an old file whole),
+        never over the model file these results came from, a special file or a folder, nor
+        over a file of another kind unless ``overwrite``.
 
-        Partial results end with a comment line ``# partial: ...`` saying where and why the
-        run stopped. The rows are written in blocks; when ``cancel()`` turns true, or SIGINT
-        or SIGTERM arrives, between two blocks, the file ends there with such a line saying
-        where the writing stopped (and the signal is raised again once the file is whole:
-        a KeyboardInterrupt). ``stop`` is a command's ``kinetwork.outputs.StopFlag``, in
-        place of ``cancel`` and the signals.
+        ``pandas.read_csv`` reads the table as it is, every column as numbers, complete or
+        partial: where and why a run stopped early is in the sidecar (``partial``). The rows
+        are written in blocks; when ``cancel()`` turns true, or SIGINT or SIGTERM arrives,
+        between two blocks, the table ends there and the sidecar says where the writing
+        stopped (``cut``; the signal is raised again once both files are whole: a
+        KeyboardInterrupt). ``stop`` is a command's ``kinetwork.outputs.StopFlag``, in place
+        of ``cancel`` and the signals.
 
         Returns
         -------
         str or None
             Why the writing stopped before the last row, or None.
         """
-        from ..outputs import StopFlag, Stopped, catching_signals, model_files, write
+        from ..outputs import StopFlag, Stopped, catching_signals, check, model_files, write
+        from .csvio import describe, sidecar
         reads = model_files(self.system.model if self.system is not None else None)
+        meta_path = sidecar(path)
+        check(meta_path, "meta", what="the CSV's sidecar", reads=reads, force=overwrite)
         flag = stop if stop is not None else StopFlag(cancel=cancel)
         line = io.StringIO(newline="")
         csv.writer(line).writerow(self.column_names())     # names such as "R[0,1]" are quoted
         header = line.getvalue()
         n = len(self.t)
+        written = {"rows": 0, "sha256": None}
 
         def fill(tmp, told):
-            written = 0
+            digest = hashlib.sha256(header.encode("utf-8"))
+            rows = 0
             with open(tmp, "w", newline="", encoding="utf-8") as fh:
                 fh.write(header)
-                while written < n and (written == 0 or told() is None):
-                    block = self._rows(written, min(n, written + CSV_BLOCK_ROWS))
-                    fh.write("".join(",".join(map(repr, row)) + "\n"
-                                     for row in block.tolist()))
-                    written += len(block)
-                why = told() if written < n else None
-                trailer = self._trailer(written, why)
-                if trailer:
-                    fh.write(trailer)
+                while rows < n and (rows == 0 or told() is None):
+                    block = self._rows(rows, min(n, rows + CSV_BLOCK_ROWS))
+                    text = "".join(",".join(map(repr, row)) + "\n" for row in block.tolist())
+                    fh.write(text)
+                    digest.update(text.encode("utf-8"))
+                    rows += len(block)
+            written.update(rows=rows, sha256=digest.hexdigest())
+
+        def fill_meta(tmp, told):
+            cut = told() if written["rows"] < n else None
+            meta = describe(self, written["rows"], written["sha256"], cut)
+            with open(tmp, "w", encoding="utf-8") as fh:
+                json.dump(meta, fh, indent=1, allow_nan=False)
+                fh.write("\n")
+
+        def both():
+            reason = write(path, fill, "csv", reads=reads, force=overwrite, stop=flag,
+                           cooperative=True)
+            write(meta_path, fill_meta, "meta", what="the CSV's sidecar", reads=reads,
+                  force=overwrite, stop=flag, cooperative=True)
+            return reason
 
         if stop is not None:
-            return write(path, fill, "csv", reads=reads, force=overwrite,
-                         stop=flag, cooperative=True)
+            return both()
         with catching_signals(flag):
-            reason = write(path, fill, "csv", reads=reads, force=overwrite,
-                           stop=flag, cooperative=True)
+            reason = both()
         if flag.signum is not None:
             raise Stopped(flag.signum)
         return reason
-
-    def _trailer(self, written, why):
-        """The comment line ending a CSV of partial results, or of rows cut short by
-        ``why`` after ``written`` rows; "" when neither."""
-        parts = []
-        if why is not None and written < len(self.t):
-            last = self.t[written - 1] if written else self.t[0]
-            parts.append(f"the writing stopped after t = {float(last)!r} s ({why}); the "
-                         f"run reached t = {float(self.t[-1])!r} s")
-        if self.partial is not None:
-            reason = " ".join(str(self.partial["reason"]).split())
-            parts.append(f"the run stopped at t = {self.partial['t_reached']!r} s: {reason}")
-        return f"# partial: {'; '.join(parts)}\n" if parts else ""
 
     def to_pandas(self, states: bool = False) -> pandas.DataFrame:
         """A ``pandas.DataFrame`` indexed by time ``t`` [s], one column per CSV column (vectors

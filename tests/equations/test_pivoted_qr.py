@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 import scipy.linalg
 
-from kinetwork.equations.loops import _pivoted_qr
+from kinetwork.equations.partitioning import _pivoted_qr
 
 ROOT = Path(__file__).resolve().parents[2]
 

@@ -1,6 +1,6 @@
 """Long point-mass chains in relative coordinates: their mass matrix is positive definite with a
 condition number growing as N^4, and kinetwork runs them as pinocchio does; a mass matrix that
-is singular is still refused, naming the joints (``System._check_mass_matrix``)."""
+is singular is still refused, naming the joints (``regularity.check_mass_matrix``)."""
 
 import numpy as np
 import pinocchio as pin
@@ -9,7 +9,7 @@ from scenes import chains
 from scipy.integrate import solve_ivp
 
 import kinetwork as kn
-from kinetwork.equations.system import _singular_directions
+from kinetwork.equations.regularity import singular_directions
 
 
 
@@ -58,7 +58,7 @@ def test_a_long_point_mass_chain_runs_and_matches_pinocchio(spec):
 def test_the_light_tip_was_refused_by_the_bound_on_eigenvalues():
     M = chains.chain_model(light_tip(128)).compile().mass_matrix(light_tip(128).q0)
     assert np.linalg.eigvalsh(M)[0] < 1e-12 * np.abs(M).max()
-    assert _singular_directions(M) == []
+    assert singular_directions(M) == []
 
 
 def test_a_short_run_of_a_long_chain_matches_pinocchio_integrated_independently():
@@ -84,15 +84,15 @@ def chain_like(n, spread):
 
 
 def test_singular_directions():
-    assert _singular_directions(chain_like(40, 13)) == []        # wide, still regular
+    assert singular_directions(chain_like(40, 13)) == []        # wide, still regular
     M = chain_like(6, 3)
     M[2, :] = M[:, 2] = 0.0                                        # a joint moving nothing
-    assert _singular_directions(M) == [2]
+    assert singular_directions(M) == [2]
     J = np.zeros((2, 5))
     J[0, 1] = J[0, 3] = 1.0                                       # two joints, one direction
     J[1, 0] = 1.0
     M = J.T @ J + np.diag([0, 0, 1.0, 0, 1.0])
-    assert _singular_directions(M) == [1, 3]
+    assert singular_directions(M) == [1, 3]
 
 
 def test_a_singular_chain_is_still_refused_by_name():

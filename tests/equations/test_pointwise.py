@@ -7,8 +7,8 @@ import pytest
 from scenes import double_pendulum
 
 import kinetwork as kn
-from kinetwork.equations import system as system_module
-from kinetwork.equations.system import pointwise
+from kinetwork.equations import pointwise as pointwise_module
+from kinetwork.equations.pointwise import pointwise
 
 
 def function():
@@ -21,7 +21,7 @@ def function():
 
 @pytest.mark.parametrize("n", [1, 5, 63, 64, 65, 200])
 def test_every_point_as_one_by_one(n, monkeypatch):
-    monkeypatch.setattr(system_module, "POINTS_PER_CALL", 64)       # calls and a remainder
+    monkeypatch.setattr(pointwise_module, "POINTS_PER_CALL", 64)       # calls and a remainder
     f, rng = function(), np.random.default_rng(n)
     T, X, p = rng.normal(size=n), rng.normal(size=(n, 3)), np.array([0.5, -2.0])
     column, matrix = pointwise(f, T[:, None], X, p)
@@ -33,7 +33,7 @@ def test_every_point_as_one_by_one(n, monkeypatch):
 
 
 def test_probe_outputs_of_a_long_run_are_those_of_each_point(monkeypatch):
-    monkeypatch.setattr(system_module, "POINTS_PER_CALL", 100)
+    monkeypatch.setattr(pointwise_module, "POINTS_PER_CALL", 100)
     system = double_pendulum().compile()
     res = kn.simulate(system, t_end=2.0, n_points=1234, jit=False)
     p = system.param_vector()

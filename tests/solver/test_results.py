@@ -2,6 +2,7 @@
 keys, CSV columns, the partial-run line and the atomic write."""
 
 import csv
+import json
 import os
 
 import numpy as np
@@ -74,14 +75,15 @@ def test_csv_names_a_column_per_entry(tmp_path):
     assert res.columns()[0] == rows[0]
 
 
-def test_a_partial_run_ends_its_csv_with_a_comment(tmp_path):
+def test_a_partial_run_says_so_in_its_sidecar_not_in_the_table(tmp_path):
     res = results()
     res.partial = {"t_reached": 1.0, "reason": "the step size\nfell below   the minimum"}
     res.to_csv(tmp_path / "out.csv")
     lines = (tmp_path / "out.csv").read_text().splitlines()
-    assert lines[-1] == ("# partial: the run stopped at t = 1.0 s: the step size fell below "
-                         "the minimum")
-    assert len(lines) == 5
+    assert len(lines) == 4 and not any(line.startswith("#") for line in lines)
+    meta = json.loads((tmp_path / "out.meta.json").read_text())
+    assert meta["partial"] == {"t_reached": 1.0,
+                               "reason": "the step size fell below the minimum"}
 
 
 def test_a_failed_write_keeps_the_old_file(tmp_path, monkeypatch):

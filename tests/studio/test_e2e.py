@@ -467,12 +467,14 @@ def test_measure_load_run_and_3d_frame_rate(page, studio, record_property):
             if (dt < 4000) requestAnimationFrame(tick); else done(1000 * n / dt); };
         requestAnimationFrame(tick); })""")
     page.evaluate("() => window.__kinetwork.viewer().pause()")
-    numbers = {"load_s": loads[1], "run_to_plot_s": sorted(runs)[1], "chain32_fps": fps}
+    calls = page.evaluate("() => window.__kinetwork.viewer().renderInfo().calls")
+    numbers = {"load_s": loads[1], "run_to_plot_s": sorted(runs)[1], "chain32_fps": fps,
+               "chain32_draw_calls": calls}
     for key, value in numbers.items():
         record_property(key, value)
     print(f"\nstudio load {loads[1]:.2f} s (median of 3); seed Run to plotted "
           f"{sorted(runs)[1]:.2f} s (median of 3, compiled); 3-D view of a 32-link chain "
-          f"{fps:.1f} frames/s")
+          f"{fps:.1f} frames/s, {calls} draw calls a frame")
     assert fps > 0 and all(r > 0 for r in runs)
     assert not page.errors, page.errors
 

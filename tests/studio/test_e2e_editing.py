@@ -43,14 +43,14 @@ def test_ctrl_a_selects_every_block_and_delete_removes_them(page, studio):
     assert not page.errors, page.errors
 
 
-def test_the_right_click_menu_renames_duplicates_rotates_deletes_and_opens(page, studio):
+def test_the_right_click_menu_renames_duplicates_rotates_flips_deletes_and_opens(page, studio):
     open_studio(page, studio, open=SEED)
     right_click(page, tid("node-mass2"))
     screenshot(page, "studio-menu.png")
     items = [el.get_attribute("data-testid") for el in
              page.locator('[data-testid^="menu-"]').all()]
-    assert items == ["menu-rename", "menu-duplicate", "menu-rotate", "menu-make-subsystem",
-                     "menu-copy", "menu-delete"]
+    assert items == ["menu-rename", "menu-duplicate", "menu-rotate", "menu-flip",
+                     "menu-make-subsystem", "menu-copy", "menu-delete"]
     page.click(tid("menu-rename"))
     set_field(page, "rename-to", "tip")
     page.wait_for_selector(tid("node-tip"))
@@ -65,6 +65,15 @@ def test_the_right_click_menu_renames_duplicates_rotates_deletes_and_opens(page,
     page.wait_for_function("() => window.__kinetwork.doc.layout.tip1.rotation === 90")
     handle = page.locator(tid("handle-tip1-frame_a"))
     assert "top" in handle.get_attribute("class")       # frame_a turned from left to top
+    right_click(page, tid("node-tip1"))
+    page.click(tid("menu-flip"))                        # mirrored first, then turned: bottom
+    page.wait_for_function("() => window.__kinetwork.doc.layout.tip1.flip === true")
+    assert "bottom" in handle.get_attribute("class")
+    page.keyboard.press("Control+z")
+    page.wait_for_function("() => !window.__kinetwork.doc.layout.tip1.flip")
+    assert "top" in handle.get_attribute("class")
+    page.keyboard.press("Control+y")
+    page.wait_for_function("() => window.__kinetwork.doc.layout.tip1.flip === true")
     right_click(page, tid("node-tip1"))
     page.click(tid("menu-delete"))
     page.wait_for_selector(tid("node-tip1"), state="detached")

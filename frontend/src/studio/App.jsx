@@ -1,7 +1,7 @@
 // The studio: palette | diagram | parameters, with the probe plots and the 3-D view below.
 // State is in the store (store.js); the work is in hooks/ (files, definitions, validation,
 // runs, editing, keys); this component puts the pieces on the page.
-import { useCallback, useEffect } from "react";
+import { useCallback, useEffect, useRef, useState } from "react";
 import { api, EXAMPLE, OPEN } from "./api.js";
 import Canvas from "./Canvas.jsx";
 import ContextMenu from "./ContextMenu.jsx";
@@ -12,6 +12,8 @@ import JsonView from "./JsonView.jsx";
 import AnalysisPanel from "./AnalysisPanel.jsx";
 import Plots, { makeBus } from "./Plots.jsx";
 import Problems from "./Problems.jsx";
+import { SPLITTER, paneSize, usePanes } from "./panes.js";
+import Splitter from "./Splitter.jsx";
 import Toolbar from "./Toolbar.jsx";
 import Viewer from "./Viewer.jsx";
 import { useDefinitions, useDefinitionTypes, useScope } from "./hooks/useDefinitions.js";
@@ -129,6 +131,37 @@ function Dialog() {
   return null;
 }
 
+/**
+ * The size of an element, as it changes.
+ * @returns {[import("react").RefObject<any>, {width: number, height: number}]}
+ */
+function useSize() {
+  const ref = useRef(null);
+  const [size, setSize] = useState({ width: window.innerWidth, height: window.innerHeight });
+  useEffect(() => {
+    if (!ref.current) return undefined;
+    const ro = new ResizeObserver((entries) => {
+      const r = entries[0].contentRect;
+      setSize({ width: Math.round(r.width), height: Math.round(r.height) });
+    });
+    ro.observe(ref.current);
+    return () => ro.disconnect();
+  }, []);
+  return [ref, size];
+}
+
+/** The panes' sizes on screen (px), from what the user chose and the room there is. */
+function usePaneSizes(main, center) {
+  const state = usePanes();
+  const side = paneSize("side", state, main.width);
+  const palette = paneSize("palette", state, main.width, side + 2 * SPLITTER);
+  const centerWidth = main.width - side - palette - 2 * SPLITTER;
+  // the results share the centre's height with the diagram (the crumbs' 30 px above)
+  const results = paneSize("results", state, center.height - 30 - SPLITTER);
+  const viewer = paneSize("viewer", state, centerWidth - SPLITTER);
+  return { palette, side, results, viewer };
+}
+
 export default function App() {
   useServerFacts();
   useDefinitions();
@@ -174,27 +207,47 @@ export default function App() {
   const shown = latest && latest.kind !== "sweep" ? latest : runs.find((r) => r.kind !== "sweep");
   const placed = (scope.body.components || []).every((c) => scope.posOf(c.name));
   const going = runner.going;
+  const [mainRef, mainSize] = useSize();
+  const [centerRef, centerSize] = useSize();
+  const sizes = usePaneSizes(mainSize, centerSize);
+  const closed = usePanes((s) => s.closed);
   return (
     <div className="kn-app">
       <Toolbar files={files} edit={edit} runner={runner} onOpen={() => studio().setDialog({ kind: "open" })} />
-      <div className="kn-main">
-        <Palette palette={palette} definitions={definitions} onAdd={edit.placeAtCentre} />
-        <div className="kn-center">
+      <div
+        className="kn-main"
+        ref={mainRef}
+        style={{ gridTemplateColumns: `${sizes.palette}px ${SPLITTER}px minmax(0, 1fr) ${SPLITTER}px ${sizes.side}px` }}
+      >
+        {closed.palette ? <div /> : <Palette palette={palette} definitions={definitions} onAdd={edit.placeAtCentre} />}
+        <Splitter pane="palette" axis="x" side="before" size={sizes.palette} label="Palette" />
+        <div className="kn-center" ref={centerRef} style={{ gridTemplateRows: `auto 30px minmax(0, 1fr) ${SPLITTER}px ${sizes.results}px` }}>
           <RecoveryBar />
           <Breadcrumbs />
           <Canvas nodes={diagram.nodes} edges={diagram.edges} placed={placed} edit={edit} />
-          <div className="kn-results">
-            <Plots runs={runs} bus={bus} running={going} progress={run && run.progress} status={run && run.state === "failed" ? `The run failed: ${run.error}` : null} />
-            <Viewer
-              key={shown ? `${shown.kind}-${shown.id}` : "none"}
-              animation={shown ? shown.results.animation || null : null}
-              reason={shown ? shown.results.animation_note || null : null}
-              bus={bus}
-              onViewer={onViewer}
-            />
+          <Splitter pane="results" axis="y" side="after" size={sizes.results} label="Plots and 3-D view" />
+          <div className="kn-results" style={{ gridTemplateColumns: `minmax(0, 1fr) ${SPLITTER}px ${sizes.viewer}px` }}>
+            {closed.results ? null : (
+              <>
+                <Plots runs={runs} bus={bus} running={going} progress={run && run.progress} status={run && run.state === "failed" ? `The run failed: ${run.error}` : null} />
+                <Splitter pane="viewer" axis="x" side="after" size={sizes.viewer} label="3-D view" />
+                {closed.viewer ? (
+                  <div />
+                ) : (
+                  <Viewer
+                    key={shown ? `${shown.kind}-${shown.id}` : "none"}
+                    animation={shown ? shown.results.animation || null : null}
+                    reason={shown ? shown.results.animation_note || null : null}
+                    bus={bus}
+                    onViewer={onViewer}
+                  />
+                )}
+              </>
+            )}
           </div>
         </div>
-        <div className="kn-right">
+        <Splitter pane="side" axis="x" side="after" size={sizes.side} label="Side panel" />
+        {closed.side ? <div /> : <div className="kn-right">
           <div className="kn-tabs" role="tablist">
             {PANELS.map(([id, label]) => (
               <button key={id} role="tab" aria-selected={panel === id} className={`kn-tab ${panel === id ? "on" : ""}`} data-testid={`tab-${id}`} onClick={() => setPanel(id)}>
@@ -206,7 +259,7 @@ export default function App() {
           {panel === "json" ? <JsonView /> : null}
           {panel === "analysis" ? <AnalysisPanel runner={runner} scope={scope} /> : null}
           <Problems places={places} ok={validationOk} onGo={goTo} />
-        </div>
+        </div>}
       </div>
       <ContextMenu edit={edit} scope={scope} />
       <Toasts />

@@ -2,7 +2,7 @@
 // (coloured by domain, as Modelica draws connectors), and what validation says about it.
 import { memo } from "react";
 import { Handle, Position } from "@xyflow/react";
-import { DOMAIN_COLORS, portSide, rotatedSide } from "./model.js";
+import { DOMAIN_COLORS, placedSide, portSide } from "./model.js";
 import { blockText } from "./problems.js";
 import { TypeIcon } from "./icons.jsx";
 
@@ -12,11 +12,12 @@ const PORT_STEP = 20;
 
 /**
  * Where each port goes: {port, side, offset (0..1 along the side)}; the block's height. A
- * block turned by ``rotation`` degrees has its ports on the sides turned with it.
+ * block turned by ``rotation`` degrees has its ports on the sides turned with it; a flipped
+ * one has left and right exchanged first.
  */
-export function blockGeometry(ports, rotation = 0) {
+export function blockGeometry(ports, rotation = 0, flip = false) {
   const sides = { left: [], right: [], top: [], bottom: [] };
-  for (const p of ports) sides[rotatedSide(p.side || portSide(p.name, p.domain, ports), rotation)].push(p);
+  for (const p of ports) sides[placedSide(p.side || portSide(p.name, p.domain, ports), rotation, flip)].push(p);
   const tall = Math.max(sides.left.length, sides.right.length);
   const height = Math.max(64, tall * PORT_STEP + 24);
   const out = [];
@@ -32,9 +33,9 @@ function shortType(type, subsystem) {
 }
 
 function BlockNode({ data, selected }) {
-  const { name, type, info, problems, subsystem, unknown, rotation } = data;
+  const { name, type, info, problems, subsystem, unknown, rotation, flip } = data;
   const ports = info ? info.ports : data.ports || [];
-  const { handles, height } = blockGeometry(ports, rotation);
+  const { handles, height } = blockGeometry(ports, rotation, flip);
   const bad = problems && problems.length > 0;
   const cls = ["kn-block", selected ? "selected" : "", bad ? "bad" : "", subsystem ? "subsystem" : "", unknown ? "unknown" : ""]
     .filter(Boolean)
@@ -42,7 +43,7 @@ function BlockNode({ data, selected }) {
   return (
     <div className={cls} data-testid={`node-${name}`} style={{ width: BLOCK_W, height }} title={`${name}: ${type}${info ? `\n${String(info.doc || "").trim()}` : " (unknown type)"}`}>
       <div className="kn-block-name">{name}</div>
-      <div className="kn-block-icon">
+      <div className="kn-block-icon" style={flip ? { transform: "scaleX(-1)" } : undefined}>
         <TypeIcon type={type} subsystem={subsystem} />
       </div>
       {bad ? (

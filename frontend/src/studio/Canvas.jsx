@@ -14,6 +14,8 @@ const nodeTypes = { block: BlockNode, extport: PortNode };
 export const DRAG_MIME = "application/x-kinetwork-type";
 /** A right button released this close to where it went down opens the menu (else it panned). */
 const CLICK_SLOP = 5;
+/** The minimap only where it leaves the diagram room: it covered half of a small canvas. */
+const MINIMAP_ROOM = { width: 700, height: 380 };
 
 function sameList(a, b) {
   return a.length === b.length && a.every((x, i) => x === b[i]);
@@ -31,6 +33,17 @@ export default function Canvas({ nodes: nodesIn, edges: edgesIn, placed, edit })
   // what React Flow holds while the mouse works: positions being dragged, measured sizes
   const [dragPos, setDragPos] = useState({});
   const [measured, setMeasured] = useState({});
+  const box = useRef(null);
+  const [roomy, setRoomy] = useState(true);
+  useEffect(() => {
+    if (!box.current) return undefined;
+    const ro = new ResizeObserver((entries) => {
+      const r = entries[0].contentRect;
+      setRoomy(r.width >= MINIMAP_ROOM.width && r.height >= MINIMAP_ROOM.height);
+    });
+    ro.observe(box.current);
+    return () => ro.disconnect();
+  }, []);
 
   const nodes = useMemo(() => {
     const chosen = new Set(selection);
@@ -179,6 +192,7 @@ export default function Canvas({ nodes: nodesIn, edges: edgesIn, placed, edit })
   return (
     <div
       className="kn-canvas"
+      ref={box}
       data-testid="canvas"
       onDragOver={onDragOver}
       onDrop={onDrop}
@@ -220,7 +234,7 @@ export default function Canvas({ nodes: nodesIn, edges: edgesIn, placed, edit })
       >
         <Background gap={GRID * 2} size={1} color="#d4d8de" />
         <Controls showInteractive={false} />
-        <MiniMap pannable zoomable nodeStrokeWidth={2} nodeColor={(n) => (/** @type {any} */ (n.data).problems?.length ? "#e05555" : "#c9ced6")} style={{ width: 140, height: 90 }} />
+        {roomy ? <MiniMap pannable zoomable nodeStrokeWidth={2} nodeColor={(n) => (/** @type {any} */ (n.data).problems?.length ? "#e05555" : "#c9ced6")} style={{ width: 140, height: 90 }} /> : null}
       </ReactFlow>
     </div>
   );

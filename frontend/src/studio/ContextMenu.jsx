@@ -1,4 +1,4 @@
-// The right-click menu of the diagram: on a block (rename, open, duplicate, rotate, make
+// The right-click menu of the diagram: on a block (rename, open, duplicate, rotate, flip, make
 // subsystem, copy, delete), on a selection, on a wire, and on the empty diagram (paste here,
 // select all). Every item is an edit of the model, undone like any other.
 import { useEffect, useRef } from "react";
@@ -35,6 +35,7 @@ export default function ContextMenu({ edit, scope }) {
     if (comp && resolveDef(comp.type, scope.ctx)) add("open", "Open subsystem", () => edit.open(one), "double-click");
     add("duplicate", "Duplicate", () => edit.duplicate(blocks), "Ctrl+D");
     add("rotate", "Rotate 90°", () => edit.rotate(blocks), "Ctrl+R");
+    add("flip", "Flip left–right", () => edit.flip(blocks), "");
     add("make-subsystem", "Make subsystem…", () => edit.makeSub(blocks), "");
     add("copy", "Copy", () => edit.copy(), "Ctrl+C");
     add("delete", "Delete", () => edit.removeSelected(), "Del");

@@ -3,7 +3,7 @@
 import { useEffect, useRef, useState } from "react";
 import { api } from "./api.js";
 
-function Modal({ title, onClose, children, testid }) {
+export function Modal({ title, onClose, children, testid, wide = false }) {
   useEffect(() => {
     const onKey = (e) => e.key === "Escape" && onClose();
     window.addEventListener("keydown", onKey);
@@ -11,7 +11,7 @@ function Modal({ title, onClose, children, testid }) {
   }, [onClose]);
   return (
     <div className="kn-modal-back" onMouseDown={(e) => e.target === e.currentTarget && onClose()}>
-      <div className="kn-modal" data-testid={testid} role="dialog" aria-label={title}>
+      <div className={`kn-modal${wide ? " kn-modal-wide" : ""}`} data-testid={testid} role="dialog" aria-label={title}>
         <div className="kn-modal-title">
           {title}
           <button className="kn-icon-btn" onClick={onClose} title="close">×</button>

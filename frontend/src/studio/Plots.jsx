@@ -5,12 +5,63 @@
 import { useEffect, useMemo, useRef, useState } from "react";
 import uPlot from "uplot";
 import "uplot/dist/uPlot.min.css";
+import { Modal } from "./Dialogs.jsx";
 import { OVERLAY } from "./hooks/useRun.js";
+import { download, fileName, plotCsv, plotSvg } from "./plotexport.js";
 import { memberLabel } from "./runs.js";
+import { useStudio } from "./store.js";
 import { TESTING, trace } from "./testing.js";
 
 const COLORS = ["#1f77b4", "#d62728", "#2ca02c", "#9467bd", "#ff7f0e", "#17becf", "#8c564b", "#e377c2", "#7f7f7f"];
 const AXES = ["x", "y", "z"];
+/** The axes' tick labels: one font, so that the y axis can be as wide as its longest label. */
+const AXIS_FONT = "11px system-ui, -apple-system, 'Segoe UI', sans-serif";
+/** The least room between two y ticks (px): uPlot's 30 left a short plot one tick. */
+const Y_TICK_SPACE = 16;
+const TICK_LENGTH = 6;
+const LABEL_GAP = 5;
+let measurer = null;
+
+/** The width (px) of ``text`` in the axes' font. */
+export function textWidth(text) {
+  if (!measurer) {
+    measurer = document.createElement("canvas").getContext("2d");
+    measurer.font = AXIS_FONT;
+  }
+  return measurer.measureText(text).width;
+}
+
+/** The nice step below ``step`` (5 -> 2 -> 1 -> 0.5 ... times a power of ten). */
+function finer(step) {
+  const p = 10 ** Math.floor(Math.log10(step));
+  const m = Math.round(step / p);
+  return m >= 5 ? 2 * p : m >= 2 ? p : p / 2;
+}
+
+/**
+ * The y ticks: uPlot's, made finer until there are at least three (a short plot of a small
+ * range had one, "0").
+ */
+export function yTicks(min, max, step) {
+  const at = (s) => {
+    const out = [];
+    for (let k = Math.ceil(min / s - 1e-9); k * s <= max + 1e-9 * s; k++) out.push(+(k * s).toPrecision(12));
+    return out;
+  };
+  if (!(max > min) || !(step > 0)) return [min];
+  let ticks = at(step);
+  for (let i = 0; ticks.length < 3 && i < 12; i++) {
+    step = finer(step);
+    ticks = at(step);
+  }
+  return ticks;
+}
+
+/** The y axis's width: its longest label, the gap and the tick (uPlot asks again as the labels change). */
+function yAxisSize(u, values) {
+  const widest = Math.max(24, ...(values || []).map((v) => textWidth(String(v))));
+  return Math.ceil(widest + LABEL_GAP + TICK_LENGTH + 4);
+}
 
 function components(sig) {
   // a signal's columns: scalars one, vectors (3,) x y z, matrices flattened
@@ -67,7 +118,7 @@ export function sourcesOf(entry) {
 function buildData(names, runs) {
   const sources = runs.slice(0, OVERLAY).flatMap((run, r) => sourcesOf(run).map((src, m) => ({ ...src, r, m, sweep: run.kind === "sweep" })));
   const t0 = sources[0].results.t;
-  const series = [{ label: "t [s]", value: (u, v) => (v == null ? "–" : v.toFixed(3)) }];
+  const series = /** @type {any[]} */ ([{ label: "t [s]", value: (u, v) => (v == null ? "–" : v.toFixed(3)) }]);
   const tables = [];
   const columns = {};
   let unit = "";
@@ -104,15 +155,69 @@ function buildData(names, runs) {
   } else {
     data = uPlot.join(tables.map((tb) => [tb.t, tb.y]));
   }
-  const latest = sources.filter((src) => src.r === 0).length;
-  const latestCount = Object.values(columns).reduce((a, c) => a + c.length, 0) * latest;
-  return { series, data, unit, columns, latestCount };
+  return { series, data, unit, columns };
 }
 
-function Panel({ title, names, runs, bus, width, height }) {
+/** The picture of a plot as PNG: uPlot's canvas, the title above, the legend below. */
+function plotPng(u, title, unit, series) {
+  const rows = Math.ceil(series.length / 2);
+  const ratio = u.ctx.canvas.width / u.width;
+  const canvas = document.createElement("canvas");
+  canvas.width = Math.round(u.width * ratio);
+  canvas.height = Math.round((u.height + 26 + 16 * rows + 8) * ratio);
+  const ctx = canvas.getContext("2d");
+  ctx.scale(ratio, ratio);
+  ctx.fillStyle = "#fff";
+  ctx.fillRect(0, 0, u.width, canvas.height / ratio);
+  ctx.fillStyle = "#222";
+  ctx.font = `600 13px ${AXIS_FONT.split(" ").slice(1).join(" ")}`;
+  ctx.fillText(`${title}${unit ? ` [${unit}]` : ""}`, 8, 17);
+  ctx.drawImage(u.ctx.canvas, 0, 26, u.width, u.height);
+  ctx.font = AXIS_FONT;
+  series.forEach((s, k) => {
+    const x = 46 + (k % 2) * ((u.width - 46) / 2);
+    const y = 26 + u.height + 14 + 16 * Math.floor(k / 2);
+    ctx.strokeStyle = s.stroke;
+    ctx.lineWidth = 2;
+    ctx.setLineDash(s.dash || []);
+    ctx.beginPath();
+    ctx.moveTo(x, y - 4);
+    ctx.lineTo(x + 16, y - 4);
+    ctx.stroke();
+    ctx.fillStyle = "#222";
+    ctx.fillText(s.label, x + 22, y);
+  });
+  return new Promise((done) => canvas.toBlob(done, "image/png"));
+}
+
+/** What the axis ``i`` of ``u`` shows: its range, ticks and their labels. */
+function axisOf(u, i) {
+  const key = i === 0 ? "x" : "y";
+  const ticks = u.axes[i]._splits || [];
+  return { min: u.scales[key].min, max: u.scales[key].max, ticks, labels: (u.axes[i]._values || []).map(String), size: u.axes[i]._size };
+}
+
+function Panel({ title, names, runs, bus, width, height, onEnlarge = null, big = false }) {
   const ref = useRef(null);
   const plotRef = useRef(null);
+  const model = useStudio((st) => st.hist.present.name);
   const built = useMemo(() => buildData(names, runs), [names, runs]);
+  const curves = built.series.slice(1);
+  const exportCsv = () => {
+    const labels = curves.map((c) => c.label);
+    download(new Blob([plotCsv(built.data, labels, built.unit)], { type: "text/csv" }), `${fileName(model, title)}.csv`);
+  };
+  const exportSvg = () => {
+    const u = plotRef.current;
+    if (!u) return;
+    const svg = plotSvg({ title, unit: built.unit, width: u.width, height: u.height + 26 + 16 * Math.ceil(curves.length / 2) + 8,
+      x: axisOf(u, 0), y: axisOf(u, 1), data: built.data, series: curves });
+    download(new Blob([svg], { type: "image/svg+xml" }), `${fileName(model, title)}.svg`);
+  };
+  const exportPng = () => {
+    const u = plotRef.current;
+    if (u) plotPng(u, title, built.unit, curves).then((blob) => blob && download(blob, `${fileName(model, title)}.png`));
+  };
   useEffect(() => {
     if (!ref.current || width < 50) return undefined;
     const opts = {
@@ -120,6 +225,7 @@ function Panel({ title, names, runs, bus, width, height }) {
       height,
       scales: { x: { time: false } },
       series: built.series,
+      // every curve named: an overlaid run by its number and what differed from the one before
       legend: { show: true, live: true },
       cursor: {
         sync: { key: "kn-plots", setSeries: false },
@@ -127,8 +233,18 @@ function Panel({ title, names, runs, bus, width, height }) {
         points: { size: 5 },
       },
       axes: [
-        { stroke: "#555", grid: { stroke: "#eceef1" }, ticks: { stroke: "#ccc" }, size: 30 },
-        { stroke: "#555", grid: { stroke: "#eceef1" }, ticks: { stroke: "#ccc" }, size: 52, values: (u, vals) => vals.map(fmt0) },
+        { stroke: "#555", font: AXIS_FONT, grid: { stroke: "#eceef1" }, ticks: { stroke: "#ccc", size: TICK_LENGTH }, gap: LABEL_GAP, size: 30 },
+        {
+          stroke: "#555",
+          font: AXIS_FONT,
+          grid: { stroke: "#eceef1" },
+          ticks: { stroke: "#ccc", size: TICK_LENGTH },
+          gap: LABEL_GAP,
+          space: Y_TICK_SPACE,
+          splits: (u, i, min, max, step) => yTicks(min, max, step),
+          size: yAxisSize,
+          values: (u, vals) => vals.map(fmt0),
+        },
       ],
       hooks: {
         setCursor: [
@@ -151,18 +267,16 @@ function Panel({ title, names, runs, bus, width, height }) {
     };
     const u = new uPlot(opts, built.data, ref.current);
     plotRef.current = u;
-    // the legend lists the latest run; older runs are drawn dashed (named in the header)
-    u.root.querySelectorAll(".u-legend .u-series").forEach((row, i) => {
-      if (i > built.latestCount) /** @type {HTMLElement} */ (row).style.display = "none";
-    });
     bus.plots.add(u);
-    if (TESTING) {
+    if (TESTING) trace.plotAxes[big ? `big:${title}` : title] = () => ({ x: axisOf(u, 0), y: axisOf(u, 1), ySize: axisOf(u, 1).size, xSize: axisOf(u, 0).size, font: AXIS_FONT });
+    if (TESTING && !big) {
       // what is drawn: per signal, t and its columns of the latest run
       for (const [name, idx] of Object.entries(built.columns)) trace.plotted[name] = [built.data[0], ...idx.map((i) => built.data[i])];
       trace.plottedSeries[title] = built.series.length - 1;
     }
     return () => {
-      if (TESTING) {
+      if (TESTING) delete trace.plotAxes[big ? `big:${title}` : title];
+      if (TESTING && !big) {
         for (const name of Object.keys(built.columns)) delete trace.plotted[name];
         delete trace.plottedSeries[title];
       }
@@ -170,12 +284,21 @@ function Panel({ title, names, runs, bus, width, height }) {
       u.destroy();
       plotRef.current = null;
     };
-  }, [built, width, height, bus, title]);
+  }, [built, width, height, bus, title, big]);
+  const id = big ? `bigplot-${title}` : `plot-${title}`;
   return (
-    <div className="kn-plot" data-testid={`plot-${title}`}>
+    <div className="kn-plot" data-testid={id}>
       <div className="kn-plot-title">
-        {title}
-        {built.unit ? <span className="kn-unit"> [{built.unit}]</span> : null}
+        <span className="kn-plot-name">
+          {title}
+          {built.unit ? <span className="kn-unit"> [{built.unit}]</span> : null}
+        </span>
+        <span className="kn-plot-tools">
+          <button className="kn-tool" data-testid={`${id}-csv`} title="The plotted data as CSV" onClick={exportCsv}>CSV</button>
+          <button className="kn-tool" data-testid={`${id}-png`} title="This plot as a PNG picture" onClick={exportPng}>PNG</button>
+          <button className="kn-tool" data-testid={`${id}-svg`} title="This plot as an SVG drawing" onClick={exportSvg}>SVG</button>
+          {onEnlarge ? <button className="kn-tool" data-testid={`${id}-enlarge`} title="A larger plot" onClick={onEnlarge}>⤢</button> : null}
+        </span>
       </div>
       <div ref={ref} />
     </div>
@@ -232,6 +355,7 @@ export default function Plots({ runs, bus, running, progress, status }) {
   const [height, setHeight] = useState(300);
   const [hidden, setHidden] = useState(() => new Set());
   const [byQuantity, setByQuantity] = useState(true);
+  const [enlarged, setEnlarged] = useState(null);
   useEffect(() => {
     if (!wrap.current) return undefined;
     const ro = new ResizeObserver((entries) => {
@@ -262,7 +386,9 @@ export default function Plots({ runs, bus, running, progress, status }) {
   const panelWidth = Math.floor((width - 12 * cols) / cols) - 8;
   // the panels fill the height they have (a title and a legend around each plot)
   const rows = Math.max(1, Math.ceil(panels.length / cols));
-  const plotHeight = Math.max(80, Math.min(240, Math.floor((height - 8) / rows) - 64));
+  // (never so short that the y axis has fewer than three ticks: the grid scrolls instead)
+  const plotHeight = Math.max(110, Math.min(240, Math.floor((height - 8) / rows) - 64));
+  const big = enlarged && panels.find((p) => p.title === enlarged);
   return (
     <div className="kn-plots" data-testid="plots" data-runs={runs.length}>
       <div className="kn-plots-head">
@@ -308,8 +434,13 @@ export default function Plots({ runs, bus, running, progress, status }) {
           </div>
         )}
         {latest && names.length === 0 && <div className="kn-empty">This model has no probes: add a Probe and wire it to a port to record its quantities.</div>}
-        {latest && panels.map((p) => <Panel key={p.title} title={p.title} names={p.names} runs={runs} bus={bus} width={panelWidth} height={plotHeight} />)}
+        {latest && panels.map((p) => <Panel key={p.title} title={p.title} names={p.names} runs={runs} bus={bus} width={panelWidth} height={plotHeight} onEnlarge={() => setEnlarged(p.title)} />)}
       </div>
+      {big ? (
+        <Modal title={`${big.title}: ${latest.label}`} onClose={() => setEnlarged(null)} testid="plot-dialog" wide>
+          <Panel title={big.title} names={big.names} runs={runs} bus={bus} width={Math.round(window.innerWidth * 0.86) - 40} height={Math.round(window.innerHeight * 0.55)} big />
+        </Modal>
+      ) : null}
     </div>
   );
 }

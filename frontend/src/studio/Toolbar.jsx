@@ -48,7 +48,7 @@ export default function Toolbar({ files, edit, runner, onOpen }) {
           <circle cx="12" cy="12" r="3" fill="#007f00" />
           <path d="M4 4L12 12" stroke="#404040" strokeWidth="2" />
         </svg>
-        kinetwork
+        <span className="kn-brand-name">kinetwork</span>
       </div>
       <div className="kn-group">
         <button className="kn-btn" data-testid="new" onClick={files.newModel} title="A new, empty model">New</button>

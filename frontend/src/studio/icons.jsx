@@ -20,6 +20,31 @@ function Dashpot({ y = 14, x0 = 6, x1 = 42 }) {
   );
 }
 
+/** A mechanism of three joints in a row (MSL's Joints.Assemblies): its joints' letters. */
+function Linkage({ ends, last }) {
+  const mark = (x, y, kind) =>
+    kind === "S" ? <circle cx={x} cy={y} r="3" fill="#fff" /> : kind === "U" ? <g><circle cx={x} cy={y} r="3" fill="#fff" /><path d={`M${x - 3} ${y} H${x + 3}`} /></g> : kind === "P" ? <rect x={x - 4} y={y - 2.5} width="8" height="5" fill="#fff" /> : <rect x={x - 2.5} y={y - 3} width="5" height="6" fill="#fff" />;
+  return (
+    <g>
+      <path d="M4 22 H8 L18 6 L32 20 H40 H44" />
+      {mark(8, 22, ends[0])}
+      {mark(18, 6, ends[1])}
+      {mark(36, 20, last)}
+    </g>
+  );
+}
+
+/** An electrical meter: a circle with the letter of what it reads. */
+function Meter({ letter }) {
+  return (
+    <g>
+      <path d="M4 14 H14 M34 14 H44" />
+      <circle cx="24" cy="14" r="10" />
+      <text x="24" y="18" textAnchor="middle" fontSize="11" fill="currentColor" stroke="none">{letter}</text>
+    </g>
+  );
+}
+
 const DRAW = {
   Ground: () => (
     <g>
@@ -255,8 +280,202 @@ const DRAW = {
       <path d="M40 6 L34 7 M40 6 L38 12" strokeWidth="2" />
     </g>
   ),
-  Subsystem: () => (
+  PointMass: () => (
     <g>
+      <path d="M4 14 H18" />
+      <circle cx="26" cy="14" r="7" fill="currentColor" />
+    </g>
+  ),
+  JointUSR: () => <Linkage ends={["U", "S"]} last="R" />,
+  JointSSR: () => <Linkage ends={["S", "S"]} last="R" />,
+  JointUSP: () => <Linkage ends={["U", "S"]} last="P" />,
+  JointSSP: () => <Linkage ends={["S", "S"]} last="P" />,
+  JointRRP: () => <Linkage ends={["R", "R"]} last="P" />,
+  JointUPS: () => <Linkage ends={["U", "P"]} last="S" />,
+  LineForceWithTwoMasses: () => (
+    <g>
+      <path d="M4 14 H10 M38 14 H44 M16 14 H32" />
+      <circle cx="13" cy="14" r="3" />
+      <circle cx="35" cy="14" r="3" />
+      <circle cx="20" cy="14" r="2.5" fill="currentColor" />
+      <circle cx="28" cy="14" r="2.5" fill="currentColor" />
+    </g>
+  ),
+  Rotor1D: () => (
+    <g>
+      <path d="M4 14 H16 M32 14 H44" />
+      <rect x="16" y="4" width="16" height="20" rx="2" fill="currentColor" opacity="0.25" />
+      <rect x="16" y="4" width="16" height="20" rx="2" />
+      <path d="M24 24 V27 M18 27 H30" />
+    </g>
+  ),
+  RollingWheelJoint: () => (
+    <g>
+      <circle cx="24" cy="12" r="9" />
+      <circle cx="24" cy="12" r="1.6" fill="currentColor" />
+      <path d="M8 22 H40" />
+    </g>
+  ),
+  RollingWheel: () => (
+    <g>
+      <circle cx="24" cy="12" r="9" fill="currentColor" opacity="0.25" />
+      <circle cx="24" cy="12" r="9" />
+      <path d="M24 3 V21 M15 12 H33" />
+      <path d="M8 22 H40" />
+    </g>
+  ),
+  BearingFriction: () => (
+    <g>
+      <path d="M4 14 H44" />
+      <path d="M14 6 H34 M14 22 H34" strokeWidth="2.2" />
+      {[16, 22, 28, 34].map((x) => <path key={x} d={`M${x} 22 L${x - 3} 26`} />)}
+    </g>
+  ),
+  Brake: () => (
+    <g>
+      <path d="M4 14 H18 M30 14 H44" />
+      <rect x="18" y="6" width="12" height="16" fill="currentColor" opacity="0.25" />
+      <rect x="18" y="6" width="12" height="16" />
+      <path d="M14 3 V8 M34 3 V8 M10 5 H18 M30 5 H38" strokeWidth="2" />
+    </g>
+  ),
+  Clutch: () => (
+    <g>
+      <path d="M4 14 H18 M30 14 H44" />
+      <rect x="18" y="5" width="5" height="18" fill="currentColor" />
+      <rect x="25" y="5" width="5" height="18" fill="currentColor" />
+      <path d="M24 2 V5" />
+    </g>
+  ),
+  ElastoGap: () => (
+    <g>
+      <path d="M4 14 H10 M38 14 H44 M10 8 V20 M38 8 V20" />
+      <Zigzag y={10} x0={10} x1={30} />
+      <path d="M30 5 V15 M34 5 V15" />
+      <Dashpot y={20} x0={10} x1={38} />
+    </g>
+  ),
+  Stop: () => (
+    <g>
+      <path d="M4 14 H20 M28 14 H44" />
+      <rect x="16" y="8" width="8" height="12" />
+      <path d="M8 5 V23 M40 5 V23" strokeWidth="2.2" />
+    </g>
+  ),
+  Rod: () => <path d="M4 14 H44" strokeWidth="3" />,
+  Friction: () => (
+    <g>
+      <path d="M4 10 H14 M34 10 H44" />
+      <rect x="14" y="4" width="20" height="12" fill="currentColor" opacity="0.25" />
+      <rect x="14" y="4" width="20" height="12" />
+      <path d="M8 19 H40" />
+      {[12, 18, 24, 30, 36].map((x) => <path key={x} d={`M${x} 19 L${x - 4} 25`} />)}
+    </g>
+  ),
+  Input: () => (
+    <g>
+      <path d="M8 6 H30 L38 14 L30 22 H8 Z" />
+      <text x="21" y="18" textAnchor="middle" fontSize="10" fill="currentColor" stroke="none">u</text>
+    </g>
+  ),
+  Pulse: () => <path d="M6 22 H12 V6 H20 V22 H28 V6 H36 V22 H42" strokeWidth="2" />,
+  SawTooth: () => <path d="M6 22 L18 6 V22 L30 6 V22 L42 6" strokeWidth="2" />,
+  Trapezoid: () => <path d="M4 22 L10 6 H18 L24 22 H26 L32 6 H40 L44 16" strokeWidth="2" />,
+  Expression: () => <text x="24" y="19" textAnchor="middle" fontSize="12" fill="currentColor" stroke="none" fontStyle="italic">f(u)</text>,
+  Table2D: () => (
+    <g>
+      <rect x="10" y="4" width="28" height="20" />
+      <path d="M10 10 H38 M10 17 H38 M19 4 V24 M29 4 V24" />
+      <rect x="10" y="4" width="9" height="6" fill="currentColor" opacity="0.3" stroke="none" />
+    </g>
+  ),
+  KinematicPTP: () => <path d="M6 22 H12 C18 22 18 6 26 6 C32 6 32 22 36 22 H42" strokeWidth="2" />,
+  Resistor: () => (
+    <g>
+      <path d="M4 14 H12 M36 14 H44" />
+      <rect x="12" y="9" width="24" height="10" />
+    </g>
+  ),
+  Conductor: () => (
+    <g>
+      <path d="M4 14 H12 M36 14 H44" />
+      <rect x="12" y="9" width="24" height="10" />
+      <text x="24" y="17.5" textAnchor="middle" fontSize="8" fill="currentColor" stroke="none">G</text>
+    </g>
+  ),
+  NonlinearResistor: () => (
+    <g>
+      <path d="M4 14 H12 M36 14 H44" />
+      <rect x="12" y="9" width="24" height="10" />
+      <path d="M10 24 L16 24 L32 4" />
+    </g>
+  ),
+  Diode: () => (
+    <g>
+      <path d="M4 14 H44" />
+      <path d="M18 6 L30 14 L18 22 Z" fill="currentColor" opacity="0.25" />
+      <path d="M18 6 L30 14 L18 22 Z M30 6 V22" />
+    </g>
+  ),
+  Inductor: () => (
+    <g>
+      <path d="M4 14 H10 M38 14 H44" />
+      <path d="M10 14 A4.67 4.67 0 0 1 19.3 14 A4.67 4.67 0 0 1 28.7 14 A4.67 4.67 0 0 1 38 14" />
+    </g>
+  ),
+  Capacitor: () => (
+    <g>
+      <path d="M4 14 H21 M27 14 H44" />
+      <path d="M21 5 V23 M27 5 V23" strokeWidth="2.4" />
+    </g>
+  ),
+  "electrical.Ground": () => (
+    <g>
+      <path d="M24 3 V13 M12 13 H36 M16 18 H32 M20 23 H28" strokeWidth="2" />
+    </g>
+  ),
+  VoltageSource: () => (
+    <g>
+      <path d="M4 14 H14 M34 14 H44" />
+      <circle cx="24" cy="14" r="10" />
+      <path d="M14 14 H34" />
+      <text x="17" y="10" textAnchor="middle" fontSize="8" fill="currentColor" stroke="none">+</text>
+    </g>
+  ),
+  CurrentSource: () => (
+    <g>
+      <path d="M4 14 H14 M34 14 H44" />
+      <circle cx="24" cy="14" r="10" />
+      <path d="M24 4 V24" />
+    </g>
+  ),
+  VoltageSensor: () => <Meter letter="V" />,
+  CurrentSensor: () => <Meter letter="A" />,
+  IdealOpAmp: () => (
+    <g>
+      <path d="M14 3 L38 14 L14 25 Z" />
+      <path d="M4 8 H14 M4 20 H14 M38 14 H44" />
+      <text x="19" y="11" fontSize="7" fill="currentColor" stroke="none">+</text>
+      <text x="19" y="22" fontSize="8" fill="currentColor" stroke="none">−</text>
+    </g>
+  ),
+  EMF: () => (
+    <g>
+      <path d="M4 14 H14 M34 14 H44" />
+      <circle cx="24" cy="14" r="10" />
+      <path d="M19 14 H29" strokeWidth="3" />
+    </g>
+  ),
+  DCMotor: () => (
+    <g>
+      <path d="M4 14 H10 M38 14 H44" />
+      <rect x="10" y="5" width="22" height="18" rx="3" fill="currentColor" opacity="0.2" />
+      <rect x="10" y="5" width="22" height="18" rx="3" />
+      <path d="M32 14 H38" strokeWidth="3" />
+      <text x="21" y="18" textAnchor="middle" fontSize="9" fill="currentColor" stroke="none">M</text>
+    </g>
+  ),
+  Subsystem: () => (    <g>
       <rect x="8" y="4" width="32" height="20" rx="2" />
       <rect x="13" y="9" width="9" height="6" />
       <rect x="26" y="13" width="9" height="6" />
@@ -285,10 +504,15 @@ export function libraryOf(type) {
   return i < 0 ? "subsystem" : type.slice(0, i);
 }
 
+/** The name of the drawing of a type: its own (by full name where two libraries share a class
+ * name that looks different, as an electrical ground), else a family's; "Unknown" is the
+ * fallback, which a test requires of no type of the palette. */
 export function iconKey(type, subsystem) {
   if (subsystem) return "Subsystem";
+  if (DRAW[type]) return type;
   const cls = String(type || "").split(".").pop();
   if (DRAW[cls]) return cls;
+  if (cls === "IdealOpAmp3Pin") return "IdealOpAmp";
   if (/Sensor$/.test(cls)) return "Sensor";
   if (cls === "Force" && String(type).startsWith("multibody.")) return "WorldForce";
   if (cls === "Torque" && String(type).startsWith("multibody.")) return "WorldTorque";
@@ -297,10 +521,11 @@ export function iconKey(type, subsystem) {
 }
 
 export function TypeIcon({ type, subsystem, size = 1 }) {
-  const Draw = DRAW[iconKey(type, subsystem)];
+  const key = iconKey(type, subsystem);
+  const Draw = DRAW[key];
   const color = LIBRARY_COLORS[subsystem ? "subsystem" : libraryOf(type)] || "#444";
   return (
-    <svg viewBox="0 0 48 28" width={48 * size} height={28 * size} style={{ color }} stroke="currentColor" {...S} aria-hidden="true">
+    <svg viewBox="0 0 48 28" width={48 * size} height={28 * size} style={{ color }} stroke="currentColor" {...S} aria-hidden="true" data-icon={key}>
       <Draw />
     </svg>
   );

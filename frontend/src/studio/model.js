@@ -439,6 +439,23 @@ export function rotateComponent(body, name, positionOf) {
   return { ...body, layout: { ...(body.layout || {}), [name]: entry } };
 }
 
+/** A block mirrored left to right (``layout[name].flip``), or mirrored back. */
+export function flipComponent(body, name, positionOf) {
+  const old = (body.layout || {})[name] || positionOf(name) || { x: 0, y: 0 };
+  const entry = { ...old, flip: !old.flip };
+  if (!entry.flip) delete entry.flip;
+  return { ...body, layout: { ...(body.layout || {}), [name]: entry } };
+}
+
+/**
+ * The side a port is drawn on once its block is mirrored (``flip``: left and right change
+ * places, in the block's own frame) and then turned by ``rotation`` degrees.
+ */
+export function placedSide(side, rotation, flip) {
+  const mirrored = flip && (side === "left" || side === "right") ? (side === "left" ? "right" : "left") : side;
+  return rotatedSide(mirrored, rotation);
+}
+
 /** The side a port is drawn on once its block is turned by ``rotation`` degrees. */
 export function rotatedSide(side, rotation) {
   const order = ["left", "top", "right", "bottom"];
@@ -473,7 +490,8 @@ export function pasteComponents(body, clip, at) {
   clip.components.forEach((c, i) => {
     const p = { x: Math.round((origin.x + pts[i].x - minX) / 10) * 10, y: Math.round((origin.y + pts[i].y - minY) / 10) * 10 };
     const rotation = clip.rotations && clip.rotations[c.name];
-    next = addComponent(next, { ...clone(c), name: rename[c.name] }, rotation ? { ...p, rotation } : p);
+    const flip = clip.flips && clip.flips[c.name];
+    next = addComponent(next, { ...clone(c), name: rename[c.name] }, { ...p, ...(rotation ? { rotation } : {}), ...(flip ? { flip: true } : {}) });
   });
   next = { ...next, connections: [...(next.connections || []), ...clip.connections.map(([a, b]) => [re(a), re(b)])] };
   return { body: next, names: Object.values(rename) };

@@ -22,6 +22,7 @@ export function installTestHook(store) {
     lastRun: () => trace.lastRun,
     plotted: () => trace.plotted,
     plottedSeries: () => trace.plottedSeries,
+    plotAxes: () => Object.fromEntries(Object.entries(trace.plotAxes).map(([k, read]) => [k, read()])),
     cursorTime: () => trace.cursorTime,
   };
   for (const [key, read] of Object.entries(view)) Object.defineProperty(K, key, { get: read, enumerable: true });

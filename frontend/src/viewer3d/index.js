@@ -9,10 +9,17 @@
 // (default false), loop (default true), speed (default 1), showFrames (the small axes on every
 // frame; default: when there are at most 24). Between samples positions are interpolated
 // linearly and orientations along the shorter arc, so any grid plays smoothly at any speed.
-// Besides: getTime(), isPlaying().
+// Besides: getTime(), isPlaying(), renderInfo() (the last frame's draw calls and triangles,
+// the renderer's name and whether it multisamples: not on a software renderer),
+// centers(kind) (where each body shape of a kind is: its frame's pose applied to its middle).
+//
+// Shapes of one kind (boxes, cylinders, spheres, rods, frame axes) are drawn as one
+// InstancedMesh: a unit geometry scaled, placed and coloured per shape, so a chain of 32
+// links costs a handful of draw calls instead of one per shape.
 import {
   AmbientLight, BoxGeometry, BufferGeometry, Color, ConeGeometry, CylinderGeometry,
-  DirectionalLight, Float32BufferAttribute, GridHelper, Group, Matrix4, Mesh, MeshBasicMaterial,
+  DirectionalLight, Float32BufferAttribute, GridHelper, Group, InstancedMesh, Matrix4, Mesh,
+  MeshBasicMaterial,
   MeshStandardMaterial, PerspectiveCamera, Quaternion, Scene, SphereGeometry, TubeGeometry, Curve,
   Vector3, WebGLRenderer,
 } from "three";
@@ -22,6 +29,24 @@ const SPEEDS = [0.1, 0.25, 0.5, 1, 2, 4];
 const FRAMES_SHOWN = 24;
 const AXIS_COLORS = [0xdc3232, 0x28a03c, 0x3250dc];
 const Y = new Vector3(0, 1, 0);
+/** The names WebGL gives a renderer without a GPU behind it. */
+const SOFTWARE = /SwiftShader|llvmpipe|softpipe|Software/i;
+
+// What draws WebGL here ("ANGLE (Google, Vulkan 1.3.0 (SwiftShader Device ...))"), asked of a
+// context made for the question and let go at once; "" where the browser does not say.
+function rendererName() {
+  try {
+    const gl = document.createElement("canvas").getContext("webgl2");
+    if (!gl) return "";
+    const info = gl.getExtension("WEBGL_debug_renderer_info");
+    const name = info ? String(gl.getParameter(info.UNMASKED_RENDERER_WEBGL)) : String(gl.getParameter(gl.RENDERER));
+    const lose = gl.getExtension("WEBGL_lose_context");
+    if (lose) lose.loseContext();
+    return name;
+  } catch {
+    return "";
+  }
+}
 
 export function createViewer(element, animation, options = {}) {
   const data = prepare(animation);
@@ -34,8 +59,11 @@ export function createViewer(element, animation, options = {}) {
   const state = { time: data.t[0], playing: false, speed: options.speed || 1, last: null,
                   frame: 0, pending: 0, disposed: false };
   let renderer;
+  const gpu = rendererName();
   try {
-    renderer = new WebGLRenderer({ antialias: true });
+    // multisampling doubles a software renderer's frame time (a 32-link chain in headless
+    // Chromium's SwiftShader: 7.6 frames/s with it, 13.6 without); a GPU does it for free
+    renderer = new WebGLRenderer({ antialias: !SOFTWARE.test(gpu) });
   } catch (err) {
     const note = document.createElement("div");
     note.className = "kn-viewer-note";
@@ -60,19 +88,29 @@ export function createViewer(element, animation, options = {}) {
     return group;
   });
   const links = [];      // shapes between two frames, rebuilt from their origins
-  const frameAxes = [];
+  const frameAxes = [];  // what the "frames" button shows and hides
   const ground = animation.shapes.find(s => s.kind === "grid");
+  const batches = makeBatches();
+  let framesWithAxes = 0;
   for (const shape of animation.shapes) {
+    const small = shape.kind === "axes" && shape.component === null
+      && !(ground && shape.frame === ground.frame);
+    if (small) framesWithAxes++;
+    if (batched(shape, batches, small)) continue;
     const object = build(shape);
     if (!object) continue;
-    if (shape.kind === "rod" || shape.kind === "spring") {
+    if (shape.kind === "spring") {
       scene.add(object);
       links.push({ shape, object });
     } else {
       frames[shape.frame].add(object);
-      const small = shape.kind === "axes" && shape.component === null;
-      if (small && !(ground && shape.frame === ground.frame)) frameAxes.push(object);
     }
+  }
+  for (const batch of Object.values(batches)) {
+    const mesh = batch.finish();
+    if (!mesh) continue;
+    scene.add(mesh);
+    if (batch.small) frameAxes.push(mesh);
   }
 
   const controls = new OrbitControls(camera, renderer.domElement);
@@ -84,7 +122,7 @@ export function createViewer(element, animation, options = {}) {
   layout();
   fitView();
   // a scene of many frames (an engine) is clearer without them until asked for
-  setFramesVisible(options.showFrames ?? frameAxes.length <= FRAMES_SHOWN);
+  setFramesVisible(options.showFrames ?? framesWithAxes <= FRAMES_SHOWN);
   apply(state.time);
   const onKey = event => {
     if (event.code === "Space") { event.preventDefault(); state.playing ? pause() : play(); }
@@ -105,9 +143,13 @@ export function createViewer(element, animation, options = {}) {
       i = lo;
       w = t[hi] > t[lo] ? Math.min(Math.max((time - t[lo]) / (t[hi] - t[lo]), 0), 1) : 0;
     }
-    data.frames.forEach((f, k) => pose(f, i, w, frames[k]));
+    data.frames.forEach((f, k) => {
+      pose(f, i, w, frames[k]);
+      frames[k].updateMatrix();
+    });
     for (const { shape, object } of links) stretch(object, frames[shape.frame].position,
                                                    frames[shape.to].position);
+    for (const batch of Object.values(batches)) batch.update(frames);
     if (ui) ui.show(time);
   }
 
@@ -294,12 +336,16 @@ export function createViewer(element, animation, options = {}) {
   return {
     setTime: time => setTime(time), play, pause, setSpeed, dispose,
     getTime: () => state.time, isPlaying: () => state.playing,
+    renderInfo: () => ({ calls: renderer.info.render.calls, triangles: renderer.info.render.triangles,
+                         gpu, antialias: renderer.getContextAttributes().antialias }),
+    centers: kind => (batches[kind] ? batches[kind].centers() : []),
   };
 }
 
 // A viewer with nothing to draw on: time still moves, so a host's cursor still follows.
 function stub(root, data, state) {
   return {
+    renderInfo: () => ({ calls: 0, triangles: 0 }), centers: () => [],
     setTime(time) { state.time = Math.min(Math.max(time, data.t[0]), data.t[data.t.length - 1]); },
     play() { state.playing = true; }, pause() { state.playing = false; }, setSpeed() {},
     dispose() { root.remove(); }, getTime: () => state.time, isPlaying: () => state.playing,
@@ -357,33 +403,10 @@ function material(color) {
   return new MeshStandardMaterial({ color: new Color(color), roughness: 0.55, metalness: 0.1 });
 }
 
-// The three.js object of one shape, in the coordinates of its frame (or, between two
-// frames, a unit along y that `stretch` places).
+// The three.js object of a shape drawn on its own (the batches take the rest): a spring
+// between two frames (a unit along y that `stretch` places), a mesh file, the ground's grid.
 function build(shape) {
   const kind = shape.kind;
-  if (kind === "box" || kind === "cylinder" || kind === "sphere") {
-    const { length, width, height } = shape;
-    let geometry;
-    if (kind === "box") geometry = new BoxGeometry(length, width, height);
-    else if (kind === "cylinder")
-      geometry = new CylinderGeometry(width / 2, width / 2, length, 32).rotateZ(-Math.PI / 2);
-    else geometry = new SphereGeometry(length / 2, 32, 16);
-    geometry.translate(length / 2, 0, 0);
-    const mesh = new Mesh(geometry, material(shape.color));
-    const l = new Vector3().fromArray(shape.length_direction);
-    const w = new Vector3().fromArray(shape.width_direction);
-    const h = new Vector3().crossVectors(l, w);
-    const holder = new Group();
-    holder.quaternion.setFromRotationMatrix(new Matrix4().makeBasis(l, w, h));
-    holder.position.fromArray(shape.r_shape);
-    holder.add(mesh);
-    return holder;
-  }
-  if (kind === "rod") {
-    const r = shape.diameter / 2;
-    const geometry = new CylinderGeometry(r, r, 1, 20).translate(0, 0.5, 0);
-    return new Mesh(geometry, material(shape.color));
-  }
   if (kind === "spring") {
     const turns = shape.windings || 8, radius = shape.diameter / 2;
     const helix = new Curve();
@@ -405,7 +428,6 @@ function build(shape) {
     geometry.computeVertexNormals();
     return new Mesh(geometry, material(shape.color));
   }
-  if (kind === "axes") return axes(shape.length);
   if (kind === "grid") {
     const color = new Color(shape.color);
     const grid = new GridHelper(shape.size, shape.divisions, color.clone().multiplyScalar(0.8), color);
@@ -416,20 +438,115 @@ function build(shape) {
   return null;
 }
 
-function axes(length) {
-  const group = new Group();
-  const radius = length / 30;
-  const directions = [new Vector3(1, 0, 0), Y, new Vector3(0, 0, 1)];
-  directions.forEach((d, k) => {
-    const paint = new MeshBasicMaterial({ color: AXIS_COLORS[k] });
-    const shaft = new CylinderGeometry(radius, radius, length * 0.8, 8).translate(0, length * 0.4, 0);
-    const head = new ConeGeometry(radius * 2.6, length * 0.2, 12).translate(0, length * 0.9, 0);
-    const arrow = new Group();
-    arrow.add(new Mesh(shaft, paint), new Mesh(head, paint.clone()));
-    arrow.quaternion.setFromUnitVectors(Y, d);
-    group.add(arrow);
-  });
-  return group;
+// -- instanced shapes ------------------------------------------------------------------------
+const matrix = new Matrix4(), basis = new Matrix4(), turn = new Quaternion();
+const scaling = new Vector3(), middle = new Vector3();
+
+// Each kind's unit geometry: a shape is this, scaled by its sizes, turned into its frame's
+// directions and moved to its place (as `build` makes one mesh of its own sizes).
+function unitGeometry(kind) {
+  if (kind === "box") return new BoxGeometry(1, 1, 1).translate(0.5, 0, 0);
+  if (kind === "cylinder") return new CylinderGeometry(0.5, 0.5, 1, 32).rotateZ(-Math.PI / 2).translate(0.5, 0, 0);
+  if (kind === "sphere") return new SphereGeometry(0.5, 32, 16).translate(0.5, 0, 0);
+  if (kind === "rod") return new CylinderGeometry(1, 1, 1, 20).translate(0, 0.5, 0);
+  if (kind === "shaft") return new CylinderGeometry(1 / 30, 1 / 30, 0.8, 8).translate(0, 0.4, 0);
+  return new ConeGeometry(2.6 / 30, 0.2, 12).translate(0, 0.9, 0);      // an arrow's head
+}
+
+// The shapes of one kind, drawn by one InstancedMesh: each on a frame (its matrix there,
+// `local`) or, for a rod, between two frames' origins.
+class Batch {
+  constructor(kind, lit, small = false) {
+    this.kind = kind;
+    this.lit = lit;
+    this.small = small;
+    this.items = [];
+    this.mesh = null;
+  }
+
+  add(item) { this.items.push(item); }
+
+  finish() {
+    if (!this.items.length) return null;
+    const paint = this.lit
+      ? new MeshStandardMaterial({ color: 0xffffff, roughness: 0.55, metalness: 0.1 })
+      : new MeshBasicMaterial({ color: 0xffffff });
+    const mesh = new InstancedMesh(unitGeometry(this.kind), paint, this.items.length);
+    this.items.forEach((item, i) => mesh.setColorAt(i, new Color(item.color)));
+    // the instances move every frame: a bounding sphere computed once would cull them
+    mesh.frustumCulled = false;
+    this.mesh = mesh;
+    return mesh;
+  }
+
+  update(frames) {
+    if (!this.mesh) return;
+    this.items.forEach((item, i) => {
+      if (item.to !== undefined) {
+        const a = frames[item.frame].position;
+        direction.subVectors(frames[item.to].position, a);
+        const length = direction.length();
+        if (length > 1e-12) turn.setFromUnitVectors(Y, direction.divideScalar(length));
+        scaling.set(item.radius, length, item.radius);
+        matrix.compose(a, turn, length > 1e-12 ? scaling : scaling.setScalar(0));
+      } else {
+        matrix.multiplyMatrices(frames[item.frame].matrix, item.local);
+      }
+      this.mesh.setMatrixAt(i, matrix);
+    });
+    this.mesh.instanceMatrix.needsUpdate = true;
+  }
+
+  centers() {
+    if (!this.mesh) return [];
+    return this.items.map((item, i) => {
+      this.mesh.getMatrixAt(i, matrix);
+      // the middle of the unit shape (half a length along x, or along y for a rod)
+      return (item.to !== undefined ? middle.set(0, 0.5, 0) : middle.set(0.5, 0, 0)).applyMatrix4(matrix).toArray();
+    });
+  }
+}
+
+function makeBatches() {
+  return {
+    box: new Batch("box", true), cylinder: new Batch("cylinder", true),
+    sphere: new Batch("sphere", true), rod: new Batch("rod", true),
+    shaft: new Batch("shaft", false), head: new Batch("head", false),
+    frameShaft: new Batch("shaft", false, true), frameHead: new Batch("head", false, true),
+  };
+}
+
+// Put ``shape`` in its kind's batch; false for what is drawn on its own (springs, mesh files,
+// the ground's grid).
+function batched(shape, batches, small) {
+  const kind = shape.kind;
+  if (kind === "box" || kind === "cylinder" || kind === "sphere") {
+    const { length, width, height } = shape;
+    const l = new Vector3().fromArray(shape.length_direction);
+    const w = new Vector3().fromArray(shape.width_direction);
+    basis.makeBasis(l, w, new Vector3().crossVectors(l, w));
+    const sizes = kind === "box" ? [length, width, height] : kind === "cylinder" ? [length, width, width] : [length, length, length];
+    const local = new Matrix4().compose(new Vector3().fromArray(shape.r_shape),
+                                        new Quaternion().setFromRotationMatrix(basis),
+                                        new Vector3(...sizes));
+    batches[kind].add({ frame: shape.frame, local, color: shape.color });
+    return true;
+  }
+  if (kind === "rod") {
+    batches.rod.add({ frame: shape.frame, to: shape.to, radius: shape.diameter / 2, color: shape.color });
+    return true;
+  }
+  if (kind === "axes") {
+    const [shafts, heads] = small ? [batches.frameShaft, batches.frameHead] : [batches.shaft, batches.head];
+    [new Vector3(1, 0, 0), Y, new Vector3(0, 0, 1)].forEach((d, k) => {
+      const local = new Matrix4().compose(new Vector3(), new Quaternion().setFromUnitVectors(Y, d),
+                                          new Vector3(shape.length, shape.length, shape.length));
+      shafts.add({ frame: shape.frame, local, color: AXIS_COLORS[k] });
+      heads.add({ frame: shape.frame, local, color: AXIS_COLORS[k] });
+    });
+    return true;
+  }
+  return false;
 }
 
 function injectStyle() {
@@ -442,14 +559,14 @@ function injectStyle() {
 .kn-viewer canvas{display:block}
 .kn-viewer-title{position:absolute;top:8px;left:12px;font-weight:600;color:#555;pointer-events:none}
 .kn-viewer-note{padding:2em;color:#a33}
-.kn-viewer-bar{position:absolute;left:0;right:0;bottom:0;display:flex;align-items:center;gap:8px;
-  padding:6px 10px;background:#fff;border-top:1px solid #dde0e4}
+.kn-viewer-bar{position:absolute;left:0;right:0;bottom:0;display:flex;flex-wrap:wrap;align-items:center;
+  gap:4px 8px;padding:6px 10px;background:#fff;border-top:1px solid #dde0e4}
 .kn-viewer-bar button{font:inherit;padding:2px 8px;border:1px solid #c8ccd2;border-radius:4px;
   background:#fff;cursor:pointer;min-width:2.2em}
 .kn-viewer-bar button.kn-play{width:2.8em}
 .kn-viewer-bar button:hover{background:#eef1f5}
 .kn-viewer-bar button.kn-on{background:#dbe8fb;border-color:#8fb3e6}
-.kn-viewer-bar input[type=range]{flex:1;min-width:80px}
+.kn-viewer-bar input[type=range]{flex:1 1 60px;min-width:60px}
 .kn-viewer-bar select{font:inherit}
 .kn-time{font-variant-numeric:tabular-nums;white-space:nowrap}`;
   document.head.appendChild(style);

@@ -63,6 +63,7 @@ export function useDiagram(scope, byBlock, here) {
           info,
           ports,
           rotation: (body.layout && body.layout[c.name] && body.layout[c.name].rotation) || 0,
+          flip: !!(body.layout && body.layout[c.name] && body.layout[c.name].flip),
           problems: byBlock.get(c.name) || [],
           subsystem: !!(info && info.subsystem),
           unknown: !info && !(r && !r.body && !r.missing),

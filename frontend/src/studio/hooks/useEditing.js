@@ -1,5 +1,5 @@
 // Every edit of the diagram and the panels, each one step of the undo history: place, wire,
-// move (mouse or arrow keys), delete, rename, duplicate, rotate, copy and paste (at the
+// move (mouse or arrow keys), delete, rename, duplicate, rotate, flip, copy and paste (at the
 // pointer), parameters, make subsystem, open a subsystem.
 import { useCallback, useMemo } from "react";
 import { useReactFlow } from "@xyflow/react";
@@ -21,6 +21,7 @@ import {
   renameComponent,
   resolveDef,
   rotateComponent,
+  flipComponent,
   setParam,
   takenNames,
 } from "../model.js";
@@ -268,6 +269,7 @@ export function useEditing(scope, exposed) {
         connections: (body.connections || []).filter(([a, b]) => chosen.has(a.split(".")[0]) && chosen.has(b.split(".")[0])),
         positions: Object.fromEntries(comps.map((c) => [c.name, posOf(c.name) || { x: 0, y: 0 }])),
         rotations: Object.fromEntries(comps.map((c) => [c.name, (body.layout && body.layout[c.name] && body.layout[c.name].rotation) || 0])),
+        flips: Object.fromEntries(comps.map((c) => [c.name, !!(body.layout && body.layout[c.name] && body.layout[c.name].flip)])),
       };
     },
     [body, posOf],
@@ -315,6 +317,14 @@ export function useEditing(scope, exposed) {
     (names) => {
       const blocks = names.filter((n) => !n.startsWith("@"));
       if (blocks.length) editScope((s) => blocks.reduce((acc, n) => rotateComponent(acc, n, posOf), s));
+    },
+    [editScope, posOf],
+  );
+
+  const flip = useCallback(
+    (names) => {
+      const blocks = names.filter((n) => !n.startsWith("@"));
+      if (blocks.length) editScope((s) => blocks.reduce((acc, n) => flipComponent(acc, n, posOf), s));
     },
     [editScope, posOf],
   );
@@ -382,10 +392,11 @@ export function useEditing(scope, exposed) {
       paste,
       duplicate,
       rotate,
+      flip,
       selectAll,
       makeSub,
     }),
-    [domainOf, checkConnection, connect, moved, nudge, remove, removeSelected, place, placeAtCentre, open, rename, askRename, setParamOf, setModelParam, renameModelParam, setSim, setField, setPort, copy, paste, duplicate, rotate, selectAll, makeSub],
+    [domainOf, checkConnection, connect, moved, nudge, remove, removeSelected, place, placeAtCentre, open, rename, askRename, setParamOf, setModelParam, renameModelParam, setSim, setField, setPort, copy, paste, duplicate, rotate, flip, selectAll, makeSub],
   );
 }
 

@@ -1,0 +1,61 @@
+"""The studio's 3-D view draws each kind of shape as one instanced mesh (issue 29 item 7): a
+chain's draw calls do not grow with its links, and every instance stands where its frame's
+pose puts it (the poses the server sent, turned by hand here: an independent reckoning)."""
+
+import numpy as np
+
+from tests.studio.helpers import IMAGES, K, open_studio, run, tid
+
+
+def rotate(q, v):
+    """The vector ``v`` turned by the unit quaternion ``q`` = (w, x, y, z)."""
+    w, u = q[0], np.asarray(q[1:])
+    return v + 2 * w * np.cross(u, v) + 2 * np.cross(u, np.cross(u, v))
+
+
+def shown_chain(page, studio, links):
+    from scenes.chains import chain
+    name = f"chain{links}.json"
+    chain(links).save(studio.root / name)
+    open_studio(page, studio, open=name)
+    assert run(page) == "done"
+    page.wait_for_selector(f'{tid("viewer")}[data-ready="1"]')
+    page.wait_for_function("() => window.__kinetwork.viewer().renderInfo().calls > 0")
+    return page.evaluate("() => window.__kinetwork.viewer().renderInfo().calls")
+
+
+def test_a_chain_is_drawn_in_a_few_calls_with_every_shape_on_its_frame(page, studio):
+    few = shown_chain(page, studio, 16)
+    calls = shown_chain(page, studio, 32)
+    # the frames' axes hidden (33 and 65 of them), as the "frames" button says; the ground's
+    # grid, and one call for each kind: cylinders, spheres, rods, the world's axes (shafts
+    # and heads), whatever the number of links
+    assert page.locator(".kn-viewer-bar button.kn-on").count() == 0
+    assert calls == few and calls <= 6, (few, calls)
+    info = page.evaluate("() => window.__kinetwork.viewer().renderInfo()")
+    # headless Chromium draws with SwiftShader: no multisampling there, which halves its frames
+    if "SwiftShader" in info["gpu"]:
+        assert info["antialias"] is False, info
+    IMAGES.mkdir(parents=True, exist_ok=True)
+    page.locator(tid("viewer")).screenshot(path=str(IMAGES / "studio-chain32-3d.png"))
+
+    animation = K(page, "K.runs[0].results.animation")
+    t = animation["t"]
+    i = len(t) // 2
+    page.evaluate(f"() => window.__kinetwork.viewer().setTime({t[i]!r})")
+    frames = animation["frames"]
+    pos = [np.asarray(f["position"][i if len(f["position"]) > 1 else 0]) for f in frames]
+    quat = [np.asarray(f["quaternion"][i if len(f["quaternion"]) > 1 else 0]) for f in frames]
+    scale = animation["scale"]
+    for kind in ("cylinder", "sphere", "rod"):
+        shapes = [s for s in animation["shapes"] if s["kind"] == kind]
+        assert len(shapes) == 32
+        if kind == "rod":
+            expected = [(pos[s["frame"]] + pos[s["to"]]) / 2 for s in shapes]
+        else:
+            expected = [pos[s["frame"]] + rotate(quat[s["frame"]], np.asarray(s["r_shape"])
+                        + s["length"] / 2 * np.asarray(s["length_direction"]))
+                        for s in shapes]
+        drawn = page.evaluate(f"() => window.__kinetwork.viewer().centers({kind!r})")
+        assert np.allclose(drawn, expected, rtol=0, atol=1e-5 * scale), kind
+    assert not page.errors, page.errors
