@@ -36,11 +36,18 @@ workers); the global error of the first member against the same reference, over 
 member runs the plan's own integrator with its own error control, so its error must be the
 one simulate's run has whatever B. Writes results/study_tolerance_sweep.{csv,md}.
 
-Run: ``.venv/bin/python bench/study_tolerance.py [--quick] [--sweep]``; writes
+With ``--horizon 100`` (issue 30 item 5): the same over 100 s (references at 3e-14), the
+undamped seed beside them, the map as it is (the tolerances tightened by the square of the
+horizon past 10 s, ``tolerance.HORIZON``) against the map without that rule ("before": as
+over 10 s), with the steps each took; no error estimates. Writes
+results/study_tolerance_h100.{csv,md}.
+
+Run: ``.venv/bin/python bench/study_tolerance.py [--quick] [--sweep] [--horizon T]``; writes
 results/study_tolerance.{csv,md}.
 """
 
 import argparse
+import math
 import sys
 import time
 
@@ -68,6 +75,10 @@ TARGET = 100.0
 #: scenes outside the criterion: the seed undamped at large angles, whose errors grow tenfold
 #: every ~2.2 s (``study_chaos``); there only the estimate is of interest
 CHAOTIC = ("chaotic",)
+#: the horizon of the main table [s]; ``--horizon`` runs another
+CALIBRATED = T_END
+#: the reference's tolerance over a longer horizon (DOP853's smallest is 100 x eps)
+REF_RTOL_LONG = 3e-14
 
 
 def _pinocchio(spec):
@@ -126,6 +137,9 @@ SCENES = {
     "chaotic": (lambda: chains.chaotic().compile(),
                 lambda t: seed_reference(t, x0=(2.5, 2.0, 0, 0), rtol=REF_RTOL, atol=1e-15,
                                          d=0.0)[:, :2], _angles),
+    "seed_undamped": (lambda: chains.seed(d=0.0).compile(),
+                      lambda t: seed_reference(t, rtol=REF_RTOL, atol=1e-16, d=0.0)[:, :2],
+                      _angles),
     "chain2": (lambda: chains.chain(2).compile(), _pinocchio(chains.chain_spec(2)), _angles),
     "chain16": (lambda: chains.chain(16).compile(), _pinocchio(chains.chain_spec(16)),
                 _angles),
@@ -162,10 +176,14 @@ SCENES = {
 }
 
 
-def measure(system, reference, names, rtol, enabled, estimate=False):
+def measure(system, reference, names, rtol, enabled, estimate=False, horizon_rule=True):
     """One default run: (global error, wall time [s], method, steps, estimated error or
-    None, the time the estimate holds until or None)."""
+    None, the time the estimate holds until or None). ``horizon_rule=False``: the map without
+    its tightening past ``tolerance.HORIZON``."""
     tolerance.ENABLED = enabled
+    calibrated = tolerance.HORIZON
+    if not horizon_rule:
+        tolerance.HORIZON = math.inf
     try:
         start = time.perf_counter()
         try:
@@ -175,7 +193,7 @@ def measure(system, reference, names, rtol, enabled, estimate=False):
             return float("inf"), time.perf_counter() - start, str(exc)[:60], 0, None, None
         wall = time.perf_counter() - start
     finally:
-        tolerance.ENABLED = True
+        tolerance.ENABLED, tolerance.HORIZON = True, calibrated
     cols = names(res)
     error = float(np.max(np.abs(np.column_stack([res[n] for n in cols]) - reference)))
     guess = until = None
@@ -315,8 +333,13 @@ def main():
                         help="simulate and sweep members side by side (issue 25 item 1)")
     parser.add_argument("--report", action="store_true",
                         help="with --sweep: write the report again from the CSV")
+    parser.add_argument("--horizon", type=float, default=None,
+                        help="another horizon [s] (issue 30 item 5): the map with and "
+                             "without its rule for long runs")
     args = parser.parse_args()
     rtols = RTOLS_QUICK if args.quick else RTOLS
+    if args.horizon is not None:
+        return horizon_main(args, rtols)
     if args.sweep and args.report:
         return sweep_rewrite(rtols)
     if args.sweep:
@@ -386,6 +409,72 @@ Largest entry after of the default, the chaotic seed left out: {worst:.3g}.{f" T
 {table(["scene", *[f"{r:.0e}" for r in rtols]],
        [[s, *[f"{by[s, r]['after_wall_s'] * 1e3:.1f} ({by[s, r]['before_wall_s'] * 1e3:.1f})"
               for r in rtols]] for s in scenes])}
+"""
+
+
+def horizon_main(args, rtols):
+    """``--horizon T``: global error / rtol over T, the map with and without its tightening
+    past ``tolerance.HORIZON``, and the steps of each."""
+    global T_END, REF_RTOL
+    T_END, REF_RTOL = args.horizon, REF_RTOL_LONG
+    scenes = [s for s in args.scenes if s not in CHAOTIC and not s.endswith(" partition")]
+    rows = []
+    started = time.perf_counter()
+    for name, system, ref, extract in compiled_scenes(scenes):
+        for rtol in rtols:
+            row = {"scene": name, "rtol": rtol}
+            for label, rule in (("before", False), ("after", True)):
+                error, wall, method, steps, _, _ = measure(system, ref, extract, rtol, True,
+                                                           horizon_rule=rule)
+                row.update({f"{label}_error": error, f"{label}_ratio": error / rtol,
+                            f"{label}_wall_s": wall, f"{label}_steps": steps,
+                            "method": method})
+            rows.append(row)
+            print(f"{name:18s} rtol {rtol:.0e} {row['method']:13s} before "
+                  f"{row['before_ratio']:9.3g} ({row['before_steps']} steps)  after "
+                  f"{row['after_ratio']:9.3g} ({row['after_steps']} steps)", flush=True)
+    label = f"study_tolerance_h{args.horizon:g}"
+    write_csv(label, rows)
+    write_markdown(label, horizon_report(rows, rtols, time.perf_counter() - started))
+
+
+def horizon_report(rows, rtols, wall):
+    scenes = list(dict.fromkeys(r["scene"] for r in rows))
+    by = {(r["scene"], r["rtol"]): r for r in rows}
+
+    def grid(fmt):
+        return table(["scene", "method", *[f"{r:.0e}" for r in rtols]],
+                     [[s, by[s, rtols[0]]["method"],
+                       *[fmt(by[s, r]) if (s, r) in by else "" for r in rtols]]
+                      for s in scenes])
+    worst = max(r["after_ratio"] for r in rows)
+    extra = [r["after_steps"] / r["before_steps"] for r in rows if r["before_steps"]]
+    return f"""## Tolerance proportionality over {T_END:g} s: global error / rtol of the default method
+
+{machine()}. Study wall time {wall:.0f} s. Each scene {T_END:g} s, {N_POINTS} points,
+`method="auto"`, atol = rtol / 100, JIT on; references as in `study_tolerance.md`, at
+{REF_RTOL:g}; `seed_undamped`: the seed with its damper at 0 (small angles: not chaotic).
+Before: the map as over {CALIBRATED:g} s (TIGHTEN only); after: tightened by
+(T / {tolerance.HORIZON:g} s)^2 more, the rule of `kinetwork/solver/tolerance.py` (errors of
+a conservative oscillation grow as the square of the horizon). The issue asks every entry
+after <= {TARGET:g}. Over {CALIBRATED:g} s nothing changes (the rule starts past it).
+
+### Before: the map as over {CALIBRATED:g} s
+
+{grid(lambda r: f"{r['before_ratio']:.3g}")}
+
+### After: tightened by the square of the horizon
+
+{grid(lambda r: f"{r['after_ratio']:.3g}")}
+
+Largest entry after: {worst:.3g}.
+
+### Steps after / before (the cost of the rule)
+
+{grid(lambda r: f"{r['after_steps'] / r['before_steps']:.2f}" if r['before_steps'] else "-")}
+
+Steps after / before: {min(extra):.2f} .. {max(extra):.2f} (median
+{sorted(extra)[len(extra) // 2]:.2f}).
 """
 
 

@@ -55,7 +55,7 @@ def add(sub):
                         help="estimate each probe signal's global error (two more runs at "
                              "tighter tolerances) and show it in the summary")
     parser.add_argument("--max-steps", type=positive(int), metavar="N",
-                        help="step budget per output interval of the variable-step methods")
+                        help="step budget of the whole run (the variable-step methods)")
     parser.add_argument("--time-limit", type=positive(float), metavar="S",
                         help="wall-clock limit [s] of the run: C compilation, integration, "
                              "probe signals and writing the outputs (what was reached is "

@@ -43,7 +43,8 @@ from ..expr import casadi_functions, parse
 from ..graph import quantities
 from ..graph.model import Model
 from ..solver.driver import DEFAULTS
-from ..solver.tolerance import RTOL_FLOOR, TIGHTEN
+from ..solver.methods import METHODS
+from ..solver.tolerance import solver_tolerances
 from ..analysis.channels import driven
 from .units import state_rate_unit
 
@@ -168,7 +169,7 @@ def content(model, name=None):
     settings = {**DEFAULTS, **model.simulation}
     rtol, atol = float(settings["rtol"]), float(settings["atol"])
     out.nominal = np.full(system.n_states, atol / rtol)
-    out.solver_rtol = solver_rtol(system, rtol)
+    out.solver_rtol = solver_rtol(system, rtol, float(settings["t_end"]))
     out.tolerance = max(out.solver_rtol / IMPORTER_MARGIN, TOLERANCE_FLOOR)
     out.experiment = {"t_end": float(settings["t_end"]),
                       "step": float(settings["t_end"]) / max(int(settings["n_points"]) - 1, 1),
@@ -179,14 +180,11 @@ def content(model, name=None):
     return out
 
 
-def solver_rtol(system, rtol):
+def solver_rtol(system, rtol, horizon):
     """The tolerance an integrator's error control gets for the model's ``rtol`` (a global
-    error): tightened as ``kn.simulate`` tightens CVODES' (``solver.tolerance``), for a tree
-    or for loops."""
-    loops = system.formulation != "tree" and not (system.formulation == "partition"
-                                                  and not system.n_algebraic)
-    factor = TIGHTEN.get(("cvodes", loops), 1.0)
-    return max(rtol / factor, min(rtol, RTOL_FLOOR["cvodes"]))
+    error) over its experiment's ``horizon`` [s]: CVODES BDF's in ``kn.simulate``, by the same
+    map (``solver.tolerance``: for a tree or for loops, and tighter for a long run)."""
+    return solver_tolerances(METHODS["cvodes"], system, rtol, rtol, horizon)[0]
 
 
 def _loops_option(system):

@@ -45,8 +45,9 @@ from .capture import SOLVER_LOCK, solver_output
 from .compiled import compiled, numeric
 from .events import EVENT_CHUNK
 from .loopwatch import Partitions, near_singular
-from .methods import (LOOK, METHODS, Failure, Interrupted, choose, shift_times,
-                      stability_held)
+from .methods import (LOOK, METHODS, Failure, Interrupted, budget_spent, choose,
+                      shift_times, stability_held)
+from .tolerance import step_budget
 
 DEFAULTS = {"t_end": 10.0, "n_points": 1001, "method": "auto", "rtol": 1e-6, "atol": 1e-8,
             "step": None, "max_step": None}
@@ -72,6 +73,10 @@ TICK = 0.1
 STALL_LOOK = 2.0
 #: Adams steps projected for a run beyond which a look asks whether they are held by stability
 STALL_STEPS = 1e6
+#: a fallback of auto (BDF after Adams) does at most this many times the work per simulated
+#: second that the method it replaces did, or gives up (issue 30: BDF after Adams on a
+#: 128-link chain took 263 s of CPU where Adams needs 3 s)
+FALLBACK_SLOWER = 2.0
 #: auto's Adams is also stopped to look when one output interval takes more steps than
 #: STALL_STEPS spread over the run's intervals, and at least this many: a step budget, so the
 #: look needs no signal and works in any thread (a sweep's mapped members, a Dask worker)
@@ -143,6 +148,8 @@ class Run:
         self.stall_look = None
         self.watched = False            # auto: its Adams may be looked at (the tick is set)
         self.stall_due = False          # set by the tick that aborted a call to look
+        #: auto's fallback runs against the method it replaces: a ``Rival``, or None
+        self.rival = None
         #: auto's Adams watched by a step budget per output interval (``look_budget``), and
         #: the time its budget ran out at (set by the method whose call it stopped)
         self.look_steps = None
@@ -178,6 +185,15 @@ class Run:
             yield
         finally:
             self.abortable = False
+
+    def budget(self, method, interval=None):
+        """The steps a run of ``method`` (None: one of scipy's) may take: ``max_steps`` if
+        given, else ``tolerance.step_budget`` for its length; with ``interval`` [s], an output
+        interval that long (``max_steps`` again if given: the run's steps are counted by the
+        driver)."""
+        if self.max_steps:
+            return int(self.max_steps)
+        return step_budget(method, self.system, self.t_end - self.t_start, interval)
 
     def rhs(self):
         """The right-hand side as a fast Python callable ``(t, x) -> xdot`` of the values the
@@ -289,14 +305,28 @@ def _finite_start(system, t, x0, p):
 
 
 def _auto(run, stats):
+    """Auto's run: its methods in turn (``choose``), each after the last failed or stalled;
+    a fallback slower than the method it replaces gives up (``Rival``), and that method's
+    answer stands: its failure, or, had it only stalled, its run to the end unwatched."""
     names, why = choose(run)
     stats.update(why)
+    before = None                       # (name, X, failure, stats) of the method replaced
     for i, name in enumerate(names):
         watch = name == "cvodes-adams" and i < len(names) - 1 and run.events is None
         run.stall_look = time.perf_counter() + STALL_LOOK if watch else None
         run.look_steps = look_budget(run) if watch else None
+        run.rival = None if before is None else \
+            Rival(before[0], _work(run, before[3]), run.t_start, run.grid[len(before[1]) - 1])
         X, failure, method_stats = _integrate(run, METHODS[name])
-        run.stall_look = run.look_steps = None
+        run.stall_look = run.look_steps = run.rival = None
+        if isinstance(failure, GaveUp) and run.stop_reason() is None:
+            stats["gave_up"] = {"method": name, "for": before[0], "at": failure.t,
+                                "why": f"{name} {failure}"}
+            name, X, failure, method_stats = before
+            if isinstance(failure, Stalled):    # it had not failed: on to the end
+                X, failure, method_stats = _integrate(run, METHODS[name])
+            stats.update(method_stats)
+            return X, failure, name
         if failure is None or i == len(names) - 1 or run.stop_reason() is not None:
             stats.update(method_stats)
             return X, failure, name
@@ -304,6 +334,7 @@ def _auto(run, stats):
         if isinstance(failure, Stalled):
             stats["switched"] = {"from": name, "to": names[i + 1], "at": failure.t,
                                  "why": str(failure)}
+        before = (name, X.copy(), failure, method_stats)
     raise AssertionError("unreachable")
 
 
@@ -361,9 +392,9 @@ def _integrate(run, method):
     X = _Rows(run.x0, n)
     parts = Partitions(run)            # the loops' partitions the run goes through
     stats, restarts = {}, []           # stats: of the steppers replaced by restarts
-    if method.fixed and run.max_steps and run.steps_per_interval > run.max_steps:
-        return X.array(), (f"the step budget of {run.max_steps} steps per output interval "
-                             f"is smaller than the {run.steps_per_interval} steps of "
+    if method.fixed and run.max_steps and run.steps_per_interval * (n - 1) > run.max_steps:
+        return X.array(), (f"the step budget of {run.max_steps} steps for the run is smaller "
+                             f"than the {run.steps_per_interval * (n - 1)} steps of "
                              f"{run.step or run.spacing:g} s that the fixed-step method "
                              f"takes"), stats
     if run.events is not None:
@@ -377,7 +408,7 @@ def _integrate(run, method):
     # (time events alone: each call goes to the next of them, the method restarts there)
     run.quiet = method.interruptible and (run.events is None or not run.events.located) and \
         run.system.f_dependent is None and run.progress is None and run.cancel is None \
-        and run.deadline is None
+        and run.deadline is None and run.rival is None
     chunk = n - 1 if method.stepper or run.quiet else _first_chunk(run, method, n - 1)
     if not method.stepper:
         chunk = min(chunk, MAX_CHUNK)
@@ -442,6 +473,12 @@ def _integrate(run, method):
                 stats = _merge(stats, stepper.stats)
                 stepper, failure, chunk = switched, None, 1
                 continue
+        if failure is None and not method.fixed:
+            if run.rival is not None:
+                failure = run.rival.outrun(run, stats, stepper.stats, grid[k])
+            failure = failure or _spent(run, method, stats, stepper.stats, grid[k])
+            if failure is not None:
+                break
         if failure is not None:
             if run.stop_reason() is None and _restart(run, method, X, restarts, failure):
                 stats = _merge(stats, stepper.stats)
@@ -528,6 +565,50 @@ def _assembly_watch(run, X, new, failure):
     return new, failure
 
 
+def _spent(run, method, stats, more, t):
+    """After a call that reached ``t``: why the run stops when it has taken more steps than
+    its budget (those of the runs restarts and events replaced counted too), else None.
+
+    SUNDIALS bounds the steps of each output interval, not of a call over many (a quiet run
+    is one call): no interval takes more than the run's budget, and a call that took more in
+    all fails here, done or not. So a run succeeds exactly when it takes no more steps than
+    its budget, however many output points it has."""
+    budget = run.budget(method)
+    steps = stats.get("steps", 0) + more.get("steps", 0)
+    return budget_spent(budget, t, steps) if steps > budget else None
+
+
+class Rival:
+    """The method a fallback replaces, and what it did (the work ``_work`` counts, over the
+    simulated time from the start to ``t``): a fallback that has done more than FALLBACK_SLOWER
+    times that work per simulated second (past one chunk's, CHUNK_WORK) gives up
+    (``outrun``)."""
+
+    def __init__(self, name, work, t_start, t):
+        self.name, self.work = name, float(work)
+        self.rate = self.work / max(float(t) - t_start, 1e-300)
+
+    def outrun(self, run, stats, more, t):
+        """A ``GaveUp`` reason when the fallback's work to ``t`` is past its allowance."""
+        work = _work(run, stats) + _work(run, more)
+        allowed = FALLBACK_SLOWER * self.rate * (float(t) - run.t_start) + CHUNK_WORK
+        return GaveUp(t, self.name, work, allowed) if work > allowed else None
+
+
+class GaveUp(str):
+    """Why auto gave up on a fallback: slower than the method it replaced (a str, as every
+    failure's reason is, with the time ``t`` it was found at)."""
+
+    def __new__(cls, t, rival, work, allowed):
+        self = super().__new__(cls, (
+            f"gave up at t = {t:g} s: it had done {work:.3g} units of work (evaluations times "
+            f"instructions, a Jacobian as one evaluation per state, a factorisation as n^3/3) "
+            f"where {FALLBACK_SLOWER:g} times what {rival} did over as long a stretch "
+            f"allows {allowed:.3g}"))
+        self.t = float(t)
+        return self
+
+
 def _first_chunk(run, method, intervals):
     """Output intervals of the first chunk, before any work is known: as many as fit a chunk's
     work if each takes FIRST_CHUNK_STEPS steps (a fixed-step method: its own), so a cheap run
@@ -604,10 +685,12 @@ def _next_chunk(run, m, work, remaining):
 
 def _work(run, stats):
     """The work a method has done so far: evaluations of the equations (a Jacobian counted as
-    one per state) times the instructions of one evaluation."""
+    one per state) times the instructions of one evaluation, and n^3/3 for each factorisation
+    of an implicit method's matrix."""
+    n = run.system.n_states + run.system.n_algebraic
     evaluations = stats.get("rhs_evaluations", stats.get("steps", 0) * 4) + \
-        stats.get("jacobian_evaluations", 0) * (run.system.n_states + run.system.n_algebraic)
-    return evaluations * run.instructions
+        stats.get("jacobian_evaluations", 0) * n
+    return evaluations * run.instructions + stats.get("factorisations", 0) * n ** 3 / 3
 
 
 def _merge(total, more):

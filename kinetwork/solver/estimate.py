@@ -117,7 +117,8 @@ def _tighter(results, runs):
         return True, True
     asked = [(results.settings["rtol"], results.settings["atol"]),
              *((r["rtol"], r["atol"]) for r in runs)]
-    given = [solver_tolerances(method, results.system, *a)[0] for a in asked]
+    horizon = results.settings["t_end"] - results.settings["t_start"]
+    given = [solver_tolerances(method, results.system, *a, horizon)[0] for a in asked]
     return tuple(b <= a / TIGHTER * (1 + 1e-9) for a, b in itertools.pairwise(given))
 
 

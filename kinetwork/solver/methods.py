@@ -36,6 +36,14 @@ class Failure(Exception):
 LOOK = "looking whether the model became stiff"
 
 
+def budget_spent(budget, t, steps=None):
+    """The reason of a run that spent its step budget (``Run.budget``) at ``t`` (``steps``:
+    how many it had taken when that was found)."""
+    took = f" (it took {steps})" if steps is not None else ""
+    return (f"the step budget of {budget} steps for the run ran out at t = {t:g} s{took}: "
+            f"the problem may be stiff for this method, or the solution blows up")
+
+
 class Interrupted(Exception):
     """Raised by the driver's signal handler to abort a compiled call (``Run.interruptible``)."""
 
@@ -189,16 +197,17 @@ class _CasadiRun:
         self.p = np.array(run.p_solver, dtype=float)     # the values held from here on
         self.stats = {"steps": 0}
         if method.sundials:
-            self.stats.update(rhs_evaluations=0, jacobian_evaluations=0)
+            self.stats.update(rhs_evaluations=0, jacobian_evaluations=0, factorisations=0)
 
     def options(self, times):
         m, run = self.method, self.run
         opts = dict(m.options)
         if m.sundials:      # tighter than asked: see tolerance.py
-            opts.update(zip(("reltol", "abstol", "max_num_steps"),
-                            solver_tolerances(m, run.system, run.rtol, run.atol)))
-            if run.max_steps:
-                opts["max_num_steps"] = int(run.max_steps)
+            opts.update(zip(("reltol", "abstol"), solver_tolerances(
+                m, run.system, run.rtol, run.atol, run.t_end - run.t_start)))
+            # SUNDIALS' budget is per output interval: the share of the run's of an interval
+            # of the grid (tolerance.step_budget); the driver counts the run's after each call
+            opts["max_num_steps"] = run.budget(m, run.spacing)
             if run.max_step:
                 opts["max_step_size"] = float(run.max_step)
             if run.look_steps is not None and run.look_steps < opts["max_num_steps"]:
@@ -319,6 +328,7 @@ class _CasadiRun:
                 self.stats["steps"] += int(st["nsteps"])
                 self.stats["rhs_evaluations"] += int(st["nfevals"])
                 self.stats["jacobian_evaluations"] += int(st["n_call_jacF"])
+                self.stats["factorisations"] += int(st.get("nlinsetups", 0))
         else:
             self.stats["steps"] += run.steps_per_interval * intervals
             self.stats["step"] = run.spacing / run.steps_per_interval
@@ -361,6 +371,7 @@ class _CasadiRun:
                 self.stats["steps"] += int(st["nsteps"])
                 self.stats["rhs_evaluations"] += int(st["nfevals"])
                 self.stats["jacobian_evaluations"] += int(st["n_call_jacF"])
+                self.stats["factorisations"] += int(st.get("nlinsetups", 0))
         else:
             self.stats["steps"] += self.run.steps_per_interval
             self.stats["step"] = self.run.spacing / self.run.steps_per_interval
@@ -403,21 +414,17 @@ class Scipy(Method):
         return _ScipyRun(solver, run)
 
 
-#: scipy's steppers stop after this many steps within one output interval unless
-#: ``max_steps`` says otherwise (a stiff problem under an explicit method would step forever)
-SCIPY_STEP_BUDGET = 100_000
-
-
 class _ScipyRun:
     def __init__(self, solver, run):
         self.solver, self.run = solver, run
-        self.budget = run.max_steps or SCIPY_STEP_BUDGET
+        # a stiff problem under an explicit method would step forever
+        self.budget = run.budget(None)
         self.steps = 0
         self.stats = {}
 
     def advance(self, times, exact=False):
         solver, run = self.solver, self.run
-        out, in_interval = [], 0
+        out = []
         with np.errstate(all="ignore"):     # a blow-up is reported below, not warned
             while len(out) < len(times):
                 if solver.t_old is not None and times[len(out)] <= solver.t:
@@ -434,7 +441,7 @@ class _ScipyRun:
                     out.append(np.array(solver.y))
                     continue
                 message = solver.step()
-                in_interval, self.steps = in_interval + 1, self.steps + 1
+                self.steps += 1
                 if solver.status == "failed":
                     raise Failure(message, np.array(out).reshape(-1, len(solver.y)))
                 if not np.all(np.isfinite(solver.y)):
@@ -444,12 +451,9 @@ class _ScipyRun:
                     dense = solver.dense_output()
                     while len(out) < len(times) and times[len(out)] <= solver.t:
                         out.append(dense(times[len(out)]))
-                    in_interval = 0
                     continue
-                if in_interval >= self.budget:
-                    raise Failure(f"the step budget of {self.budget} steps per output "
-                                  f"interval ran out at t = {solver.t:g} s: the problem may be "
-                                  f"stiff for this method, or the solution blows up",
+                if self.steps >= self.budget:
+                    raise Failure(budget_spent(self.budget, solver.t),
                                   np.array(out).reshape(-1, len(solver.y)))
                 run.check_stop(np.array(out).reshape(-1, len(solver.y)))
         self.stats = {"steps": self.steps,

@@ -373,8 +373,10 @@ def simulate(model: Model | System, t_end: float | None = None, n_points: int | 
         compiler is found and ``KINETWORK_JIT`` is not 0, and falls back to CasADi's virtual
         machine, with a warning, when compilation fails.
     max_steps : int, optional
-        Step budget per output interval (SUNDIALS' mxstep; counted here for scipy's, whose
-        default is SCIPY_STEP_BUDGET): when it runs out the run stops with a SimulationError.
+        Step budget of the run, whatever its number of output points (default
+        ``tolerance.step_budget``: 10^7 steps per 10 s of the run, more at the tighter
+        tolerances the solvers are given, and at most its length's share for a stretch of
+        it): a run that takes more stops with a SimulationError.
     time_limit : float, optional
         Wall-clock limit [s] of the run, compilation included.
     progress : bool or callable, optional
