@@ -68,19 +68,18 @@ CHUNK_GROWTH = 16
 MAX_CHUNK = 2**16
 #: seconds between looks at the time limit and cancel= within a compiled call
 TICK = 0.1
-#: seconds of a run after which auto's Adams is stopped to look whether the model became
-#: stiff (then BDF takes over), and again after twice the time since the start each time
-STALL_LOOK = 2.0
 #: Adams steps projected for a run beyond which a look asks whether they are held by stability
 STALL_STEPS = 1e6
 #: a fallback of auto (BDF after Adams) does at most this many times the work per simulated
 #: second that the method it replaces did, or gives up (issue 30: BDF after Adams on a
 #: 128-link chain took 263 s of CPU where Adams needs 3 s)
 FALLBACK_SLOWER = 2.0
-#: auto's Adams is also stopped to look when one output interval takes more steps than
-#: STALL_STEPS spread over the run's intervals, and at least this many: a step budget, so the
-#: look needs no signal and works in any thread (a sweep's mapped members, a Dask worker)
-LOOK_STEPS = 500
+#: auto's Adams is stopped to look whether it stalls when one output interval takes more
+#: steps than STALL_STEPS spread over the run's intervals, and at least this many (then twice
+#: as many, after a look that let it go on): a step budget, so the look is where the steps
+#: are, on every machine and in any thread (a sweep's mapped members, a Dask worker), never
+#: where a clock says
+LOOK_STEPS = 100
 #: restarts after a failure, with ``restart=True``, at most
 MAX_RESTARTS = 3
 #: a restarted run must keep the loops closed to this (m, or rotation-matrix entries)
@@ -143,11 +142,6 @@ class Run:
         self.said = []                  # what the solvers printed
         self.quiet = False              # nothing to watch: one call over the grid
         self.abortable = False          # a signal now aborts the compiled call
-        #: auto's Adams watched for a stall (``_stalled``): the perf_counter of its next look
-        #: within a compiled call, doubling the time since the start after each, or None
-        self.stall_look = None
-        self.watched = False            # auto: its Adams may be looked at (the tick is set)
-        self.stall_due = False          # set by the tick that aborted a call to look
         #: auto's fallback runs against the method it replaces: a ``Rival``, or None
         self.rival = None
         #: auto's Adams watched by a step budget per output interval (``look_budget``), and
@@ -171,7 +165,7 @@ class Run:
                 yield
         finally:                        # a failing solver's words are the ones wanted
             if box is not None and box["text"].strip() and self.signal is None \
-                    and not self.stall_due and self.stop_reason() is None:
+                    and self.stop_reason() is None:
                 self.said.append(shift_times(box["text"], t0))
 
     @contextlib.contextmanager
@@ -313,12 +307,11 @@ def _auto(run, stats):
     before = None                       # (name, X, failure, stats) of the method replaced
     for i, name in enumerate(names):
         watch = name == "cvodes-adams" and i < len(names) - 1 and run.events is None
-        run.stall_look = time.perf_counter() + STALL_LOOK if watch else None
         run.look_steps = look_budget(run) if watch else None
         run.rival = None if before is None else \
             Rival(before[0], _work(run, before[3]), run.t_start, run.grid[len(before[1]) - 1])
         X, failure, method_stats = _integrate(run, METHODS[name])
-        run.stall_look = run.look_steps = run.rival = None
+        run.look_steps = run.rival = None
         if isinstance(failure, GaveUp) and run.stop_reason() is None:
             stats["gave_up"] = {"method": name, "for": before[0], "at": failure.t,
                                 "why": f"{name} {failure}"}
@@ -360,30 +353,24 @@ def look_budget(run):
 
 
 def _stalled(run, t, x, steps):
-    """After a look at a long Adams call that took ``steps`` steps to the output ``t``
-    (state ``x``): a ``Stalled`` reason when the evidence says Adams cannot finish in
-    reasonable work (more than STALL_STEPS projected for the run, its mean step held by the
-    stability of a fast mode that decays, ``methods.stability_held``), else None (Adams goes
-    on). A look by the step budget (``look_budget``) takes the mean step of the interval whose
-    budget ran out, and the rest of the run goes on under the run's own budget."""
+    """After auto's Adams spent its look budget (``look_budget``) in the output interval
+    that starts at ``t`` (state ``x``; ``steps`` taken before): a ``Stalled`` reason when the
+    evidence says Adams cannot finish in reasonable work (more than STALL_STEPS projected
+    for the run at the mean step of that interval, a step held by the stability of a fast
+    mode that decays, ``methods.stability_held``), else None: Adams goes on, looked at again
+    when an interval takes twice as many steps."""
     t, hit = float(t), run.look_hit
-    run.look_hit = None
-    if hit is not None:
-        budget, run.look_steps = run.look_steps, None
-        step = (hit - t) / budget
-        if step <= 0:
-            return None
-        projected = steps + (run.t_end - hit) / step
-    else:
-        if t <= run.t_start or steps <= 0:
-            return None
-        step = (t - run.t_start) / steps
-        projected = steps * (run.t_end - run.t_start) / (t - run.t_start)
+    budget, run.look_hit = run.look_steps, None
+    run.look_steps = 2 * budget
+    step = (hit - t) / budget
+    if step <= 0:
+        return None
+    projected = steps + budget + (run.t_end - hit) / step
     if projected <= STALL_STEPS:
         return None
     held, rate, decay = stability_held(run.rhs(), t, run.t_end,
                                        np.asarray(x)[:run.system.n_states], step)
-    return Stalled(max(t, hit or t), step, projected, rate, decay) if held else None
+    return Stalled(hit, step, projected, rate, decay) if held else None
 
 
 def _integrate(run, method):
@@ -768,12 +755,7 @@ def _running(run):
         # not abortable while it looks: a tick arriving within this one (cancel= may wait on
         # a lock, as the studio's Event does) returns at once instead of taking it again
         run.abortable = False
-        now = time.perf_counter()
-        due = run.stall_look is not None and now > run.stall_look
-        if due or run.stop_reason() is not None:
-            if due:
-                run.stall_due = True
-                run.stall_look = now + 2 * (now - run.started)
+        if run.stop_reason() is not None:
             raise Interrupted
         run.abortable = True
     saved, timer = {}, None
@@ -784,7 +766,7 @@ def _running(run):
             saved[sig] = _signal.signal(sig, handler)
         except (ValueError, OSError):     # not settable here (an embedded interpreter)
             pass
-    if run.deadline is not None or run.cancel is not None or run.watched:
+    if run.deadline is not None or run.cancel is not None:
         # the time limit and cancel= are looked at every TICK s within a compiled call as
         # well: a chunk sized for a fraction of a second can take minutes (a stiff model
         # under Adams takes 100x the steps the chunk was sized for)

@@ -301,9 +301,6 @@ class _CasadiRun:
             stop = run.stop_reason()
             if stop is not None:        # aborted by a signal, the time limit or cancel=
                 raise Failure(stop, reached)
-            if run.stall_due:           # aborted to look at the model (auto's stall watch)
-                run.stall_due = False
-                raise Failure(LOOK, reached)
             if opts.get("max_num_steps") == run.look_steps and "TOO_MUCH_WORK" in str(failed):
                 # auto's look budget ran out: the driver looks. Where, CVODES printed (its
                 # words, not the run's); else, at most the next output time

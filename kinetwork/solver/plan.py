@@ -200,7 +200,6 @@ class Plan:
         if self.lifted is not None:
             stats["lifted"] = self.lifted.note
         run = self.new_run(p, x0, cancel, progress, started)
-        run.watched = self.key == "auto"
         with _running(run):
             if self.jit_on:
                 run.jit = {"stats": stats, "required": self.jit is True,

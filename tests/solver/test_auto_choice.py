@@ -47,7 +47,7 @@ def test_adams_held_by_a_hard_damped_spring_given_at_run_time_gives_way_to_bdf()
 def stiffening():
     """A mass pulled by 1 - s, damped by 1e16 s^2 v: no damping at the start (s = 0), a
     decay rate of ~1e6/s once it has moved: Adams would take ~1e7 steps (minutes on any
-    machine), far past the first look at 2 s."""
+    machine): an output interval soon takes more steps than the look's budget."""
     m = kn.Model("stiffens")
     m.add(kn.translational.Mass("mass", m=1.0))
     m.add(kn.translational.Force("push"))
@@ -116,8 +116,8 @@ def test_each_member_of_a_sweep_is_tested_with_its_own_parameters():
 
 
 def test_adams_gives_way_in_a_thread_and_in_a_sweep_member_too():
-    """The look at a running Adams is a step budget per output interval, not only a timer
-    signal (which Python delivers to the main thread alone): a run started in another thread
+    """The look at a running Adams is a step budget per output interval, not a timer signal
+    (which Python delivers to the main thread alone): a run started in another thread
     and a sweep's thread-mapped member switch as a run in the main thread does. Before, the
     member ran Adams to the end (1.3e7 steps, 80 s) and the thread's run likewise."""
     import threading
