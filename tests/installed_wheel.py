@@ -59,13 +59,13 @@ def _venv(folder, wheel):
     own = subprocess.run([str(python), "-c", "import sysconfig; "
                           "print(sysconfig.get_paths()['purelib'])"],
                          capture_output=True, text=True, check=True).stdout.strip()
-    # this interpreter's site-packages (the worktree's venv and those its .pth names), never
-    # the checkout: a .pth line adds a folder without reading the .pth files inside it, so
-    # an editable install of the checkout found there is not followed
+    # this interpreter's site-packages (its venv's, inside the checkout after `make test`, and
+    # those its .pth names), never the checkout's sources: a .pth line adds a folder without
+    # reading the .pth files inside it, so an editable install of the checkout found in a
+    # site-packages is not followed
     here = {sysconfig.get_paths()["purelib"], *site.getsitepackages()}
     paths = [p for p in sys.path if p in here or p.endswith("site-packages")]
-    paths = [p for p in dict.fromkeys(paths)
-             if not pathlib.Path(p).resolve().is_relative_to(ROOT)]
+    paths = [p for p in dict.fromkeys(paths) if pathlib.Path(p).resolve() != ROOT]
     (pathlib.Path(own) / "zz_dependencies.pth").write_text("\n".join(paths) + "\n")
     run([str(python), "-m", "pip", "install", "--no-deps", "--no-index", "-q", str(wheel)])
 
