@@ -38,7 +38,7 @@ from scenes.reference import PAPER, seed_mvg
 
 import kinetwork as kn
 from scenes import chains as scenes
-from kinetwork.solver.methods import STIFF_HORIZON_STEPS, STIFF_RATIO
+from kinetwork.solver.stiffness import STIFF_HORIZON_STEPS, STIFF_RATIO
 
 RTOL, ATOL = 1e-6, 1e-8
 SPACING = 0.01

@@ -32,7 +32,9 @@ from ..expr import parse
 from ..graph.model import evaluate
 from ..util import quote, suggest
 from .compiled import compiled
-from .driver import CHUNK_WORK, FIRST_CHUNK_STEPS, _finite_start, _work, look_budget
+from .chunks import CHUNK_WORK, FIRST_CHUNK_STEPS, _work
+from .driver import _finite_start
+from .fallback import look_budget
 from .methods import METHODS, Casadi, Failure, _CasadiRun
 
 #: members of one mapped call at most

@@ -10,7 +10,7 @@ A run that must be watched (a time limit, progress reports, a ``cancel`` callabl
 loops, events) is handed to the method in chunks of the output grid: between chunks the driver
 reads the clock and the cancel flag, reports progress and checks the loops. A chunk is sized by
 the work the last one took (equation evaluations times the instructions of one evaluation) to
-about ``CHUNK_WORK``: a fraction of a second on any machine, and the same chunks on every
+about ``chunks.CHUNK_WORK``: a fraction of a second on any machine, and the same chunks on every
 machine, so a run's numbers never depend on how fast the machine is or how loaded.
 
 Each chunk restarts a multistep method (order and step size begin again from one step of order
@@ -42,44 +42,19 @@ from ..errors import ModelError
 from ..graph.settings import check_output, check_settings
 from ..util import quote, suggest
 from .capture import SOLVER_LOCK, solver_output
+from .chunks import MAX_CHUNK, _first_chunk, _merge, _next_chunk, _Rows, _work
 from .compiled import compiled, numeric
 from .events import EVENT_CHUNK
+from .fallback import GaveUp, Rival, Stalled, _stalled, look_budget
 from .loopwatch import Partitions, near_singular
-from .methods import (LOOK, METHODS, Failure, Interrupted, budget_spent, choose,
-                      shift_times, stability_held)
+from .methods import LOOK, METHODS, Failure, Interrupted, budget_spent, shift_times
+from .stiffness import choose
 from .tolerance import step_budget
 
 DEFAULTS = {"t_end": 10.0, "n_points": 1001, "method": "auto", "rtol": 1e-6, "atol": 1e-8,
             "step": None, "max_step": None}
-#: a chunk of a CasADi integration is sized to about this much work (evaluations of the
-#: equations times their instructions: ~1 ns an instruction compiled, ~10 in CasADi's virtual
-#: machine, so 0.1 to 1 s): cancellation, time limits and progress are served between
-#: chunks, and each chunk restarts the method (a BDF method recomputes its Jacobian). The same
-#: with and without C, so that both give the same numbers
-CHUNK_WORK = 1e8
-#: the first chunk is sized as if each output interval took this many steps (how many it
-#: takes is not known before); later ones from the work the last took, growing at most
-#: CHUNK_GROWTH-fold (each chunk restarts a multistep method: few chunks for a fast run)
-FIRST_CHUNK_STEPS = 100
-CHUNK_GROWTH = 16
-#: output intervals of one CasADi call at most, quiet runs included: building an integrator
-#: over 6e6 output times took 4 s and stopping it only comes between calls (a signal aborts
-#: a call, not the building), and work counts miss the cost of the outputs themselves
-MAX_CHUNK = 2**16
 #: seconds between looks at the time limit and cancel= within a compiled call
 TICK = 0.1
-#: Adams steps projected for a run beyond which a look asks whether they are held by stability
-STALL_STEPS = 1e6
-#: a fallback of auto (BDF after Adams) does at most this many times the work per simulated
-#: second that the method it replaces did, or gives up (issue 30: BDF after Adams on a
-#: 128-link chain took 263 s of CPU where Adams needs 3 s)
-FALLBACK_SLOWER = 2.0
-#: auto's Adams is stopped to look whether it stalls when one output interval takes more
-#: steps than STALL_STEPS spread over the run's intervals, and at least this many (then twice
-#: as many, after a look that let it go on): a step budget, so the look is where the steps
-#: are, on every machine and in any thread (a sweep's mapped members, a Dask worker), never
-#: where a clock says
-LOOK_STEPS = 100
 #: restarts after a failure, with ``restart=True``, at most
 MAX_RESTARTS = 3
 #: a restarted run must keep the loops closed to this (m, or rotation-matrix entries)
@@ -331,48 +306,6 @@ def _auto(run, stats):
     raise AssertionError("unreachable")
 
 
-class Stalled(str):
-    """Why auto's Adams gave way to BDF mid-run (a str, as every failure's reason is, with
-    the time ``t`` it was found at)."""
-
-    def __new__(cls, t, step, projected, rate, decay):
-        self = super().__new__(cls, (
-            f"Adams stalled at t = {t:g} s: its steps ({step:.3g} s on average, "
-            f"{projected:.3g} projected for the run) are held by the stability of a mode "
-            f"of rate {rate:.3g}/s that decays at {decay:.3g}/s, not by accuracy; BDF took "
-            f"over from the start"))
-        self.t = float(t)
-        return self
-
-
-def look_budget(run):
-    """The steps of one output interval after which auto's Adams is stopped to look whether
-    it stalls: STALL_STEPS spread over the run's intervals, at least LOOK_STEPS."""
-    intervals = max(1, len(run.grid) - 1)
-    return max(LOOK_STEPS, math.ceil(STALL_STEPS / intervals))
-
-
-def _stalled(run, t, x, steps):
-    """After auto's Adams spent its look budget (``look_budget``) in the output interval
-    that starts at ``t`` (state ``x``; ``steps`` taken before): a ``Stalled`` reason when the
-    evidence says Adams cannot finish in reasonable work (more than STALL_STEPS projected
-    for the run at the mean step of that interval, a step held by the stability of a fast
-    mode that decays, ``methods.stability_held``), else None: Adams goes on, looked at again
-    when an interval takes twice as many steps."""
-    t, hit = float(t), run.look_hit
-    budget, run.look_hit = run.look_steps, None
-    run.look_steps = 2 * budget
-    step = (hit - t) / budget
-    if step <= 0:
-        return None
-    projected = steps + budget + (run.t_end - hit) / step
-    if projected <= STALL_STEPS:
-        return None
-    held, rate, decay = stability_held(run.rhs(), t, run.t_end,
-                                       np.asarray(x)[:run.system.n_states], step)
-    return Stalled(hit, step, projected, rate, decay) if held else None
-
-
 def _integrate(run, method):
     """States on the grid from ``method``, chunk by chunk: (X, failure or None, stats)."""
     grid, n = run.grid, len(run.grid)
@@ -565,131 +498,6 @@ def _spent(run, method, stats, more, t):
     return budget_spent(budget, t, steps) if steps > budget else None
 
 
-class Rival:
-    """The method a fallback replaces, and what it did (the work ``_work`` counts, over the
-    simulated time from the start to ``t``): a fallback that has done more than FALLBACK_SLOWER
-    times that work per simulated second (past one chunk's, CHUNK_WORK) gives up
-    (``outrun``)."""
-
-    def __init__(self, name, work, t_start, t):
-        self.name, self.work = name, float(work)
-        self.rate = self.work / max(float(t) - t_start, 1e-300)
-
-    def outrun(self, run, stats, more, t):
-        """A ``GaveUp`` reason when the fallback's work to ``t`` is past its allowance."""
-        work = _work(run, stats) + _work(run, more)
-        allowed = FALLBACK_SLOWER * self.rate * (float(t) - run.t_start) + CHUNK_WORK
-        return GaveUp(t, self.name, work, allowed) if work > allowed else None
-
-
-class GaveUp(str):
-    """Why auto gave up on a fallback: slower than the method it replaced (a str, as every
-    failure's reason is, with the time ``t`` it was found at)."""
-
-    def __new__(cls, t, rival, work, allowed):
-        self = super().__new__(cls, (
-            f"gave up at t = {t:g} s: it had done {work:.3g} units of work (evaluations times "
-            f"instructions, a Jacobian as one evaluation per state, a factorisation as n^3/3) "
-            f"where {FALLBACK_SLOWER:g} times what {rival} did over as long a stretch "
-            f"allows {allowed:.3g}"))
-        self.t = float(t)
-        return self
-
-
-def _first_chunk(run, method, intervals):
-    """Output intervals of the first chunk, before any work is known: as many as fit a chunk's
-    work if each takes FIRST_CHUNK_STEPS steps (a fixed-step method: its own), so a cheap run
-    goes in one call; a power of two otherwise."""
-    steps = run.steps_per_interval if method.fixed else FIRST_CHUNK_STEPS
-    per_interval = 4 * steps * run.instructions
-    fit = CHUNK_WORK / per_interval
-    if fit >= intervals:
-        return intervals
-    return 2 ** int(np.log2(max(1.0, fit)))
-
-
-class _Rows:
-    """The states reached, in one array of the grid's size allocated at the start (a list of
-    10^5 rows costs more to build and join than the integration of a small model, and
-    joining blocks at the end would hold the states twice): a CasADi method writes its
-    outputs straight into the rows reserved for them (``slot``)."""
-
-    def __init__(self, x0, n):
-        x0 = np.asarray(x0, dtype=float)
-        self.data = np.empty((max(n, 1), len(x0)))
-        self.data[0] = x0
-        self.n = 1
-
-    def __len__(self):
-        return self.n
-
-    def __getitem__(self, i):
-        return self.data[:self.n][i]
-
-    def slot(self, m):
-        """The next ``m`` rows, for a method to write into (then ``extend`` with them)."""
-        return self.data[self.n:self.n + m]
-
-    def extend(self, rows):
-        rows = np.asarray(rows, dtype=float).reshape(-1, self.data.shape[1])
-        m = len(rows)
-        if not m:
-            return
-        if self.n + m > len(self.data):             # a restart's row past the grid: grow
-            self.data = np.concatenate([self.data[:self.n], rows])
-            self.n += m
-            return
-        target = self.data[self.n:self.n + m]
-        if rows.ctypes.data != target.ctypes.data or rows.strides != target.strides:
-            target[...] = rows                      # not written in place by the method
-        self.n += m
-
-    def append(self, row):
-        self.extend(np.asarray(row)[None, :])
-
-    def replace_last(self, row):
-        self.data[self.n - 1] = row
-
-    def array(self):
-        """The rows reached (a view, not a copy)."""
-        return self.data[:self.n]
-
-    def __array__(self, dtype=None, copy=None):
-        out = self.array()
-        return out if dtype is None else out.astype(dtype)
-
-
-def _next_chunk(run, m, work, remaining):
-    """Output intervals of the next chunk, from the work the last one (``m`` intervals) took:
-    the rest at once when even sixteen times its estimate is within a chunk's work (a fast
-    run goes in two calls), else a power of two (each length's integrator is kept) sized to
-    a chunk's work, at most CHUNK_GROWTH times the last."""
-    per_interval = max(work, 1.0) / m
-    if CHUNK_GROWTH * per_interval * remaining <= CHUNK_WORK:
-        return remaining
-    return 2 ** int(np.log2(max(1, min(CHUNK_GROWTH * m, CHUNK_WORK / per_interval))))
-
-
-def _work(run, stats):
-    """The work a method has done so far: evaluations of the equations (a Jacobian counted as
-    one per state) times the instructions of one evaluation, and n^3/3 for each factorisation
-    of an implicit method's matrix."""
-    n = run.system.n_states + run.system.n_algebraic
-    evaluations = stats.get("rhs_evaluations", stats.get("steps", 0) * 4) + \
-        stats.get("jacobian_evaluations", 0) * n
-    return evaluations * run.instructions + stats.get("factorisations", 0) * n ** 3 / 3
-
-
-def _merge(total, more):
-    """The statistics of a stepper and of the one that replaced it (a restart): counters
-    added, anything else (a step size, a residual) as the later one says."""
-    out = {**total, **more}
-    for key in total.keys() & more.keys():
-        if isinstance(more[key], int) and not isinstance(more[key], bool):
-            out[key] = total[key] + more[key]
-    return out
-
-
 def _piecewise(run, method, t, x, times, reason):
     """The outputs a failed chunk reached, found by integrating it an output at a time from
     its start; the run stops at the end of them all the same (a fresh start can pass where
@@ -749,6 +557,7 @@ def _running(run):
         if run.abortable:           # raised in CasADi's check for signals: the call stops
             run.abortable = False
             raise Interrupted
+
     def tick(signum, frame):
         if not run.abortable:
             return
@@ -780,4 +589,3 @@ def _running(run):
             signal.setitimer(signal.ITIMER_REAL, *timer)
         for sig, handler in saved.items():
             _signal.signal(sig, handler)
-

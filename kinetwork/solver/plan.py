@@ -4,7 +4,7 @@ through it.
 A ``Plan`` holds what a run of a model needs beyond its parameter values: the System (a model
 is compiled once; component parameters named by path are lifted to model parameters of a twin
 compiled once, ``graph/lift.py``), the output grid, the method and how ``auto`` chooses it
-(the stiffness test, ``methods.choose``), the tolerances (mapped to the solvers' by
+(the stiffness test, ``stiffness.choose``), the tolerances (mapped to the solvers' by
 ``tolerance.solver_tolerances`` inside the methods), JIT, events, chunking, cancellation and
 the detection of failures (``driver.py``). Its ways to an answer:
 
@@ -42,7 +42,8 @@ from .compiled import compiled
 from .driver import (DEFAULTS, Run, _assembly_watch, _auto, _check, _check_finite_start,
                      _integrate, _probe_outputs, _running, output_values)
 from .events import Events
-from .methods import METHODS, Casadi, _CasadiRun, choose
+from .methods import METHODS, Casadi, _CasadiRun
+from .stiffness import choose
 from .progress import progress_bar
 from .results import Results
 

@@ -81,7 +81,7 @@ def test_the_time_limit_stops_a_long_compiled_call():
                     time_limit=1.0)
     took = time.perf_counter() - start
     err = caught.value
-    assert 0 < err.t_reached < 10.0
+    assert 0 <= err.t_reached < 10.0      # a loaded machine may stop before the first output
     assert len(err.results.t) >= 1 and np.all(np.isfinite(err.results.states))
     assert "the solver said" not in str(err)       # a stop, not a solver failure
     print(f"\ntime limit 1 s: stopped after {took:.2f} s at t = {err.t_reached:g} s")
@@ -95,7 +95,7 @@ def test_cancel_stops_a_long_compiled_call():
     with pytest.raises(kn.SimulationError, match="cancelled") as caught:
         kn.simulate(model, params=HARD, method="cvodes-adams", t_end=10.0, n_points=1001,
                     cancel=asked)
-    assert 0 < caught.value.t_reached < 10.0
+    assert 0 <= caught.value.t_reached < 10.0
     assert time.perf_counter() - start < 60.0
     assert math.isfinite(caught.value.results.t[-1])
 

@@ -17,6 +17,7 @@ from scenes.reference import seed_energy
 
 import kinetwork as kn
 from kinetwork.solver import driver, methods
+from kinetwork.solver import stiffness as stiffness_module
 
 LONG = 200.0
 
@@ -85,7 +86,7 @@ def test_a_fallback_slower_than_the_method_it_replaces_gives_up(seed, monkeypatc
     monkeypatch.setattr(driver.Run, "budget", short_for_adams)
     monkeypatch.setattr(methods._CasadiRun, "_count", slow_bdf)
     # the stiffness test would not pick Adams for a damped seed it called stiff: it does not
-    monkeypatch.setattr(methods, "stiffness", lambda *a, **k: (False, 0.0, 0.0))
+    monkeypatch.setattr(stiffness_module, "stiffness", lambda *a, **k: (False, 0.0, 0.0))
     with pytest.raises(kn.SimulationError, match="step budget") as info:
         kn.simulate(seed, t_end=20.0, n_points=201)
     res = info.value.results

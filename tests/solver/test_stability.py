@@ -8,8 +8,8 @@ import numpy as np
 import pytest
 
 import kinetwork as kn
-from kinetwork.solver import methods
-from kinetwork.solver.methods import stiffness
+from kinetwork.solver import stiffness as stiffness_module
+from kinetwork.solver.stiffness import stiffness
 from scenes import chain, double_pendulum   # chain: n uniform rods on revolute z joints
 from scenes.reference import PAPER, seed_energy, seed_mvg, seed_reference
 
@@ -50,7 +50,7 @@ def test_undamped_mechanisms_are_never_stiff(build):
 
 
 def test_auto_skips_the_test_on_undamped_models(monkeypatch):
-    monkeypatch.setattr(methods, "stiffness", None)     # calling it would fail
+    monkeypatch.setattr(stiffness_module, "stiffness", None)     # calling it would fail
     res = kn.simulate(chain(4), t_end=1.0)
     assert res.method == "cvodes-adams"
     assert res.stats["stiff"] is False and res.stats["damped"] is False
@@ -83,7 +83,7 @@ def test_adams_fails_on_the_stiffest_scene_and_auto_falls_back(monkeypatch):
         kn.simulate(system, t_end=0.2, n_points=21, method="cvodes-adams")
     assert err.value.t_reached < 0.2
     # were the stiffness test to miss it, the failure of Adams still hands over to BDF
-    monkeypatch.setattr(methods, "stiffness", lambda *a, **k: (False, 0.0, 0.0))
+    monkeypatch.setattr(stiffness_module, "stiffness", lambda *a, **k: (False, 0.0, 0.0))
     res = kn.simulate(system, t_end=0.2, n_points=21)
     assert res.method == "cvodes" and "too many steps" in res.stats["adams_failure"]
 
