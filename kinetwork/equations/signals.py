@@ -61,6 +61,9 @@ def probe_signals(asm, topo, net, bound, model):
     """The Signals of every probe of the model, in model order."""
     out = []
     units = None
+    # a probe on a composite part's pin reads an inner part's (a DCMotor's p is its Ra's):
+    # the signal names the pin the user wired (the flattening's aliases)
+    aliases = getattr(model, "aliases", None) or {}
     for probe, target in topo.probes:
         where = model.place(probe)
         unit = None
@@ -77,7 +80,8 @@ def probe_signals(asm, topo, net, bound, model):
         for quantity in probe.asked(target.domain):
             spec = QUANTITIES[target.domain][quantity]
             out.append(Signal(f"{probe.name}.{quantity}", unit or spec.unit, spec.shape,
-                              probe.name, quantity, target.path, ca.SX(spec.formula(view))))
+                              probe.name, quantity, aliases.get(target.path, target.path),
+                              ca.SX(spec.formula(view))))
     return out
 
 

@@ -58,6 +58,8 @@ def test_a_probe_on_the_motor_names_the_motors_pin():
     m.components["pm"].quantities = ["voltage", "current"]
     res = kn.simulate(m, t_end=0.1, n_points=11)
     assert res.probe_targets["pm"] == "motor.p"
+    # the descriptor the CSV's sidecar and the studio read too
+    assert {res.signals[n].target for n in ("pm.voltage", "pm.current")} == {"motor.p"}
     from kinetwork.plotlayout import Panel
     assert Panel(res, "pm.voltage").title == "pm (motor.p): voltage"
     np.testing.assert_allclose(res["pm.voltage"], 12.0, rtol=1e-12)
