@@ -26,18 +26,25 @@ FALLBACK_SLOWER = 2.0
 LOOK_STEPS = 100
 
 
-class Stalled(str):
-    """Why auto's Adams gave way to BDF mid-run (a str, as every failure's reason is, with
-    the time ``t`` it was found at)."""
+class _Found(str):
+    """A reason a method stops (a str, as every failure's reason is) with the time ``t`` it
+    was found at."""
+
+    def __new__(cls, t, text):
+        self = super().__new__(cls, text)
+        self.t = float(t)
+        return self
+
+
+class Stalled(_Found):
+    """Why auto's Adams gave way to BDF mid-run."""
 
     def __new__(cls, t, step, projected, rate, decay):
-        self = super().__new__(cls, (
+        return super().__new__(cls, t, (
             f"Adams stalled at t = {t:g} s: its steps ({step:.3g} s on average, "
             f"{projected:.3g} projected for the run) are held by the stability of a mode "
             f"of rate {rate:.3g}/s that decays at {decay:.3g}/s, not by accuracy; BDF took "
             f"over from the start"))
-        self.t = float(t)
-        return self
 
 
 def look_budget(run):
@@ -85,15 +92,12 @@ class Rival:
         return GaveUp(t, self.name, work, allowed) if work > allowed else None
 
 
-class GaveUp(str):
-    """Why auto gave up on a fallback: slower than the method it replaced (a str, as every
-    failure's reason is, with the time ``t`` it was found at)."""
+class GaveUp(_Found):
+    """Why auto gave up on a fallback: slower than the method it replaced."""
 
     def __new__(cls, t, rival, work, allowed):
-        self = super().__new__(cls, (
+        return super().__new__(cls, t, (
             f"gave up at t = {t:g} s: it had done {work:.3g} units of work (evaluations times "
             f"instructions, a Jacobian as one evaluation per state, a factorisation as n^3/3) "
             f"where {FALLBACK_SLOWER:g} times what {rival} did over as long a stretch "
             f"allows {allowed:.3g}"))
-        self.t = float(t)
-        return self
