@@ -281,7 +281,9 @@ def _method(plan, template, p, x0):
     # the member's own values, also where the stiffness test reads them (p_solver)
     template.p = template.p_solver = p
     template.x0 = x0
-    names, _ = plan.methods(template, keep=False)
+    names, why = plan.methods(template, keep=False)
+    if why.get("rk4", {}).get("step"):     # auto's RK4 at the member's own step
+        return None
     method = METHODS[names[0]]
     return names[0] if getattr(method, "plugin", None) in MAPPED else None
 

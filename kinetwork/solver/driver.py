@@ -283,7 +283,8 @@ def _auto(run, stats):
     for i, name in enumerate(names):
         watch = name == "cvodes-adams" and i < len(names) - 1 and run.events is None
         run.look_steps = look_budget(run) if watch else None
-        run.rival = None if before is None else \
+        # a fixed step replaced (its step too long somewhere) sets no pace for Adams
+        run.rival = None if before is None or METHODS[before[0]].fixed else \
             Rival(before[0], _work(run, before[3]), run.t_start, run.grid[len(before[1]) - 1])
         X, failure, method_stats = _integrate(run, METHODS[name])
         run.look_steps = run.rival = None
