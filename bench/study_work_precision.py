@@ -762,7 +762,14 @@ def main():
     parser.add_argument("--overheads", action="store_true",
                         help="where auto's run spends the time the hand-written route does "
                              "not (results/work_precision_casadi_overheads.md)")
+    parser.add_argument("--point-masses", action="store_true",
+                        help="only the point-mass chains with a damper (planar and 3-D, N = 2, "
+                             "16, 128): auto against the hand-written route, pinocchio and "
+                             "MuJoCo RK4 in CPU time (results/work_precision_points.md)")
     args = parser.parse_args()
+    if args.point_masses:
+        import work_precision_points
+        return work_precision_points.study(args.quick)
     if args.overheads:
         return overheads()
     if args.casadi:

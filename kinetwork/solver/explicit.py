@@ -60,15 +60,12 @@ def rk4_stable_step(eigenvalues):
         return math.inf
     # along each ray of the complex plane RK4's region is an interval from 0 (|z| < 2.9)
     fractions = np.linspace(0.0, 3.0, 601)[1:]
-    h = math.inf
-    for one in lam:
-        z = fractions * one / abs(one)
-        unstable = np.abs(_rk4_gain(z)) > 1 + 1e-12
-        reach = fractions[np.argmax(unstable) - 1] if unstable.any() else fractions[-1]
-        if unstable[0]:
-            reach = 0.0
-        h = min(h, reach / abs(one))
-    return h
+    rays = fractions[None, :] * (lam / np.abs(lam))[:, None]
+    unstable = np.abs(_rk4_gain(rays)) > 1 + 1e-12
+    # the last stable fraction along each ray (none: 0; all: the whole 3)
+    first = np.where(unstable.any(axis=1), np.argmax(unstable, axis=1), len(fractions))
+    reach = np.where(first > 0, fractions[np.maximum(first - 1, 0)], 0.0)
+    return float(np.min(reach / np.abs(lam)))
 
 
 def _rk4(rhs, t, x, h, steps):

@@ -201,4 +201,7 @@ SCENES = {
     **{f"chain{n}": ((lambda n=n: chain(n)), (lambda n=n: chain_spec(n)), 10.0)
        for n in (2, 4, 8, 16, 32, 64, 128)},
     "spatial6": ((lambda: spatial(6)), (lambda: spatial_spec(6)), 10.0),
+    **{f"{kind}{n}": ((lambda n=n, p=planar: point_masses(n, p)),
+                      (lambda n=n, p=planar: point_mass_spec(n, p)), 10.0)
+       for kind, planar in (("points", True), ("points3d_", False)) for n in (2, 16, 128)},
 }

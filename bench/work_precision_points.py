@@ -1,0 +1,165 @@
+"""Work-precision on the point-mass chains with a damper: kinetwork's ``auto`` against the same
+route by hand, pinocchio + DOP853 and MuJoCo RK4, in CPU time, at 1e-4, 1e-6 and 1e-9.
+
+Scenes (``scenes.chains.point_mass_spec``): N point masses of 1 kg on massless 1 m links, a
+damper of 0.1 N m s/rad on each joint, about z (planar) or about z and x in turn (3-D); N = 2,
+16, 128; 10 s, output every 0.01 s. Reference: pinocchio's ABA with DOP853 at rtol 1e-13 (atol
+1e-15), independent of kinetwork; the hand-written route at rtol 1e-12 is compared with it.
+
+Timing: CPU time (``time.process_time``) of one run, the least of REPEATS, the curves' runs of
+one setting taken in turn (interleaved: a shared machine's load falls on every tool alike);
+every model is built and every integrator called once first. A curve stops after a run over
+CAP s of CPU or once its error is below FLOOR. Time to an accuracy: log-log interpolation on
+each curve's Pareto front (``study_work_precision.time_to``).
+
+Run: ``python bench/study_work_precision.py --point-masses [--quick]``; writes
+``results/work_precision_points.{md,csv}``.
+"""
+
+import math
+import time
+
+import numpy as np
+
+import kinetwork as kn
+
+import common
+from common import machine, max_error, table, write_csv, write_markdown
+from scenes import chains
+
+import casadi_peer
+import mujoco_peer
+import pinocchio_peer
+
+NAME = "work_precision_points"
+SIZES = (2, 16, 128)
+HORIZON, SPACING = 10.0, 0.01
+ACCURACIES = (1e-4, 1e-6, 1e-9)
+RTOLS = tuple(10.0 ** -k for k in range(1, 13))
+REF_RTOL = 1e-13
+CAP, FLOOR, REPEATS = 3.0, 1e-11, 3
+AUTO, HAND, PIN, MUJOCO = ("kinetwork auto", "by hand (CasADi ABA + CVODES Adams)",
+                           "pinocchio + DOP853", "MuJoCo RK4")
+
+
+def cpu(fn, setting):
+    """(CPU seconds, value or the exception) of one call."""
+    start = time.process_time()
+    try:
+        value = fn(setting)
+    except Exception as exc:  # noqa: BLE001 -- a failed run is a result
+        value = exc
+    return time.process_time() - start, value
+
+
+def curves_of(spec, system, t, quick):
+    """label -> (settings, run(setting) -> joint angles), and auto's runs' details."""
+    rtols = (1e-4, 1e-8) if quick else RTOLS
+    steps = (1e-2, 1e-3) if quick else [h for h in mujoco_peer.TIMESTEPS if h >= 5e-5]
+    hand, pin, mj = casadi_peer.build(spec), pinocchio_peer.build(spec), mujoco_peer.build(spec)
+    details = {}
+
+    def auto(s):
+        res = kn.simulate(system, t_end=HORIZON, n_points=len(t), **s)
+        details[s["rtol"]] = (res.method, res.stats.get("rhs_evaluations",
+                                                        4 * res.stats.get("steps", 0)))
+        return chains.joint_angles(res)
+
+    curves = {
+        AUTO: ([{"rtol": r, "atol": r * 1e-2} for r in rtols], auto),
+        HAND: ([{"rtol": r} for r in rtols], lambda s: casadi_peer.run(hand, t, **s)),
+        PIN: ([{"method": "DOP853", "rtol": r} for r in rtols if r <= 1e-2],
+              lambda s: pinocchio_peer.run(pin, t, **s)),
+        MUJOCO: ([{"integrator": "RK4", "timestep": h} for h in steps],
+                 lambda s: mujoco_peer.run(mj, t, **s)),
+    }
+    return curves, details, hand
+
+
+def sweep(curves, ref):
+    """Interleaved: every curve's k-th setting in turn, REPEATS times; rows per curve."""
+    rows = {label: [] for label in curves}
+    active = set(curves)
+    for k in range(max(len(s) for s, _ in curves.values())):
+        best, value = {}, {}
+        for _ in range(REPEATS):
+            for label in curves:
+                settings, run = curves[label]
+                if label in active and k < len(settings):
+                    took, value[label] = cpu(run, settings[k])
+                    best[label] = min(best.get(label, math.inf), took)
+        for label, took in best.items():
+            v = value[label]
+            error = math.inf if isinstance(v, Exception) else max_error(v, ref)
+            rows[label].append({"setting": curves[label][0][k], "cpu_s": took, "error": error,
+                                "status": f"failed: {str(v)[:120]}"
+                                if isinstance(v, Exception) else "ok"})
+            if took > CAP or error < FLOOR:
+                active.discard(label)
+    return rows
+
+
+def time_to(rows, target):
+    from study_work_precision import time_to as along_front
+    return along_front([(r["cpu_s"], r["error"]) for r in rows if r["status"] == "ok"], target)
+
+
+def study(quick=False):
+    start = time.perf_counter()
+    sizes = (2, 16) if quick else SIZES
+    t = np.linspace(0.0, HORIZON, round(HORIZON / SPACING) + 1)
+    summary, every, csv_rows, notes = [], [], [], []
+    for planar in (True, False):
+        for n in sizes:
+            scene = f"{'planar' if planar else '3-D'} N = {n}"
+            spec = chains.point_mass_spec(n, planar)
+            system = chains.point_masses(n, planar).compile()
+            ref = pinocchio_peer.run(pinocchio_peer.build(spec), t, method="DOP853",
+                                     rtol=REF_RTOL, atol=REF_RTOL * 1e-2)
+            curves, details, hand = curves_of(spec, system, t, quick)
+            for settings, run in curves.values():           # JIT, integrators, first calls
+                cpu(run, settings[0])
+            agree = max_error(casadi_peer.run(hand, t, rtol=1e-12), ref)
+            notes.append(f"{scene}: the hand-written route at rtol 1e-12 is {agree:.1e} rad "
+                         f"from the reference")
+            rows = sweep(curves, ref)
+            cells = [scene]
+            for e in ACCURACIES:
+                mine = time_to(rows[AUTO], e)
+                for peer in (HAND, PIN, MUJOCO):
+                    theirs = time_to(rows[peer], e)
+                    cells.append(f"{theirs / mine:.2f}" if mine and theirs else
+                                 "auto never" if theirs else "—")
+                cells.insert(len(cells) - 3, f"{mine * 1e3:.2f} ms" if mine else "—")
+            summary.append(cells)
+            for label, rs in rows.items():
+                for r in rs:
+                    s = r["setting"]
+                    chosen = details.get(s.get("rtol")) if label == AUTO else None
+                    every.append([scene, label, " ".join(f"{k}={v}" for k, v in s.items()),
+                                  f"{r['cpu_s'] * 1e3:.2f}", f"{r['error']:.1e}",
+                                  f"{chosen[0]}, {chosen[1]} evaluations" if chosen else "",
+                                  r["status"]])
+                    csv_rows.append({"scene": scene, "curve": label, "setting": every[-1][2],
+                                     "cpu_s": r["cpu_s"], "error": r["error"],
+                                     "auto_ran": every[-1][5], "status": r["status"]})
+            print(f"  {scene}: done at {time.perf_counter() - start:.0f} s", flush=True)
+    write_csv(NAME, csv_rows)
+    header = ["scene"]
+    for e in ACCURACIES:
+        header += [f"auto to {e:.0e}", "by hand / auto", "pinocchio / auto", "MuJoCo / auto"]
+    lines = [
+        "# Work-precision: point-mass chains with a damper, CPU time", "",
+        f"{machine()}; {common.load()}. Study run time {time.perf_counter() - start:.0f} s"
+        + (" (quick: N = 2, 16; rtol 1e-4, 1e-8)." if quick else "."), "",
+        "CPU time to each accuracy (max joint-angle error against pinocchio ABA + DOP853 at "
+        f"rtol {REF_RTOL:g}) along each curve's Pareto front; a ratio is the peer's time over "
+        "auto's: above 1, kinetwork is faster. — : never reached in the settings swept; "
+        "`auto never`: the peer reaches it and auto does not. Settings: rtol 1e-1..1e-12 "
+        "(atol = rtol * 1e-2) for kinetwork and by hand, 1e-2..1e-12 for DOP853, steps "
+        "1e-2..5e-5 s for MuJoCo RK4; least CPU time of "
+        f"{REPEATS} interleaved runs; a curve stops after a run over {CAP:g} s.", "",
+        table(header, summary), "", *[f"- {n}" for n in notes], "",
+        "## Every run", "",
+        table(["scene", "curve", "setting", "CPU ms", "error", "auto ran", "status"], every)]
+    write_markdown(NAME, "\n".join(lines))
