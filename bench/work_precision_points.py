@@ -136,7 +136,8 @@ def study(quick=False):
                 for r in rs:
                     s = r["setting"]
                     chosen = details.get(s.get("rtol")) if label == AUTO else None
-                    every.append([scene, label, " ".join(f"{k}={v}" for k, v in s.items()),
+                    every.append([scene, label, " ".join(f"{k}={v:g}" if isinstance(v, float)
+                                                         else f"{k}={v}" for k, v in s.items()),
                                   f"{r['cpu_s'] * 1e3:.2f}", f"{r['error']:.1e}",
                                   f"{chosen[0]}, {chosen[1]} evaluations" if chosen else "",
                                   r["status"]])
