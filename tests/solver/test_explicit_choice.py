@@ -1,56 +1,23 @@
 """``auto`` takes fixed-step RK4 where stability, not accuracy, holds the step (issue 30, item 3),
 and Adams or BDF where they belong; each answer within its tolerance.
 
-The scene held by stability: a slow mass (1 kg on a 1 N/m spring, released 1 m out) carrying a
-fast one (1 g on a 90 N/m spring, lightly damped: a mode of 300 rad/s that decays at 3/s),
-started where the fast spring already carries the slow mass's first acceleration, so that the
-fast mode is barely excited. Adams's steps are held by that mode's stability at any loose
-tolerance; RK4 is stable on it at about twice the step per evaluation. Reference: DOP853 at
-rtol 1e-13 on the hand-written equations of the two masses. Work is counted in evaluations,
+The scene held by stability (``scenes/follower.py``): a slow mass carrying a fast one, whose
+mode of 300 rad/s is barely excited. Adams's steps are held by that mode's stability at any
+loose tolerance; RK4 is stable on it at about twice the step per evaluation. Reference: DOP853
+at rtol 1e-13 on the hand-written equations of the two masses. Work is counted in evaluations,
 never timed.
 """
 
 import numpy as np
 import pytest
-from scipy.integrate import solve_ivp
 
 import kinetwork as kn
 from kinetwork.solver import explicit, stiffness
 from kinetwork.solver.compiled import compiled, numeric
 from scenes import chains
+from scenes.follower import follower, follower_reference
 
-K, M2, D2 = 90.0, 1e-3, 0.006
 T_END, POINTS = 10.0, 101
-
-
-def follower():
-    """Two prismatic joints along x in series: the slow body, then the fast one on it."""
-    m = kn.Model("fast_follower")
-    mb, tr = kn.multibody, kn.translational
-    m.add(mb.Ground("ground", gravity=[0, -9.81, 0]))
-    previous = "ground.frame"
-    for name, mass, c, d, q0 in (("slow", 1.0, 1.0, 0.01, 1.0), ("fast", M2, K, D2, M2 / K)):
-        joint = m.add(mb.Prismatic(f"{name}_joint", axis=[1, 0, 0], q0=q0))
-        body = m.add(mb.RigidBody(name, mass=mass, inertia=np.eye(3).tolist()))
-        spring = m.add(tr.SpringDamper(f"{name}_spring", c=c, d=d))
-        m.connect(previous, joint.frame_a)
-        m.connect(joint.frame_b, body.frame_a)
-        m.connect(spring.flange_a, joint.support)
-        m.connect(spring.flange_b, joint.axis)
-        previous = joint.frame_b
-    return m
-
-
-def reference():
-    """(q1, q2, v1, v2) at the output times: the masses' own equations, x2 = q1 + q2."""
-    def rhs(t, y):
-        q1, q2, v1, v2 = y
-        forces = [-q1 - 0.01 * v1, -K * q2 - D2 * v2]
-        a = np.linalg.solve([[1 + M2, M2], [M2, M2]], forces)
-        return [v1, v2, a[0], a[1]]
-    t = np.linspace(0.0, T_END, POINTS)
-    return solve_ivp(rhs, (0, T_END), [1.0, M2 / K, 0, 0], method="DOP853", rtol=1e-13,
-                     atol=1e-15, t_eval=t).y.T
 
 
 @pytest.fixture(scope="module")
@@ -60,7 +27,7 @@ def system():
 
 @pytest.fixture(scope="module")
 def ref():
-    return reference()
+    return follower_reference(np.linspace(0.0, T_END, POINTS))
 
 
 def within(res, ref):
