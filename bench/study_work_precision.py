@@ -21,7 +21,8 @@ at ``LIMIT`` times the budget. The sympy derivations run in the background of th
 preparation, two at a time, each in its own process.
 
 Writes ``results/work_precision.{csv,md}`` and ``results/work_precision_<scene>.png``.
-Run: ``python bench/study_work_precision.py [--quick]``.
+Run: ``python bench/study_work_precision.py [--quick]``; ``--casadi``, ``--overheads``,
+``--point-masses`` and ``--choice`` run one part alone (see ``--help``).
 """
 
 import argparse

@@ -11,16 +11,18 @@ is stable to about |hλ| ~ 0.2..2 at 1.5..2 evaluations a step; the classical RK
    radian of the fastest mode over the run that Adams held by that mode's stability takes
    (``adams_floor``); and
 2. at that step the global error is within the asked tolerance, by step doubling over a trial
-   stretch at the start (``trial_error``), the error of RK4 at h estimated from the difference
-   to h/2 (16/15 of it: fourth order) and grown linearly to the horizon. A step too long for
-   the tolerance is shortened by the fourth root of the excess and checked again; if RK4 then
-   costs more than Adams's floor, Adams it is.
+   stretch at the start (``trial_error``): the error of RK4 at h estimated from the difference
+   to h/2 (16/15 of it: fourth order) at the middle and the end of the stretch, its growth
+   between them carried on linearly to the horizon. A step too long for the tolerance is
+   shortened by the fourth root of the excess and checked again; if RK4 then costs more than
+   MARGIN times Adams's floor, Adams it is.
 
-The floor, measured on 16-link point-mass chains at rtol 1e-1 (bench/results/work_precision.md,
-"auto's choice"): CVODES's Adams takes 1.96 evaluations per radian of |λ|max over the run
-where the fastest mode is a real decay (0.1 m links), 3.2-4.5 where it rings (stiff joint
-springs): Adams-Moulton's stability region reaches further along the negative real axis than
-along the imaginary one, where RK4's reaches 2.8.
+Adams's floor is an estimate from runs where the fastest mode's stability held CVODES's Adams
+(its evaluations nearly the same from rtol 1e-1 to 1e-3): 1.96 evaluations per radian of
+|λ|max over the run where that mode is a real decay (16-link point-mass chains on 0.1 m
+links), 2.8 to 3.2 where it rings (``tests/scenes/follower.py``, 300 rad/s) and up to 4.5 on
+16-link chains with stiff joint springs: Adams-Moulton's stability region reaches further
+along the negative real axis than along the imaginary one, where RK4's reaches 2.8.
 """
 
 import math
