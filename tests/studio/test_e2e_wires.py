@@ -9,6 +9,7 @@ file would group them, not from the page's router. One page serves the whole mod
 
 import json
 import os
+import pathlib
 import re
 import shutil
 
@@ -181,8 +182,9 @@ def test_every_example_readable_at_1400x900(screen, site, name):
     other net's track, through no block, and ending at their ports."""
     show(screen, site, example=name)
     if os.environ.get("KINETWORK_E2E_SHOTS"):
-        screen.screenshot(path=os.path.join(os.environ["KINETWORK_E2E_SHOTS"],
-                                            f"{name.replace('/', '-')}.png"))
+        stem = os.path.join(os.environ["KINETWORK_E2E_SHOTS"], name.replace("/", "-"))
+        screen.screenshot(path=f"{stem}.png")
+        pathlib.Path(f"{stem}.json").write_text(json.dumps(K(screen, "K.wires")))
     assert_readable(faults(screen), name)
     assert not screen.errors, screen.errors
 

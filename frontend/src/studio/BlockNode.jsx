@@ -3,7 +3,7 @@
 import { memo } from "react";
 import { Handle, Position } from "@xyflow/react";
 import { DOMAIN_COLORS } from "./model.js";
-import { BLOCK_W, blockGeometry } from "./geometry.js";
+import { blockGeometry } from "./geometry.js";
 import { blockText } from "./problems.js";
 import { TypeIcon } from "./icons.jsx";
 
@@ -16,13 +16,13 @@ function shortType(type, subsystem) {
 function BlockNode({ data, selected }) {
   const { name, type, info, problems, subsystem, unknown, rotation, flip } = data;
   const ports = info ? info.ports : data.ports || [];
-  const { handles, height } = blockGeometry(ports, rotation, flip);
+  const { handles, height, width } = blockGeometry(ports, rotation, flip);
   const bad = problems && problems.length > 0;
   const cls = ["kn-block", selected ? "selected" : "", bad ? "bad" : "", subsystem ? "subsystem" : "", unknown ? "unknown" : ""]
     .filter(Boolean)
     .join(" ");
   return (
-    <div className={cls} data-testid={`node-${name}`} style={{ width: BLOCK_W, height }} title={`${name}: ${type}${info ? `\n${String(info.doc || "").trim()}` : " (unknown type)"}`}>
+    <div className={cls} data-testid={`node-${name}`} style={{ width, height }} title={`${name}: ${type}${info ? `\n${String(info.doc || "").trim()}` : " (unknown type)"}`}>
       <div className="kn-block-name">{name}</div>
       <div className="kn-block-icon" style={flip ? { transform: "scaleX(-1)" } : undefined}>
         <TypeIcon type={type} subsystem={subsystem} />
@@ -38,7 +38,7 @@ function BlockNode({ data, selected }) {
       {handles.map(({ port, side, x, y }) => {
         // the name of a port on the top or bottom stands beside it, outwards (left of the
         // middle: to the left), in the margin wires keep from the block
-        const beside = side === "top" || side === "bottom" ? (x < BLOCK_W / 2 ? "-before" : "-after") : "";
+        const beside = side === "top" || side === "bottom" ? (x < width / 2 ? "-before" : "-after") : "";
         const color = DOMAIN_COLORS[port.domain] || "#888";
         const style = side === "left" || side === "right" ? { top: y } : { left: x };
         return (

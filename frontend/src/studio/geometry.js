@@ -6,6 +6,8 @@ import { placedSide, portSide } from "./model.js";
 export const BLOCK_W = 116;
 /** Pixels between neighbouring ports on a side. */
 export const PORT_STEP = 20;
+/** Pixels between ports on the top or bottom when there are more than two (room for names). */
+const END_STEP = 40;
 /** A handle's size: big enough to hit with the mouse. */
 export const HANDLE = 14;
 const NAME_ROW = 16;
@@ -30,18 +32,20 @@ export function blockGeometry(ports, rotation = 0, flip = false) {
   const tall = Math.max(sides.left.length, sides.right.length);
   const body = Math.max(BODY_MIN, tall * PORT_STEP);
   const height = NAME_ROW + body + TYPE_ROW;
+  const ends = Math.max(sides.top.length, sides.bottom.length);
+  const width = ends > 2 ? Math.max(BLOCK_W, (ends + 1) * END_STEP) : BLOCK_W;
   const out = [];
   for (const side of ["left", "right"]) {
     const list = sides[side];
     // centred on the body's middle, PORT_STEP apart (whole pixels: the wires run straight)
     const mid = NAME_ROW + body / 2;
-    list.forEach((p, i) => out.push({ port: p, side, x: side === "left" ? 0 : BLOCK_W, y: Math.round(mid + (i - (list.length - 1) / 2) * PORT_STEP) }));
+    list.forEach((p, i) => out.push({ port: p, side, x: side === "left" ? 0 : width, y: Math.round(mid + (i - (list.length - 1) / 2) * PORT_STEP) }));
   }
   for (const side of ["top", "bottom"]) {
     const list = sides[side];
-    list.forEach((p, i) => out.push({ port: p, side, x: Math.round(((i + 1) / (list.length + 1)) * BLOCK_W), y: side === "top" ? 0 : height }));
+    list.forEach((p, i) => out.push({ port: p, side, x: Math.round(((i + 1) / (list.length + 1)) * width), y: side === "top" ? 0 : height }));
   }
-  return { handles: out, width: BLOCK_W, height };
+  return { handles: out, width, height };
 }
 
 /** A wire's end at a port: the outer edge of its handle (where React Flow ends it too). */

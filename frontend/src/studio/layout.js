@@ -5,11 +5,11 @@
 // it, then cut into rows when it is much wider than the diagram (a long chain wraps, as text
 // does), and the connected groups packed into rows of about the diagram's shape. All in
 // diagram pixels; positions are given back in the file's layout units, on the snap grid.
-import { BLOCK_W, blockGeometry } from "./geometry.js";
+import { blockGeometry } from "./geometry.js";
 import { GRID, SCALE } from "./model.js";
 
 const LAYER_GAP = 64; // px between layers (room for the wires between them)
-const NODE_GAP = 44; // px between blocks of a layer
+const NODE_GAP = 52; // px between blocks of a layer (room for two wires between)
 const SAT_GAP = 50; // px between a block and the parts stacked on it (room for a wire)
 const ROW_GAP = 70; // px between the rows of a wrapped layout
 const GROUP_GAP = 60; // px between connected groups
@@ -75,12 +75,13 @@ export function layoutBlocks(body, only, ctx, typeInfo) {
   const hosts = new Set();
   for (const [a, sa, b, sb] of links) {
     if (![sa, sb].some((s) => s === "top" || s === "bottom")) continue;
-    const [sat, ssat, anc, sanc] = degree.get(a) <= degree.get(b) ? [a, sa, b, sb] : [b, sb, a, sa];
+    const [sat, anc, sanc] = degree.get(a) <= degree.get(b) ? [a, b, sb] : [b, a, sa];
     if (degree.get(sat) > 2 || host.has(sat) || host.has(anc) || hosts.has(sat)) continue;
     // a part on both the top and the bottom of one block (a spring-damper on a joint's support
     // and axis) stands above it, as in Modelica's diagrams
     const both = links.filter(([p, , q]) => (p === sat && q === anc) || (p === anc && q === sat)).length > 1;
-    const where = both || sanc === "top" ? -1 : sanc === "bottom" ? 1 : ssat === "bottom" ? -1 : 1;
+    if (!both && sanc !== "top" && sanc !== "bottom") continue; // on a side port: next layer
+    const where = both || sanc === "top" ? -1 : 1;
     host.set(sat, [anc, where]);
     hosts.add(anc);
   }
@@ -91,7 +92,7 @@ export function layoutBlocks(body, only, ctx, typeInfo) {
   for (const [sat, [anc, where]] of host) units.get(top(anc))[where < 0 ? "above" : "below"].push(sat);
   for (const u of units.values()) {
     const hs = (list) => list.reduce((s, n) => s + shape.get(n).h + SAT_GAP, 0);
-    u.w = BLOCK_W;
+    u.w = Math.max(...[u.id, ...u.above, ...u.below].map((m) => shape.get(m).w));
     u.up = hs(u.above);
     u.h = u.up + shape.get(u.id).h + hs(u.below);
   }
@@ -137,21 +138,17 @@ export function layoutBlocks(body, only, ctx, typeInfo) {
     }
   }
   if (!Number.isFinite(x0)) x0 = 0;
+  // on the snap grid, rounded up down a stack so that no gap shrinks
   const snap = (v) => (Math.round(v / GRID) * GRID) / SCALE;
+  const down = (v) => Math.ceil(v / GRID - 1e-9) * GRID;
   const pos = {};
   for (const [id, p] of boxes) {
     const u = units.get(id);
-    const x = x0 + p.x;
-    let y = y0 + p.y;
-    for (const n of u.above) {
-      pos[n] = { x: snap(x), y: snap(y) };
-      y += shape.get(n).h + SAT_GAP;
-    }
-    pos[id] = { x: snap(x), y: snap(y) };
-    y += shape.get(id).h + SAT_GAP;
-    for (const n of u.below) {
-      pos[n] = { x: snap(x), y: snap(y) };
-      y += shape.get(n).h + SAT_GAP;
+    const x = snap(x0 + p.x);
+    let y = down(y0 + p.y);
+    for (const n of [...u.above, id, ...u.below]) {
+      pos[n] = { x, y: y / SCALE };
+      y = down(y + shape.get(n).h + SAT_GAP);
     }
   }
   return pos;
@@ -235,49 +232,75 @@ function layered(members, out, units) {
       l.forEach((m, i) => rank.set(m, i));
     }
   }
-  // heights: each block level with what feeds it where there is room
-  const y = new Map();
-  for (const l of layers) {
-    let floor = 0;
+  // a layer much taller than the group is wide folds into columns side by side (twelve
+  // signal sources feeding six drives stand in two columns, not one)
+  const area = members.reduce((t, m) => t + (units.get(m).w + LAYER_GAP) * (units.get(m).h + NODE_GAP), 0);
+  const tallest = Math.max(...members.map((m) => units.get(m).h));
+  const reach = Math.max(tallest, Math.sqrt(area / ASPECT) * 1.15);
+  const slots = []; // columns, in order: [layer, members]
+  for (const [k, l] of layers.entries()) {
+    let col = [];
+    let h = 0;
     for (const m of l) {
-      const feeds = nbrs.get(m).filter((n) => y.has(n) && layer.get(n) < layer.get(m));
-      const want = feeds.length ? feeds.reduce((s, n) => s + y.get(n) + units.get(n).up, 0) / feeds.length - units.get(m).up : floor;
+      const dh = units.get(m).h + NODE_GAP;
+      if (col.length && h + dh - NODE_GAP > reach) {
+        slots.push([k, col]);
+        col = [];
+        h = 0;
+      }
+      col.push(m);
+      h += dh;
+    }
+    if (col.length) slots.push([k, col]);
+  }
+  // heights: each block level with what feeds it, where there is room
+  const y = new Map();
+  const slotOf = new Map();
+  slots.forEach(([, col], i) => col.forEach((m) => slotOf.set(m, i)));
+  for (const [i, [, col]] of slots.entries()) {
+    let floor = 0;
+    for (const m of col) {
+      const feeds = nbrs.get(m).filter((n) => y.has(n) && slotOf.get(n) < i);
+      const want = feeds.length ? feeds.reduce((t, n) => t + y.get(n) + units.get(n).up, 0) / feeds.length - units.get(m).up : floor;
       const at = Math.max(floor, want);
       y.set(m, at);
       floor = at + units.get(m).h + NODE_GAP;
     }
   }
-  // cut into rows where that brings the group nearer the diagram's shape
-  const width = (k0, k1) => (k1 - k0) * (BLOCK_W + LAYER_GAP) - LAYER_GAP;
-  const height = (k0, k1) => {
+  const slotW = slots.map(([, col]) => Math.max(...col.map((m) => units.get(m).w)));
+  const span = (k0, k1) => {
     let lo = Infinity;
     let hi = -Infinity;
-    for (let k = k0; k < k1; k++) for (const m of layers[k]) (lo = Math.min(lo, y.get(m)), hi = Math.max(hi, y.get(m) + units.get(m).h));
+    for (let k = k0; k < k1; k++) for (const m of slots[k][1]) (lo = Math.min(lo, y.get(m)), hi = Math.max(hi, y.get(m) + units.get(m).h));
     return [lo, hi];
   };
+  const width = (k0, k1) => slotW.slice(k0, k1).reduce((t, w) => t + w + LAYER_GAP, 0) - LAYER_GAP;
+  // cut into rows where that brings the group nearer the diagram's shape
+  const n = slots.length;
   let best = null;
-  for (let rows = 1; rows <= depth; rows++) {
-    const per = Math.ceil(depth / rows);
+  for (let rows = 1; rows <= n; rows++) {
+    const per = Math.ceil(n / rows);
     let h = 0;
+    let w = 0;
     const cuts = [];
-    for (let k = 0; k < depth; k += per) {
-      const [lo, hi] = height(k, Math.min(depth, k + per));
+    for (let k = 0; k < n; k += per) {
+      const [lo, hi] = span(k, Math.min(n, k + per));
       cuts.push([k, lo, h]);
       h += hi - lo + ROW_GAP;
+      w = Math.max(w, width(k, Math.min(n, k + per)));
     }
-    const w = width(0, Math.min(depth, per));
     const score = Math.max(w / ASPECT, h - ROW_GAP);
-    if (!best || score < best.score - 1) best = { score, per, cuts };
+    if (!best || score < best.score - 1) best = { score, per, cuts, w, h: h - ROW_GAP };
   }
   const at = new Map();
   for (const [k0, lo, top] of best.cuts) {
-    for (let k = k0; k < Math.min(depth, k0 + best.per); k++) {
-      for (const m of layers[k]) at.set(m, { x: (k - k0) * (BLOCK_W + LAYER_GAP), y: top + y.get(m) - lo });
+    let x = 0;
+    for (let k = k0; k < Math.min(n, k0 + best.per); k++) {
+      for (const m of slots[k][1]) at.set(m, { x, y: top + y.get(m) - lo });
+      x += slotW[k] + LAYER_GAP;
     }
   }
-  const w = width(0, Math.min(depth, best.per));
-  const h = Math.max(...[...at].map(([m, p]) => p.y + units.get(m).h));
-  return { at, w, h };
+  return { at, w: best.w, h: best.h };
 }
 
 /** Groups packed in rows, the widest first, to about the diagram's shape: unit -> {x, y}. */

@@ -10,6 +10,8 @@
 export const CLEAR = 16;
 /** Pixels between neighbouring parallel tracks. */
 export const TRACK = 8;
+/** Pixels from a port's handle kept for its own net: past the first track beside its block. */
+const STUB = CLEAR + 4;
 const BEND = 30;
 const CROSS = 14;
 const MERGE = 0.35; // the price of a pixel along a wire of the same net, against 1 elsewhere
@@ -137,6 +139,12 @@ class Grid {
         ex.push(p.x);
         ey.push(p.y);
       }
+    }
+    // and a few tracks around everything, for the wires that go round the outside
+    for (const [exact, wanted] of [[ex, wx], [ey, wy]]) {
+      const lo = Math.min(...exact, ...wanted);
+      const hi = Math.max(...exact, ...wanted);
+      for (let k = 1; k <= 4; k++) wanted.push(lo - k * TRACK, hi + k * TRACK);
     }
     this.xs = tracks(ex, wx);
     this.ys = tracks(ey, wy);
@@ -369,7 +377,8 @@ export function segmentHits(p, q, r, m = 0) {
  * @param {{rects: Map<string, string>, wires: Map<string, {key: string, points: any[]}>} | null}
  *   before the answer for the diagram as it was: wires that need not change are kept
  * @returns {{rects: Map<string, string>, wires: Map<string, {key: string, points: any[]}>,
- *   routed: number}} each wire's points; ``routed``: how many were routed this time
+ *   routed: number, clashes: string[]}} each wire's points; ``routed``: how many were routed
+ *   this time; ``clashes``: the wires that found no way but along another net's wire
  */
 export function routeWires(rects, wires, before = null) {
   const rectKeys = new Map(rects.map((r) => [r.id, rectKey(r)]));
@@ -387,11 +396,11 @@ export function routeWires(rects, wires, before = null) {
     }
   }
   const todo = wires.filter((w) => !keep.has(w.id));
-  if (before && !todo.length) return { rects: rectKeys, wires: keep, routed: 0 };
+  if (before && !todo.length) return { rects: rectKeys, wires: keep, routed: 0, clashes: [] };
   const out = route(rects, wires, keep, todo);
   // a wire that found no way but along another net's: all of them again, from scratch
-  if (before && out.clashes) return routeWires(rects, wires, null);
-  return { rects: rectKeys, wires: out.wires, routed: todo.length };
+  if (before && out.clashes.length) return routeWires(rects, wires, null);
+  return { rects: rectKeys, wires: out.wires, routed: todo.length, clashes: out.clashes };
 }
 
 /**
@@ -414,6 +423,11 @@ function route(rects, wires, keep, todo) {
   const ends = wires.flatMap((w) => [w.a, w.b]);
   const grid = new Grid(rects, ends, [...keep.values()].map((k) => k.points));
   const byId = new Map(wires.map((w) => [w.id, w]));
+  // each port's way out is its net's: another net running along it would leave the port
+  // no way to go
+  for (const w of wires) {
+    for (const e of [w.a, w.b]) grid.occupy([e, { x: e.x + e.dir[0] * STUB, y: e.y + e.dir[1] * STUB }], w.net);
+  }
   for (const [id, k] of keep) grid.occupy(k.points, byId.get(id).net);
   // the nets with the shortest reach first (they have the fewest ways), a net's wires together
   const reach = new Map();
@@ -423,11 +437,11 @@ function route(rects, wires, keep, todo) {
   }
   const order = [...todo].sort((p, q) => reach.get(p.net) - reach.get(q.net) || p.net - q.net || String(p.id).localeCompare(String(q.id)));
   const result = new Map(keep);
-  let clashes = 0;
+  const clashes = [];
   for (const w of order) {
     let points = grid.search(w.a, w.b, w.net, true);
     if (!points) {
-      clashes += 1;
+      clashes.push(w.id);
       points = grid.search(w.a, w.b, w.net, false);
     }
     if (!points) {

@@ -1,9 +1,10 @@
 // The wires of the diagram, routed (routing.js) from where the blocks are shown: their
 // places in the document or, while the mouse drags, React Flow's. Each change routes again
 // only the wires it concerns.
-import { useMemo, useState } from "react";
-import { BLOCK_W, OUTWARD, blockGeometry, portPoint } from "../geometry.js";
+import { useEffect, useMemo, useState } from "react";
+import { OUTWARD, blockGeometry, portPoint } from "../geometry.js";
 import { WireRouter } from "../routing.js";
+import { TESTING, trace } from "../testing.js";
 
 const EXTPORT = { width: 90, height: 26 };
 const FACING = { left: "right", right: "left", top: "bottom", bottom: "top" };
@@ -45,7 +46,7 @@ export function shapes(nodes) {
     const ports = n.data.info ? n.data.info.ports : n.data.ports || [];
     const g = blockGeometry(ports, n.data.rotation, n.data.flip);
     out.set(n.id, {
-      rect: { id: n.id, x0: x, y0: y, x1: x + BLOCK_W, y1: y + g.height },
+      rect: { id: n.id, x0: x, y0: y, x1: x + g.width, y1: y + g.height },
       ports: new Map(g.handles.map((h) => [h.port.name, portPoint(x, y, h)])),
     });
   }
@@ -69,7 +70,7 @@ function endOf(shape, port, other) {
  */
 export function useWires(nodes, edges) {
   const [router] = useState(() => new WireRouter());
-  return useMemo(() => {
+  const out = useMemo(() => {
     const shape = shapes(nodes);
     const nets = netsOf(edges);
     const wires = edges.map((e) => {
@@ -81,6 +82,10 @@ export function useWires(nodes, edges) {
     });
     const rects = [...shape.values()].map((s) => s.rect);
     const routed = router.route(rects, wires);
-    return edges.map((e) => ({ ...e, type: "wire", data: { ...e.data, points: routed.wires.get(e.id).points } }));
+    return { rects, wires, routed: routed.routed, edges: edges.map((e) => ({ ...e, type: "wire", data: { ...e.data, points: routed.wires.get(e.id).points } })) };
   }, [router, nodes, edges]);
+  useEffect(() => {
+    if (TESTING) trace.wires = { rects: out.rects, wires: out.wires, routed: out.routed };
+  }, [out]);
+  return out.edges;
 }
