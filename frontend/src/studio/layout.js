@@ -64,7 +64,7 @@ export function layoutBlocks(body, only, ctx, typeInfo) {
     if (a === b || !shape.has(a) || !shape.has(b)) continue;
     const sa = shape.get(a).side.get(porta);
     const sb = shape.get(b).side.get(portb);
-    links.push([a, sa ? sa.side : "right", b, sb ? sb.side : "left"]);
+    links.push([a, sa ? sa.side : "right", b, sb ? sb.side : "left", pa, pb]);
   }
   const degree = new Map();
   for (const [a, , b] of links) for (const n of [a, b]) degree.set(n, (degree.get(n) || 0) + 1);
@@ -73,7 +73,7 @@ export function layoutBlocks(body, only, ctx, typeInfo) {
   // with at most two wires) stands above or below the other end, by the side of its port
   const host = new Map(); // satellite -> [anchor, -1 above | +1 below]
   const hosts = new Set();
-  for (const [a, sa, b, sb] of links) {
+  for (const [a, sa, b, sb, pa, pb] of links) {
     if (![sa, sb].some((s) => s === "top" || s === "bottom")) continue;
     const [sat, anc, sanc] = degree.get(a) <= degree.get(b) ? [a, b, sb] : [b, a, sa];
     if (degree.get(sat) > 2 || host.has(sat) || host.has(anc) || hosts.has(sat)) continue;
@@ -82,7 +82,8 @@ export function layoutBlocks(body, only, ctx, typeInfo) {
     const both = links.filter(([p, , q]) => (p === sat && q === anc) || (p === anc && q === sat)).length > 1;
     if (!both && sanc !== "top" && sanc !== "bottom") continue; // on a side port: next layer
     const where = both || sanc === "top" ? -1 : 1;
-    host.set(sat, [anc, where]);
+    const hook = shape.get(anc).side.get(ref(sat === a ? pb : pa)[1]);
+    host.set(sat, [anc, where, hook ? hook.x : 0]);
     hosts.add(anc);
   }
   const top = (n) => (host.has(n) ? host.get(n)[0] : n);
@@ -91,10 +92,19 @@ export function layoutBlocks(body, only, ctx, typeInfo) {
   for (const c of free) if (!host.has(c.name)) units.set(c.name, { id: c.name, above: [], below: [] });
   for (const [sat, [anc, where]] of host) units.get(top(anc))[where < 0 ? "above" : "below"].push(sat);
   for (const u of units.values()) {
-    const hs = (list) => list.reduce((s, n) => s + shape.get(n).h + SAT_GAP, 0);
-    u.w = Math.max(...[u.id, ...u.above, ...u.below].map((m) => shape.get(m).w));
-    u.up = hs(u.above);
-    u.h = u.up + shape.get(u.id).h + hs(u.below);
+    // above: stacked; below: side by side, each under the port it hangs on
+    u.up = u.above.reduce((t, n) => t + shape.get(n).h + SAT_GAP, 0);
+    u.below.sort((p, q) => host.get(p)[2] - host.get(q)[2]);
+    u.dx = new Map();
+    let right = -Infinity;
+    for (const n of u.below) {
+      const at = Math.max(right + NODE_GAP, host.get(n)[2] - shape.get(n).w / 2, 0);
+      u.dx.set(n, at);
+      right = at + shape.get(n).w;
+    }
+    u.w = Math.max(right, ...[u.id, ...u.above].map((m) => shape.get(m).w));
+    const low = u.below.length ? SAT_GAP + Math.max(...u.below.map((n) => shape.get(n).h)) : 0;
+    u.h = u.up + shape.get(u.id).h + low;
   }
 
   // the flow between units: right side to left side goes forward
@@ -127,17 +137,24 @@ export function layoutBlocks(body, only, ctx, typeInfo) {
   }
   const boxes = pack(groups);
 
-  // below what the layout places already
+  // beside or below what the layout places already, whichever keeps the diagram's shape
+  const given = comps.filter((c) => !want.has(c.name) && (body.layout || {})[c.name] && typeof body.layout[c.name].y === "number");
+  let x0 = 0;
   let y0 = 0;
-  let x0 = Infinity;
-  for (const c of comps) {
-    const p = (body.layout || {})[c.name];
-    if (!want.has(c.name) && p && typeof p.y === "number") {
-      y0 = Math.max(y0, (p.y + 100) * SCALE);
-      x0 = Math.min(x0, p.x * SCALE);
-    }
+  if (given.length) {
+    const rects = given.map((c) => {
+      const p = body.layout[c.name];
+      const sh = shapeOf(c, body, ctx, typeInfo);
+      return [p.x * SCALE, p.y * SCALE, p.x * SCALE + sh.w, p.y * SCALE + sh.h];
+    });
+    const [gx0, gy0, gx1, gy1] = [0, 1, 2, 3].map((k) => (k < 2 ? Math.min : Math.max)(...rects.map((r) => r[k])));
+    const fw = Math.max(0, ...[...boxes].map(([id, p]) => p.x + units.get(id).w));
+    const fh = Math.max(0, ...[...boxes].map(([id, p]) => p.y + units.get(id).h));
+    const fit = (w, h) => Math.max(w / ASPECT, h);
+    const below = fit(Math.max(gx1 - gx0, fw), gy1 - gy0 + GROUP_GAP + fh);
+    const beside = fit(gx1 - gx0 + GROUP_GAP + fw, Math.max(gy1 - gy0, fh));
+    [x0, y0] = below <= beside ? [gx0, gy1 + GROUP_GAP] : [gx1 + GROUP_GAP, gy0];
   }
-  if (!Number.isFinite(x0)) x0 = 0;
   // on the snap grid, rounded up down a stack so that no gap shrinks
   const snap = (v) => (Math.round(v / GRID) * GRID) / SCALE;
   const down = (v) => Math.ceil(v / GRID - 1e-9) * GRID;
@@ -146,10 +163,11 @@ export function layoutBlocks(body, only, ctx, typeInfo) {
     const u = units.get(id);
     const x = snap(x0 + p.x);
     let y = down(y0 + p.y);
-    for (const n of [...u.above, id, ...u.below]) {
+    for (const n of [...u.above, id]) {
       pos[n] = { x, y: y / SCALE };
       y = down(y + shape.get(n).h + SAT_GAP);
     }
+    for (const n of u.below) pos[n] = { x: snap(x0 + p.x + u.dx.get(n)), y: y / SCALE };
   }
   return pos;
 }
@@ -228,7 +246,9 @@ function layered(members, out, units) {
         const near = nbrs.get(m).filter((n) => layer.get(n) === layer.get(m) + side);
         bary.set(m, near.length ? near.reduce((s, n) => s + rank.get(n), 0) / near.length : rank.get(m));
       }
-      l.sort((p, q) => bary.get(p) - bary.get(q));
+      // on a tie, what leads on (a chain's next link) above a leaf (a body on a joint): the
+      // chain then runs straight instead of down a staircase
+      l.sort((p, q) => bary.get(p) - bary.get(q) || (forward.get(p).length ? 0 : 1) - (forward.get(q).length ? 0 : 1));
       l.forEach((m, i) => rank.set(m, i));
     }
   }
@@ -236,7 +256,7 @@ function layered(members, out, units) {
   // signal sources feeding six drives stand in two columns, not one)
   const area = members.reduce((t, m) => t + (units.get(m).w + LAYER_GAP) * (units.get(m).h + NODE_GAP), 0);
   const tallest = Math.max(...members.map((m) => units.get(m).h));
-  const reach = Math.max(tallest, Math.sqrt(area / ASPECT) * 1.15);
+  const reach = Math.max(tallest, Math.sqrt(area / ASPECT) * 0.8);
   const slots = []; // columns, in order: [layer, members]
   for (const [k, l] of layers.entries()) {
     let col = [];
