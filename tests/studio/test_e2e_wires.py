@@ -210,7 +210,7 @@ def drag_block(page, name, dx, dy):
 
 
 @pytest.mark.parametrize("model, block", [
-    ({"open": "models/double_pendulum.json"}, "revolute2"),
+    ({"open": "models/double_pendulum.json"}, "elbow"),
     ({"example": "arm_computed_torque"}, None),
     ({"example": "robot_r3/FullRobot"}, None),
     ({"open": "chain32.json"}, None),

@@ -24,7 +24,7 @@ function BlockNode({ data, selected }) {
   return (
     <div className={cls} data-testid={`node-${name}`} style={{ width, height }} title={`${name}: ${type}${info ? `\n${String(info.doc || "").trim()}` : " (unknown type)"}`}>
       <div className="kn-block-name">{name}</div>
-      <div className="kn-block-icon" style={flip ? { transform: "scaleX(-1)" } : undefined}>
+      <div className={`kn-block-icon${flip ? " flipped" : ""}`}>
         <TypeIcon type={type} subsystem={subsystem} />
       </div>
       {bad ? (

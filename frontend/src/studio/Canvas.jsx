@@ -124,7 +124,7 @@ export default function Canvas({ nodes: nodesIn, edges: edgesIn, placed, edit })
   useEffect(() => {
     if (!fitRequest || fitted.current === fitRequest || !initialized || !nodes.length || !placed) return undefined;
     const id = requestAnimationFrame(() => {
-      flow.fitView({ padding: 0.05, maxZoom: 1.1, duration: 0 });
+      flow.fitView({ padding: 0.03, maxZoom: 1.1, duration: 0 });
       fitted.current = fitRequest;
     });
     return () => cancelAnimationFrame(id);

@@ -256,7 +256,7 @@ function layered(members, out, units) {
   // signal sources feeding six drives stand in two columns, not one)
   const area = members.reduce((t, m) => t + (units.get(m).w + LAYER_GAP) * (units.get(m).h + NODE_GAP), 0);
   const tallest = Math.max(...members.map((m) => units.get(m).h));
-  const reach = Math.max(tallest, Math.sqrt(area / ASPECT) * 0.8);
+  const reach = Math.max(tallest, Math.sqrt(area / ASPECT) * 0.7);
   const slots = []; // columns, in order: [layer, members]
   for (const [k, l] of layers.entries()) {
     let col = [];

@@ -18,6 +18,7 @@ const MERGE = 0.35; // the price of a pixel along a wire of the same net, agains
 const CLASH = 4000; // a pixel along another net's wire, when there is no other way
 const MAX_FILL = 6; // extra tracks across one gap
 const NEAR = 3; // tracks closer than this are one track
+const RETRIES = 3; // rounds of routing a crowded diagram again, the wires that failed first
 
 const DIRS = [[1, 0], [-1, 0], [0, 1], [0, -1]];
 
@@ -300,7 +301,10 @@ class Grid {
         let extra = 0;
         if (d2 !== d) {
           // a bend on another net's wire reads as a junction
-          if (other(this.stop[node]) || other(this.passH[node]) || other(this.passV[node])) continue;
+          if (other(this.stop[node]) || other(this.passH[node]) || other(this.passV[node])) {
+            if (strict) continue;
+            extra += CLASH;
+          }
           extra += BEND;
         }
         const [dx, dy] = DIRS[d2];
@@ -397,7 +401,14 @@ export function routeWires(rects, wires, before = null) {
   }
   const todo = wires.filter((w) => !keep.has(w.id));
   if (before && !todo.length) return { rects: rectKeys, wires: keep, routed: 0, clashes: [] };
-  const out = route(rects, wires, keep, todo);
+  let out = route(rects, wires, keep, todo);
+  // a wire that found no way of its own goes first next time (a crowded diagram): a few rounds
+  for (let round = 0; round < RETRIES && out.clashes.length && !keep.size; round++) {
+    const first = new Set(out.clashes);
+    const again = route(rects, wires, keep, todo, first);
+    if (again.clashes.length < out.clashes.length) out = again;
+    else break;
+  }
   // a wire that found no way but along another net's: all of them again, from scratch
   if (before && out.clashes.length) return routeWires(rects, wires, null);
   return { rects: rectKeys, wires: out.wires, routed: todo.length, clashes: out.clashes };
@@ -419,7 +430,7 @@ export class WireRouter {
   }
 }
 
-function route(rects, wires, keep, todo) {
+function route(rects, wires, keep, todo, first = new Set()) {
   const ends = wires.flatMap((w) => [w.a, w.b]);
   const grid = new Grid(rects, ends, [...keep.values()].map((k) => k.points));
   const byId = new Map(wires.map((w) => [w.id, w]));
@@ -435,7 +446,9 @@ function route(rects, wires, keep, todo) {
     const d = Math.abs(w.a.x - w.b.x) + Math.abs(w.a.y - w.b.y);
     reach.set(w.net, Math.max(reach.get(w.net) || 0, d));
   }
-  const order = [...todo].sort((p, q) => reach.get(p.net) - reach.get(q.net) || p.net - q.net || String(p.id).localeCompare(String(q.id)));
+  const ahead = new Set([...todo].filter((w) => first.has(w.id)).map((w) => w.net));
+  const rank = (w) => (ahead.has(w.net) ? 0 : 1);
+  const order = [...todo].sort((p, q) => rank(p) - rank(q) || reach.get(p.net) - reach.get(q.net) || p.net - q.net || String(p.id).localeCompare(String(q.id)));
   const result = new Map(keep);
   const clashes = [];
   for (const w of order) {
