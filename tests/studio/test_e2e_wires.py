@@ -34,9 +34,10 @@ DRAWN = """() => {
         return {id: el.getAttribute('data-id'), x: +m[1], y: +m[2],
                 w: el.offsetWidth, h: el.offsetHeight};
     });
-    const vp = getComputedStyle(document.querySelector('.react-flow__viewport')).transform;
-    const zoom = new DOMMatrix(vp).a;
-    return {wires, blocks, zoom};
+    const m = new DOMMatrix(getComputedStyle(document.querySelector('.react-flow__viewport')).transform);
+    const r = document.querySelector('.react-flow').getBoundingClientRect();
+    return {wires, blocks, zoom: m.a, tx: m.e, ty: m.f,
+            pane: {x: r.left, y: r.top, w: r.width, h: r.height}};
 }"""
 
 
@@ -194,9 +195,35 @@ def test_chain_of_32_links_readable(screen, site):
     assert_readable(faults(screen), "chain32")
 
 
-def drag_block(page, name, dx, dy):
-    """Drag block ``name`` by (dx, dy) screen pixels with the mouse, by its name (not a
-    port); waits until the model holds its new place."""
+def free_spot(page, name):
+    """Where block ``name`` can go in the part of the diagram on screen, clear of every other
+    block by 40 px and of the corner controls, as far from where it is as there is: the
+    move (dx, dy) in screen pixels."""
+    d = page.evaluate(DRAWN)
+    z, pane = d["zoom"], d["pane"]
+    me = next(b for b in d["blocks"] if b["id"] == name)
+    others = [b for b in d["blocks"] if b["id"] != name]
+    # the pane's corners hold the zoom buttons (left) and the minimap (right)
+    x0, x1 = (60 - d["tx"]) / z, (pane["w"] - 20 - d["tx"]) / z - me["w"]
+    y0, y1 = (20 - d["ty"]) / z, (pane["h"] - 110 - d["ty"]) / z - me["h"]
+    best = None
+    for i in range(41):
+        for j in range(41):
+            x, y = x0 + (x1 - x0) * i / 40, y0 + (y1 - y0) * j / 40
+            if any(x < b["x"] + b["w"] + 40 and b["x"] < x + me["w"] + 40 and
+                   y < b["y"] + b["h"] + 40 and b["y"] < y + me["h"] + 40 for b in others):
+                continue
+            far = abs(x - me["x"]) + abs(y - me["y"])
+            if best is None or far > best[0]:
+                best = (far, x, y)
+    assert best, f"no free room for {name} on screen"
+    return (best[1] - me["x"]) * z, (best[2] - me["y"]) * z
+
+
+def drag_block(page, name):
+    """Drag block ``name`` with the mouse, by its name (not a port), to the free place
+    farthest from it on screen; waits until the model holds its new place."""
+    dx, dy = free_spot(page, name)
     before = K(page, f"K.doc.layout && K.doc.layout[{json.dumps(name)}]")
     box = page.locator(f"{tid(f'node-{name}')} .kn-block-name").bounding_box()
     x, y = box["x"] + box["width"] / 2, box["y"] + box["height"] / 2
@@ -216,13 +243,13 @@ def drag_block(page, name, dx, dy):
     ({"open": "chain32.json"}, None),
 ])
 def test_wires_rerouted_when_a_block_is_dragged(screen, site, model, block):
-    """A block dragged with the mouse across its neighbours: its wires follow it and every
-    wire still keeps off other nets' tracks and out of blocks."""
+    """A block dragged with the mouse to the free place farthest from it: its wires follow it
+    and every wire still keeps off other nets' tracks and out of blocks."""
     show(screen, site, **model)
     names = [c["name"] for c in K(screen, "K.doc.components")]
     name = block or names[len(names) // 2]
     assert_readable(faults(screen), f"{model} before the drag")
-    drag_block(screen, name, 70, 110)
+    drag_block(screen, name)
     screen.wait_for_function("() => new Promise((done) => requestAnimationFrame(() => done(true)))")
     assert_readable(faults(screen), f"{model} after dragging {name}", fit=False)
     assert not screen.errors, screen.errors

@@ -14,7 +14,9 @@ const SAT_GAP = 50; // px between a block and the parts stacked on it (room for 
 const ROW_GAP = 70; // px between the rows of a wrapped layout
 const GROUP_GAP = 60; // px between connected groups
 /** The diagram's shape (width over height) the layout aims at: the studio's canvas. */
-export const ASPECT = 1.75;
+export const ASPECT = 1.6;
+/** How tall a layer may stand before it folds into columns, against the group's ideal height. */
+const FOLDS = [0.5, 0.65, 0.8, 1.0, 1.3];
 
 function ref(path) {
   const s = String(path);
@@ -133,28 +135,33 @@ export function layoutBlocks(body, only, ctx, typeInfo) {
       for (const m of undirected.get(n)) if (!seen.has(m)) (seen.add(m), todo.push(m));
     }
     members.sort((p, q) => order.get(p) - order.get(q));
-    groups.push(layered(members, out, units));
+    groups.push(members);
   }
-  const boxes = pack(groups);
 
   // beside or below what the layout places already, whichever keeps the diagram's shape
   const given = comps.filter((c) => !want.has(c.name) && (body.layout || {})[c.name] && typeof body.layout[c.name].y === "number");
-  let x0 = 0;
-  let y0 = 0;
-  if (given.length) {
-    const rects = given.map((c) => {
-      const p = body.layout[c.name];
-      const sh = shapeOf(c, body, ctx, typeInfo);
-      return [p.x * SCALE, p.y * SCALE, p.x * SCALE + sh.w, p.y * SCALE + sh.h];
-    });
-    const [gx0, gy0, gx1, gy1] = [0, 1, 2, 3].map((k) => (k < 2 ? Math.min : Math.max)(...rects.map((r) => r[k])));
+  const placed = given.map((c) => {
+    const p = body.layout[c.name];
+    const sh = shapeOf(c, body, ctx, typeInfo);
+    return [p.x * SCALE, p.y * SCALE, p.x * SCALE + sh.w, p.y * SCALE + sh.h];
+  });
+  const fit = (w, h) => Math.max(w / ASPECT, h);
+  // how tall a layer may stand before it folds: a few tried, the one that fits best kept
+  let best = null;
+  for (const fold of FOLDS) {
+    const boxes = pack(groups.map((members) => layered(members, out, units, fold)));
     const fw = Math.max(0, ...[...boxes].map(([id, p]) => p.x + units.get(id).w));
     const fh = Math.max(0, ...[...boxes].map(([id, p]) => p.y + units.get(id).h));
-    const fit = (w, h) => Math.max(w / ASPECT, h);
-    const below = fit(Math.max(gx1 - gx0, fw), gy1 - gy0 + GROUP_GAP + fh);
-    const beside = fit(gx1 - gx0 + GROUP_GAP + fw, Math.max(gy1 - gy0, fh));
-    [x0, y0] = below <= beside ? [gx0, gy1 + GROUP_GAP] : [gx1 + GROUP_GAP, gy0];
+    let choice = { boxes, x0: 0, y0: 0, score: fit(fw, fh) };
+    if (placed.length) {
+      const [gx0, gy0, gx1, gy1] = [0, 1, 2, 3].map((k) => (k < 2 ? Math.min : Math.max)(...placed.map((r) => r[k])));
+      const below = fit(Math.max(gx1 - gx0, fw), gy1 - gy0 + GROUP_GAP + fh);
+      const beside = fit(gx1 - gx0 + GROUP_GAP + fw, Math.max(gy1 - gy0, fh));
+      choice = below <= beside ? { boxes, x0: gx0, y0: gy1 + GROUP_GAP, score: below } : { boxes, x0: gx1 + GROUP_GAP, y0: gy0, score: beside };
+    }
+    if (!best || choice.score < best.score - 1) best = choice;
   }
+  const { boxes, x0, y0 } = best;
   // on the snap grid, rounded up down a stack so that no gap shrinks
   const snap = (v) => (Math.round(v / GRID) * GRID) / SCALE;
   const down = (v) => Math.ceil(v / GRID - 1e-9) * GRID;
@@ -173,7 +180,7 @@ export function layoutBlocks(body, only, ctx, typeInfo) {
 }
 
 /** One connected group laid out in layers (wrapped into rows when long): unit -> {x, y}. */
-function layered(members, out, units) {
+function layered(members, out, units, fold) {
   const inGroup = new Set(members);
   // break cycles where a depth-first walk from the sources closes them
   const state = new Map();
@@ -256,7 +263,7 @@ function layered(members, out, units) {
   // signal sources feeding six drives stand in two columns, not one)
   const area = members.reduce((t, m) => t + (units.get(m).w + LAYER_GAP) * (units.get(m).h + NODE_GAP), 0);
   const tallest = Math.max(...members.map((m) => units.get(m).h));
-  const reach = Math.max(tallest, Math.sqrt(area / ASPECT) * 0.7);
+  const reach = Math.max(tallest, Math.sqrt(area / ASPECT) * fold);
   const slots = []; // columns, in order: [layer, members]
   for (const [k, l] of layers.entries()) {
     let col = [];
