@@ -204,15 +204,16 @@ def test_chain_of_32_links_wraps_into_rows(screen, site):
 
 def free_spot(page, name):
     """Where block ``name`` can go in the part of the diagram on screen, clear of every other
-    block by 40 px and of the corner controls, as far from where it is as there is: the
-    move (dx, dy) in screen pixels."""
+    block by 40 px and of the pane's edges and controls, about 400 px (of the diagram) from
+    where it is: the move (dx, dy) in screen pixels."""
     d = page.evaluate(DRAWN)
     z, pane = d["zoom"], d["pane"]
     me = next(b for b in d["blocks"] if b["id"] == name)
     others = [b for b in d["blocks"] if b["id"] != name]
-    # the pane's corners hold the zoom buttons (left) and the minimap (right)
-    x0, x1 = (60 - d["tx"]) / z, (pane["w"] - 20 - d["tx"]) / z - me["w"]
-    y0, y1 = (20 - d["ty"]) / z, (pane["h"] - 110 - d["ty"]) / z - me["h"]
+    # away from the pane's edges (where a drag pans the view) and the corners that hold the
+    # zoom buttons (left) and the minimap (right)
+    x0, x1 = (80 - d["tx"]) / z, (pane["w"] - 80 - d["tx"]) / z - me["w"]
+    y0, y1 = (60 - d["ty"]) / z, (pane["h"] - 120 - d["ty"]) / z - me["h"]
     best = None
     for i in range(41):
         for j in range(41):
@@ -220,16 +221,17 @@ def free_spot(page, name):
             if any(x < b["x"] + b["w"] + 40 and b["x"] < x + me["w"] + 40 and
                    y < b["y"] + b["h"] + 40 and b["y"] < y + me["h"] + 40 for b in others):
                 continue
-            far = abs(x - me["x"]) + abs(y - me["y"])
-            if best is None or far > best[0]:
-                best = (far, x, y)
+            # a move across the neighbours, not to the far edge of the pane
+            off = abs(abs(x - me["x"]) + abs(y - me["y"]) - 400)
+            if best is None or off < best[0]:
+                best = (off, x, y)
     assert best, f"no free room for {name} on screen"
     return (best[1] - me["x"]) * z, (best[2] - me["y"]) * z
 
 
 def drag_block(page, name):
-    """Drag block ``name`` with the mouse, by its name (not a port), to the free place
-    farthest from it on screen; waits until the model holds its new place."""
+    """Drag block ``name`` with the mouse, by its name (not a port), to a free place about
+    400 px away; waits until the model holds its new place."""
     dx, dy = free_spot(page, name)
     before = K(page, f"K.doc.layout && K.doc.layout[{json.dumps(name)}]")
     box = page.locator(f"{tid(f'node-{name}')} .kn-block-name").bounding_box()
@@ -250,14 +252,19 @@ def drag_block(page, name):
     ({"open": "chain32.json"}, None),
 ])
 def test_wires_rerouted_when_a_block_is_dragged(screen, site, model, block):
-    """A block dragged with the mouse to the free place farthest from it: its wires follow it
-    and every wire still keeps off other nets' tracks and out of blocks."""
+    """A block dragged with the mouse across its neighbours to a free place: its wires follow
+    it and every wire still keeps off other nets' tracks and out of blocks."""
     show(screen, site, **model)
     names = [c["name"] for c in K(screen, "K.doc.components")]
     name = block or names[len(names) // 2]
     assert_readable(faults(screen), f"{model} before the drag", fit="chain32.json" not in model.values())
     drag_block(screen, name)
     screen.wait_for_function("() => new Promise((done) => requestAnimationFrame(() => done(true)))")
+    drawn = screen.evaluate(DRAWN)["blocks"]
+    me = next(b for b in drawn if b["id"] == name)
+    assert not [b["id"] for b in drawn if b is not me and b["x"] < me["x"] + me["w"] and
+                me["x"] < b["x"] + b["w"] and b["y"] < me["y"] + me["h"] and
+                me["y"] < b["y"] + b["h"]], "the block was dropped on another"
     assert_readable(faults(screen), f"{model} after dragging {name}", fit=False)
     assert not screen.errors, screen.errors
 

@@ -34,7 +34,7 @@ function lowerBound(list, v) {
 }
 
 /** Sorted track positions: ``exact`` ones as given, the others where no track is near. */
-function tracks(exact, wanted) {
+function tracks(exact, wanted, dense = 1) {
   const lines = [...new Set(exact)].sort((a, b) => a - b);
   for (const v of [...new Set(wanted)].sort((a, b) => a - b)) {
     const i = lowerBound(lines, v);
@@ -43,7 +43,7 @@ function tracks(exact, wanted) {
   const fill = [];
   for (let i = 0; i + 1 < lines.length; i++) {
     const gap = lines[i + 1] - lines[i];
-    const n = Math.min(MAX_FILL, Math.floor(gap / TRACK) - 1);
+    const n = Math.min(MAX_FILL * dense, Math.floor((gap * dense) / TRACK) - 1);
     for (let k = 1; k <= n; k++) fill.push(Math.round(lines[i] + (gap * k) / (n + 1)));
   }
   return [...new Set([...lines, ...fill])].sort((a, b) => a - b);
@@ -122,7 +122,7 @@ export function simplify(points) {
  * wires already drawn occupy.
  */
 class Grid {
-  constructor(rects, ends, kept) {
+  constructor(rects, ends, kept, dense = 1) {
     const ex = [];
     const ey = [];
     const wx = [];
@@ -147,8 +147,8 @@ class Grid {
       const hi = Math.max(...exact, ...wanted);
       for (let k = 1; k <= 4; k++) wanted.push(lo - k * TRACK, hi + k * TRACK);
     }
-    this.xs = tracks(ex, wx);
-    this.ys = tracks(ey, wy);
+    this.xs = tracks(ex, wx, dense);
+    this.ys = tracks(ey, wy, dense);
     this.nx = this.xs.length;
     this.ny = this.ys.length;
     const n = this.nx * this.ny;
@@ -409,6 +409,11 @@ export function routeWires(rects, wires, before = null) {
     if (again.clashes.length < out.clashes.length) out = again;
     else break;
   }
+  // still crowded: tracks twice as close together
+  if (out.clashes.length && !keep.size) {
+    const dense = route(rects, wires, keep, todo, new Set(out.clashes), 2);
+    if (dense.clashes.length < out.clashes.length) out = dense;
+  }
   // a wire that found no way but along another net's: all of them again, from scratch
   if (before && out.clashes.length) return routeWires(rects, wires, null);
   return { rects: rectKeys, wires: out.wires, routed: todo.length, clashes: out.clashes };
@@ -430,9 +435,9 @@ export class WireRouter {
   }
 }
 
-function route(rects, wires, keep, todo, first = new Set()) {
+function route(rects, wires, keep, todo, first = new Set(), dense = 1) {
   const ends = wires.flatMap((w) => [w.a, w.b]);
-  const grid = new Grid(rects, ends, [...keep.values()].map((k) => k.points));
+  const grid = new Grid(rects, ends, [...keep.values()].map((k) => k.points), dense);
   const byId = new Map(wires.map((w) => [w.id, w]));
   // each port's way out is its net's: another net running along it would leave the port
   // no way to go
