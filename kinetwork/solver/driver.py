@@ -65,6 +65,9 @@ OUTPUT_CHUNK_WORK = 1e7
 #: after a run stopped (a signal, the time limit), the probe signals of what it reached are
 #: still computed for at most this long [s] (unless stopped again), and kept
 OUTPUT_GRACE = 0.5
+#: a run whose states hold at most this many numbers computes its probe signals when they are
+#: first read (``deferred_outputs``): the seed's 1001 points took 0.5 ms, a tenth of its run
+DEFERRED_VALUES = 10**6
 #: an assembly whose (dimensionless) measure of a singular position is below this at the last
 #: output of a failed run is named as near its singular position there
 NEAR_SINGULAR_ASSEMBLY = 1e-3
@@ -130,13 +133,15 @@ class Run:
 
     # -- what methods use --------------------------------------------------------------------
     @contextlib.contextmanager
-    def solver_section(self, t0=0.0):
+    def solver_section(self, t0=0.0, descriptors=True):
         """Run compiled solver code with its printing captured (and serialised: see
         ``capture.SOLVER_LOCK``); the code integrates in the time since ``t0``, so the times it
-        names are shifted back by ``t0``."""
+        names are shifted back by ``t0``. Without ``descriptors``: code that prints through
+        Python's streams only, CasADi's integrators (``capture.solver_output``)."""
         box = None
         try:
-            with SOLVER_LOCK, solver_output(_sink()) as box:
+            with SOLVER_LOCK, solver_output(_sink() if descriptors else None,
+                                            descriptors) as box:
                 yield
         finally:                        # a failing solver's words are the ones wanted
             if box is not None and box["text"].strip() and self.signal is None \
@@ -462,6 +467,26 @@ def _probe_outputs(run, t, X):
             polished[rows] = system.polish(polished[rows], p, t[rows])
         system.outputs_into(t[rows], polished[rows], p, outputs[rows], f_out)
     return polished, outputs, None
+
+
+def deferred_outputs(run, t, X):
+    """The probe signals of states X at times t as a callable that computes them when the
+    Results first read them (``Results``), or None where they must be computed at once: a
+    run the time limit, ``cancel`` or a progress report watches (their stops are served
+    between chunks of the outputs too), loops to polish, a clock to check, or states of
+    over DEFERRED_VALUES numbers (they are copied, so that writes into ``res.states`` do
+    not change the signals)."""
+    system = run.system
+    if system.n_algebraic or system.eq.clock is not None or X.size > DEFERRED_VALUES or \
+            run.deadline is not None or run.cancel is not None or run.progress is not None:
+        return None
+    f_out = compiled(system).outputs(run.jit)
+    t, X, p = np.array(t, dtype=float), np.array(X, dtype=float), np.array(run.p, dtype=float)
+
+    def values():
+        return system.outputs_into(t, X, p, np.empty((len(t), system.f_out.size1_out(0))),
+                                   f_out)
+    return values
 
 
 def _assembly_watch(run, X, new, failure):

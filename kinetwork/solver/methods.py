@@ -289,7 +289,7 @@ class _CasadiRun:
             if value.size:
                 buffer.set_res(integ.index_out(name), memoryview(value))
         try:
-            with run.solver_section(self.t), run.interruptible():
+            with run.solver_section(self.t, descriptors=False), run.interruptible():
                 evaluate()
             failed = None
         except (RuntimeError, Interrupted) as exc:
@@ -347,7 +347,7 @@ class _CasadiRun:
         integ = run.compiled.integrator(key, lambda: ca.integrator(
             "locate", m.plugin, run.compiled.dae_scaled(run.jit, m.newton), 0.0, [1.0], opts))
         try:
-            with run.solver_section(self.t):
+            with run.solver_section(self.t, descriptors=False):
                 out = integ(x0=self.x[:nx], z0=self.x[nx:],
                             p=np.concatenate([self.p, [self.t, t - self.t]]))
         except RuntimeError as exc:

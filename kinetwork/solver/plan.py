@@ -40,7 +40,8 @@ from . import jit as _jit
 from .capture import last_words
 from .compiled import compiled
 from .driver import (DEFAULTS, Run, _assembly_watch, _auto, _check, _check_finite_start,
-                     _integrate, _probe_outputs, _running, output_values)
+                     _integrate, _probe_outputs, _running, deferred_outputs,
+                     output_values)
 from .events import Events
 from .methods import METHODS, Casadi, _CasadiRun
 from .stiffness import choose
@@ -250,12 +251,16 @@ class Plan:
         """(X, outputs, why cut or None) of states X on the first rows of the grid: the
         loops' coordinates polished onto their closure, the probe signals computed, in
         chunks between which a stop is served (``driver._probe_outputs``: what was computed
-        is kept)."""
+        is kept); or, for a run nothing watches, ``outputs`` a callable that computes them
+        when the Results first read them (``driver.deferred_outputs``)."""
         t = self.grid[:len(X)]
         parts = getattr(run, "partitions", None)
         if parts is not None and parts.events:     # re-partitioned: each part by its equations
             X, outputs = parts.finish(t, X)
             return X, outputs, None
+        later = deferred_outputs(run, t, X)
+        if later is not None:
+            return X, later, None
         return _probe_outputs(run, t, X)
 
     def results(self, run, X, p, stats, key, params=None, outputs=None):
