@@ -114,9 +114,11 @@ class Compiled:
     def dae(self, jit=None, jacobian=False):
         """The equations as CasADi's integrators take them, in the time tau since the start of
         a chunk: their parameters are the model's then that start t0 (t = t0 + tau), so one
-        integrator serves every chunk of the same length. A dict of SX (VM), or an MX
-        Function of (tau, x, z, [p; t0], u) around the compiled code (CasADi's integrators
-        compile nothing themselves unless handed a compiled Function).
+        integrator serves every chunk of the same length. A dict of SX (VM), or a Function
+        of (tau, x, z, [p; t0], u) that runs compiled code (CasADi's integrators compile
+        nothing themselves unless handed a compiled Function): the equations compiled in
+        that scheme themselves for a small model without Newton (``_direct``), else an MX
+        Function around the compiled right-hand side.
 
         ``jacobian``: the method iterates with Newton. Without (Adams' functional iteration)
         the equations hide their derivatives in x (``_no_newton``)."""
