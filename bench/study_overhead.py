@@ -12,8 +12,9 @@ links with a damper on each joint, planar and 3-D (``scenes.chains.point_masses`
 - the hand-written route (``peers/casadi_peer.py``: Featherstone's ABA in SX, gcc -O1,
   ``casadi.external``, CVODES Adams in one ``casadi.integrator`` call) at the solver
   tolerances kinetwork hands CVODES for that rtol (``tolerance.solver_tolerances``: the same
-  method at the same tolerances, the same steps), and at the same accuracy: its error against
-  the reference interpolated (log-log) over its rtol ladder, at kinetwork's error.
+  method at the same tolerances, the same steps), and at the same accuracy: its time at
+  kinetwork's error, interpolated (log-log) between the two runs of its rtol ladder
+  (1e-3 .. 1e-13, atol = rtol * 1e-2) whose errors bracket it, both timed in the rounds.
 
 Error: the largest joint-angle difference on the output grid from a reference by DOP853 at
 rtol 3e-14 on equations that share nothing with kinetwork's (the seed: its closed-form
@@ -91,19 +92,30 @@ def integrator_call(system):
     return call, int(call().stats()["nfevals"])
 
 
-def at_accuracy(ladder, target):
-    """The time to ``target`` error along ``ladder`` [(time, error)] (log-log interpolation
-    between the neighbouring runs; the fastest run's time when it is already as accurate)."""
-    pts = sorted((e, s) for s, e in ladder if np.isfinite(e) and e > 0)
-    if not pts:
-        return float("nan")
-    if target >= pts[-1][0]:
-        return min(s for e, s in pts if e <= target)
-    for (e1, s1), (e2, s2) in zip(pts, pts[1:]):
-        if e1 <= target <= e2:
-            w = (np.log(target) - np.log(e1)) / (np.log(e2) - np.log(e1))
-            return float(np.exp(np.log(s1) + w * (np.log(s2) - np.log(s1))))
-    return float("nan")            # more accurate than any run of the ladder
+def bracket(ladder, target):
+    """The rtols of the hand route's ladder [(rtol, error)] whose errors bracket ``target``
+    ((r1, e1), (r2, e2)) with e1 <= target <= e2; one pair twice when the loosest run
+    that is as accurate stands alone; None when no run is as accurate."""
+    pts = sorted((e, r) for r, e in ladder if np.isfinite(e) and e > 0)
+    if not pts or target < pts[0][0]:
+        return None
+    below = [(e, r) for e, r in pts if e <= target]
+    above = [(e, r) for e, r in pts if e > target]
+    lo = max(below, key=lambda er: er[1])          # the loosest rtol as accurate
+    if not above:
+        return (lo[1], lo[0]), (lo[1], lo[0])
+    hi = min(above)                                  # the nearest less accurate
+    return (lo[1], lo[0]), (hi[1], hi[0])
+
+
+def at_accuracy(pair, times, target):
+    """The time to ``target`` error between the bracketing runs ``pair`` (log-log)."""
+    (r1, e1), (r2, e2) = pair
+    s1, s2 = times[r1], times[r2]
+    if r1 == r2 or e2 <= e1:
+        return s1
+    w = (np.log(target) - np.log(e1)) / (np.log(e2) - np.log(e1))
+    return float(np.exp(np.log(s1) + w * (np.log(s2) - np.log(s1))))
 
 
 def cpu(fn, rounds_out, key):
@@ -122,19 +134,13 @@ def study(rounds):
         n = spec.n
         ref = reference(name, spec, t)
         hand = casadi_peer.build(spec)
-        # the hand route's ladder: error and CPU time per rtol (median of a few)
+        # the hand route's ladder: its error per rtol (its times are taken in the rounds)
         ladder = []
         for r in LADDER:
             try:
-                q = casadi_peer.run(hand, t, rtol=r)
+                ladder.append((r, error(casadi_peer.run(hand, t, rtol=r), ref)))
             except RuntimeError:            # below what CVODES can do
                 continue
-            times = []
-            for _ in range(5):
-                start = time.process_time()
-                casadi_peer.run(hand, t, rtol=r)
-                times.append(time.process_time() - start)
-            ladder.append((statistics.median(times), error(q, ref)))
         for rtol in RTOLS:
             kw = {"t_end": HORIZON, "n_points": POINTS, "rtol": rtol, "atol": rtol * 1e-2}
             res = kn.simulate(system, **kw)
@@ -142,15 +148,19 @@ def study(rounds):
             call, evals = integrator_call(system)
             casadi_peer.run(hand, t, rtol=srt, atol=sat)
             hand_evals = int(casadi_peer.integrator(hand, t, srt, sat).stats()["nfevals"])
+            err = error(chains.joint_angles(res), ref)
+            pair = bracket(ladder, err)
+            neighbours = sorted({r for r, _ in pair}) if pair else []
             spent = {}
             for _ in range(rounds):
                 cpu(lambda: kn.simulate(system, **kw), spent, "kinetwork")
                 cpu(call, spent, "call")
                 cpu(lambda: casadi_peer.run(hand, t, rtol=srt, atol=sat), spent, "hand")
+                for r in neighbours:
+                    cpu(lambda r=r: casadi_peer.run(hand, t, rtol=r), spent, r)
             med = {k: statistics.median(v) for k, v in spent.items()}
-            err = error(chains.joint_angles(res), ref)
             hand_err = error(casadi_peer.run(hand, t, rtol=srt, atol=sat)[:, :n], ref)
-            same_accuracy = at_accuracy(ladder, err)
+            same_accuracy = at_accuracy(pair, med, err) if pair else float("nan")
             rows.append([name, f"{rtol:.0e} ({srt:.0e})", res.method, f"{err:.1e}",
                          f"{med['kinetwork'] * 1e3:.3f}", f"{med['hand'] * 1e3:.3f}",
                          f"{hand_err:.1e}", f"{med['hand'] / med['kinetwork']:.2f}",
