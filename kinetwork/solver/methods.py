@@ -359,6 +359,32 @@ class _CasadiRun:
             raise Failure("the state became non-finite (Inf or NaN)")
         return x
 
+    def grid(self, t, k):
+        """The states at k equal steps from the start to ``t`` (k rows, the last at t), not
+        advancing: one integration whatever the stretch (``state_at``'s, on a grid), or
+        None for a method whose runs cannot (IDAS, fixed steps)."""
+        m, run = self.method, self.run
+        if m.plugin == "idas" or m.fixed:
+            return None
+        nx = run.system.n_states
+        opts = self.options([t])
+        key = ("stretch grid", k, m.plugin, tuple(sorted(opts.items())), bool(run.jit))
+        integ = run.compiled.integrator(key, lambda: ca.integrator(
+            "locate", m.plugin, run.compiled.dae_scaled(run.jit, m.newton), 0.0,
+            list(np.arange(1, k + 1) / k), opts))
+        try:
+            with run.solver_section(self.t):
+                out = integ(x0=self.x[:nx], z0=self.x[nx:],
+                            p=np.concatenate([self.p, [self.t, t - self.t]]))
+        except RuntimeError as exc:
+            run.said.append(shift_times(solver_words(str(exc)), self.t))
+            raise Failure(solver_reason(str(exc))) from None
+        self._count_call(integ)
+        rows = np.hstack([np.asarray(out["xf"]).T, np.asarray(out["zf"]).T])
+        if not np.all(np.isfinite(rows)):
+            raise Failure("the state became non-finite (Inf or NaN)")
+        return rows
+
     def _count_call(self, integ):
         """Steps and evaluations of the plain call of ``integ`` just made."""
         if self.method.sundials:

@@ -263,17 +263,26 @@ def test_a_signal_stops_a_quiet_run_within_its_one_call_and_keeps_the_rows_it_re
     kn.simulate(system, t_end=0.1, jit=False)                 # built: the run starts at once
     sent = []
 
+    done = threading.Event()
+
     def interrupt():
-        sent.append(time.process_time())
-        os.kill(os.getpid(), signal.SIGINT)
-    timer = threading.Timer(0.5, interrupt)
+        # after 0.5 s of the process's CPU time, not of the clock: a loaded machine gives
+        # the run less of it, and it must have reached rows by then
+        start = time.process_time()
+        while not done.wait(0.02):
+            if time.process_time() - start >= 0.5:
+                sent.append(time.process_time())
+                os.kill(os.getpid(), signal.SIGINT)
+                return
+    timer = threading.Thread(target=interrupt)
     timer.start()
     try:
         with pytest.raises(kn.SimulationError) as info:
             kn.simulate(system, t_end=1e4, n_points=10**5 + 1, rtol=1e-10, atol=1e-12,
                         jit=False)
     finally:
-        timer.cancel()
+        done.set()
+        timer.join()
     # CPU time from the signal (other processes' load does not count): the run stopped
     took = time.process_time() - sent[0]
     err = info.value

@@ -1,0 +1,77 @@
+"""How state events are located (``solver/events.py``): on one integration over a sampled
+interval and the Hermite curve through its points, then checked on the integration; and a
+relation the equations compute twice is one event (``equations/relations.py``). Against the
+event-to-event DOP853 reference of ``scenes/bumps.py`` and closed forms."""
+
+import numpy as np
+import pytest
+
+import kinetwork as kn
+from kinetwork.solver import events as events_module
+from kinetwork.solver import methods
+from scenes.bumps import ball, ball_reference
+
+
+@pytest.fixture(scope="module")
+def reference():
+    return ball_reference(np.linspace(0.0, 3.0, 301))
+
+
+def test_each_contact_is_located_by_one_integration_and_a_check(reference, monkeypatch):
+    """Every event of the ball's if_else contact costs one integration over its sampled
+    interval and one or two from the point before it, not one per trial time; the contact
+    times agree with the reference's root finder to 1e-9 s."""
+    calls = {"grid": 0, "state_at": 0}
+    for name in calls:
+        original = getattr(methods._CasadiRun, name)
+
+        def counted(self, *args, _original=original, _name=name):
+            calls[_name] += 1
+            return _original(self, *args)
+        monkeypatch.setattr(methods._CasadiRun, name, counted)
+    exact = []
+    monkeypatch.setattr(events_module.Events, "_locate_exact",
+                        lambda self, *args: exact.append(args) or None)
+    _, contacts = reference
+    res = kn.simulate(ball(), t_end=3.0, n_points=301, method="cvodes-adams", rtol=1e-10,
+                      atol=1e-12)
+    times = [e["t"] for e in res.stats["events"]]
+    assert len(times) == len(contacts) == 8 and not exact
+    np.testing.assert_allclose(times, contacts, atol=1e-9)
+    assert calls["grid"] == 8 and calls["state_at"] <= 2 * 8
+
+
+def test_dense_and_exact_location_agree_on_a_stop_of_friction(monkeypatch):
+    """A block at 3 m/s against Coulomb friction 4 N, 2 kg: stuck from t = 1.5 s at 2.25 m,
+    located on the curve as on every trial integrated (the closed form to 1e-10)."""
+    model = kn.Model("block")
+    block = model.add(kn.translational.Mass("block", m=2.0, v0=3.0))
+    floor = model.add(kn.translational.Friction("floor", f_c=4.0))
+    model.connect(block.flange_a, floor.flange)
+    dense = kn.simulate(model, t_end=2.0, n_points=21, method="cvodes", rtol=1e-10,
+                        atol=1e-12)
+    monkeypatch.setattr(events_module.Events, "_locate",
+                        lambda self, *args: self._locate_exact(*args))
+    exact = kn.simulate(model, t_end=2.0, n_points=21, method="cvodes", rtol=1e-10,
+                        atol=1e-12)
+    for res in (dense, exact):
+        (event,) = res.stats["events"]
+        assert event["kind"] == "stuck" and abs(event["t"] - 1.5) < 1e-10
+        assert abs(res["block.s"][-1] - 2.25) < 1e-10
+
+
+def test_a_relation_computed_twice_is_one_event(reference):
+    """The contact law read by two forces of half the stiffness each (one expression each,
+    the same relation in both): one relation on the states, the same contacts."""
+    half = "if_else(s < 0, (-k*s - d*v)/2, 0)"
+    m = ball(half)
+    m.add(kn.translational.Force("contact2"))
+    m.add(kn.signals.Expression("law2", expression=half, names=["s", "v"]))
+    for a, b in [("contact2.flange", "ball.flange_a"), ("height.y", "law2.u1"),
+                 ("speed.y", "law2.u2"), ("law2.y", "contact2.u")]:
+        m.connect(a, b)
+    system = m.compile()
+    assert len(system.relations.state) == 1
+    _, contacts = reference
+    res = kn.simulate(system, t_end=3.0, n_points=301, rtol=1e-10, atol=1e-12)
+    np.testing.assert_allclose([e["t"] for e in res.stats["events"]], contacts, atol=1e-9)
