@@ -132,21 +132,12 @@ class Run:
         self.p_solver = p
 
     # -- what methods use --------------------------------------------------------------------
-    @contextlib.contextmanager
     def solver_section(self, t0=0.0, descriptors=True):
         """Run compiled solver code with its printing captured (and serialised: see
         ``capture.SOLVER_LOCK``); the code integrates in the time since ``t0``, so the times it
         names are shifted back by ``t0``. Without ``descriptors``: code that prints through
         Python's streams only, CasADi's integrators (``capture.solver_output``)."""
-        box = None
-        try:
-            with SOLVER_LOCK, solver_output(_sink() if descriptors else None,
-                                            descriptors) as box:
-                yield
-        finally:                        # a failing solver's words are the ones wanted
-            if box is not None and box["text"].strip() and self.signal is None \
-                    and self.stop_reason() is None:
-                self.said.append(shift_times(box["text"], t0))
+        return _Section(self, t0, descriptors)
 
     @contextlib.contextmanager
     def interruptible(self):
@@ -200,6 +191,35 @@ class Run:
         reason = self.stop_reason()
         if reason is not None:
             raise Failure(reason, states)
+
+
+class _Section:
+    """``Run.solver_section``: a class rather than a generator (a run enters one or two:
+    the generator's machinery cost as much as what it does)."""
+
+    def __init__(self, run, t0, descriptors):
+        self.run, self.t0, self.descriptors = run, t0, descriptors
+        self.capture = self.box = None
+
+    def __enter__(self):
+        SOLVER_LOCK.acquire()
+        try:
+            self.capture = solver_output(_sink() if self.descriptors else None,
+                                         self.descriptors)
+            self.box = self.capture.__enter__()
+        except BaseException:
+            SOLVER_LOCK.release()
+            raise
+
+    def __exit__(self, *exc):
+        try:
+            self.capture.__exit__(*exc)
+        finally:
+            SOLVER_LOCK.release()
+            run, box = self.run, self.box      # a failing solver's words are the ones wanted
+            if box["text"].strip() and run.signal is None and run.stop_reason() is None:
+                run.said.append(shift_times(box["text"], self.t0))
+        return False
 
 
 def _check(system, settings, t_start, max_steps, time_limit, runs=1):
@@ -445,9 +465,7 @@ def _probe_outputs(run, t, X):
     outputs = np.empty((n, width))
     if not n:
         return X, outputs, None
-    size = int(min(max(OUTPUT_CHUNK_WORK / max(system.f_out.n_instructions(), 1), 256),
-                   2**16))
-    size = 2 ** int(np.log2(size))          # few sizes: each has its mapped Function
+    size = _output_chunk(system)
     started, earlier, seen = time.perf_counter(), run.stop_reason(), run.signals_seen
 
     def stopped():
@@ -469,16 +487,26 @@ def _probe_outputs(run, t, X):
     return polished, outputs, None
 
 
+def _output_chunk(system):
+    """Points per chunk of the probe signals (``_probe_outputs``): about OUTPUT_CHUNK_WORK
+    of work, a power of two (few sizes: each has its mapped Function)."""
+    size = int(min(max(OUTPUT_CHUNK_WORK / max(system.f_out.n_instructions(), 1), 256),
+                   2**16))
+    return 2 ** int(np.log2(size))
+
+
 def deferred_outputs(run, t, X):
     """The probe signals of states X at times t as a callable that computes them when the
     Results first read them (``Results``), or None where they must be computed at once: a
     run the time limit, ``cancel`` or a progress report watches (their stops are served
-    between chunks of the outputs too), loops to polish, a clock to check, or states of
-    over DEFERRED_VALUES numbers (they are copied, so that writes into ``res.states`` do
-    not change the signals)."""
+    between chunks of the outputs too), signals of more than one chunk (a signal stops
+    the run between them), loops to polish, a clock to check, or states of over
+    DEFERRED_VALUES numbers (they are copied, so that writes into ``res.states`` do not
+    change the signals)."""
     system = run.system
     if system.n_algebraic or system.eq.clock is not None or X.size > DEFERRED_VALUES or \
-            run.deadline is not None or run.cancel is not None or run.progress is not None:
+            run.deadline is not None or run.cancel is not None or run.progress is not None \
+            or len(t) > _output_chunk(system):
         return None
     f_out = compiled(system).outputs(run.jit)
     t, X, p = np.array(t, dtype=float), np.array(X, dtype=float), np.array(run.p, dtype=float)

@@ -185,6 +185,10 @@ class Casadi(Method):
 #: an integrator over more output times than this is not kept for the next run: CasADi
 #: holds about 50 bytes per output time in it
 KEPT_GRID = 100_000
+#: the places of an integrator's inputs and outputs by name, the same for every one of
+#: CasADi's integrators (looked up once: ``Function.index_in`` costs 2 us a call)
+INTEGRATOR_IN = {name: i for i, name in enumerate(ca.integrator_in())}
+INTEGRATOR_OUT = {name: i for i, name in enumerate(ca.integrator_out())}
 
 
 class _CasadiRun:
@@ -284,10 +288,10 @@ class _CasadiRun:
         buffer, evaluate = integ.buffer()
         for name, value in (("x0", x0), ("z0", z0), ("p", p)):
             if value.size:
-                buffer.set_arg(integ.index_in(name), memoryview(value))
+                buffer.set_arg(INTEGRATOR_IN[name], memoryview(value))
         for name, value in (("xf", xf), ("zf", zf)):
             if value.size:
-                buffer.set_res(integ.index_out(name), memoryview(value))
+                buffer.set_res(INTEGRATOR_OUT[name], memoryview(value))
         try:
             with run.solver_section(self.t, descriptors=False), run.interruptible():
                 evaluate()
