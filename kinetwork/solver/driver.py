@@ -26,12 +26,9 @@ level of the tolerance (their restarts differ); each gives the same numbers ever
 from __future__ import annotations
 
 import _signal
-import atexit
 import contextlib
 import math
-import os
 import signal
-import tempfile
 import threading
 import time
 
@@ -41,13 +38,13 @@ from ..equations.system import OVERFLOW, overflow_message
 from ..errors import ModelError
 from ..graph.settings import check_output, check_settings
 from ..util import quote, suggest
-from .capture import SOLVER_LOCK, solver_output
+from .capture import Section
 from .chunks import MAX_CHUNK, _first_chunk, _merge, _next_chunk, _Rows, _work
 from .compiled import compiled, numeric
 from .events import EVENT_CHUNK
 from .fallback import GaveUp, Rival, Stalled, _stalled, look_budget
 from .loopwatch import Partitions, near_singular
-from .methods import LOOK, METHODS, Failure, Interrupted, budget_spent, shift_times
+from .methods import LOOK, METHODS, Failure, Interrupted, budget_spent
 from .stiffness import choose
 from .tolerance import step_budget
 
@@ -71,25 +68,6 @@ DEFERRED_VALUES = 10**6
 #: an assembly whose (dimensionless) measure of a singular position is below this at the last
 #: output of a failed run is named as near its singular position there
 NEAR_SINGULAR_ASSEMBLY = 1e-3
-
-
-_SINK = {}
-
-
-def _sink():
-    """The file that catches what the solvers print: one per process, used under SOLVER_LOCK
-    (a temporary file per run cost 0.3 ms, a tenth of a small model's run)."""
-    if _SINK.get("pid") != os.getpid():
-        if "file" in _SINK:                    # a forked child's copy of its parent's
-            _SINK["file"].close()
-        _SINK.update(pid=os.getpid(), file=tempfile.TemporaryFile())  # noqa: SIM115
-    return _SINK["file"]
-
-
-@atexit.register
-def _close_sink():
-    if _SINK.get("pid") == os.getpid():
-        _SINK.pop("file").close()
 
 
 class Run:
@@ -137,7 +115,7 @@ class Run:
         ``capture.SOLVER_LOCK``); the code integrates in the time since ``t0``, so the times it
         names are shifted back by ``t0``. Without ``descriptors``: code that prints through
         Python's streams only, CasADi's integrators (``capture.solver_output``)."""
-        return _Section(self, t0, descriptors)
+        return Section(self, t0, descriptors)
 
     @contextlib.contextmanager
     def interruptible(self):
@@ -191,35 +169,6 @@ class Run:
         reason = self.stop_reason()
         if reason is not None:
             raise Failure(reason, states)
-
-
-class _Section:
-    """``Run.solver_section``: a class rather than a generator (a run enters one or two:
-    the generator's machinery cost as much as what it does)."""
-
-    def __init__(self, run, t0, descriptors):
-        self.run, self.t0, self.descriptors = run, t0, descriptors
-        self.capture = self.box = None
-
-    def __enter__(self):
-        SOLVER_LOCK.acquire()
-        try:
-            self.capture = solver_output(_sink() if self.descriptors else None,
-                                         self.descriptors)
-            self.box = self.capture.__enter__()
-        except BaseException:
-            SOLVER_LOCK.release()
-            raise
-
-    def __exit__(self, *exc):
-        try:
-            self.capture.__exit__(*exc)
-        finally:
-            SOLVER_LOCK.release()
-            run, box = self.run, self.box      # a failing solver's words are the ones wanted
-            if box["text"].strip() and run.signal is None and run.stop_reason() is None:
-                run.said.append(shift_times(box["text"], self.t0))
-        return False
 
 
 def _check(system, settings, t_start, max_steps, time_limit, runs=1):
