@@ -12,6 +12,7 @@ import hashlib
 import io
 import json
 import os
+import threading
 from collections.abc import Callable, Sequence
 from typing import TYPE_CHECKING, Any
 
@@ -20,6 +21,8 @@ import numpy as np
 from ..upcalls import upcall
 from ..util import suggest
 
+#: held while the signals of a Results are computed on first read
+_COMPUTING = threading.RLock()
 #: rows of a CSV written at a time: between blocks a write can be stopped (SIGINT, SIGTERM,
 #: a cancel) and keep the rows before
 CSV_BLOCK_ROWS = 4096
@@ -100,9 +103,12 @@ class Results:
 
     @property
     def _values(self):
-        """{signal name: its values (n_points, *shape)}, computed on first read."""
+        """{signal name: its values (n_points, *shape)}, computed on first read (once: two
+        threads reading at once wait for one computation)."""
         if self._split is None:
-            self._split, self._pending = self._columns(self._pending()), None
+            with _COMPUTING:
+                if self._split is None:
+                    self._split, self._pending = self._columns(self._pending()), None
         return self._split
 
     @property
