@@ -24,10 +24,6 @@ from . import jit as _jit
 #: Jacobian is 2.5 million instructions, minutes of gcc)
 JACOBIAN_JIT_LIMIT = 200_000
 
-#: a model of up to this many states (and algebraic variables) is integrated without Newton
-#: on its compiled equations called directly (``Compiled._direct``)
-DIRECT_STATES = 64
-
 #: checked run settings kept per System (``Compiled.checked``), least recently used dropped
 SETTINGS_KEPT = 64
 
@@ -114,11 +110,9 @@ class Compiled:
     def dae(self, jit=None, jacobian=False):
         """The equations as CasADi's integrators take them, in the time tau since the start of
         a chunk: their parameters are the model's then that start t0 (t = t0 + tau), so one
-        integrator serves every chunk of the same length. A dict of SX (VM), or a Function
-        of (tau, x, z, [p; t0], u) that runs compiled code (CasADi's integrators compile
-        nothing themselves unless handed a compiled Function): the equations compiled in
-        that scheme themselves for a small model without Newton (``_direct``), else an MX
-        Function around the compiled right-hand side.
+        integrator serves every chunk of the same length. A dict of SX (VM), or an MX
+        Function of (tau, x, z, [p; t0], u) around the compiled code (CasADi's integrators
+        compile nothing themselves unless handed a compiled Function).
 
         ``jacobian``: the method iterates with Newton. Without (Adams' functional iteration)
         the equations hide their derivatives in x (``_no_newton``)."""
@@ -151,21 +145,6 @@ class Compiled:
                         "alg": ca.substitute(held.alg, held.t, t)}
             return self._get(f"{name}_sx", build_sx)
         exact = jacobian and bool(jit) and self.jacobian_small()
-        if jit and not jacobian and self._direct():
-            def build_direct():
-                tau, extra = ca.SX.sym("tau"), ca.SX.sym("extra", n_extra)
-                t, factor = clock(tau, extra)
-                p = ca.SX.sym("p", held.p.numel())
-                ode, alg = (ca.substitute([e], [held.t, held.p], [t, p])[0]
-                            for e in (held.ode, held.alg))
-                empty = ca.SX(0, 1)
-                f = ca.Function(f"{name}_direct", [tau, held.x, held.z, ca.vertcat(p, extra),
-                                                   ca.SX.sym("u", 0)],
-                                [rates(ode, factor), alg, empty, empty], ca.dyn_in(),
-                                ca.dyn_out())
-                return self._external(f, False, jit)
-            return self._get((name, "direct"), build_direct)
-
         def build():
             tau, x = ca.MX.sym("tau"), ca.MX.sym("x", system.n_states)
             z = ca.MX.sym("z", system.n_algebraic)
@@ -194,16 +173,6 @@ class Compiled:
             f = self._external(held.f_dae, exact, jit) if jit else held.f_dae
             return f(t, x, z, p)
         return (self.rhs(jit, exact) if jit else held.f_rhs)(t, x, p), ca.MX(0, 1)
-
-    def _direct(self):
-        """Whether an integrator without Newton gets the compiled equations themselves, in
-        its own scheme (t, x, z, p, u), rather than an MX Function around the compiled
-        right-hand side: for models of up to DIRECT_STATES states, where CasADi's MX
-        machinery cost 0.3 us of the ~2 us of an evaluation (the seed: 12 % of a run).
-        A larger model keeps the wrapper, whose hidden derivatives keep CVODES' set-up of
-        a Jacobian it never evaluates cheap (``_equations``); its evaluations take far longer
-        than the wrapper."""
-        return self.system.n_states + self.system.n_algebraic <= DIRECT_STATES
 
     def _no_newton_vm(self):
         """Whether an integrator without Newton runs in the VM around the SX Function, its

@@ -1,8 +1,7 @@
 """A quiet run pays nothing per run that it need not: its settings are checked once per
 System and settings, the solvers' words are caught without system calls, its probe signals
-are computed when first read, and a small model's compiled equations go to CVODES without an
-MX wrapper. Every promise stays: the same fields and numbers, failures and solver words
-surfaced, bad settings refused every time."""
+are computed when first read. Every promise stays: the same fields and numbers, failures
+and solver words surfaced, bad settings refused every time."""
 
 import os
 import pickle
@@ -14,7 +13,6 @@ from scenes import double_pendulum, stiff
 
 import kinetwork as kn
 from kinetwork.equations.system import System
-from kinetwork.solver import compiled as compiled_module
 from kinetwork.solver import plan
 
 SETTINGS = {"t_end": 2.0, "n_points": 201, "rtol": 1e-8, "atol": 1e-10}
@@ -111,14 +109,3 @@ def test_results_of_a_quiet_run_equal_those_computed_at_once(seed, tmp_path):
     header, table = quiet.columns()
     back = np.loadtxt(tmp_path / "quiet.csv", delimiter=",", skiprows=1)
     np.testing.assert_allclose(back, table, rtol=1e-15, atol=0)
-
-
-def test_direct_equations_give_the_wrapped_ones_numbers(monkeypatch):
-    """CVODES on the compiled equations in its own scheme (a small model) and on the MX
-    wrapper around the compiled right-hand side (what larger models get): the same
-    arithmetic, the same steps, the same numbers within round-off."""
-    direct = kn.simulate(double_pendulum().compile(), **SETTINGS, method="cvodes-adams")
-    monkeypatch.setattr(compiled_module, "DIRECT_STATES", 0)
-    wrapped = kn.simulate(double_pendulum().compile(), **SETTINGS, method="cvodes-adams")
-    assert direct.stats["steps"] == wrapped.stats["steps"]
-    np.testing.assert_allclose(direct.states, wrapped.states, rtol=0, atol=1e-12)
