@@ -41,10 +41,12 @@ import bisect
 
 import numpy as np
 
+from ..equations.pointwise import pointwise
 from .compiled import numeric
 from .methods import Failure
 from .modechange import ModeChanges
 from .switches import Switches
+from .tolerance import solver_tolerances
 
 #: output intervals of a chunk after an event, in a run with state events (what follows an
 #: event in a chunk is computed again from it), and at most after chunks without one
@@ -68,9 +70,14 @@ SHORT = 1e-6
 SCAN = np.array([1e-12, 1e-9, 1e-6, 1e-3, *np.arange(1, 16) / 16])
 #: points of the one integration over a sampled interval an event is located on (between
 #: them, a cubic Hermite curve)
-DENSE = 16
-#: steps at most from the time found on that curve to the side where the integration has
-#: crossed
+DENSE = 32
+#: how close to the solution, as a fraction of the solver's tolerances, a curve is taken as it
+#: is (its states are the event's): as close as the integration's own points are, which
+#: CVODES interpolates between its steps (right after a start, at order one or two, to about
+#: half its tolerances on EngineV6)
+FIT = 1.0
+#: Newton's steps at most from the time found on a curve not within FIT to the integration's
+#: own root, on the side where it has crossed
 POLISH = 4
 
 
@@ -224,7 +231,7 @@ class Events:
             t, t_prev = times[j], (before[0] if j == 0 else times[j - 1])
             x_prev = before[1] if j == 0 else rows[j - 1]
             found = self._locate(method, t_prev, x_prev, t, np.flatnonzero(crossed[j]),
-                                 np.flatnonzero(dipped[j]))
+                                 np.flatnonzero(dipped[j]), rows[j])
             if found is not None:
                 t_ev, x_ev, i = found
                 after = self.apply(t_ev, x_ev, i)
@@ -241,11 +248,13 @@ class Events:
         parts = [s.indicator_rows(times, rows) for s in self.sources]
         return np.hstack([p[0] for p in parts]), np.hstack([p[1] for p in parts])
 
-    def _locate(self, method, t0, x0, t1, crossed, dipped=()):
+    def _locate(self, method, t0, x0, t1, crossed, dipped=(), x1=None):
         """The earliest crossing in (t0, t1]: (time, state, element). ``dipped``: elements
-        above zero at both ends with a minimum between, which cross if it reaches zero."""
-        if not self.run.system.n_algebraic and t1 - t0 >= SHORT * max(1.0, abs(t0)):
-            found = self._locate_dense(method, t0, x0, t1, crossed, dipped)
+        above zero at both ends with a minimum between, which cross if it reaches zero.
+        ``x1``: the state at t1, when known."""
+        if not self.run.system.n_algebraic and not method.fixed and \
+                t1 - t0 >= SHORT * max(1.0, abs(t0)):
+            found = self._locate_dense(method, t0, x0, t1, x1, crossed, dipped)
             if found is not _UNSURE:
                 return found
         return self._locate_exact(method, t0, x0, t1, crossed, dipped)
@@ -275,28 +284,46 @@ class Events:
             return None
         return best[0], state(best[0]), best[1]
 
-    def _locate_dense(self, method, t0, x0, t1, crossed, dipped):
-        """``_locate`` on one integration to DENSE points of (t0, t1] and the cubic Hermite
-        curve through their states and rates: the trial times cost no integration, and the
-        time found is then checked, and moved to the side where the indicator has crossed,
-        on states integrated from the point before it. _UNSURE when it cannot be (a method
-        without that integration, a crossing the curve sees and the integration does not):
+    def _locate_dense(self, method, t0, x0, t1, x1, crossed, dipped):
+        """``_locate`` on the cubic Hermite curve through the states and rates at t0 and t1
+        or, where that curve is farther from the equations than FIT of the solver's
+        tolerances, through those of one integration to DENSE points of (t0, t1]: the trial
+        times cost no integration. On a curve that is not within FIT either, the time found
+        is checked, and moved to the side where the indicator has crossed, on states
+        integrated from the point before it. _UNSURE when it cannot be (a method without
+        that integration, a crossing the curve sees and the integration does not):
         ``_locate_exact`` decides."""
-        grid = getattr(method.start(self.run, t0, x0), "grid", None)
-        rows = grid(t1, DENSE) if grid is not None else None
-        if rows is None:
-            return _UNSURE
-        T = np.concatenate([[t0], t0 + (t1 - t0) * np.arange(1, DENSE + 1) / DENSE])
-        T[-1] = t1
-        X = np.vstack([np.asarray(x0, dtype=float)[None, :], rows])
-        f = self._rhs(self.run.jit, method.newton)
-        curve = _Hermite(T, X, np.array([f(t, x).ravel() for t, x in zip(T, X)]))
+        fun = self.run.compiled.rhs(self.run.jit, method.newton) if self.run.jit \
+            else self.run.compiled.rhs(None)
+
+        def rates(T, X):            # the equations' rates at every (T[k], X[k]), one call
+            return pointwise(fun, np.asarray(T, dtype=float)[:, None], X,
+                             self.run.p_solver)[0]
+        x0 = np.asarray(x0, dtype=float)
+        tol = self._tolerance(method)
+        fitted = False
+        if x1 is not None:
+            T, X = np.array([t0, t1]), np.vstack([x0, x1])
+            curve = _Hermite(T, X, rates(T, X))
+            fitted = curve.fits(rates, tol)
+        if not fitted:
+            grid = getattr(method.start(self.run, t0, x0), "grid", None)
+            rows = grid(t1, DENSE) if grid is not None else None
+            if rows is None:
+                return _UNSURE
+            T = np.concatenate([[t0], t0 + (t1 - t0) * np.arange(1, DENSE + 1) / DENSE])
+            T[-1] = t1
+            X = np.vstack([x0[None, :], rows])
+            curve = _Hermite(T, X, rates(T, X))
+            fitted = curve.fits(rates, tol)
         best = _search(lambda t, i: self.levels(t, curve(t))[i],
                        lambda t, i: self.indicators(t, curve(t))[1][i],
                        t0, t1, crossed, dipped)
         if best is None:
             return None
         t_i, i = best
+        if fitted:
+            return t_i, curve(t_i), i
 
         def exact(t):
             j = max(0, int(np.searchsorted(T, t, side="right")) - 1)
@@ -304,18 +331,31 @@ class Events:
                 return self._rk4(T[j], X[j], t - T[j])
             return method.start(self.run, T[j], X[j]).state_at(t)
 
-        x_i = exact(t_i)
+        # Newton on the integration from the curve's root (off by the curve's error): to
+        # the integration's own root, on the side where the indicator has crossed
+        tiny = 4 * np.finfo(float).eps
+        x_i, crossed_at = exact(t_i), None
         for _ in range(POLISH):
             g_i = self.levels(t_i, x_i)[i]
             if g_i <= 0:
-                return t_i, x_i, i
+                crossed_at = (t_i, x_i, i)
             rate = self.indicators(t_i, x_i)[1][i]
-            if not rate < 0 or t_i >= t1:
+            if not rate < 0:
                 break
-            # just short of the crossing by the curve's error: past it along the rate
-            t_i = min(t1, t_i + max(2 * g_i / -rate, 4 * np.finfo(float).eps * max(1.0, abs(t_i))))
+            dt = g_i / -rate
+            if g_i <= 0 and -dt <= tiny * max(1.0, abs(t_i)):
+                break                       # at the root, to rounding
+            t_i = min(t1, max(t0, t_i + dt + (tiny * max(1.0, abs(t_i)) if g_i > 0 else 0)))
             x_i = exact(t_i)
-        return _UNSURE
+        return crossed_at if crossed_at is not None else _UNSURE
+
+    def _tolerance(self, method):
+        """(rtol, atol) the method's solver is given for this run (``tolerance.py``)."""
+        run = self.run
+        if getattr(method, "sundials", False):
+            return solver_tolerances(method, run.system, run.rtol, run.atol,
+                                     run.t_end - run.t_start)
+        return run.rtol, run.atol
 
     def _rk4(self, t, x, h):
         """One classical Runge-Kutta step of the equations the method integrates: for
@@ -330,12 +370,11 @@ class Events:
         k4 = f(t + h, x + h * k3)
         return x + h / 6 * (k1 + 2 * k2 + 2 * k3 + k4)
 
-    def _rhs(self, jit=None, newton=False):
-        """The held right-hand side at the values held now, as a Python callable: compiled
-        as the method's is when ``jit`` (the very function its integrator calls)."""
-        key = (self.run.p_solver.tobytes(), bool(jit), newton)
+    def _rhs(self):
+        """The held right-hand side at the values held now, as a Python callable."""
+        key = self.run.p_solver.tobytes()
         if self._f_rhs is None or self._f_rhs[0] != key:
-            f = self.run.compiled.rhs(jit, newton) if jit else self.run.compiled.rhs(None)
+            f = self.run.compiled.rhs(None)
             self._f_rhs = (key, numeric(f, self.run.p_solver, self.run.system.n_states))
         return self._f_rhs[1]
 
@@ -426,19 +465,43 @@ def _search(g, rate, t0, t1, crossed, dipped):
 
 
 class _Hermite:
-    """The cubic Hermite curve through states X at times T with rates F (error h^4/384
-    |d4x/dt4| on steps h: far below the integration's own at DENSE points an interval), as
-    a cubic in s = (t - T[j]) / h on each step."""
+    """The cubic Hermite curve through states X at times T with rates F, as a cubic in
+    s = (t - T[j]) / h on each step h. Its error, h^4/384 |d4x/dt4| at most, is read off
+    the equations: the curve's rate less the equations' at points of each step."""
 
     def __init__(self, T, X, F):
         self.T = [float(t) for t in T]
         h = np.diff(T)[:, None]
         x0, x1, f0, f1 = X[:-1], X[1:], h * F[:-1], h * F[1:]
         self.cubic = (x0, f0, 3 * (x1 - x0) - 2 * f0 - f1, 2 * (x0 - x1) + f0 + f1)
+        self.scale = np.max(np.abs(X), axis=0)
 
-    def __call__(self, t):
+    def _step(self, t):
         T = self.T
         j = min(max(bisect.bisect_right(T, t) - 1, 0), len(T) - 2)
-        s = (t - T[j]) / (T[j + 1] - T[j])
+        return j, (t - T[j]) / (T[j + 1] - T[j])
+
+    def __call__(self, t):
+        j, s = self._step(t)
         a, b, c, d = (k[j] for k in self.cubic)
         return a + s * (b + s * (c + s * d))
+
+    def fits(self, rates, tol):
+        """Whether the curve is within FIT of the tolerances ``tol`` = (rtol, atol) of the
+        solution through its points: its error at most h/6 times its rate's distance from
+        the equations' (``rates(T, X)``, at many points at once) at a quarter, half and three
+        quarters of each step (a quartic error's, largest at the middle, is h/6 times its
+        rate's at the quarters)."""
+        rtol, atol = tol
+        a, b, c, d = self.cubic
+        T = np.asarray(self.T)
+        h = np.diff(T)[:, None]
+        points, defects = [], []
+        for s in (0.25, 0.5, 0.75):
+            points.append((T[:-1] + s * h[:, 0], a + s * (b + s * (c + s * d))))
+            defects.append((b + s * (2 * c + 3 * s * d)) / h)
+        times = np.concatenate([p[0] for p in points])
+        states = np.vstack([p[1] for p in points])
+        defect = np.vstack(defects) - rates(times, states)
+        error = np.abs(defect) * np.tile(h, (3, 1)) / 6
+        return bool(np.all(error <= FIT * (atol + rtol * self.scale)))

@@ -18,9 +18,13 @@ def reference():
 
 
 def test_each_contact_is_located_by_one_integration_and_a_check(reference, monkeypatch):
-    """Every event of the ball's if_else contact costs one integration over its sampled
-    interval and one or two from the point before it, not one per trial time; the contact
-    times agree with the reference's root finder to 1e-9 s."""
+    """No event of the ball's if_else contact costs an integration per trial time. Each
+    fall onto the contact is a parabola, which the cubic through the sampled points and
+    their rates is: located on it with no integration at all. Each rise off it (the
+    contact's spring, stiff) costs at most one integration over its sampled interval and
+    two or three from the point before the time found (Newton's steps from the curve's
+    root to the integration's). The contact times agree with the reference's root finder
+    to 1e-9 s."""
     calls = {"grid": 0, "state_at": 0}
     for name in calls:
         original = getattr(methods._CasadiRun, name)
@@ -38,7 +42,7 @@ def test_each_contact_is_located_by_one_integration_and_a_check(reference, monke
     times = [e["t"] for e in res.stats["events"]]
     assert len(times) == len(contacts) == 8 and not exact
     np.testing.assert_allclose(times, contacts, atol=1e-9)
-    assert calls["grid"] == 8 and calls["state_at"] <= 2 * 8
+    assert calls["grid"] <= 4 and calls["state_at"] <= 3 * 4
 
 
 def test_dense_and_exact_location_agree_on_a_stop_of_friction(monkeypatch):
@@ -51,7 +55,7 @@ def test_dense_and_exact_location_agree_on_a_stop_of_friction(monkeypatch):
     dense = kn.simulate(model, t_end=2.0, n_points=21, method="cvodes", rtol=1e-10,
                         atol=1e-12)
     monkeypatch.setattr(events_module.Events, "_locate",
-                        lambda self, *args: self._locate_exact(*args))
+                        lambda self, *args: self._locate_exact(*args[:6]))
     exact = kn.simulate(model, t_end=2.0, n_points=21, method="cvodes", rtol=1e-10,
                         atol=1e-12)
     for res in (dense, exact):
