@@ -151,21 +151,35 @@ SOLVER_LOCK = threading.RLock()
 
 
 @contextlib.contextmanager
-def solver_output(sink):
+def solver_output(sink, descriptors=True):
     """What the integrators print (SUNDIALS' failure chatter, CasADi's warnings) captured
     instead of reaching the user's terminal: CasADi writes through Python's sys.stdout and
     sys.stderr, plain C code to file descriptors 1 and 2; both are caught, in the file
     ``sink`` (emptied first). The text is in the yielded dict's "text" afterwards. Callers
-    hold ``SOLVER_LOCK``."""
+    hold ``SOLVER_LOCK``.
+
+    Without ``descriptors``, only Python's streams are swapped (no system call): for calls
+    of CasADi's own integrators, whose every word (SUNDIALS' through the error handler
+    CasADi installs) reaches Python's streams; ten system calls a run were 1 % of a small
+    model's."""
     box = {"text": ""}
-    fd = sink.fileno()
-    if os.fstat(fd).st_size:            # (a seek and a truncate cost 25 us: only when needed)
-        sink.seek(0)
-        sink.truncate()
     python_level = io.StringIO()
     for stream in (sys.stdout, sys.stderr):
         with contextlib.suppress(Exception):
             stream.flush()
+    if not descriptors:
+        streams = sys.stdout, sys.stderr
+        sys.stdout = sys.stderr = python_level
+        try:
+            yield box
+        finally:
+            sys.stdout, sys.stderr = streams
+            box["text"] = python_level.getvalue()
+        return
+    fd = sink.fileno()
+    if os.fstat(fd).st_size:            # (a seek and a truncate cost 25 us: only when needed)
+        sink.seek(0)
+        sink.truncate()
     try:
         saved = [os.dup(1), os.dup(2)]
     except OSError:                            # no file descriptors to redirect

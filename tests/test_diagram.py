@@ -258,3 +258,48 @@ def test_the_cli_draws_a_model_that_does_not_validate(tmp_path):
         kn.load(broken)
     assert main(["diagram", str(broken), "-o", str(tmp_path / "broken.svg")]) == 0
     assert len(wires(ET.fromstring((tmp_path / "broken.svg").read_text()))) == 8
+
+
+def turned_seed(**turns):
+    """The seed with the layout entries of some blocks given a rotation and/or a flip."""
+    import json
+    data = json.loads((ROOT / "models" / "double_pendulum.json").read_text())
+    for name, extra in turns.items():
+        data["layout"][name] = {**data["layout"][name], **extra}
+    return kn.loads(json.dumps(data), validate=False)
+
+
+@pytest.mark.parametrize("turn, frame_a, frame_b", [
+    ({"rotation": 90}, "top", "bottom"),
+    ({"rotation": 180}, "right", "left"),
+    ({"rotation": 270}, "bottom", "top"),
+    ({"flip": True}, "right", "left"),
+    ({"flip": True, "rotation": 90}, "bottom", "top"),
+])
+def test_rotation_and_flip_in_the_layout_move_the_ports(turn, frame_a, frame_b):
+    """A block turned (clockwise, in quarters) or mirrored in the layout has its ports on the
+    sides that gives, in the SVG as in the studio: frame_a's marker on the block's edge of
+    that side, and the wires still end on their markers."""
+    model = turned_seed(link1=turn)
+    root = ET.fromstring(svg(model))
+    x, y, w, h = blocks(root)["link1"]
+    at = markers(root)
+    edge = {"left": lambda p: p[0] == pytest.approx(x), "right": lambda p: p[0] == pytest.approx(x + w),
+            "top": lambda p: p[1] == pytest.approx(y), "bottom": lambda p: p[1] == pytest.approx(y + h)}
+    assert edge[frame_a](at["link1.frame_a"]), at["link1.frame_a"]
+    assert edge[frame_b](at["link1.frame_b"]), at["link1.frame_b"]
+    for a, b, points in wires(root):
+        assert points[0] == pytest.approx(at[a], abs=0.06)
+        assert points[-1] == pytest.approx(at[b], abs=0.06)
+
+
+def test_a_flipped_block_mirrors_its_sign_and_never_its_text():
+    """Flip mirrors the glyph (a transform on it alone); names and labels are never mirrored."""
+    root = ET.fromstring(svg(turned_seed(shoulder={"flip": True})))
+    block = next(g for g in root.iter(f"{NS}g") if g.get("data-name") == "shoulder")
+    mirrored = [g for g in block.iter(f"{NS}g") if "scale(-1,1)" in (g.get("transform") or "")]
+    assert len(mirrored) == 1 and mirrored[0].find(f"{NS}path").get("class") == "glyph"
+    assert not list(mirrored[0].iter(f"{NS}text"))
+    assert all("scale" not in (t.get("transform") or "") for t in root.iter(f"{NS}text"))
+    # the names still read "shoulder", left to right
+    assert "shoulder" in [t.text for t in block.iter(f"{NS}text")]

@@ -33,6 +33,7 @@ LIBRARIES = {"multibody": ("#5f5f5f", "#f5f5f5"), "rotational": ("#404040", "#f7
              "probe": ("#a86b00", "#fff8e8"), "subsystem": ("#3a3a3a", "#fffdf2"),
              "electrical": ("#0000ff", "#f2f2ff")}
 OUTWARD = {"left": (-1, 0), "right": (1, 0), "top": (0, -1), "bottom": (0, 1)}
+_CLOCKWISE = ("left", "top", "right", "bottom")
 _PRINCIPAL = re.compile(r"(?:frame|flange)_([ab])")
 
 
@@ -95,6 +96,27 @@ def _side(comp, port, depth=0):
     return "top"                       # a joint's axis and support, as in Modelica
 
 
+def placed_side(side, rotation=0, flip=False):
+    """The side a port on ``side`` is drawn on once its block is mirrored left to right
+    (``flip``) and then turned ``rotation`` degrees clockwise, as the studio keeps them in a
+    model's ``layout``: the left side of a block turned by 90 is its top."""
+    if flip and side in ("left", "right"):
+        side = "right" if side == "left" else "left"
+    return _CLOCKWISE[(_CLOCKWISE.index(side) + round(rotation / 90)) % 4]
+
+
+def placement(model, name):
+    """``(rotation, flip)`` of a component's block, from the model's layout: a quarter turn
+    in degrees (0, 90, 180 or 270; another angle counts as the nearest quarter) and whether
+    it is mirrored."""
+    spot = (model.layout or {}).get(name)
+    if not isinstance(spot, dict):
+        return 0, False
+    turn = spot.get("rotation", 0)
+    ok = isinstance(turn, (int, float)) and not isinstance(turn, bool) and math.isfinite(turn)
+    return (round(turn / 90) % 4) * 90 if ok else 0, spot.get("flip") is True
+
+
 class Block:
     """A component's block: its size, and where each of its ports sits on its sides.
 
@@ -102,11 +124,14 @@ class Block:
     type. Ports on the top and bottom have their labels outside, so that the side ports of
     all blocks are at one height and wires between blocks placed in a row run straight."""
 
-    def __init__(self, comp):
+    def __init__(self, comp, rotation=0, flip=False):
         self.comp, self.name = comp, comp.name
         self.probe = comp.role == "probe" and not isinstance(comp, Subsystem)
         self.single = len(comp.ports) == 1 and not isinstance(comp, Subsystem)
-        self.sides = {p: _side(comp, p) for p in comp.ports}
+        #: turned or mirrored by the user: its ports stay on the sides that gives them
+        self.rotation, self.flip = rotation, flip
+        self.turned = bool(rotation) or flip
+        self.sides = {p: placed_side(_side(comp, p), rotation, flip) for p in comp.ports}
         self.kind = comp.definition.name if isinstance(comp, Subsystem) else \
             (comp.type_name or type(comp).__name__).rpartition(".")[2]
         if self.probe:

@@ -9,7 +9,7 @@ import networkx as nx
 from ..components.base import ANY
 from ..graph.subsystem import Subsystem
 from .blocks import (DOMAINS, LABEL_PX, LIBRARIES, NAME_PX, OUTWARD, ROUTED, ROW, STUB, TYPE_PX,
-                     Block, connections_of, library_of, port_domain, text_width)
+                     Block, connections_of, library_of, placement, port_domain, text_width)
 from .layout import place_blocks
 from .routing import Router, sign, simplify, spread, wire_junctions
 
@@ -19,7 +19,7 @@ def svg(model):
     ports on their sides in Modelica's colours, orthogonal wires. A model of subsystems is
     drawn one level deep (each subsystem a block with its exposed ports); a half-built
     model (ports left open, no layout) draws too."""
-    boxes = {name: Block(comp) for name, comp in model.components.items()}
+    boxes = {name: Block(comp, *placement(model, name)) for name, comp in model.components.items()}
     spots = place_blocks(model, boxes)
     links = connections_of(model)
     _face_ports(boxes, spots, links)
@@ -64,7 +64,7 @@ def _face_ports(boxes, spots, links):
     def centre(name):
         return spots[name][0] + boxes[name].w / 2, spots[name][1] + boxes[name].h / 2
     for name, box in boxes.items():
-        if box.single:
+        if box.single or box.turned:
             continue
         ends = [p for p, side in box.sides.items() if side in ("top", "bottom")]
         chosen = {}
@@ -82,7 +82,7 @@ def _face_ports(boxes, spots, links):
             box.sides.update(chosen)
             box.arrange()
     for name, box in boxes.items():
-        if not box.single:
+        if not box.single or box.turned:
             continue
         for port in box.sides:
             others = [o for o in peers.get((name, port), ()) if o[0] != name]
@@ -207,7 +207,15 @@ def _block(box, x, y, domains, nets, turns):
         labels = [p for p in comp.ports if box.sides[p] in ("left", "right")]
         room = box.w - 2 * max((text_width(p, LABEL_PX) for p in labels), default=0) - 18
         if room >= 14:
-            out.append(_glyph(library, cx, y + 17 + box.rows * ROW / 2, border))
+            gy = y + 17 + box.rows * ROW / 2
+            glyph = _glyph(library, cx, gy, border)
+            # the sign turns and mirrors with its block; the texts never do (they would read
+            # backwards)
+            if box.turned:
+                mirror = f" translate({_f(2 * cx)},0) scale(-1,1)" if box.flip else ""
+                glyph = f'<g transform="rotate({box.rotation} {_f(cx)} {_f(gy)}){mirror}">' \
+                        f"{glyph}</g>"
+            out.append(glyph)
     for port, (dx, dy) in box.at.items():
         px, py = x + dx, y + dy
         side = box.sides[port]

@@ -21,7 +21,7 @@ import networkx as nx
 
 from ..graph.subsystem import Subsystem
 from .blocks import (LAYER_GAP, NODE_GAP, ROOM, SAT_GAP, TRACK, Block, connections_of,
-                     given_positions)
+                     given_positions, placement)
 
 
 def auto_layout(model):
@@ -32,7 +32,7 @@ def auto_layout(model):
     the others are placed by a port-aware layered layout (see the module's docstring).
     The same model always gets the same layout.
     """
-    boxes = {name: Block(comp) for name, comp in model.components.items()}
+    boxes = {name: Block(comp, *placement(model, name)) for name, comp in model.components.items()}
     spots = place_blocks(model, boxes)
     return {name: {"x": spots[name][0], "y": spots[name][1], "w": boxes[name].w,
                    "h": boxes[name].h} for name in model.components}

@@ -24,6 +24,9 @@ from . import jit as _jit
 #: Jacobian is 2.5 million instructions, minutes of gcc)
 JACOBIAN_JIT_LIMIT = 200_000
 
+#: checked run settings kept per System (``Compiled.checked``), least recently used dropped
+SETTINGS_KEPT = 64
+
 #: CasADi integrators kept per System (the chunks of recent runs), least recently used dropped
 INTEGRATORS_KEPT = 64
 
@@ -38,6 +41,7 @@ class Compiled:
         self._system = weakref.ref(system)
         self._cache = {}
         self._integrators = collections.OrderedDict()
+        self._checked = collections.OrderedDict()
 
     @property
     def system(self):
@@ -141,7 +145,6 @@ class Compiled:
                         "alg": ca.substitute(held.alg, held.t, t)}
             return self._get(f"{name}_sx", build_sx)
         exact = jacobian and bool(jit) and self.jacobian_small()
-
         def build():
             tau, x = ca.MX.sym("tau"), ca.MX.sym("x", system.n_states)
             z = ca.MX.sym("z", system.n_algebraic)
@@ -191,6 +194,21 @@ class Compiled:
             while len(self._integrators) > INTEGRATORS_KEPT:
                 self._integrators.popitem(last=False)
         return made
+
+    def checked(self, key, check):
+        """What ``check()`` answers for run settings ``key`` (``plan._checked``), found once:
+        the answers of the most recent SETTINGS_KEPT settings are kept. A refusal (an
+        exception) is not kept: it is raised again, found again."""
+        with _LOCK:
+            if key in self._checked:
+                self._checked.move_to_end(key)
+                return self._checked[key]
+        answer = check()
+        with _LOCK:
+            self._checked[key] = answer
+            while len(self._checked) > SETTINGS_KEPT:
+                self._checked.popitem(last=False)
+        return answer
 
     def memo(self, key, build):
         """Anything else a method builds once per System (the midpoint rule's step)."""

@@ -26,12 +26,9 @@ level of the tolerance (their restarts differ); each gives the same numbers ever
 from __future__ import annotations
 
 import _signal
-import atexit
 import contextlib
 import math
-import os
 import signal
-import tempfile
 import threading
 import time
 
@@ -41,13 +38,13 @@ from ..equations.system import OVERFLOW, overflow_message
 from ..errors import ModelError
 from ..graph.settings import check_output, check_settings
 from ..util import quote, suggest
-from .capture import SOLVER_LOCK, solver_output
+from .capture import Section
 from .chunks import MAX_CHUNK, _first_chunk, _merge, _next_chunk, _Rows, _work
 from .compiled import compiled, numeric
 from .events import EVENT_CHUNK
 from .fallback import GaveUp, Rival, Stalled, _stalled, look_budget
 from .loopwatch import Partitions, near_singular
-from .methods import LOOK, METHODS, Failure, Interrupted, budget_spent, shift_times
+from .methods import LOOK, METHODS, Failure, Interrupted, budget_spent
 from .stiffness import choose
 from .tolerance import step_budget
 
@@ -65,28 +62,12 @@ OUTPUT_CHUNK_WORK = 1e7
 #: after a run stopped (a signal, the time limit), the probe signals of what it reached are
 #: still computed for at most this long [s] (unless stopped again), and kept
 OUTPUT_GRACE = 0.5
+#: a run whose states hold at most this many numbers computes its probe signals when they are
+#: first read (``deferred_outputs``): the seed's 1001 points took 0.5 ms, a tenth of its run
+DEFERRED_VALUES = 10**6
 #: an assembly whose (dimensionless) measure of a singular position is below this at the last
 #: output of a failed run is named as near its singular position there
 NEAR_SINGULAR_ASSEMBLY = 1e-3
-
-
-_SINK = {}
-
-
-def _sink():
-    """The file that catches what the solvers print: one per process, used under SOLVER_LOCK
-    (a temporary file per run cost 0.3 ms, a tenth of a small model's run)."""
-    if _SINK.get("pid") != os.getpid():
-        if "file" in _SINK:                    # a forked child's copy of its parent's
-            _SINK["file"].close()
-        _SINK.update(pid=os.getpid(), file=tempfile.TemporaryFile())  # noqa: SIM115
-    return _SINK["file"]
-
-
-@atexit.register
-def _close_sink():
-    if _SINK.get("pid") == os.getpid():
-        _SINK.pop("file").close()
 
 
 class Run:
@@ -129,19 +110,12 @@ class Run:
         self.p_solver = p
 
     # -- what methods use --------------------------------------------------------------------
-    @contextlib.contextmanager
-    def solver_section(self, t0=0.0):
+    def solver_section(self, t0=0.0, descriptors=True):
         """Run compiled solver code with its printing captured (and serialised: see
         ``capture.SOLVER_LOCK``); the code integrates in the time since ``t0``, so the times it
-        names are shifted back by ``t0``."""
-        box = None
-        try:
-            with SOLVER_LOCK, solver_output(_sink()) as box:
-                yield
-        finally:                        # a failing solver's words are the ones wanted
-            if box is not None and box["text"].strip() and self.signal is None \
-                    and self.stop_reason() is None:
-                self.said.append(shift_times(box["text"], t0))
+        names are shifted back by ``t0``. Without ``descriptors``: code that prints through
+        Python's streams only, CasADi's integrators (``capture.solver_output``)."""
+        return Section(self, t0, descriptors)
 
     @contextlib.contextmanager
     def interruptible(self):
@@ -441,9 +415,7 @@ def _probe_outputs(run, t, X):
     outputs = np.empty((n, width))
     if not n:
         return X, outputs, None
-    size = int(min(max(OUTPUT_CHUNK_WORK / max(system.f_out.n_instructions(), 1), 256),
-                   2**16))
-    size = 2 ** int(np.log2(size))          # few sizes: each has its mapped Function
+    size = _output_chunk(system)
     started, earlier, seen = time.perf_counter(), run.stop_reason(), run.signals_seen
 
     def stopped():
@@ -463,6 +435,36 @@ def _probe_outputs(run, t, X):
             polished[rows] = system.polish(polished[rows], p, t[rows])
         system.outputs_into(t[rows], polished[rows], p, outputs[rows], f_out)
     return polished, outputs, None
+
+
+def _output_chunk(system):
+    """Points per chunk of the probe signals (``_probe_outputs``): about OUTPUT_CHUNK_WORK
+    of work, a power of two (few sizes: each has its mapped Function)."""
+    size = int(min(max(OUTPUT_CHUNK_WORK / max(system.f_out.n_instructions(), 1), 256),
+                   2**16))
+    return 2 ** int(np.log2(size))
+
+
+def deferred_outputs(run, t, X):
+    """The probe signals of states X at times t as a callable that computes them when the
+    Results first read them (``Results``), or None where they must be computed at once: a
+    run the time limit, ``cancel`` or a progress report watches (their stops are served
+    between chunks of the outputs too), signals of more than one chunk (a signal stops
+    the run between them), loops to polish, a clock to check, or states of over
+    DEFERRED_VALUES numbers (they are copied, so that writes into ``res.states`` do not
+    change the signals)."""
+    system = run.system
+    if system.n_algebraic or system.eq.clock is not None or X.size > DEFERRED_VALUES or \
+            run.deadline is not None or run.cancel is not None or run.progress is not None \
+            or len(t) > _output_chunk(system):
+        return None
+    f_out = compiled(system).outputs(run.jit)
+    t, X, p = np.array(t, dtype=float), np.array(X, dtype=float), np.array(run.p, dtype=float)
+
+    def values():
+        return system.outputs_into(t, X, p, np.empty((len(t), system.f_out.size1_out(0))),
+                                   f_out)
+    return values
 
 
 def _assembly_watch(run, X, new, failure):

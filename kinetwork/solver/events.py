@@ -76,8 +76,8 @@ DENSE = 32
 #: CVODES interpolates between its steps (right after a start, at order one or two, to about
 #: half its tolerances on EngineV6)
 FIT = 1.0
-#: steps at most from the time found on that curve to the side where the integration has
-#: crossed
+#: Newton's steps at most from the time found on a curve not within FIT to the integration's
+#: own root, on the side where it has crossed
 POLISH = 4
 
 
@@ -331,19 +331,23 @@ class Events:
                 return self._rk4(T[j], X[j], t - T[j])
             return method.start(self.run, T[j], X[j]).state_at(t)
 
-        x_i = exact(t_i)
+        # Newton on the integration from the curve's root (off by the curve's error): to
+        # the integration's own root, on the side where the indicator has crossed
         tiny = 4 * np.finfo(float).eps
+        x_i, crossed_at = exact(t_i), None
         for _ in range(POLISH):
             g_i = self.levels(t_i, x_i)[i]
             if g_i <= 0:
-                return t_i, x_i, i
+                crossed_at = (t_i, x_i, i)
             rate = self.indicators(t_i, x_i)[1][i]
-            if not rate < 0 or t_i >= t1:
+            if not rate < 0:
                 break
-            # just short of the crossing by the curve's error: past it along the rate
-            t_i = min(t1, t_i + max(2 * g_i / -rate, tiny * max(1.0, abs(t_i))))
+            dt = g_i / -rate
+            if g_i <= 0 and -dt <= tiny * max(1.0, abs(t_i)):
+                break                       # at the root, to rounding
+            t_i = min(t1, max(t0, t_i + dt + (tiny * max(1.0, abs(t_i)) if g_i > 0 else 0)))
             x_i = exact(t_i)
-        return _UNSURE
+        return crossed_at if crossed_at is not None else _UNSURE
 
     def _tolerance(self, method):
         """(rtol, atol) the method's solver is given for this run (``tolerance.py``)."""

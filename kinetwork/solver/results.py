@@ -12,6 +12,7 @@ import hashlib
 import io
 import json
 import os
+import threading
 from collections.abc import Callable, Sequence
 from typing import TYPE_CHECKING, Any
 
@@ -20,6 +21,8 @@ import numpy as np
 from ..upcalls import upcall
 from ..util import suggest
 
+#: held while the signals of a Results are computed on first read
+_COMPUTING = threading.RLock()
 #: rows of a CSV written at a time: between blocks a write can be stopped (SIGINT, SIGTERM,
 #: a cancel) and keep the rows before
 CSV_BLOCK_ROWS = 4096
@@ -58,10 +61,13 @@ class Results:
     """Simulation output: ``res.t``, ``res["probe1.angle"]``, ``res.states``.
 
     Scalars read as (n_points,), vectors as (n_points, 3), orientations as (n_points, 3, 3).
+    ``values``, every signal's columns side by side, may be a callable that computes them: it
+    is called once, when a signal is first read.
     """
 
     def __init__(self, t: np.ndarray, states: np.ndarray, state_names: Sequence[str],
-                 values: np.ndarray, signals: Sequence[Signal], stats: dict | None = None,
+                 values: np.ndarray | Callable[[], np.ndarray], signals: Sequence[Signal],
+                 stats: dict | None = None,
                  state_units: Sequence[str] | None = None, settings: dict | None = None,
                  probe_targets: dict[str, str] | None = None, system: System | None = None):
         self.t = np.asarray(t, dtype=float)
@@ -81,13 +87,29 @@ class Results:
         self.partial = None
         #: the System that made these results, when known: what ``animate`` draws
         self.system = system
-        self._values = {}
-        col = 0
+        #: the probe signals' values (n_points, their columns), or a callable that computes
+        #: them when first read (a run's probes are worth nothing to a caller reading states)
+        self._pending = values if callable(values) else None
+        self._split = None if callable(values) else self._columns(values)
+
+    def _columns(self, values):
+        """{signal name: its values} from the table of every signal's columns."""
+        out, col = {}, 0
         values = np.asarray(values, dtype=float).reshape(len(self.t), -1)
         for sig in self.signals.values():
-            block = values[:, col:col + sig.size]
+            out[sig.name] = values[:, col:col + sig.size].reshape(len(self.t), *sig.shape)
             col += sig.size
-            self._values[sig.name] = block.reshape(len(self.t), *sig.shape)
+        return out
+
+    @property
+    def _values(self):
+        """{signal name: its values (n_points, *shape)}, computed on first read (once: two
+        threads reading at once wait for one computation)."""
+        if self._split is None:
+            with _COMPUTING:
+                if self._split is None:
+                    self._split, self._pending = self._columns(self._pending()), None
+        return self._split
 
     @property
     def system(self) -> System | None:
@@ -105,6 +127,7 @@ class Results:
     def __getstate__(self):
         """Pickled with the System as its recipe (its model's text, compiled again only if
         the results' System is asked for): CasADi's expressions do not pickle."""
+        self._values                  # noqa: B018 (computed: the System is not pickled)
         state = dict(self.__dict__)
         if self._system is not None:
             state["_system"], state["_recipe"] = None, self._system.__reduce__()
@@ -139,7 +162,7 @@ class Results:
     def __getitem__(self, key: str) -> np.ndarray:
         if key == "t":
             return self.t
-        if key in self._values:
+        if key in self.signals:
             return self._values[key]
         if key in self.state_names:
             return self.states[:, self.state_names.index(key)]
@@ -147,7 +170,7 @@ class Results:
                        f"{', '.join(self.keys())}")
 
     def __contains__(self, key: object) -> bool:
-        return key == "t" or key in self._values or key in self.state_names
+        return key == "t" or key in self.signals or key in self.state_names
 
     def __len__(self) -> int:
         return len(self.t)

@@ -7,7 +7,9 @@ breakpoint) switches where that line crosses zero, or for ``floor``, ``ceil`` an
 where it crosses a whole number: those instants are exact. Any other (``sin(w*t) > 0.5``) is
 scanned at SCAN points over the run, and between two of them a switch is found where the
 indicator changes sign, or where it has an extremum (its derivative changes sign) beyond
-zero: two switches close together, a pulse shorter than the scan's spacing. Each is then
+zero: two switches close together, a pulse shorter than the scan's spacing. An indicator at
+zero over a stretch (a max of two equal values) switches nothing there, only where it leaves
+zero. Each is then
 located by Brent's method to about 1e-15 s. (A curved pulse so narrow that its indicator and
 derivative are flat zero at the scan's points, exp(-((t - t0)/1e-6)^2), is not seen: write
 such a pulse's edges as relations on t, which are exact.)
@@ -159,7 +161,7 @@ def _wholes(a, b):
 def _n_crossings(ga, gb, level):
     """How many crossings ``_crossings`` finds between ends of values ga and gb."""
     if not level:
-        return int(ga == 0.0 or ga * gb < 0)
+        return int((ga == 0.0 and gb != 0.0) or ga * gb < 0)
     if not (np.isfinite(ga) and np.isfinite(gb)):
         return 0
     return len(_wholes(ga, gb))
@@ -170,7 +172,9 @@ def _crossings(at, ta, tb, ga, gb, level, brentq):
     monotone there, with values ga and gb at the ends."""
     if not level:
         if ga == 0.0:
-            return [ta]
+            # zero all along (a max of two equal values: a Brake's normal force before it
+            # is applied) switches nothing; else where it leaves zero
+            return [_leaves_zero(at, ta, tb)] if gb != 0.0 else []
         if ga * gb < 0:
             return [brentq(at, ta, tb, xtol=1e-15, rtol=4 * np.finfo(float).eps,
                            maxiter=200)]
@@ -180,6 +184,22 @@ def _crossings(at, ta, tb, ga, gb, level, brentq):
         found.append(brentq(lambda t, w=whole: at(t, shift=w), ta, tb, xtol=1e-15,
                             rtol=4 * np.finfo(float).eps, maxiter=200))
     return found
+
+
+def _leaves_zero(at, ta, tb):
+    """Where the indicator ``at``, zero at ta and not at tb, leaves zero: at ta itself when
+    it rises from there, later when it holds at zero first (it then jumps, at an instant of
+    another node's)."""
+    low, high = ta, tb
+    while high - low > 4 * np.finfo(float).eps * max(1.0, abs(high)):
+        mid = low + (high - low) / 2
+        if mid <= low or mid >= high:
+            break
+        if at(mid) == 0.0:
+            low = mid
+        else:
+            high = mid
+    return high
 
 
 def _position(a, knots):

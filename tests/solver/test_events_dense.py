@@ -22,8 +22,9 @@ def test_each_contact_is_located_by_one_integration_and_a_check(reference, monke
     fall onto the contact is a parabola, which the cubic through the sampled points and
     their rates is: located on it with no integration at all. Each rise off it (the
     contact's spring, stiff) costs at most one integration over its sampled interval and
-    one or two from the point before the time found. The contact times agree with the
-    reference's root finder to 1e-9 s."""
+    two or three from the point before the time found (Newton's steps from the curve's
+    root to the integration's). The contact times agree with the reference's root finder
+    to 1e-9 s."""
     calls = {"grid": 0, "state_at": 0}
     for name in calls:
         original = getattr(methods._CasadiRun, name)
@@ -41,7 +42,7 @@ def test_each_contact_is_located_by_one_integration_and_a_check(reference, monke
     times = [e["t"] for e in res.stats["events"]]
     assert len(times) == len(contacts) == 8 and not exact
     np.testing.assert_allclose(times, contacts, atol=1e-9)
-    assert calls["grid"] <= 4 and calls["state_at"] <= 2 * 4
+    assert calls["grid"] <= 4 and calls["state_at"] <= 3 * 4
 
 
 def test_dense_and_exact_location_agree_on_a_stop_of_friction(monkeypatch):

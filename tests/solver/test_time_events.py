@@ -93,6 +93,30 @@ def test_a_pulse_far_shorter_than_the_outputs_gives_its_whole_impulse(method):
         assert res["mass.s"][-1] == pytest.approx(2.5e-3 * (2.0 - t0 - 0.3005), abs=1e-7)
 
 
+def test_a_max_of_two_equal_values_switches_nothing_until_they_part():
+    # max(if_else(t > 0.5, 4 (t - 0.5), 0), 0): zero and zero until 0.5, then 4 (t - 0.5)
+    # and 0 (a Brake's normal force before it is applied); one switch, where they part (MSL's
+    # Friction example made 3,414 events of its plateau, one at every scanned point)
+    model = free_mass("max(if_else(t > 0.5, 4*(t - 0.5) + sin(t) - sin(0.5), 0), 0)")
+    res = kn.simulate(model, t_end=1.0, n_points=11)
+    assert res.stats.get("time_events", 0) <= 2
+    # v = integral of f / 2 from 0.5: (2 (t - 0.5)^2 - cos t + cos 0.5 - (t - 0.5) sin 0.5) / 2
+    t = 1.0
+    v = (2 * (t - 0.5) ** 2 - np.cos(t) + np.cos(0.5) - (t - 0.5) * np.sin(0.5)) / 2
+    assert res["mass.v"][-1] == pytest.approx(v, abs=1e-8)
+
+
+def test_msl_friction_has_its_documented_switches_and_no_others():
+    # Modelica.Mechanics.Rotational.Examples.Friction: the brake stops inertia1 at 0.64 s,
+    # the clutch locks for good at 1.66 s (MSL's documentation); the brake's normal force,
+    # zero until 0.5 s, is one time event, not one per scanned point
+    res = kn.simulate(kn.load("msl_friction"))
+    assert res.stats["time_events"] == 1
+    events = [(e["component"], e["kind"]) for e in res.stats["events"]]
+    assert events[-2:] == [("brake", "stuck"), ("clutch", "stuck")]
+    assert [round(e["t"], 2) for e in res.stats["events"][-2:]] == [0.64, 1.66]
+
+
 def msl_periodic(kind, t, start=0.3, period=0.2, nperiod=-1):
     """MSL's Pulse (amplitude 2, width 30 %), SawTooth (amplitude 2) and Trapezoid
     (amplitude 2, rising 0.02, width 0.05, falling 0.04 s) with offset 0.5, written from

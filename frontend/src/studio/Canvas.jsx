@@ -6,11 +6,14 @@ import { useCallback, useEffect, useMemo, useRef, useState } from "react";
 import { Background, ConnectionMode, Controls, MiniMap, ReactFlow, useNodesInitialized, useReactFlow, useStoreApi } from "@xyflow/react";
 import BlockNode from "./BlockNode.jsx";
 import PortNode from "./PortNode.jsx";
+import WireEdge from "./WireEdge.jsx";
 import { GRID, SCALE } from "./model.js";
 import { studio, useStudio } from "./store.js";
 import { edgeData } from "./hooks/useEditing.js";
+import { useWires } from "./hooks/useWires.js";
 
 const nodeTypes = { block: BlockNode, extport: PortNode };
+const edgeTypes = { wire: WireEdge };
 export const DRAG_MIME = "application/x-kinetwork-type";
 /** A right button released this close to where it went down opens the menu (else it panned). */
 const CLICK_SLOP = 5;
@@ -53,10 +56,12 @@ export default function Canvas({ nodes: nodesIn, edges: edgesIn, placed, edit })
     });
   }, [nodesIn, selection, dragPos, measured]);
 
+  // wires routed around the blocks where they are shown, again as a block is dragged
+  const routed = useWires(nodes, edgesIn);
   const edges = useMemo(() => {
     const chosen = new Set(selectedEdges);
-    return edgesIn.map((e) => (chosen.has(e.id) ? { ...e, selected: true } : e));
-  }, [edgesIn, selectedEdges]);
+    return routed.map((e) => (chosen.has(e.id) ? { ...e, selected: true } : e));
+  }, [routed, selectedEdges]);
 
   // a selection set by the studio (not by a box): React Flow's box over the last one goes,
   // or it would take the clicks (a double-click on a block made a subsystem did nothing)
@@ -119,7 +124,7 @@ export default function Canvas({ nodes: nodesIn, edges: edgesIn, placed, edit })
   useEffect(() => {
     if (!fitRequest || fitted.current === fitRequest || !initialized || !nodes.length || !placed) return undefined;
     const id = requestAnimationFrame(() => {
-      flow.fitView({ padding: 0.15, maxZoom: 1.1, duration: 0 });
+      flow.fitView({ padding: 0.03, maxZoom: 1.1, duration: 0 });
       fitted.current = fitRequest;
     });
     return () => cancelAnimationFrame(id);
@@ -187,8 +192,6 @@ export default function Canvas({ nodes: nodesIn, edges: edgesIn, placed, edit })
 
   const onNodeDoubleClick = useCallback((_e, node) => edit.open(node.id), [edit]);
 
-  const defaultEdgeOptions = useMemo(() => ({ type: "smoothstep", pathOptions: { borderRadius: 6 } }), []);
-
   return (
     <div
       className="kn-canvas"
@@ -204,6 +207,7 @@ export default function Canvas({ nodes: nodesIn, edges: edgesIn, placed, edit })
         nodes={nodes}
         edges={edges}
         nodeTypes={nodeTypes}
+        edgeTypes={edgeTypes}
         onNodesChange={onNodesChange}
         onEdgesChange={onEdgesChange}
         onNodeDragStop={onNodeDragStop}
@@ -217,7 +221,6 @@ export default function Canvas({ nodes: nodesIn, edges: edgesIn, placed, edit })
         onEdgeContextMenu={onEdgeContextMenu}
         onPaneClick={onPaneClick}
         connectionMode={ConnectionMode.Loose}
-        defaultEdgeOptions={defaultEdgeOptions}
         snapToGrid
         snapGrid={[GRID, GRID]}
         selectionOnDrag

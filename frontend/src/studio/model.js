@@ -497,63 +497,6 @@ export function pasteComponents(body, clip, at) {
   return { body: next, names: Object.values(rename) };
 }
 
-// -- layout ---------------------------------------------------------------------------------
-
-/**
- * Positions (layout units) for the components of ``body`` that have none: a layered
- * layout along the wiring from the grounds (or the first component), placed below what is
- * already laid out.
- */
-export function autoLayout(body, only) {
-  const comps = body.components || [];
-  const want = new Set(only || comps.map((c) => c.name));
-  if (!want.size) return {};
-  const adj = new Map(comps.map((c) => [c.name, []]));
-  for (const [a, b] of body.connections || []) {
-    const ca = String(a).split(".")[0];
-    const cb = String(b).split(".")[0];
-    const pa = String(a).split(".")[1] || "";
-    const pb = String(b).split(".")[1] || "";
-    if (!adj.has(ca) || !adj.has(cb)) continue;
-    adj.get(ca).push([cb, pa, pb]);
-    adj.get(cb).push([ca, pb, pa]);
-  }
-  const depth = new Map();
-  const order = [];
-  const roots = comps.filter((c) => /Ground$/.test(c.type)).map((c) => c.name);
-  const visit = (start) => {
-    depth.set(start, depth.has(start) ? depth.get(start) : 0);
-    const queue = [start];
-    while (queue.length) {
-      const n = queue.shift();
-      order.push(n);
-      for (const [m, , pm] of adj.get(n) || []) {
-        if (depth.has(m)) continue;
-        // a body, a probe or a sensor hangs below; a chain goes on to the right
-        const side = /^support|^axis|^port$|^y$|^u/.test(pm) || /^(port)$/.test(pm) ? 0 : 1;
-        depth.set(m, depth.get(n) + side);
-        queue.push(m);
-      }
-    }
-  };
-  for (const r of roots) if (!depth.has(r)) visit(r);
-  for (const c of comps) if (!depth.has(c.name)) visit(c.name);
-  const rows = new Map();
-  const pos = {};
-  let top = 0;
-  for (const [, p] of Object.entries(body.layout || {})) {
-    if (p && typeof p.y === "number") top = Math.max(top, p.y + 100);
-  }
-  for (const n of order) {
-    if (!want.has(n)) continue;
-    const col = depth.get(n);
-    const row = rows.get(col) || 0;
-    rows.set(col, row + 1);
-    pos[n] = { x: col * 130, y: top + row * 90 };
-  }
-  return pos;
-}
-
 /**
  * Why the studio cannot show ``data`` as a diagram (its validation says the rest), or null:
  * the parts it draws must have their shape (lists of named components and of pairs).

@@ -13,7 +13,7 @@ import { createJSONStorage, persist } from "zustand/middleware";
 export const PANES = {
   palette: { axis: "x", min: 150, max: 0.3, initial: (room) => clamp(0.17 * room, 170, 240) },
   side: { axis: "x", min: 230, max: 0.4, initial: (room) => clamp(0.22 * room, 250, 330) },
-  results: { axis: "y", min: 150, max: 0.75, initial: (room) => 0.45 * room },
+  results: { axis: "y", min: 150, max: 0.75, initial: (room) => 0.36 * room },
   viewer: { axis: "x", min: 200, max: 0.7, initial: (room) => 0.4 * room },
 };
 /** The diagram and the plots keep at least this much room (px). */

@@ -24,6 +24,7 @@ export function installTestHook(store) {
     plottedSeries: () => trace.plottedSeries,
     plotAxes: () => Object.fromEntries(Object.entries(trace.plotAxes).map(([k, read]) => [k, read()])),
     cursorTime: () => trace.cursorTime,
+    wires: () => trace.wires,
   };
   for (const [key, read] of Object.entries(view)) Object.defineProperty(K, key, { get: read, enumerable: true });
   Object.defineProperty(K, "lastSave", {

@@ -3,7 +3,8 @@
 // fetched into the store's cache as they are met.
 import { useCallback, useEffect, useMemo } from "react";
 import { api } from "../api.js";
-import { autoLayout, resolveDef, resolveScope, shapeProblem, typeInfo, definitionSource } from "../model.js";
+import { layoutBlocks } from "../layout.js";
+import { resolveDef, resolveScope, shapeProblem, typeInfo, definitionSource } from "../model.js";
 import { useStudio } from "../store.js";
 
 /**
@@ -77,7 +78,7 @@ export function wantedFiles(doc, rootCtx) {
  * without a place one.
  */
 export function useDefinitions() {
-  const { rootCtx, resolved, body, scope, scopeKey, posOf } = useScope();
+  const { rootCtx, resolved, body, ctx, scopeKey, posOf } = useScope();
   const scopes = useStudio((s) => s.scopes);
   const doc = rootCtx.doc;
 
@@ -108,50 +109,14 @@ export function useDefinitions() {
   // blocks the layout does not place: the studio's own layered layout
   useEffect(() => {
     const missing = (body.components || []).map((c) => c.name).filter((n) => !posOf(n));
-    if (missing.length) useStudio.getState().setAutoPos(scopeKey, autoLayout(body, missing));
-  }, [body, posOf, scopeKey]);
-
-  // a definition opened without a layout: the server lays it out, as it does a model
-  useEffect(() => {
-    if (!scopes.length || !resolved) return undefined;
-    const layout = body.layout || {};
-    const comps = body.components || [];
-    if (!comps.length || comps.some((c) => layout[c.name])) return undefined;
-    let gone = false;
-    const model = { format: "kinetwork.model", version: 2, name: scope };
-    for (const k of ["parameters", "ports", "components", "connections"]) if (body[k] !== undefined) model[k] = body[k];
-    if (body.definitions) model.definitions = body.definitions;
-    api
-      .layout(model, resolved.ctx.docPath)
-      .then((lr) => {
-        if (gone) return;
-        const pos = positions((lr && lr.layout) || {}, comps);
-        if (Object.keys(pos).length) {
-          useStudio.getState().setAutoPos(scopeKey, pos);
-          useStudio.getState().fit();
-        }
-      })
-      .catch(() => {
-        /* the studio's own layout stays */
-      });
-    return () => {
-      gone = true;
-    };
-    // laid out once per definition opened: its edits keep the positions they have
-    // eslint-disable-next-line react-hooks/exhaustive-deps
-  }, [scopeKey, !!resolved]);
+    // laid out once the ports of every block are known: definitions still loading wait
+    const loading = (body.components || []).some((c) => {
+      const r = !typeInfo(c.type, ctx) && resolveDef(c.type, ctx);
+      return r && !r.body && !r.missing;
+    });
+    if (missing.length && !loading) useStudio.getState().setAutoPos(scopeKey, layoutBlocks(body, missing, ctx, typeInfo));
+  }, [body, ctx, posOf, scopeKey]);
 }
-
-/** {name: {x, y}} of a layout answer, for the components given. */
-export function positions(got, comps) {
-  const pos = {};
-  for (const c of comps) {
-    const p = got[c.name];
-    if (p && typeof p.x === "number" && typeof p.y === "number") pos[c.name] = { x: p.x, y: p.y };
-  }
-  return pos;
-}
-
 /** TypeInfo of the definitions the model has or places: the palette's "subsystems" group. */
 export function useDefinitionTypes() {
   const { rootCtx } = useScope();

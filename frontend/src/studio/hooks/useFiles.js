@@ -9,7 +9,6 @@ import { emptyModel, orderKeys, shapeProblem } from "../model.js";
 import { newFile, studio, useStudio } from "../store.js";
 import { TESTING, trace } from "../testing.js";
 import { forgetJobs } from "./useRun.js";
-import { positions } from "./useDefinitions.js";
 
 /** Seconds after the last edit before the model is autosaved. */
 export const AUTOSAVE_MS = 1500;
@@ -106,23 +105,6 @@ async function mayDiscard(action) {
   return false;
 }
 
-/** Lay out, from the server, a model opened without any layout. */
-async function layOut(model, path) {
-  const comps = model.components || [];
-  const layout = model.layout || {};
-  if (!comps.length || comps.some((c) => layout[c.name])) return;
-  try {
-    const lr = await api.layout(model, path);
-    const pos = positions((lr && lr.layout) || {}, comps);
-    if (Object.keys(pos).length) {
-      studio().setAutoPos("", pos);
-      studio().fit();
-    }
-  } catch {
-    /* no layout: the studio lays the blocks out itself */
-  }
-}
-
 /** Offer the recovery file of ``path`` (null: the unsaved model) when there is one. */
 async function offerRecovery(path) {
   let rec;
@@ -174,7 +156,6 @@ export async function openModel(src, { ask: asking = true } = {}) {
     s.load(r.model, { path: r.path || null, text: r.text, version: r.version || null, baseline: JSON.stringify(r.model), example: src.example || null });
     s.setDialog(null);
     setUrl(r.path || null);
-    await layOut(r.model, r.path);
     if (TESTING) trace.timings.opened = performance.now();
     if (r.path) await offerRecovery(r.path);
     return true;
