@@ -345,11 +345,26 @@ class _CasadiRun:
             x = fresh.advance(np.array([t]), exact=True)[0]
             _add_counts(self.stats, fresh.stats)
             return x
+        return self._stretch(t, 1)[0]
+
+    def grid(self, t, k):
+        """The states at k equal steps from the start to ``t`` (k rows, the last at t), not
+        advancing: one integration whatever the stretch (``state_at``'s, on a grid), or
+        None for a method whose runs cannot (IDAS, fixed steps)."""
+        if self.method.plugin == "idas" or self.method.fixed:
+            return None
+        return self._stretch(t, k)
+
+    def _stretch(self, t, k):
+        """The states at k equal steps from the start to ``t``, by one integrator over a
+        stretch of any length (``Compiled.dae_scaled``) built once per k."""
+        m, run = self.method, self.run
         nx = run.system.n_states
         opts = self.options([t])
-        key = ("stretch", m.plugin, tuple(sorted(opts.items())), bool(run.jit))
+        key = ("stretch", k, m.plugin, tuple(sorted(opts.items())), bool(run.jit))
         integ = run.compiled.integrator(key, lambda: ca.integrator(
-            "locate", m.plugin, run.compiled.dae_scaled(run.jit, m.newton), 0.0, [1.0], opts))
+            "locate", m.plugin, run.compiled.dae_scaled(run.jit, m.newton), 0.0,
+            list(np.arange(1, k + 1) / k), opts))
         try:
             with run.solver_section(self.t, descriptors=False):
                 out = integ(x0=self.x[:nx], z0=self.x[nx:],
@@ -358,33 +373,8 @@ class _CasadiRun:
             run.said.append(shift_times(solver_words(str(exc)), self.t))
             raise Failure(solver_reason(str(exc))) from None
         self._count_call(integ)
-        x = np.concatenate([np.asarray(out["xf"]).ravel(), np.asarray(out["zf"]).ravel()])
-        if not np.all(np.isfinite(x)):
-            raise Failure("the state became non-finite (Inf or NaN)")
-        return x
-
-    def grid(self, t, k):
-        """The states at k equal steps from the start to ``t`` (k rows, the last at t), not
-        advancing: one integration whatever the stretch (``state_at``'s, on a grid), or
-        None for a method whose runs cannot (IDAS, fixed steps)."""
-        m, run = self.method, self.run
-        if m.plugin == "idas" or m.fixed:
-            return None
-        nx = run.system.n_states
-        opts = self.options([t])
-        key = ("stretch grid", k, m.plugin, tuple(sorted(opts.items())), bool(run.jit))
-        integ = run.compiled.integrator(key, lambda: ca.integrator(
-            "locate", m.plugin, run.compiled.dae_scaled(run.jit, m.newton), 0.0,
-            list(np.arange(1, k + 1) / k), opts))
-        try:
-            with run.solver_section(self.t):
-                out = integ(x0=self.x[:nx], z0=self.x[nx:],
-                            p=np.concatenate([self.p, [self.t, t - self.t]]))
-        except RuntimeError as exc:
-            run.said.append(shift_times(solver_words(str(exc)), self.t))
-            raise Failure(solver_reason(str(exc))) from None
-        self._count_call(integ)
-        rows = np.hstack([np.asarray(out["xf"]).T, np.asarray(out["zf"]).T])
+        rows = np.hstack([np.asarray(out["xf"]).reshape(nx, k).T,
+                          np.asarray(out["zf"]).reshape(-1, k).T])
         if not np.all(np.isfinite(rows)):
             raise Failure("the state became non-finite (Inf or NaN)")
         return rows
