@@ -42,6 +42,9 @@ MARGIN = 0.7
 #: TRIAL_STEPS steps of RK4 (6 evaluations a step: RK4 at h and at h/2)
 TRIAL_FRACTION = 0.05
 TRIAL_STEPS = 16
+#: and at most this many (the trial steps in Python: bounded work whatever the horizon, a
+#: linearisation at t = 1e300 included; beyond, the error's growth is extrapolated)
+TRIAL_MAX_STEPS = 512
 #: the global error predicted by the trial at most this fraction of the tolerance
 ERROR_SHARE = 0.5
 
@@ -92,7 +95,7 @@ def trial_error(rhs, t0, t_end, x0, h, rtol, atol):
     the horizon (an error that a damped mode carries away does not grow; one in the phase of
     the motion grows with time). inf when the trial blows up. Also the evaluations it took.
     """
-    steps = max(TRIAL_STEPS, math.ceil(TRIAL_FRACTION * (t_end - t0) / h))
+    steps = min(TRIAL_MAX_STEPS, max(TRIAL_STEPS, math.ceil(TRIAL_FRACTION * (t_end - t0) / h)))
     steps = 2 * math.ceil(min(steps, max(2, math.ceil((t_end - t0) / h))) / 2)
     x0 = np.asarray(x0, float)
     errors = []
