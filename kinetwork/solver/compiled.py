@@ -184,31 +184,13 @@ class Compiled:
     def integrator(self, key, build):
         """A CasADi integrator built once for ``key`` (its grid and options): the same chunks
         of the same run, again, reuse it. Only the most recent INTEGRATORS_KEPT are kept."""
-        with _LOCK:
-            if key in self._integrators:
-                self._integrators.move_to_end(key)
-                return self._integrators[key]
-        made = build()
-        with _LOCK:
-            self._integrators[key] = made
-            while len(self._integrators) > INTEGRATORS_KEPT:
-                self._integrators.popitem(last=False)
-        return made
+        return _kept(self._integrators, key, build, INTEGRATORS_KEPT)
 
     def checked(self, key, check):
         """What ``check()`` answers for run settings ``key`` (``plan._checked``), found once:
         the answers of the most recent SETTINGS_KEPT settings are kept. A refusal (an
         exception) is not kept: it is raised again, found again."""
-        with _LOCK:
-            if key in self._checked:
-                self._checked.move_to_end(key)
-                return self._checked[key]
-        answer = check()
-        with _LOCK:
-            self._checked[key] = answer
-            while len(self._checked) > SETTINGS_KEPT:
-                self._checked.popitem(last=False)
-        return answer
+        return _kept(self._checked, key, check, SETTINGS_KEPT)
 
     def memo(self, key, build):
         """Anything else a method builds once per System (the midpoint rule's step)."""
@@ -231,6 +213,21 @@ class Held:
             self.p, self.ode, self.alg = rel.p, rel.ode, rel.alg
             self.f_rhs, self.f_dae = rel.f_rhs, rel.f_dae
             self.jacobian_function = rel.jacobian_function
+
+
+def _kept(table, key, build, most):
+    """``table[key]``, built by ``build()`` when missing: ``table`` (an OrderedDict) keeps
+    the ``most`` recently used. An exception of ``build`` is not kept."""
+    with _LOCK:
+        if key in table:
+            table.move_to_end(key)
+            return table[key]
+    made = build()
+    with _LOCK:
+        table[key] = made
+        while len(table) > most:
+            table.popitem(last=False)
+    return made
 
 
 def compiled(system):

@@ -43,6 +43,7 @@ import numpy as np
 
 from ..equations.pointwise import pointwise
 from .compiled import numeric
+from .explicit import rk4
 from .methods import Failure
 from .modechange import ModeChanges
 from .switches import Switches
@@ -293,8 +294,7 @@ class Events:
         integrated from the point before it. _UNSURE when it cannot be (a method without
         that integration, a crossing the curve sees and the integration does not):
         ``_locate_exact`` decides."""
-        fun = self.run.compiled.rhs(self.run.jit, method.newton) if self.run.jit \
-            else self.run.compiled.rhs(None)
+        fun = self.run.compiled.rhs(self.run.jit, method.newton)
 
         def rates(T, X):            # the equations' rates at every (T[k], X[k]), one call
             return pointwise(fun, np.asarray(T, dtype=float)[:, None], X,
@@ -363,12 +363,7 @@ class Events:
         variables the state is kept (an error of h |xdot|)."""
         if self.run.system.n_algebraic:
             return np.array(x, dtype=float)
-        f = self._rhs()
-        k1 = f(t, x)
-        k2 = f(t + h / 2, x + h / 2 * k1)
-        k3 = f(t + h / 2, x + h / 2 * k2)
-        k4 = f(t + h, x + h * k3)
-        return x + h / 6 * (k1 + 2 * k2 + 2 * k3 + k4)
+        return rk4(self._rhs(), t, x, h, 1)
 
     def _rhs(self):
         """The held right-hand side at the values held now, as a Python callable."""

@@ -73,7 +73,7 @@ def rk4_stable_step(eigenvalues):
     return float(np.min(reach / np.abs(lam)))
 
 
-def _rk4(rhs, t, x, h, steps):
+def rk4(rhs, t, x, h, steps):
     """``steps`` steps of the classical RK4 from (t, x): the end state."""
     for _ in range(steps):
         k1 = rhs(t, x)
@@ -102,8 +102,8 @@ def trial_error(rhs, t0, t_end, x0, h, rtol, atol):
     with np.errstate(all="ignore"):
         coarse, fine, t = x0, x0, t0
         for _ in range(2):
-            coarse = _rk4(rhs, t, coarse, h, steps // 2)
-            fine = _rk4(rhs, t, fine, h / 2, steps)
+            coarse = rk4(rhs, t, coarse, h, steps // 2)
+            fine = rk4(rhs, t, fine, h / 2, steps)
             t += h * steps / 2
             scale = atol + rtol * np.maximum(np.abs(fine), np.abs(x0))
             errors.append(np.max(np.abs(coarse - fine) * 16 / 15 / scale) if len(x0) else 0.0)
