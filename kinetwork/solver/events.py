@@ -15,16 +15,16 @@ at least whatever its output grid. An event is an indicator going from positive 
 below between two of those points, or one above zero at both but falling, then rising, whose
 minimum between them (where its rate is zero) reaches zero: a friction sticking for less
 than the sampled interval, a contact shorter than it. It is located by Brent's method on the
-indicator along the state integrated by the same method from the row before it: one
-integration to DENSE points of the interval, and the cubic Hermite curve through their
-states and rates between them (its error, h^4/384 |d4x/dt4| on steps of 1/16 of a sampled
-interval, is far below the integration's own), so that the trial times cost no integration;
-the state at the time found is then integrated from the point before it, and the time moved
-along the indicator's rate until that state has crossed (a method without that one
-integration, IDAS or fixed steps, and a crossing the curve sees and the integration does
-not: every trial time integrated from the row before). The time is as exact as the
-integration, to about 1e-14 s in the bracketing itself; the source applies the event, and
-the method starts afresh there. Events are logged (time,
+indicator along the cubic Hermite curve through states and their rates, so that the trial
+times cost no integration: the curve through the two sampled rows, else through DENSE points
+of one integration of the same method from the row before, whichever is within FIT of the
+solver's tolerances (its rate checked against the equations' at three points of each step).
+On a curve that is not, Newton's steps on the integration from the point before take the time
+found to the integration's own root (a method without that one integration, IDAS or fixed
+steps, and a crossing the curve sees and the integration does not: every trial time
+integrated from the row before). The time is as exact as the integration, to about 1e-14 s
+in the bracketing itself; the source applies the event, and the method starts afresh there.
+Events are logged (time,
 component, kind) for ``res.stats["events"]``; time events are counted
 (``res.stats["time_events"]``).
 
