@@ -18,7 +18,7 @@ import pytest
 from browser import browser_missing
 
 from tests.studio.conftest import E2E_TOKEN, REPO, Studio, _why_not, npm_installed
-from tests.studio.helpers import K, open_studio, screenshot, serving, tid
+from tests.studio.helpers import K, open_studio, screenshot, serving, set_field, tid
 
 SIZE = {"width": 1400, "height": 900}
 TOL = 1.0            # px: collinear within it, and overlapping by more than it, is one track
@@ -162,6 +162,11 @@ def show(page, site, **query):
     """Open a model (an example by name, or a file of the studio's folder) and wait until it
     is drawn, fitted and its wires are routed."""
     open_studio(page, site, **query)
+    settle(page)
+
+
+def settle(page):
+    """Wait until the diagram shown is drawn, fitted and its wires are routed."""
     page.wait_for_function("() => { const v = document.querySelector('.react-flow__viewport');"
                            " return v && v.style.transform && document.querySelectorAll("
                            "'.react-flow__edge-path').length > 0; }")
@@ -209,6 +214,33 @@ def test_chain_of_32_links_wraps_into_rows(screen, site):
     assert found["zoom"] >= 0.3, found["zoom"]
     rows = sorted({round(b["y"] / 150) for b in screen.evaluate(DRAWN)["blocks"]})
     assert len(rows) >= 4, rows
+
+
+def test_chain_of_32_links_folded_reads_at_half_zoom(screen, site):
+    """The studio offers to fold the 32 alike links (joint, body, translation) into
+    subsystems; with the mouse: Fold, the definition's name, Enter. The diagram then shows
+    the ground and 32 instances of the new definition, fitted at a zoom of at least 0.5 in
+    a 1400x900 window, its wires as readable as any model's; the folded document is valid,
+    and Undo brings the flat chain back."""
+    show(screen, site, open="chain32.json")
+    assert faults(screen)["zoom"] < MIN_ZOOM      # the flat chain cannot be read whole
+    screen.locator(tid("fold-offer")).wait_for()
+    screen.locator(tid("fold-accept")).click()
+    set_field(screen, "fold-name", "Link")
+    screen.wait_for_function("() => window.__kinetwork.doc.components.length === 33")
+    screen.wait_for_selector(tid("node-link31"))
+    settle(screen)
+    doc = K(screen, "K.doc")
+    assert [c["type"] for c in doc["components"]].count("Link") == 32
+    assert sorted(doc["definitions"]["Link"]["ports"]) == ["frame_a", "frame_b"]
+    screenshot(screen, "studio-chain32-folded-1400x900.png")
+    assert_readable(faults(screen), "chain32 folded")
+    assert not screen.locator(tid("fold-offer")).count()
+    screen.wait_for_function("() => window.__kinetwork.validated")
+    assert K(screen, "K.validation.ok"), K(screen, "K.validation.problems")
+    screen.keyboard.press("Control+z")
+    screen.wait_for_function("() => window.__kinetwork.doc.components.length === 97")
+    assert not screen.errors, screen.errors
 
 
 def free_spot(page, name):
