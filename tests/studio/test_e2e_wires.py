@@ -18,7 +18,8 @@ import pytest
 from browser import browser_missing
 
 from tests.studio.conftest import E2E_TOKEN, REPO, Studio, _why_not, npm_installed
-from tests.studio.helpers import K, open_studio, screenshot, serving, set_field, tid
+from tests.studio.helpers import (K, open_studio, screenshot, serving, set_field, tid,
+                                  wait_validated)
 
 SIZE = {"width": 1400, "height": 900}
 TOL = 1.0            # px: collinear within it, and overlapping by more than it, is one track
@@ -193,9 +194,12 @@ def examples():
 
 @pytest.mark.parametrize("name", examples())
 def test_every_example_readable_at_1400x900(screen, site, name):
-    """Each example opens fitted at a zoom of at least 0.5, its wires orthogonal, on no
-    other net's track, through no block, and ending at their ports."""
+    """Each example opens valid (no problem listed, no error on the page), fitted at a zoom
+    of at least 0.5, its wires orthogonal, on no other net's track, through no block, and
+    ending at their ports (the examples run from the page are test_e2e's)."""
     show(screen, site, example=name)
+    wait_validated(screen)
+    assert K(screen, "K.validation.ok"), (name, K(screen, "K.validation.problems"))
     if os.environ.get("KINETWORK_E2E_SHOTS"):
         stem = os.path.join(os.environ["KINETWORK_E2E_SHOTS"], name.replace("/", "-"))
         screen.screenshot(path=f"{stem}.png")
