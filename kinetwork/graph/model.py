@@ -375,6 +375,12 @@ class Model:
         self._validated = (key, values, topology)
         return topology
 
+    def _keep_topology(self, topology):
+        """Keep ``topology`` as this content's validation: what a System kept on disk for
+        this content was built from (``kinetwork.equations.stored``)."""
+        self._validated = (self.content_key(), (dict(self.parameters),
+                                                dict(self.parameter_text)), topology)
+
     def compile(self, loops: str = "projected", baumgarte_rate: float | None = None
                 ) -> System:
         """Validate and build the equations: a ``kn.System``.
@@ -400,8 +406,8 @@ class Model:
         with _compile_lock:
             if key not in self._compiled:
                 # the equations layer builds it: kinetwork.equations.system.System
-                system = upcall("compile")(self, loops=loops, baumgarte_rate=baumgarte_rate,
-                                           topology=self.validate())
+                # (kinetwork.equations.stored: loaded when kept on disk, validated then)
+                system = upcall("compile")(self, loops=loops, baumgarte_rate=baumgarte_rate)
                 # a System is built for one content: any other is stale now
                 self._compiled = {k: v for k, v in self._compiled.items() if k[0] == key[0]}
                 self._compiled[key] = system

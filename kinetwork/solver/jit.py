@@ -61,6 +61,7 @@ import warnings
 import casadi as ca
 
 from ..errors import KinetworkWarning, ModelError
+from ..util import cache_folder
 from . import jit_source, jit_tiers
 from .jit_build import (BUILD_PREFIX, Unavailable as _Unavailable, build, cores as _cores,
                         os_error as _os_error, record as _record, sha256 as _sha256,
@@ -138,12 +139,8 @@ def level():
 def cache_dir():
     """Where compiled libraries are kept (a ``ModelError`` when there is no home to keep
     them in)."""
-    if path := os.environ.get("KINETWORK_CACHE"):
-        return pathlib.Path(path)
-    if base := os.environ.get("XDG_CACHE_HOME"):
-        return pathlib.Path(base) / "kinetwork"
-    if home := os.environ.get("HOME"):
-        return pathlib.Path(home) / ".cache" / "kinetwork"
+    if (folder := cache_folder()) is not None:
+        return folder
     raise _Unavailable("no-home", "jit: no cache folder ($HOME is not set; set "
                                   "$KINETWORK_CACHE to a private folder)")
 
