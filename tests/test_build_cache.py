@@ -247,3 +247,15 @@ def test_the_folder_is_bounded(cache, monkeypatch):
     kn.load(MODELS / "fourbar.json").compile()
     (left,) = files(cache)                            # only the one just written
     assert left.stat().st_size > 1
+
+
+def test_a_build_that_warned_is_not_kept_and_its_warning_is_said(cache, monkeypatch):
+    init = System.__init__
+
+    def warning(self, *args, **kwargs):
+        init(self, *args, **kwargs)
+        warnings.warn("something about this model", UserWarning)
+    monkeypatch.setattr(System, "__init__", warning)
+    with pytest.warns(UserWarning, match="something about this model"):
+        kn.load(MODELS / "double_pendulum.json").compile()
+    assert not files(cache)

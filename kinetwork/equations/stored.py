@@ -83,12 +83,15 @@ def compile(model, loops="projected", baumgarte_rate=None, topology=None):
         system = _load(folder / f"{key}{SUFFIX}", model)
         if system is not None:
             return system
-    with warnings.catch_warnings(record=True) as said:
-        warnings.simplefilter("always")
-        system = System(model, loops=loops, baumgarte_rate=baumgarte_rate,
-                        topology=topology)
-    for w in said:          # said again as they came, under the caller's filters
-        warnings.warn_explicit(w.message, w.category, w.filename, w.lineno)
+    said = []
+    try:
+        with warnings.catch_warnings(record=True) as said:
+            warnings.simplefilter("always")
+            system = System(model, loops=loops, baumgarte_rate=baumgarte_rate,
+                            topology=topology)
+    finally:                # said again as they came (a failed build's too), under the
+        for w in said:      # caller's filters
+            warnings.warn_explicit(w.message, w.category, w.filename, w.lineno)
     if folder is not None and not said:
         _store(folder, key, system)
     return system
@@ -100,10 +103,11 @@ def key_of(model, loops, baumgarte_rate):
     kept (see the module's docstring)."""
     try:
         content = _canonical(_content(model))
+        environment = _environment()
     except _Uncacheable:
         return None
     digest = hashlib.sha256(FORMAT)
-    for part in (_environment(), content, repr((loops, baumgarte_rate))):
+    for part in (environment, content, repr((loops, baumgarte_rate))):
         digest.update(part.encode())
         digest.update(b"\0")
     return digest.hexdigest()
@@ -149,11 +153,14 @@ def _canonical(value):
 
 @functools.lru_cache(maxsize=1)
 def _environment():
-    """The versions and the sources' hash, once per process."""
+    """The versions and the sources' hash, once per process (_Uncacheable without sources)."""
     import cloudpickle
     import networkx
     digest = hashlib.sha256()
-    for path in sorted(_PACKAGE.rglob("*.py")):
+    sources = sorted(_PACKAGE.rglob("*.py"))
+    if not any(path.name == "system.py" for path in sources):
+        raise _Uncacheable("no sources")      # bytecode only: the key could not see a change
+    for path in sources:
         digest.update(str(path.relative_to(_PACKAGE)).encode() + b"\0")
         digest.update(path.read_bytes() + b"\0")
     return repr((sys.version, sys.platform, platform.machine(), ca.__version__,
