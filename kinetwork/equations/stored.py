@@ -48,6 +48,7 @@ import casadi as ca
 import numpy as np
 
 from ..errors import KinetworkWarning
+from ..graph.model import keep_topology
 from ..util import cache_folder
 from .system import System
 
@@ -358,7 +359,7 @@ def _load(path, model):
         return None
     with contextlib.suppress(OSError):
         os.utime(path)                 # recently used: trimmed last
-    model._keep_topology(system.topology)
+    keep_topology(model, system.topology)
     return system
 
 

@@ -375,12 +375,6 @@ class Model:
         self._validated = (key, values, topology)
         return topology
 
-    def _keep_topology(self, topology):
-        """Keep ``topology`` as this content's validation: what a System kept on disk for
-        this content was built from (``kinetwork.equations.stored``)."""
-        self._validated = (self.content_key(), (dict(self.parameters),
-                                                dict(self.parameter_text)), topology)
-
     def compile(self, loops: str = "projected", baumgarte_rate: float | None = None
                 ) -> System:
         """Validate and build the equations: a ``kn.System``.
@@ -405,8 +399,7 @@ class Model:
         key = (self.content_key(), loops, baumgarte_rate)
         with _compile_lock:
             if key not in self._compiled:
-                # the equations layer builds it: kinetwork.equations.system.System
-                # (kinetwork.equations.stored: loaded when kept on disk, validated then)
+                # kinetwork.equations.stored.compile: loaded when kept on disk, else built
                 system = upcall("compile")(self, loops=loops, baumgarte_rate=baumgarte_rate)
                 # a System is built for one content: any other is stale now
                 self._compiled = {k: v for k, v in self._compiled.items() if k[0] == key[0]}
@@ -442,6 +435,13 @@ class Model:
     def __repr__(self):
         return (f"<Model {self.name!r}: {len(self.components)} components, "
                 f"{len(self.connections)} connections>")
+
+
+def keep_topology(model, topology):
+    """Keep ``topology`` as the validation of ``model``'s content: what a System kept on disk
+    for that content was built from (``kinetwork.equations.stored``)."""
+    model._validated = (model.content_key(), (dict(model.parameters),
+                                              dict(model.parameter_text)), topology)
 
 
 def evaluate(value, spec, env, where, signals=None):
