@@ -13,8 +13,9 @@ import importlib
 
 #: name -> (module, function): what each method of a lower layer hands its work to
 UPCALLS = {
-    # Model.compile -> System(model, loops=, baumgarte_rate=, topology=)
-    "compile": ("kinetwork.equations.system", "System"),
+    # Model.compile -> compile(model, loops=, baumgarte_rate=): the System, loaded when
+    # kept on disk, else built (and validated) then kept
+    "compile": ("kinetwork.equations.stored", "compile"),
     # Model._repr_svg_ -> svg(model): the wiring diagram Jupyter shows
     "diagram": ("kinetwork.diagram", "svg"),
     # Results.plot, Results._repr_html_ -> plot_results(results, *names, **options)

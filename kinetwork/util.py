@@ -131,6 +131,20 @@ def atomic_write(path, write, mode=0o666):
     policy_write(path, write, mode=mode)
 
 
+def cache_folder():
+    """The folder of kinetwork's caches (compiled libraries, derived Systems):
+    ``$KINETWORK_CACHE``, else ``$XDG_CACHE_HOME/kinetwork``, else ``$HOME/.cache/kinetwork``;
+    None without a home to keep them in."""
+    import pathlib
+    if path := os.environ.get("KINETWORK_CACHE"):
+        return pathlib.Path(path)
+    if base := os.environ.get("XDG_CACHE_HOME"):
+        return pathlib.Path(base) / "kinetwork"
+    if home := os.environ.get("HOME"):
+        return pathlib.Path(home) / ".cache" / "kinetwork"
+    return None
+
+
 def callable_module(name, function):
     """Make the module ``name`` callable as ``function``: ``kn.plot(...)`` and ``kn.schema()``
     are functions named like their modules, and once a submodule is imported the package's

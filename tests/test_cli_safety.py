@@ -282,8 +282,11 @@ def test_cache_shows_and_clears_only_what_kinetwork_built(tmp_path, monkeypatch,
     assert cli.main(["cache"]) == 0
     shown = capsys.readouterr().out
     assert f"{folder}: 2 compiled libraries" in shown and "rhs_" in shown
+    assert "and 1 derived System kept" in shown
     (folder / "notes.txt").write_text("mine")
     assert cli.main(["cache", "--clear"]) == 0
-    assert "removed 4 files" in capsys.readouterr().out
-    assert sorted(p.name for p in folder.iterdir()) == ["notes.txt"]
+    # two libraries, their records, the kept System
+    assert "removed 5 files" in capsys.readouterr().out
+    assert sorted(p.name for p in folder.iterdir()) == ["notes.txt", "systems"]
+    assert not list((folder / "systems").iterdir())
     assert cli.main(["cache"]) == 0 and ": 0 compiled libraries" in capsys.readouterr().out

@@ -53,6 +53,7 @@ def schema(args):
 
 
 def cache(args):
+    from ..equations import stored
     from ..solver import jit
     if args.clear:
         removed = jit.clear_cache()
@@ -62,6 +63,9 @@ def cache(args):
     print(f"{info['folder']}: {info['entries']} compiled librar"
           f"{'y' if info['entries'] == 1 else 'ies'}, {info['bytes'] / 2**20:.1f} MiB "
           f"(at most {jit.MAX_CACHE_BYTES / 2**20:.0f} MiB are kept)")
+    print(f"  and {info['systems']} derived System{'s' * (info['systems'] != 1)} kept, "
+          f"{info['systems_bytes'] / 2**20:.1f} MiB (at most "
+          f"{stored.MAX_BYTES / 2**20:.0f} MiB)")
     for name, size, _ in info["libraries"][:20]:
         print(f"  {name}  {size / 1024:.0f} KiB")
     if info["entries"] > 20:

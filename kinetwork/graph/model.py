@@ -399,9 +399,8 @@ class Model:
         key = (self.content_key(), loops, baumgarte_rate)
         with _compile_lock:
             if key not in self._compiled:
-                # the equations layer builds it: kinetwork.equations.system.System
-                system = upcall("compile")(self, loops=loops, baumgarte_rate=baumgarte_rate,
-                                           topology=self.validate())
+                # kinetwork.equations.stored.compile: loaded when kept on disk, else built
+                system = upcall("compile")(self, loops=loops, baumgarte_rate=baumgarte_rate)
                 # a System is built for one content: any other is stale now
                 self._compiled = {k: v for k, v in self._compiled.items() if k[0] == key[0]}
                 self._compiled[key] = system
@@ -436,6 +435,13 @@ class Model:
     def __repr__(self):
         return (f"<Model {self.name!r}: {len(self.components)} components, "
                 f"{len(self.connections)} connections>")
+
+
+def keep_topology(model, topology):
+    """Keep ``topology`` as the validation of ``model``'s content: what a System kept on disk
+    for that content was built from (``kinetwork.equations.stored``)."""
+    model._validated = (model.content_key(), (dict(model.parameters),
+                                              dict(model.parameter_text)), topology)
 
 
 def evaluate(value, spec, env, where, signals=None):

@@ -61,6 +61,8 @@ import warnings
 import casadi as ca
 
 from ..errors import KinetworkWarning, ModelError
+from ..equations import stored
+from ..util import cache_folder
 from . import jit_source, jit_tiers
 from .jit_build import (BUILD_PREFIX, Unavailable as _Unavailable, build, cores as _cores,
                         os_error as _os_error, record as _record, sha256 as _sha256,
@@ -138,12 +140,8 @@ def level():
 def cache_dir():
     """Where compiled libraries are kept (a ``ModelError`` when there is no home to keep
     them in)."""
-    if path := os.environ.get("KINETWORK_CACHE"):
-        return pathlib.Path(path)
-    if base := os.environ.get("XDG_CACHE_HOME"):
-        return pathlib.Path(base) / "kinetwork"
-    if home := os.environ.get("HOME"):
-        return pathlib.Path(home) / ".cache" / "kinetwork"
+    if (folder := cache_folder()) is not None:
+        return folder
     raise _Unavailable("no-home", "jit: no cache folder ($HOME is not set; set "
                                   "$KINETWORK_CACHE to a private folder)")
 
@@ -261,12 +259,15 @@ def wait(timeout=None):
 def cache_info():
     """What the cache holds of kinetwork's own (libraries with their records, see
     :func:`recorded`): ``folder``, ``entries``, ``bytes`` and ``libraries``, a list of (file
-    name, bytes, mtime), the most recently loaded first."""
+    name, bytes, mtime), the most recently loaded first; ``systems`` and ``systems_bytes``,
+    the derived Systems kept (``equations.stored``)."""
     folder = cache_dir()
     libraries = [(lib.name, size, mtime) for lib, size, mtime in recorded(folder)]
     libraries.sort(key=lambda entry: -entry[2])
+    systems = stored.kept()
     return {"folder": str(folder), "entries": len(libraries),
-            "bytes": sum(size for _, size, _ in libraries), "libraries": libraries}
+            "bytes": sum(size for _, size, _ in libraries), "libraries": libraries,
+            "systems": len(systems), "systems_bytes": sum(size for _, size, _ in systems)}
 
 
 def recorded(folder):
@@ -289,13 +290,14 @@ def recorded(folder):
 def clear_cache():
     """Remove what kinetwork wrote in the cache: the libraries its records name, those
     records, records left without their library, the notes of failed background builds and
-    lock files no build holds (of libraries named as kinetwork names them), and build
-    folders left by killed processes; return the number of files removed. Anything else in
-    the folder (a library without a record, any other file) is left alone."""
+    lock files no build holds (of libraries named as kinetwork names them), build folders
+    left by killed processes, and the derived Systems kept (``equations.stored``); return
+    the number of files removed. Anything else in the folder (a library without a record,
+    any other file) is left alone."""
     folder = cache_dir()
     if not folder.is_dir():
         return 0
-    removed = 0
+    removed = stored.clear()
     with _LOCK:
         for lib, _, _ in recorded(folder):
             removed += _remove(lib) + _remove(_record(lib))

@@ -8,6 +8,7 @@ import pytest
 
 import kinetwork as kn
 from kinetwork.equations.system import System
+from kinetwork.equations import stored
 import kinetwork.graph.model
 import kinetwork.upcalls
 from scenes import double_pendulum
@@ -108,9 +109,9 @@ def compilations(monkeypatch):
     built = []
 
     def counting(*args, **kwargs):
-        built.append(System(*args, **kwargs))
+        built.append(stored.compile(*args, **kwargs))
         return built[-1]
-    assert kinetwork.upcalls.UPCALLS["compile"] == ("kinetwork.equations.system", "System")
+    assert kinetwork.upcalls.UPCALLS["compile"] == ("kinetwork.equations.stored", "compile")
     monkeypatch.setattr(kinetwork.graph.model, "upcall", lambda name: counting)
     yield built
 
