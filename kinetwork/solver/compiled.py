@@ -27,6 +27,10 @@ JACOBIAN_JIT_LIMIT = 200_000
 #: checked run settings kept per System (``Compiled.checked``), least recently used dropped
 SETTINGS_KEPT = 64
 
+#: replay recipes kept per System (``replay.py``: settings and parameter values), least
+#: recently used dropped
+RECIPES_KEPT = 64
+
 #: CasADi integrators kept per System (the chunks of recent runs), least recently used dropped
 INTEGRATORS_KEPT = 64
 
@@ -42,6 +46,7 @@ class Compiled:
         self._cache = {}
         self._integrators = collections.OrderedDict()
         self._checked = collections.OrderedDict()
+        self._recipes = collections.OrderedDict()
 
     @property
     def system(self):
@@ -191,6 +196,17 @@ class Compiled:
         the answers of the most recent SETTINGS_KEPT settings are kept. A refusal (an
         exception) is not kept: it is raised again, found again."""
         return _kept(self._checked, key, check, SETTINGS_KEPT)
+
+    def recipe(self, key, build=None):
+        """The replay recipe kept for ``key`` (``replay.py``), made by ``build()`` when missing
+        and ``build`` is given (else None). Only the most recent RECIPES_KEPT are kept."""
+        if build is None:
+            with _LOCK:
+                found = self._recipes.get(key)
+                if found is not None:
+                    self._recipes.move_to_end(key)
+                return found
+        return _kept(self._recipes, key, build, RECIPES_KEPT)
 
     def memo(self, key, build):
         """Anything else a method builds once per System (the midpoint rule's step)."""
