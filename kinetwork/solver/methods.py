@@ -239,11 +239,11 @@ class _CasadiRun:
         m, run = self.method, self.run
         dae = run.compiled.dae(run.jit, m.newton)
         n = len(times)
-        if not exact and \
-                abs(times[-1] - self.t - n * run.spacing) <= 1e-9 * max(1.0, abs(times[-1])):
-            grid = ("uniform", n, run.spacing)          # equal intervals: j * spacing
+        step = None if exact else _equal_step(times, self.t, run.spacing)
+        if step is not None:
+            grid = ("uniform", n, step)          # equal intervals: j * step
             # an array, not a list: 8 bytes a time instead of 32 (a grid of millions)
-            taus = lambda: np.arange(1, n + 1) * run.spacing  # noqa: E731
+            taus = lambda: np.arange(1, n + 1) * step  # noqa: E731
         else:
             grid = tuple((np.asarray(times, dtype=float) - self.t).tolist())
             taus = lambda: list(grid)  # noqa: E731
@@ -400,6 +400,24 @@ class _CasadiRun:
         else:
             self.stats["steps"] += self.run.steps_per_interval
             self.stats["step"] = self.run.spacing / self.run.steps_per_interval
+
+
+def _equal_step(times, t0, spacing):
+    """The step of ``times`` after ``t0`` when they are equal steps of the output
+    ``spacing`` or of a whole fraction of it (the events' lattice), to rounding; else None.
+    Such grids share one integrator whatever their start (each costs ~1 ms to build)."""
+    n = len(times)
+    if not n:
+        return None
+    step = (float(times[-1]) - t0) / n
+    parts = round(spacing / step) if step > 0 else 0
+    tiny = 1e-9 * max(1.0, abs(float(times[-1])))
+    if parts < 1 or abs(parts * step - spacing) * n > tiny:
+        return None
+    step = spacing / parts
+    if n > 1 and np.max(np.abs(np.asarray(times) - t0 - step * np.arange(1, n + 1))) > tiny:
+        return None
+    return step
 
 
 def _add_counts(total, more):
