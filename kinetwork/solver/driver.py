@@ -109,8 +109,7 @@ class Run:
         #: the parameters of the equations the integrators see (``compiled.Held``): the
         #: model's, then the values the relations are held at (``switches.py``)
         self.p_solver = p
-        #: the integrator calls made (``_CasadiRun.call``), and the last one's (integrator,
-        #: options, look budget): what a run's recipe keeps (``replay.py``)
+        #: integrator calls made, and the last one's (integrator, options, look budget)
         self.calls, self.called = 0, None
 
     # -- what methods use --------------------------------------------------------------------
@@ -419,7 +418,7 @@ def _probe_outputs(run, t, X):
     outputs = np.empty((n, width))
     if not n:
         return X, outputs, None
-    size = _output_chunk(system)
+    size = _output_layout(system)[0]
     started, earlier, seen = time.perf_counter(), run.stop_reason(), run.signals_seen
 
     def stopped():
@@ -441,15 +440,9 @@ def _probe_outputs(run, t, X):
     return polished, outputs, None
 
 
-def _output_chunk(system):
-    """Points per chunk of the probe signals (``_probe_outputs``): about OUTPUT_CHUNK_WORK
-    of work, a power of two (few sizes: each has its mapped Function)."""
-    return _output_layout(system)[0]
-
-
 def _output_layout(system):
-    """(points per chunk of the probe signals, their columns at one point), found once per
-    System (each of CasADi's answers costs 5-10 us, a run asks three)."""
+    """(points per chunk of the probe signals: about OUTPUT_CHUNK_WORK of work, a power of
+    two, few sizes, each a mapped Function; their columns), found once per System."""
     def layout():
         most = int(min(max(OUTPUT_CHUNK_WORK / max(system.f_out.n_instructions(), 1), 256),
                        2**16))
@@ -468,7 +461,7 @@ def deferred_outputs(run, t, X):
     system = run.system
     if system.n_algebraic or system.eq.clock is not None or X.size > DEFERRED_VALUES or \
             run.deadline is not None or run.cancel is not None or run.progress is not None \
-            or len(t) > _output_chunk(system):
+            or len(t) > _output_layout(system)[0]:
         return None
     f_out = compiled(system).outputs(run.jit)
     t, X, p = np.array(t, dtype=float), np.array(X, dtype=float), np.array(run.p, dtype=float)
