@@ -31,9 +31,19 @@ def pytest_collection_modifyitems(items):
 
 @pytest.fixture(autouse=True, scope="session")
 def jit_cache(tmp_path_factory):
-    """Compiled models go to a folder of this test run, not to the user's cache."""
+    """Compiled models go to a folder of this test run, not to the user's cache: one folder
+    for all of the run's workers (pytest-xdist's share the parent of their base folders), so a
+    model the two workers both compile is compiled once. The cache is made for processes that
+    share it (atomic renames, a lock file per optimised build); tests that need a cold cache
+    set their own."""
+    import os
     mp = pytest.MonkeyPatch()
-    mp.setenv("KINETWORK_CACHE", str(tmp_path_factory.mktemp("kinetwork-cache")))
+    if os.environ.get("PYTEST_XDIST_WORKER"):
+        folder = tmp_path_factory.getbasetemp().parent / "kinetwork-cache"
+        folder.mkdir(mode=0o700, exist_ok=True)
+    else:
+        folder = tmp_path_factory.mktemp("kinetwork-cache")
+    mp.setenv("KINETWORK_CACHE", str(folder))
     yield
     mp.undo()
 

@@ -27,7 +27,6 @@ LIBRARY_ORDER = ("multibody", "rotational", "translational", "signals", "electri
 COMPILE_LIMIT = 400
 #: problems sent to the page at most (a model of a million broken parts lists the first)
 MAX_PROBLEMS = 200
-GRID_COLUMNS, GRID_DX, GRID_DY = 4, 220, 140
 
 
 # -- the palette -------------------------------------------------------------------------------
@@ -211,26 +210,6 @@ def _reason(rest):
         value, _, what = rest[2:].partition(": ")
         return f"{what} (got {value})"
     return rest.lstrip(":").strip() or None
-
-
-# -- layout ------------------------------------------------------------------------------------
-def layout(model):
-    """Diagram positions for every component: ``kinetwork.diagram.auto_layout`` when that
-    module is there, else a plain grid in file order."""
-    try:
-        from ..diagram import auto_layout
-    except ImportError:
-        auto_layout = None
-    if auto_layout is not None:
-        return {str(name): _position(value) for name, value in auto_layout(model).items()}
-    return {name: {"x": GRID_DX * (i % GRID_COLUMNS), "y": GRID_DY * (i // GRID_COLUMNS)}
-            for i, name in enumerate(model.components)}
-
-
-def _position(value):
-    if isinstance(value, (list, tuple)) and len(value) == 2:
-        return {"x": plain(value[0]), "y": plain(value[1])}
-    return plain(value)
 
 
 def folder_of(root, real_path):

@@ -279,16 +279,6 @@ def _routes(api, studio):
         files.discard_recovery(studio.root, _rel_or_none(studio, body.get("path")))
         return StudioJSON({"ok": True})
 
-    @api.post("/layout")
-    async def layout(body: dict = Depends(_body)):
-        _keys(body, "layout", required=("model",), optional=("path",))
-        data = _model(body)
-        answer = await studio.call(work.layout, data, studio.folder(studio.model_path(body)),
-                                   studio.library, what="laying out the model")
-        if "problems" in answer:
-            raise StudioError(400, "the model cannot be read", answer["problems"])
-        return StudioJSON(answer)
-
     @api.post("/run")
     def run(body: dict = Depends(_body)):
         _keys(body, "run", required=("model",), optional=("settings", "path"))
@@ -476,6 +466,6 @@ code{background:#f3f3f3;padding:0 .3em}</style></head>
 <code>cd frontend &amp;&amp; npm ci &amp;&amp; npm run build</code>, then reload.</p>
 <p>The HTTP API is up meanwhile: <code>/api/palette</code>, <code>/api/files</code>,
 <code>/api/examples</code>, <code>/api/open</code>, <code>/api/validate</code>,
-<code>/api/save</code>, <code>/api/layout</code>, <code>/api/run</code> (each needs the
+<code>/api/save</code>, <code>/api/run</code> (each needs the
 token).</p></body></html>
 """

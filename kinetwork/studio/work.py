@@ -56,16 +56,6 @@ def summarize(data, folder, library, channel):
     return checks.summarize(data, _ctx(folder, library))
 
 
-def layout(data, folder, library, channel):
-    """``{"layout": ...}`` of the model, or ``{"problems": [...]}`` when it cannot be read."""
-    channel.enter("checking")
-    try:
-        model = checks.build(data, _ctx(folder, library), validate=False)
-    except ModelError as exc:
-        return {"problems": checks.problems_of(exc)}
-    return {"layout": checks.layout(model)}
-
-
 def render(data, text, folder, library, channel):
     """The text to write for a save: ``{"text", "problems", "canonical"}``.
 

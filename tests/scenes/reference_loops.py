@@ -57,6 +57,7 @@ ks=0, x_rest=l).
 """
 
 import functools
+import math
 
 import numpy as np
 import sympy as sp
@@ -111,9 +112,11 @@ def slider_crank_params(**overrides):
 _FB_ARGS = ("a", "b", "c", "d", "m1", "m2", "m3", "J1", "J2", "J3", "g")
 
 
-@functools.lru_cache(maxsize=1)
-def _fourbar_functions():
-    """Exact kinematic and dynamic functions of (theta, phi, psi, *_FB_ARGS).
+@functools.lru_cache(maxsize=2)
+def _fourbar_functions(module="numpy"):
+    """Exact kinematic and dynamic functions of (theta, phi, psi, *_FB_ARGS), on arrays
+    (``module="numpy"``) or on floats (``"math"``: the integrator's right-hand side, 4x
+    faster on one point).
 
     theta, phi, psi are treated as independent symbols tied by the loop closure
     a e(theta) + b e(phi) - c e(psi) - (d, 0) = 0. Its theta-derivative is linear in
@@ -151,7 +154,7 @@ def _fourbar_functions():
         "Vg": Vg, "Vg_p": D(Vg), "Vg_pp": D(D(Vg)),
     }
     args = (th, ph, ps) + (a, b, c, d, m1, m2, m3, J1, J2, J3, g)
-    return {name: sp.lambdify(args, ex, modules="numpy", cse=True) for name, ex in exprs.items()}
+    return {name: sp.lambdify(args, ex, modules=module, cse=True) for name, ex in exprs.items()}
 
 
 def fourbar_closure(theta, branch=1, a=FOURBAR["a"], b=FOURBAR["b"], c=FOURBAR["c"],
@@ -173,6 +176,19 @@ def fourbar_closure(theta, branch=1, a=FOURBAR["a"], b=FOURBAR["b"], c=FOURBAR["
     psi = np.arctan2(Cy, Cx - d)
     phi = np.angle(np.exp(1j * phi))              # wrap to (-pi, pi]
     return phi, psi
+
+
+def _closure_of_one(theta, branch, a, b, c, d):
+    """fourbar_closure of one crank angle, on floats (the same formulas)."""
+    Bx, By = a * math.cos(theta), a * math.sin(theta)
+    wx, wy = d - Bx, -By
+    f = math.hypot(wx, wy)
+    cos_alpha = (b ** 2 + f ** 2 - c ** 2) / (2 * b * f)
+    if abs(cos_alpha) > 1:
+        raise ValueError("four-bar cannot be assembled at this crank angle")
+    phi = math.atan2(wy, wx) + branch * math.acos(cos_alpha)
+    psi = math.atan2(By + b * math.sin(phi), Bx + b * math.cos(phi) - d)
+    return math.remainder(phi, 2 * math.pi), psi
 
 
 def fourbar_points(theta, branch=1, a=FOURBAR["a"], b=FOURBAR["b"], c=FOURBAR["c"],
@@ -230,14 +246,14 @@ def fourbar_simulate(theta0, thetad0, t_eval, rtol=1e-12, atol=1e-12, **params):
     phid, psid, phidd, psidd, B, C (shape (n, 2)) and energy.
     """
     p = fourbar_params(**params)
-    fns = _fourbar_functions()
+    fns = _fourbar_functions("math")
     args = [p[name] for name in _FB_ARGS]
     mass, mass_p, Vg_p = fns["mass"], fns["mass_p"], fns["Vg_p"]
     branch, geometry = p["branch"], {key: p[key] for key in "abcd"}
 
     def rhs(_, y):                                 # scalar fast path of fourbar_rhs
-        theta, thetad = y
-        phi, psi = fourbar_closure(theta, branch, **geometry)
+        theta, thetad = float(y[0]), float(y[1])
+        phi, psi = _closure_of_one(theta, branch, **geometry)
         kin = {"mass": mass(theta, phi, psi, *args), "mass_p": mass_p(theta, phi, psi, *args),
                "Vg_p": Vg_p(theta, phi, psi, *args)}
         return [thetad, _fourbar_accel(theta, thetad, p, kin)]

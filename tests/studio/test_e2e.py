@@ -467,9 +467,11 @@ def test_measure_load_run_and_3d_frame_rate(page, studio, record_property):
             if (dt < 4000) requestAnimationFrame(tick); else done(1000 * n / dt); };
         requestAnimationFrame(tick); })""")
     page.evaluate("() => window.__kinetwork.viewer().pause()")
-    calls = page.evaluate("() => window.__kinetwork.viewer().renderInfo().calls")
+    info = page.evaluate("() => window.__kinetwork.viewer().renderInfo()")
+    calls = info["calls"]
     numbers = {"load_s": loads[1], "run_to_plot_s": sorted(runs)[1], "chain32_fps": fps,
-               "chain32_draw_calls": calls}
+               "chain32_draw_calls": calls, "chain32_triangles": info["triangles"],
+               "chain32_pixel_ratio": info["pixelRatio"]}
     for key, value in numbers.items():
         record_property(key, value)
     print(f"\nstudio load {loads[1]:.2f} s (median of 3); seed Run to plotted "

@@ -18,7 +18,7 @@ import pytest
 from browser import browser_missing
 
 from tests.studio.conftest import E2E_TOKEN, REPO, Studio, _why_not, npm_installed
-from tests.studio.helpers import K, open_studio, screenshot, serving, tid
+from tests.studio.helpers import K, open_studio, screenshot, serving, set_field, tid
 
 SIZE = {"width": 1400, "height": 900}
 TOL = 1.0            # px: collinear within it, and overlapping by more than it, is one track
@@ -162,6 +162,11 @@ def show(page, site, **query):
     """Open a model (an example by name, or a file of the studio's folder) and wait until it
     is drawn, fitted and its wires are routed."""
     open_studio(page, site, **query)
+    settle(page)
+
+
+def settle(page):
+    """Wait until the diagram shown is drawn, fitted and its wires are routed."""
     page.wait_for_function("() => { const v = document.querySelector('.react-flow__viewport');"
                            " return v && v.style.transform && document.querySelectorAll("
                            "'.react-flow__edge-path').length > 0; }")
@@ -170,6 +175,15 @@ def show(page, site, **query):
         const z = () => document.querySelector('.react-flow__viewport').style.transform;
         const a = z(); requestAnimationFrame(() => requestAnimationFrame(() => done(a === z())));
     })""")
+    wait_routed(page)
+
+
+def wait_routed(page):
+    """Wait until the wires drawn are the routing worker's answer for the diagram as shown,
+    and drawn (the routes arrive between frames)."""
+    page.wait_for_function("() => window.__kinetwork.routed")
+    page.wait_for_function("() => new Promise((done) => requestAnimationFrame(() => "
+                           "requestAnimationFrame(() => done(window.__kinetwork.routed))))")
 
 
 def examples():
@@ -200,6 +214,33 @@ def test_chain_of_32_links_wraps_into_rows(screen, site):
     assert found["zoom"] >= 0.3, found["zoom"]
     rows = sorted({round(b["y"] / 150) for b in screen.evaluate(DRAWN)["blocks"]})
     assert len(rows) >= 4, rows
+
+
+def test_chain_of_32_links_folded_reads_at_half_zoom(screen, site):
+    """The studio offers to fold the 32 alike links (joint, body, translation) into
+    subsystems; with the mouse: Fold, the definition's name, Enter. The diagram then shows
+    the ground and 32 instances of the new definition, fitted at a zoom of at least 0.5 in
+    a 1400x900 window, its wires as readable as any model's; the folded document is valid,
+    and Undo brings the flat chain back."""
+    show(screen, site, open="chain32.json")
+    assert faults(screen)["zoom"] < MIN_ZOOM      # the flat chain cannot be read whole
+    screen.locator(tid("fold-offer")).wait_for()
+    screen.locator(tid("fold-accept")).click()
+    set_field(screen, "fold-name", "Link")
+    screen.wait_for_function("() => window.__kinetwork.doc.components.length === 33")
+    screen.wait_for_selector(tid("node-link31"))
+    settle(screen)
+    doc = K(screen, "K.doc")
+    assert [c["type"] for c in doc["components"]].count("Link") == 32
+    assert sorted(doc["definitions"]["Link"]["ports"]) == ["frame_a", "frame_b"]
+    screenshot(screen, "studio-chain32-folded-1400x900.png")
+    assert_readable(faults(screen), "chain32 folded")
+    assert not screen.locator(tid("fold-offer")).count()
+    screen.wait_for_function("() => window.__kinetwork.validated")
+    assert K(screen, "K.validation.ok"), K(screen, "K.validation.problems")
+    screen.keyboard.press("Control+z")
+    screen.wait_for_function("() => window.__kinetwork.doc.components.length === 97")
+    assert not screen.errors, screen.errors
 
 
 def free_spot(page, name):
@@ -259,7 +300,7 @@ def test_wires_rerouted_when_a_block_is_dragged(screen, site, model, block):
     name = block or names[len(names) // 2]
     assert_readable(faults(screen), f"{model} before the drag", fit="chain32.json" not in model.values())
     drag_block(screen, name)
-    screen.wait_for_function("() => new Promise((done) => requestAnimationFrame(() => done(true)))")
+    wait_routed(screen)
     drawn = screen.evaluate(DRAWN)["blocks"]
     me = next(b for b in drawn if b["id"] == name)
     assert not [b["id"] for b in drawn if b is not me and b["x"] < me["x"] + me["w"] and
@@ -280,3 +321,39 @@ def test_screenshots(screen, site, model, w, h):
         assert_readable(faults(screen), f"{model} at {w}x{h}", fit=False)
     finally:
         screen.set_viewport_size(SIZE)
+
+
+def test_page_answers_while_wires_are_routed(screen, site):
+    """Routing runs in a web worker: with its answer outstanding (held back through the test
+    hook, so that the machine's speed does not matter) a block dragged with the mouse drops,
+    a click on another block selects it, the wires not touching the dragged block keep their
+    routes on screen; released, the worker's routes are drawn and as readable as before."""
+    show(screen, site, open="chain32.json")
+    assert K(screen, "K.wires.where") == "worker"
+    names = [c["name"] for c in K(screen, "K.doc.components")]
+    name, other = names[len(names) // 2], names[3]
+    paths = "() => Object.fromEntries([...document.querySelectorAll('.react-flow__edge')].map(" \
+            "(g) => [g.getAttribute('data-id'), g.querySelector('.react-flow__edge-path')" \
+            ".getAttribute('d')]))"
+    before = screen.evaluate(paths)
+    K(screen, "K.holdRouting(true)")
+    try:
+        drag_block(screen, name)
+        assert not K(screen, "K.routed")
+        screen.evaluate("() => document.addEventListener('click', (e) => { window.__clicked ="
+                        " [e.timeStamp, performance.now()]; }, {once: true, capture: true})")
+        box = screen.locator(f"{tid(f'node-{other}')} .kn-block-name").bounding_box()
+        screen.mouse.click(box["x"] + box["width"] / 2, box["y"] + box["height"] / 2)
+        screen.wait_for_function(f"() => window.__kinetwork.selection.includes({json.dumps(other)})")
+        assert not K(screen, "K.routed"), "the routes arrived before the click was answered"
+        now = screen.evaluate(paths)
+        away = [w for w in before if name not in {end.split(".")[0] for end in w.split("~")[:2]}]
+        assert away and all(now[w] == before[w] for w in away)
+        waited = screen.evaluate("() => window.__clicked[1] - window.__clicked[0]")
+        print(f"click taken {waited:.0f} ms after the event, with the routing outstanding")
+    finally:
+        K(screen, "K.holdRouting(false)")
+    wait_routed(screen)
+    assert K(screen, "K.wires.where") == "worker"
+    assert_readable(faults(screen), "chain32 after the held drag", fit=False)
+    assert not screen.errors, screen.errors

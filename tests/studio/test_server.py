@@ -21,7 +21,7 @@ with warnings.catch_warnings():
 
 import kinetwork as kn
 from kinetwork.components.base import REGISTRY
-from kinetwork.studio import checks, launch, results
+from kinetwork.studio import launch, results
 from kinetwork.studio.server import TOKEN_HEADER, create_app
 from tests.studio.helpers import serving
 
@@ -60,7 +60,7 @@ def wait(client, run_id, timeout=120.0):
 # -- the token ---------------------------------------------------------------------------------
 API_GETS = ["/api/palette", "/api/schema", "/api/files", "/api/examples",
             f"/api/open?path={SEED}", "/api/run/r1"]
-API_POSTS = ["/api/validate", "/api/save", "/api/layout", "/api/run", "/api/run/r1/cancel"]
+API_POSTS = ["/api/validate", "/api/save", "/api/run", "/api/run/r1/cancel"]
 
 
 @pytest.mark.parametrize("route", API_GETS + API_POSTS)
@@ -335,14 +335,10 @@ def test_validate_finds_subsystem_files_next_to_the_model(client):
     assert not unsaved["ok"] and "Axis" in unsaved["problems"][0]["message"]
 
 
-def test_layout_places_every_component(client):
-    data = seed(client)
-    layout = client.post("/api/layout", json={"model": data}).json()["layout"]
-    assert set(layout) == {c["name"] for c in data["components"]}
-    assert all(isinstance(p["x"], (int, float)) and isinstance(p["y"], (int, float))
-               for p in layout.values())
-    answer = client.post("/api/layout", json={"model": {"components": 3}})
-    assert answer.status_code == 400 and answer.json()["problems"]
+def test_there_is_no_layout_endpoint(client):
+    """The page lays out its diagrams itself (frontend/src/studio/layout.js); the server's
+    layout, which the page never asked for and which placed blocks otherwise, is gone."""
+    assert client.post("/api/layout", json={"model": seed(client)}).status_code in (404, 405)
 
 
 # -- runs --------------------------------------------------------------------------------------
@@ -403,12 +399,6 @@ def test_a_1d_model_runs_and_says_the_3d_view_has_nothing_to_show(client, name, 
     assert answer["results"]["animation"] is None
     assert answer["results"]["animation_note"] == results.NO_SCENE
     assert not [r for r in caplog.records if r.levelname in ("WARNING", "ERROR")]
-
-
-def test_layout_without_the_diagram_module_is_a_grid(root, monkeypatch):
-    monkeypatch.setitem(sys.modules, "kinetwork.diagram", None)
-    layout = checks.layout(kn.load(root / SEED))
-    assert len({(p["x"], p["y"]) for p in layout.values()}) == len(layout) == 9
 
 
 def test_run_settings_override_the_models(client):
@@ -523,7 +513,6 @@ MALFORMED = [
     ("/api/save", b'{"path": "a.json"}'), ("/api/save", b'{"path": 1, "model": {}}'),
     ("/api/save", b'{"path": "a.json", "model": {}, "text": 5}'),
     ("/api/save", b'{"path": "a.json", "model": [], "text": null}'),
-    ("/api/layout", b'{"model": "x"}'),
     ("/api/run", b'{"model": {}, "settings": []}'),
     ("/api/run", b'{"model": {}, "settings": {"speed": 1}}'),
     ("/api/run", b'{"settings": {}}'),

@@ -1,9 +1,10 @@
 // The studio: palette | diagram | parameters, with the probe plots and the 3-D view below.
 // State is in the store (store.js); the work is in hooks/ (files, definitions, validation,
 // runs, editing, keys); this component puts the pieces on the page.
-import { useCallback, useEffect, useRef, useState } from "react";
+import { useCallback, useEffect, useMemo, useRef, useState } from "react";
 import { api, EXAMPLE, OPEN } from "./api.js";
 import Canvas from "./Canvas.jsx";
+import { findRepeat } from "./fold.js";
 import ContextMenu from "./ContextMenu.jsx";
 import { ChoiceDialog, OpenDialog, PromptDialog } from "./Dialogs.jsx";
 import Palette from "./Palette.jsx";
@@ -102,6 +103,36 @@ function RecoveryBar() {
       </button>
       <button className="kn-btn" data-testid="choice-discard" onClick={offer.discard}>
         Discard them
+      </button>
+    </div>
+  );
+}
+
+/** Blocks a fold must take off the diagram before the studio offers it unasked. */
+const FOLD_OFFER = 24;
+
+/**
+ * A long repeated pattern (a chain of 32 links) offered folded into subsystems, over the
+ * diagram, until folded or dismissed.
+ * @param {{scope: any, edit: import("./hooks/useEditing.js").Edit}} props
+ */
+function FoldOffer({ scope, edit }) {
+  const repeat = useMemo(() => findRepeat(scope.body), [scope.body]);
+  const file = useStudio((s) => s.file);
+  const [dismissed, setDismissed] = useState(() => new Set());
+  const key = `${file.path || file.example || ""}|${scope.scopeKey}`;
+  if (!repeat || repeat.n * (repeat.p - 1) < FOLD_OFFER || dismissed.has(key)) return null;
+  const kinds = repeat.units[0].map((c) => String(c.type).split(".").pop()).join(" + ");
+  return (
+    <div className="kn-fold-offer" data-testid="fold-offer" role="status">
+      <span>
+        {repeat.n} alike units ({kinds}): fold each into a subsystem to read the diagram at a normal zoom?
+      </span>
+      <button className="kn-btn kn-primary" data-testid="fold-accept" onClick={() => edit.fold()}>
+        Fold
+      </button>
+      <button className="kn-btn" data-testid="fold-dismiss" onClick={() => setDismissed(new Set([...dismissed, key]))}>
+        Not now
       </button>
     </div>
   );
@@ -224,7 +255,9 @@ export default function App() {
         <div className="kn-center" ref={centerRef} style={{ gridTemplateRows: `auto 30px minmax(0, 1fr) ${SPLITTER}px ${sizes.results}px` }}>
           <RecoveryBar />
           <Breadcrumbs />
-          <Canvas nodes={diagram.nodes} edges={diagram.edges} placed={placed} edit={edit} />
+          <Canvas nodes={diagram.nodes} edges={diagram.edges} placed={placed} edit={edit}>
+            <FoldOffer scope={scope} edit={edit} />
+          </Canvas>
           <Splitter pane="results" axis="y" side="after" size={sizes.results} label="Plots and 3-D view" />
           <div className="kn-results" style={{ gridTemplateColumns: `minmax(0, 1fr) ${SPLITTER}px ${sizes.viewer}px` }}>
             {closed.results ? null : (

@@ -25,9 +25,10 @@ function sameList(a, b) {
 }
 
 /**
- * @param {{nodes: any[], edges: any[], placed: boolean, edit: import("./hooks/useEditing.js").Edit}} props
+ * @param {{nodes: any[], edges: any[], placed: boolean, edit: import("./hooks/useEditing.js").Edit, children?: any}} props
+ *   ``children``: shown over the diagram (an offer)
  */
-export default function Canvas({ nodes: nodesIn, edges: edgesIn, placed, edit }) {
+export default function Canvas({ nodes: nodesIn, edges: edgesIn, placed, edit, children }) {
   const flow = useReactFlow();
   const rf = useStoreApi();
   const selection = useStudio((s) => s.selection);
@@ -239,6 +240,7 @@ export default function Canvas({ nodes: nodesIn, edges: edgesIn, placed, edit })
         <Controls showInteractive={false} />
         {roomy ? <MiniMap pannable zoomable nodeStrokeWidth={2} nodeColor={(n) => (/** @type {any} */ (n.data).problems?.length ? "#e05555" : "#c9ced6")} style={{ width: 140, height: 90 }} /> : null}
       </ReactFlow>
+      {children}
     </div>
   );
 }

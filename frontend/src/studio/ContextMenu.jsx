@@ -4,6 +4,7 @@
 import { useEffect, useRef } from "react";
 import { useStudio } from "./store.js";
 import { resolveDef } from "./model.js";
+import { findRepeat } from "./fold.js";
 
 /**
  * @param {{edit: import("./hooks/useEditing.js").Edit, scope: import("./hooks/useDefinitions.js").Scope}} props
@@ -47,6 +48,7 @@ export default function ContextMenu({ edit, scope }) {
     add("paste", "Paste here", () => edit.paste(menu.at), "Ctrl+V");
     add("select-all", "Select all", () => edit.selectAll(), "Ctrl+A");
     add("fit", "Fit to view", () => useStudio.getState().fit(), "");
+    if (findRepeat(scope.body)) add("fold", "Fold repeated blocks into subsystems…", () => edit.fold(), "");
   }
   const style = { left: Math.min(menu.x, window.innerWidth - 220), top: Math.min(menu.y, window.innerHeight - 34 * items.length - 12) };
   return (

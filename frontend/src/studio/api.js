@@ -64,5 +64,4 @@ export const api = {
   /** Cancel run or sweep ``id`` (``kind`` "run" or "sweep"). */
   cancel: (kind, id) => call("POST", `api/${kind === "sweep" ? "sweep" : "run"}/${q(id)}/cancel`),
   linearize: (model, spec, path) => call("POST", "api/linearize", { model, ...spec, path: path || null }),
-  layout: (model, path) => call("POST", "api/layout", { model, path: path || null }),
 };

@@ -25,6 +25,8 @@ export function installTestHook(store) {
     plotAxes: () => Object.fromEntries(Object.entries(trace.plotAxes).map(([k, read]) => [k, read()])),
     cursorTime: () => trace.cursorTime,
     wires: () => trace.wires,
+    /** the wires drawn are routed for the diagram as shown (no routing outstanding) */
+    routed: () => !!trace.wires && trace.wires.asked === trace.wires.answered,
   };
   for (const [key, read] of Object.entries(view)) Object.defineProperty(K, key, { get: read, enumerable: true });
   Object.defineProperty(K, "lastSave", {
@@ -41,6 +43,8 @@ export function installTestHook(store) {
   });
   K.store = store;
   K.viewer = () => trace.viewer;
+  /** answers of the routing worker held back (true) or delivered (false) */
+  K.holdRouting = (on) => trace.routing.hold(on);
   K.setTime = (t) => {
     if (trace.bus) trace.bus.setTime(t);
     if (trace.viewer) trace.viewer.setTime(t);

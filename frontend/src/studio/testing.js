@@ -11,5 +11,5 @@ export const TESTING = __TEST_HOOK__;
  * ranges, ticks, labels and sizes), the plot and 3-D view times, the router's last input.
  */
 export const trace = TESTING
-  ? { timings: {}, lastSave: null, lastRun: null, plotted: {}, plottedSeries: {}, plotAxes: {}, cursorTime: null, plotTime: null, viewer: null, bus: null, wires: null }
+  ? { timings: {}, lastSave: null, lastRun: null, plotted: {}, plottedSeries: {}, plotAxes: {}, cursorTime: null, plotTime: null, viewer: null, bus: null, wires: null, routing: null }
   : null;

@@ -10,7 +10,8 @@
 // frame; default: when there are at most 24). Between samples positions are interpolated
 // linearly and orientations along the shorter arc, so any grid plays smoothly at any speed.
 // Besides: getTime(), isPlaying(), renderInfo() (the last frame's draw calls and triangles,
-// the renderer's name and whether it multisamples: not on a software renderer),
+// the renderer's name, whether it multisamples (not on a software renderer) and the pixel
+// ratio, which playing lowers while frames come slowly and fewer pixels make them faster),
 // centers(kind) (where each body shape of a kind is: its frame's pose applied to its middle).
 //
 // Shapes of one kind (boxes, cylinders, spheres, rods, frame axes) are drawn as one
@@ -19,7 +20,7 @@
 import {
   AmbientLight, BoxGeometry, BufferGeometry, Color, ConeGeometry, CylinderGeometry,
   DirectionalLight, Float32BufferAttribute, GridHelper, Group, InstancedMesh, Matrix4, Mesh,
-  MeshBasicMaterial,
+  MeshBasicMaterial, MeshLambertMaterial,
   MeshStandardMaterial, PerspectiveCamera, Quaternion, Scene, SphereGeometry, TubeGeometry, Curve,
   Vector3, WebGLRenderer,
 } from "three";
@@ -72,7 +73,8 @@ export function createViewer(element, animation, options = {}) {
     console.warn("kinetwork viewer:", err);
     return stub(root, data, state);
   }
-  renderer.setPixelRatio(Math.min(window.devicePixelRatio || 1, 2));
+  const pixels = new PixelBudget(Math.min(window.devicePixelRatio || 1, 2));
+  renderer.setPixelRatio(pixels.ratio);
   root.appendChild(renderer.domElement);
 
   const scene = new Scene();
@@ -90,7 +92,7 @@ export function createViewer(element, animation, options = {}) {
   const links = [];      // shapes between two frames, rebuilt from their origins
   const frameAxes = [];  // what the "frames" button shows and hides
   const ground = animation.shapes.find(s => s.kind === "grid");
-  const batches = makeBatches();
+  const batches = makeBatches(SOFTWARE.test(gpu));
   let framesWithAxes = 0;
   for (const shape of animation.shapes) {
     const small = shape.kind === "axes" && shape.component === null
@@ -178,6 +180,10 @@ export function createViewer(element, animation, options = {}) {
       }
       apply(state.time);
       if (options.onTime) options.onTime(state.time);
+      if (pixels.frame(now)) {
+        renderer.setPixelRatio(pixels.ratio);
+        layout();
+      }
     }
     renderer.render(scene, camera);
     if (state.playing) request();
@@ -192,6 +198,7 @@ export function createViewer(element, animation, options = {}) {
     if (state.time >= t[t.length - 1] && options.loop === false) state.time = t[0];
     state.playing = true;
     state.last = null;
+    pixels.restart();
     if (ui) ui.playing(true);
     request();
   }
@@ -337,9 +344,71 @@ export function createViewer(element, animation, options = {}) {
     setTime: time => setTime(time), play, pause, setSpeed, dispose,
     getTime: () => state.time, isPlaying: () => state.playing,
     renderInfo: () => ({ calls: renderer.info.render.calls, triangles: renderer.info.render.triangles,
-                         gpu, antialias: renderer.getContextAttributes().antialias }),
+                         gpu, antialias: renderer.getContextAttributes().antialias,
+                         pixelRatio: renderer.getPixelRatio() }),
     centers: kind => (batches[kind] ? batches[kind].centers() : []),
   };
+}
+
+// The pixel ratio while playing, from the time between frames: lowered by steps (to half the
+// screen's at most) while frames come slower than SLOW, kept lower only where that made them
+// faster (a renderer held back by its vertices, not its pixels, keeps its picture), raised
+// again once they come faster than FAST for a while.
+const SLOW = 1000 / 45, FAST = 1000 / 57, STEP = 0.75, SETTLE = 30, RISE = 120;
+
+export class PixelBudget {
+  constructor(base) {
+    this.base = base;
+    this.ratio = base;
+    this.floor = base * 0.5;
+    this.cap = base;
+    this.rose = false;
+    this.trial = null;
+    this.restart();
+  }
+
+  restart() {
+    this.last = null;
+    this.mean = null;
+    this.count = 0;
+  }
+
+  /** One frame drawn at ``now`` (ms); true when the ratio changed. */
+  frame(now) {
+    if (this.last !== null) {
+      const dt = now - this.last;
+      this.mean = this.mean === null ? dt : 0.9 * this.mean + 0.1 * dt;
+      this.count++;
+    }
+    this.last = now;
+    if (this.count < SETTLE) return false;
+    if (this.trial) {
+      const { before, ratio } = this.trial;
+      this.trial = null;
+      this.count = 0;
+      if (this.mean < 0.9 * before) return false;
+      // no faster with fewer pixels: back, and no lower than that again
+      this.floor = ratio;
+      this.ratio = ratio;
+      return true;
+    }
+    if (this.mean > SLOW && this.ratio * STEP >= this.floor - 1e-9) {
+      // slow again at a ratio it rose to: it stays below that one (no see-saw)
+      if (this.rose) this.cap = this.ratio * STEP;
+      this.rose = false;
+      this.trial = { before: this.mean, ratio: this.ratio };
+      this.ratio *= STEP;
+      this.count = 0;
+      return true;
+    }
+    if (this.mean < FAST && this.ratio < this.cap - 1e-9 && this.count >= RISE) {
+      this.ratio = Math.min(this.cap, this.ratio / STEP);
+      this.rose = true;
+      this.count = 0;
+      return true;
+    }
+    return false;
+  }
 }
 
 // A viewer with nothing to draw on: time still moves, so a host's cursor still follows.
@@ -442,13 +511,28 @@ function build(shape) {
 const matrix = new Matrix4(), basis = new Matrix4(), turn = new Quaternion();
 const scaling = new Vector3(), middle = new Vector3();
 
+// Triangles a kind's instances may take together. A software renderer (headless Chromium's
+// SwiftShader) pays per vertex of every instance: 32 spheres of 32x16 segments (30 720
+// triangles) held a 32-link chain at 15 frames/s, 47 without them. Many small shapes get
+// fewer segments (a sphere a few pixels wide shows none of its 32), one shape the most.
+const TRIANGLES = 8000;
+
+/** Segments round a kind's shapes when there are ``count`` of them: between ``lo`` and ``hi``. */
+export function segments(count, perSegment, lo, hi) {
+  return Math.max(lo, Math.min(hi, Math.floor(TRIANGLES / (perSegment * Math.max(count, 1)))));
+}
+
 // Each kind's unit geometry: a shape is this, scaled by its sizes, turned into its frame's
 // directions and moved to its place (as `build` makes one mesh of its own sizes).
-function unitGeometry(kind) {
+function unitGeometry(kind, count) {
   if (kind === "box") return new BoxGeometry(1, 1, 1).translate(0.5, 0, 0);
-  if (kind === "cylinder") return new CylinderGeometry(0.5, 0.5, 1, 32).rotateZ(-Math.PI / 2).translate(0.5, 0, 0);
-  if (kind === "sphere") return new SphereGeometry(0.5, 32, 16).translate(0.5, 0, 0);
-  if (kind === "rod") return new CylinderGeometry(1, 1, 1, 20).translate(0, 0.5, 0);
+  if (kind === "cylinder") return new CylinderGeometry(0.5, 0.5, 1, segments(count, 4, 12, 32)).rotateZ(-Math.PI / 2).translate(0.5, 0, 0);
+  if (kind === "sphere") {
+    // a sphere of w x w/2 segments has about w*w triangles
+    const w = 2 * Math.max(6, Math.min(16, Math.floor(Math.sqrt(TRIANGLES / Math.max(count, 1)) / 2)));
+    return new SphereGeometry(0.5, w, w / 2).translate(0.5, 0, 0);
+  }
+  if (kind === "rod") return new CylinderGeometry(1, 1, 1, segments(count, 4, 10, 20)).translate(0, 0.5, 0);
   if (kind === "shaft") return new CylinderGeometry(1 / 30, 1 / 30, 0.8, 8).translate(0, 0.4, 0);
   return new ConeGeometry(2.6 / 30, 0.2, 12).translate(0, 0.9, 0);      // an arrow's head
 }
@@ -456,10 +540,11 @@ function unitGeometry(kind) {
 // The shapes of one kind, drawn by one InstancedMesh: each on a frame (its matrix there,
 // `local`) or, for a rod, between two frames' origins.
 class Batch {
-  constructor(kind, lit, small = false) {
+  constructor(kind, lit, small = false, soft = false) {
     this.kind = kind;
     this.lit = lit;
     this.small = small;
+    this.soft = soft;
     this.items = [];
     this.mesh = null;
   }
@@ -468,10 +553,13 @@ class Batch {
 
   finish() {
     if (!this.items.length) return null;
-    const paint = this.lit
-      ? new MeshStandardMaterial({ color: 0xffffff, roughness: 0.55, metalness: 0.1 })
-      : new MeshBasicMaterial({ color: 0xffffff });
-    const mesh = new InstancedMesh(unitGeometry(this.kind), paint, this.items.length);
+    // a software renderer draws Lambert's diffuse light 1.4 times as fast as the physical
+    // material (a 32-link chain: 24-27 frames/s against 17-18, drawing only); the picture
+    // loses the highlights, which shapes a few pixels wide hardly show
+    const paint = !this.lit ? new MeshBasicMaterial({ color: 0xffffff })
+      : this.soft ? new MeshLambertMaterial({ color: 0xffffff })
+        : new MeshStandardMaterial({ color: 0xffffff, roughness: 0.55, metalness: 0.1 });
+    const mesh = new InstancedMesh(unitGeometry(this.kind, this.items.length), paint, this.items.length);
     this.items.forEach((item, i) => mesh.setColorAt(i, new Color(item.color)));
     // the instances move every frame: a bounding sphere computed once would cull them
     mesh.frustumCulled = false;
@@ -507,10 +595,10 @@ class Batch {
   }
 }
 
-function makeBatches() {
+function makeBatches(soft) {
   return {
-    box: new Batch("box", true), cylinder: new Batch("cylinder", true),
-    sphere: new Batch("sphere", true), rod: new Batch("rod", true),
+    box: new Batch("box", true, false, soft), cylinder: new Batch("cylinder", true, false, soft),
+    sphere: new Batch("sphere", true, false, soft), rod: new Batch("rod", true, false, soft),
     shaft: new Batch("shaft", false), head: new Batch("head", false),
     frameShaft: new Batch("shaft", false, true), frameHead: new Batch("head", false, true),
   };

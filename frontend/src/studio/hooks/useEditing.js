@@ -25,6 +25,7 @@ import {
   setParam,
   takenNames,
 } from "../model.js";
+import { findRepeat, foldRepeat } from "../fold.js";
 import { makeSubsystem } from "../subsystem.js";
 import { studio, useStudio } from "../store.js";
 import { prompt } from "./useFiles.js";
@@ -368,6 +369,47 @@ export function useEditing(scope, exposed) {
     [body, posOf, select, toast],
   );
 
+  const fold = useCallback(
+    /** Folds the longest repeated pattern of the scope into instances of a new definition. */
+    async () => {
+      const found = findRepeat(body);
+      if (!found) {
+        toast("no pattern of blocks repeats here (three or more alike units, wired alike, one after the other)");
+        return;
+      }
+      const { palette, hist } = studio();
+      const taken = new Set([...Object.keys(hist.present.definitions || {}), ...Object.keys(palette ? palette.types : {})]);
+      const joint = found.units[0].some((c) => /Revolute|Prismatic|Spherical|Universal|Cylindrical|Planar|FreeMotion/.test(c.type));
+      const stem = joint ? "Link" : "Unit";
+      let defName = stem;
+      for (let i = 2; taken.has(defName); i++) defName = `${stem}${i}`;
+      const kinds = found.units[0].map((c) => String(c.type).split(".").pop()).join(", ");
+      defName = await prompt({
+        title: "Fold into subsystems",
+        label: `${found.n} alike units of ${found.p} blocks (${kinds}) become ${found.n} instances of a new definition: its name`,
+        value: defName,
+        testid: "fold-name",
+      });
+      if (defName === null) return;
+      if (!IDENT.test(defName) || taken.has(defName)) {
+        toast(`${JSON.stringify(defName)}: a definition needs a new identifier for a name, not a kinetwork type nor another definition`);
+        return;
+      }
+      const { body: next, definition, instances } = foldRepeat(body, found, defName);
+      const { scopes, file, defCache } = studio();
+      // the blocks the studio placed itself are placed again, with the instances
+      useStudio.setState((s) => ({ autoPos: { ...s.autoPos, [scopeKey]: {} } }));
+      studio().update((d) => {
+        const out = editInScope(d, scopes, { palette, docPath: file.path, defCache }, () => next);
+        return orderKeys({ ...out, version: 2, definitions: { ...(out.definitions || {}), [defName]: definition } });
+      });
+      select([]);
+      studio().fit();
+      toast(`${found.n} units folded into ${defName} (${instances[0]} … ${instances[instances.length - 1]}); double-click one to open it, Undo to unfold`, "info");
+    },
+    [body, scopeKey, select, toast],
+  );
+
   return useMemo(
     () => ({
       domainOf,
@@ -395,8 +437,9 @@ export function useEditing(scope, exposed) {
       flip,
       selectAll,
       makeSub,
+      fold,
     }),
-    [domainOf, checkConnection, connect, moved, nudge, remove, removeSelected, place, placeAtCentre, open, rename, askRename, setParamOf, setModelParam, renameModelParam, setSim, setField, setPort, copy, paste, duplicate, rotate, flip, selectAll, makeSub],
+    [domainOf, checkConnection, connect, moved, nudge, remove, removeSelected, place, placeAtCentre, open, rename, askRename, setParamOf, setModelParam, renameModelParam, setSim, setField, setPort, copy, paste, duplicate, rotate, flip, selectAll, makeSub, fold],
   );
 }
 

@@ -1,9 +1,12 @@
 // The wires of the diagram, routed (routing.js) from where the blocks are shown: their
 // places in the document or, while the mouse drags, React Flow's. Each change routes again
-// only the wires it concerns.
+// only the wires it concerns, in a web worker (routeservice.js): the page answers input
+// meanwhile and draws each wire as last routed (a wire whose ends moved, as a plain elbow)
+// until the new routes arrive.
 import { useEffect, useMemo, useState } from "react";
 import { OUTWARD, blockGeometry, portPoint } from "../geometry.js";
-import { WireRouter } from "../routing.js";
+import { simplify } from "../routing.js";
+import { RouteService, startWorker } from "../routeservice.js";
 import { TESTING, trace } from "../testing.js";
 
 const EXTPORT = { width: 90, height: 26 };
@@ -63,14 +66,23 @@ function endOf(shape, port, other) {
   return { x: side === "left" ? r.x0 - 7 : r.x1 + 7, y: Math.round((r.y0 + r.y1) / 2), dir: OUTWARD[side] };
 }
 
+/** Whether the route ``points`` still joins ends ``a`` and ``b``. */
+function joins(points, a, b) {
+  const p = points[0];
+  const q = points[points.length - 1];
+  return p.x === a.x && p.y === a.y && q.x === b.x && q.y === b.y;
+}
+
 /**
  * The edges with their routes in ``data.points``.
  * @param {any[]} nodes as shown (dragged positions, measured sizes)
  * @param {any[]} edges
  */
 export function useWires(nodes, edges) {
-  const [router] = useState(() => new WireRouter());
-  const out = useMemo(() => {
+  const [routes, setRoutes] = useState(() => /** @type {any} */ ({ seq: 0, wires: new Map(), routed: 0, ms: 0, where: null }));
+  const [service] = useState(() => new RouteService(startWorker(), (r) => setRoutes(r)));
+  useEffect(() => () => service.stop(), [service]);
+  const asked = useMemo(() => {
     const shape = shapes(nodes);
     const nets = netsOf(edges);
     const wires = edges.map((e) => {
@@ -80,12 +92,22 @@ export function useWires(nodes, edges) {
       const b = endOf(sb, e.targetHandle, sa && sa.rect);
       return { id: e.id, net: nets.get(e.id), a, b };
     });
-    const rects = [...shape.values()].map((s) => s.rect);
-    const routed = router.route(rects, wires);
-    return { rects, wires, routed: routed.routed, edges: edges.map((e) => ({ ...e, type: "wire", data: { ...e.data, points: routed.wires.get(e.id).points } })) };
-  }, [router, nodes, edges]);
+    return { rects: [...shape.values()].map((s) => s.rect), wires };
+  }, [nodes, edges]);
+  useEffect(() => service.request(asked.rects, asked.wires), [service, asked]);
+  const out = useMemo(() => {
+    const ends = new Map(asked.wires.map((w) => [w.id, w]));
+    return edges.map((e) => {
+      const w = ends.get(e.id);
+      const old = routes.wires.get(e.id);
+      const points = old && joins(old.points, w.a, w.b) ? old.points : simplify([w.a, { x: w.b.x, y: w.a.y }, w.b]);
+      return { ...e, type: "wire", data: { ...e.data, points } };
+    });
+  }, [edges, asked, routes]);
   useEffect(() => {
-    if (TESTING) trace.wires = { rects: out.rects, wires: out.wires, routed: out.routed };
-  }, [out]);
-  return out.edges;
+    if (!TESTING) return;
+    trace.wires = { rects: asked.rects, wires: asked.wires, routed: routes.routed, ms: routes.ms, where: routes.where, asked: service.seq, answered: routes.seq };
+    trace.routing = service;
+  }, [asked, routes, service]);
+  return out;
 }

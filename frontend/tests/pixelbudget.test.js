@@ -1,0 +1,50 @@
+// The 3-D view's pixel ratio follows the time between frames: lowered while frames are slow
+// and only kept where that helped, raised again when they are fast, never below half.
+import { describe, expect, it } from "vitest";
+import { PixelBudget, segments } from "../src/viewer3d/index.js";
+
+/** Frames drawn ``n`` times, each taking ``cost(ratio)`` ms. */
+function play(budget, n, cost) {
+  let t = budget.clock || 0;
+  for (let i = 0; i < n; i++) {
+    t += cost(budget.ratio);
+    budget.frame(t);
+  }
+  budget.clock = t;
+}
+
+describe("PixelBudget", () => {
+  it("lowers the ratio of a renderer held back by its pixels, to half at most", () => {
+    const b = new PixelBudget(1);
+    play(b, 400, (r) => 10 + 40 * r * r); // 50 ms at full size
+    expect(b.ratio).toBeCloseTo(0.5625, 6);
+    expect(b.ratio).toBeGreaterThanOrEqual(0.5);
+  });
+
+  it("keeps the picture where fewer pixels are no faster", () => {
+    const b = new PixelBudget(1);
+    play(b, 400, () => 60);
+    expect(b.ratio).toBe(1);
+  });
+
+  it("rises again when frames come fast, without see-sawing", () => {
+    const b = new PixelBudget(1);
+    play(b, 200, (r) => 40 * r * r);
+    const low = b.ratio;
+    expect(low).toBeLessThan(1);
+    play(b, 400, () => 5); // the load went away
+    expect(b.ratio).toBe(1);
+    play(b, 400, (r) => 30 * r * r);
+    const settled = b.ratio;
+    play(b, 1000, (r) => 30 * r * r);
+    expect(b.ratio).toBe(settled);
+  });
+});
+
+describe("segments", () => {
+  it("fewer segments for many shapes, within bounds", () => {
+    expect(segments(1, 4, 12, 32)).toBe(32);
+    expect(segments(200, 4, 12, 32)).toBe(12);
+    expect(segments(32, 4, 12, 32)).toBe(32);
+  });
+});
