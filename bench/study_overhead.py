@@ -5,8 +5,9 @@ links with a damper on each joint, planar and 3-D (``scenes.chains.point_masses`
 1001 output points. Per scene and rtol (1e-4, 1e-6, 1e-9; atol = rtol * 1e-2):
 
 - kinetwork: ``kn.simulate(system, t_end, n_points, rtol, atol)`` (``auto``) on a compiled
-  System, run once beforehand (its C code, integrators and settings are cached, as in any
-  later run of a session);
+  System, run once beforehand (its C code, integrators, plan and the run's recipe are kept,
+  as in any later run of a session: a repeated quiet run replays the recipe,
+  ``kinetwork/solver/replay.py``);
 - its integrator call alone: the very CasADi integrator the run called, through its buffer,
   with the run's inputs (what the run would cost with no Python around it);
 - the hand-written route (``peers/casadi_peer.py``: Featherstone's ABA in SX, gcc -O1,
@@ -198,8 +199,9 @@ def main():
         "## Where the time goes", "",
         "Evaluations of the right-hand side per run, CPU time per evaluation (each route's "
         "integrator call divided by its evaluations: CVODES' work included), and what "
-        "kinetwork's run costs beyond its integrator call (settings, start, handlers, "
-        "Results; the probe signals are computed when first read).", "",
+        "kinetwork's run costs beyond its integrator call (the replay: parameters, "
+        "handlers, the solvers' words caught, the counts, Results; the probe signals are "
+        "computed when first read).", "",
         table(["scene", "rtol", "kinetwork evaluations", "hand evaluations",
                "kinetwork us/evaluation", "hand us/evaluation (whole run)",
                "kinetwork per-run overhead [us]", "share of the run"], counts)])

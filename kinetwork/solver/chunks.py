@@ -46,6 +46,7 @@ class _Rows:
         self.data = np.empty((max(n, 1), len(x0)))
         self.data[0] = x0
         self.n = 1
+        self._slot = None                   # the rows last handed out by ``slot``
 
     def __len__(self):
         return self.n
@@ -55,9 +56,14 @@ class _Rows:
 
     def slot(self, m):
         """The next ``m`` rows, for a method to write into (then ``extend`` with them)."""
-        return self.data[self.n:self.n + m]
+        self._slot = self.data[self.n:self.n + m]
+        return self._slot
 
     def extend(self, rows):
+        slot, self._slot = self._slot, None
+        if slot is not None and rows is slot:       # written in place, all of it
+            self.n += len(rows)
+            return
         rows = np.asarray(rows, dtype=float).reshape(-1, self.data.shape[1])
         m = len(rows)
         if not m:

@@ -27,8 +27,18 @@ JACOBIAN_JIT_LIMIT = 200_000
 #: checked run settings kept per System (``Compiled.checked``), least recently used dropped
 SETTINGS_KEPT = 64
 
-#: CasADi integrators kept per System (the chunks of recent runs), least recently used dropped
+#: replay recipes kept per System (``replay.py``: settings and parameter values), least
+#: recently used dropped
+RECIPES_KEPT = 64
+
+#: CasADi integrators kept per System (the chunks of recent runs), least recently used dropped:
+#: at least INTEGRATORS_KEPT, and as many as INTEGRATOR_VALUES / (states) allows up to
+#: INTEGRATORS_MOST. A run with events has a chunk of its own grid after each event, and the
+#: same run again has the same chunks: EngineV6's (22 states) are 341 integrators of ~40 kB,
+#: 13 MB kept that were built again on every run (0.3 s of its 3.4 s) when 64 were kept
 INTEGRATORS_KEPT = 64
+INTEGRATORS_MOST = 1024
+INTEGRATOR_VALUES = 20_000
 
 _TABLE = weakref.WeakKeyDictionary()
 _LOCK = threading.RLock()
@@ -42,6 +52,7 @@ class Compiled:
         self._cache = {}
         self._integrators = collections.OrderedDict()
         self._checked = collections.OrderedDict()
+        self._recipes = collections.OrderedDict()
 
     @property
     def system(self):
@@ -183,14 +194,32 @@ class Compiled:
 
     def integrator(self, key, build):
         """A CasADi integrator built once for ``key`` (its grid and options): the same chunks
-        of the same run, again, reuse it. Only the most recent INTEGRATORS_KEPT are kept."""
-        return _kept(self._integrators, key, build, INTEGRATORS_KEPT)
+        of the same run, again, reuse it. Only the most recent are kept (``integrators_kept``)."""
+        return _kept(self._integrators, key, build, self.integrators_kept())
+
+    def integrators_kept(self):
+        """How many integrators are kept: INTEGRATORS_KEPT, or more for a model of few states
+        (INTEGRATOR_VALUES / states, at most INTEGRATORS_MOST)."""
+        system = self.system
+        size = max(1, system.n_states + system.n_algebraic)
+        return max(INTEGRATORS_KEPT, min(INTEGRATORS_MOST, INTEGRATOR_VALUES // size))
 
     def checked(self, key, check):
         """What ``check()`` answers for run settings ``key`` (``plan._checked``), found once:
         the answers of the most recent SETTINGS_KEPT settings are kept. A refusal (an
         exception) is not kept: it is raised again, found again."""
         return _kept(self._checked, key, check, SETTINGS_KEPT)
+
+    def recipe(self, key, build=None):
+        """The replay recipe kept for ``key`` (``replay.py``), made by ``build()`` when missing
+        and ``build`` is given (else None). Only the most recent RECIPES_KEPT are kept."""
+        if build is None:
+            with _LOCK:
+                found = self._recipes.get(key)
+                if found is not None:
+                    self._recipes.move_to_end(key)
+                return found
+        return _kept(self._recipes, key, build, RECIPES_KEPT)
 
     def memo(self, key, build):
         """Anything else a method builds once per System (the midpoint rule's step)."""

@@ -94,7 +94,8 @@ class Run:
         self.cancel, self.progress, self.restart = cancel, progress, restart
         self.signal = None              # the signal that stopped the run, if one did
         self.signals_seen = 0           # how many arrived
-        self.instructions = (system.f_rhs or system.f_dae).n_instructions()
+        self.instructions = self.compiled.memo(
+            "instructions", lambda: (system.f_rhs or system.f_dae).n_instructions())
         self.said = []                  # what the solvers printed
         self.quiet = False              # nothing to watch: one call over the grid
         self.abortable = False          # a signal now aborts the compiled call
@@ -108,6 +109,8 @@ class Run:
         #: the parameters of the equations the integrators see (``compiled.Held``): the
         #: model's, then the values the relations are held at (``switches.py``)
         self.p_solver = p
+        #: integrator calls made, and the last one's (integrator, options, look budget)
+        self.calls, self.called = 0, None
 
     # -- what methods use --------------------------------------------------------------------
     def solver_section(self, t0=0.0, descriptors=True):
@@ -415,7 +418,7 @@ def _probe_outputs(run, t, X):
     outputs = np.empty((n, width))
     if not n:
         return X, outputs, None
-    size = _output_chunk(system)
+    size = _output_layout(system)[0]
     started, earlier, seen = time.perf_counter(), run.stop_reason(), run.signals_seen
 
     def stopped():
@@ -437,12 +440,14 @@ def _probe_outputs(run, t, X):
     return polished, outputs, None
 
 
-def _output_chunk(system):
-    """Points per chunk of the probe signals (``_probe_outputs``): about OUTPUT_CHUNK_WORK
-    of work, a power of two (few sizes: each has its mapped Function)."""
-    size = int(min(max(OUTPUT_CHUNK_WORK / max(system.f_out.n_instructions(), 1), 256),
-                   2**16))
-    return 2 ** int(np.log2(size))
+def _output_layout(system):
+    """(points per chunk of the probe signals: about OUTPUT_CHUNK_WORK of work, a power of
+    two, few sizes, each a mapped Function; their columns), found once per System."""
+    def layout():
+        most = int(min(max(OUTPUT_CHUNK_WORK / max(system.f_out.n_instructions(), 1), 256),
+                       2**16))
+        return 2 ** int(np.log2(most)), system.f_out.size1_out(0)
+    return compiled(system).memo("output layout", layout)
 
 
 def deferred_outputs(run, t, X):
@@ -456,14 +461,15 @@ def deferred_outputs(run, t, X):
     system = run.system
     if system.n_algebraic or system.eq.clock is not None or X.size > DEFERRED_VALUES or \
             run.deadline is not None or run.cancel is not None or run.progress is not None \
-            or len(t) > _output_chunk(system):
+            or len(t) > _output_layout(system)[0]:
         return None
     f_out = compiled(system).outputs(run.jit)
     t, X, p = np.array(t, dtype=float), np.array(X, dtype=float), np.array(run.p, dtype=float)
 
+    width = _output_layout(system)[1]
+
     def values():
-        return system.outputs_into(t, X, p, np.empty((len(t), system.f_out.size1_out(0))),
-                                   f_out)
+        return system.outputs_into(t, X, p, np.empty((len(t), width)), f_out)
     return values
 
 

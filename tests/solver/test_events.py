@@ -91,3 +91,30 @@ def test_events_are_marked_in_plots():
     assert len(marks) == 2 * len(res.stats["events"]) > 0
     assert sorted({line.get_xdata()[0] for line in marks}) == \
         sorted({ev["t"] for ev in res.stats["events"]})
+
+
+def test_a_run_again_builds_no_integrator_for_its_event_chunks(monkeypatch):
+    """After each event a chunk starts off the output grid, with an integrator of its own
+    grid; the same run again has the same chunks, and finds every one of them kept (a run of
+    over a hundred events: more than the 64 once kept, which were all built again)."""
+    from unittest import mock
+    from kinetwork.solver import compiled as compiled_module, methods
+    system = ball(0.9).compile()
+    kw = {"t_end": 9.0, "n_points": 91, "method": "cvodes", "rtol": 1e-8, "atol": 1e-10}
+    first = kn.simulate(system, **kw)
+    assert len(first.stats["events"]) > 64
+
+    def again():
+        with mock.patch.object(methods.ca, "integrator", wraps=methods.ca.integrator) as build:
+            res = kn.simulate(system, **kw)
+        return res, build.call_count
+    res, built = again()
+    assert built == 0
+    np.testing.assert_array_equal([e["t"] for e in res.stats["events"]],
+                                  [e["t"] for e in first.stats["events"]])
+    times, _ = bounce_times(0.9, 20)
+    assert np.max(np.abs([e["t"] for e in res.stats["events"][:20]] - times)) < 1e-6
+    monkeypatch.setattr(compiled_module, "INTEGRATORS_MOST", 64)    # as before: rebuilt
+    compiled_module.compiled(system)._integrators.clear()
+    again()
+    assert again()[1] > 64

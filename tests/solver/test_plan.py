@@ -113,3 +113,15 @@ def test_simulate_is_its_plan_run_and_settings_are_checked_once():
         Plan(model, rtool=1e-3)
     with pytest.raises(kn.ModelError, match="is no model parameter"):
         plan.run({"mass.m": 2.0})          # not one of the plan's: its twin has no such name
+
+
+@pytest.mark.parametrize("grid", [[0.0, 1.0, 1.5, 3.0], [0.0, 0.5, 2.5, 3.0],
+                                  [0.0, 1.0, 2.0, 2.5, 4.0]])
+def test_a_grid_of_unequal_intervals_is_never_taken_for_equal_ones(grid):
+    """Output times whose span is a whole number of the first interval (0, 1, 1.5, 3: three
+    intervals of 1 in all) are the times asked, not j times the first interval: the closed
+    form at each."""
+    res = Plan(oscillator(), grid=grid, rtol=1e-10, atol=1e-12).run()
+    np.testing.assert_array_equal(res.t, grid)
+    np.testing.assert_allclose(res.states[:, 0], closed_form(np.asarray(grid), 4.0, 1.0),
+                               rtol=0, atol=1e-8)

@@ -1,0 +1,131 @@
+"""EngineV6 cached: where a repeated run of MSL's six-cylinder engine spends its CPU time.
+
+``models/engine_v6/EngineV6.json`` (six kinematic loops, the gas force of each cylinder a
+relation on its piston's position: 337 state events in the default 1.01 s run) compiled once
+and run once beforehand, then run again in rounds, in one process: CPU time
+(``time.process_time``) per run, medians, with two ways of keeping the integrators interleaved:
+
+- ``kept``: as kinetwork keeps them now (``compiled.integrators_kept``: as many as the run
+  has chunks of their own grid, one after each event);
+- ``64 kept``: at most 64 per System (``compiled.INTEGRATORS_MOST = 64``), as before: every
+  run built its event chunks' integrators again.
+
+Per way, what the run spent: integrators built and the time to build them, the integrator
+calls over the chunks (``_CasadiRun.call``), the locating of the events (``Events._locate``:
+the curves, their checks on the equations, Brent's method, the integrations to 32 points),
+the rest (indicators on the sampled rows, the loops' watch, the driver's Python), the
+right-hand-side evaluations and the events. The event times of both ways agree (the largest
+difference is printed).
+
+Writes ``results/study_engine_cached.md``. Run: ``python bench/study_engine_cached.py
+[--rounds R]``.
+"""
+
+import argparse
+import collections
+import statistics
+import time
+from unittest import mock
+
+import numpy as np
+
+import common
+from common import load, machine, table, write_markdown
+
+import kinetwork as kn
+from kinetwork.solver import compiled as compiled_module, events, methods
+
+NAME = "study_engine_cached"
+MODEL = common.HERE.parent / "models" / "engine_v6" / "EngineV6.json"
+
+
+def timed_parts():
+    """Patches that add the CPU time and count of the phases of a run into a Counter pair."""
+    spent, count = collections.Counter(), collections.Counter()
+
+    def wrap(owner, name, label):
+        original = getattr(owner, name)
+
+        def timed(*args, **kwargs):
+            start = time.process_time()
+            try:
+                return original(*args, **kwargs)
+            finally:
+                spent[label] += time.process_time() - start
+                count[label] += 1
+        return mock.patch.object(owner, name, timed)
+    patches = [wrap(methods.ca, "integrator", "build"),
+               wrap(methods._CasadiRun, "call", "integrate"),
+               wrap(events.Events, "_locate", "locate")]
+    return patches, spent, count
+
+
+def run_once(system, most, parts=False):
+    """One run with at most ``most`` integrators kept: (CPU s, Results, phases or None)."""
+    with mock.patch.object(compiled_module, "INTEGRATORS_MOST", most):
+        if not parts:
+            start = time.process_time()
+            res = kn.simulate(system)
+            return time.process_time() - start, res, None
+        patches, spent, count = timed_parts()
+        for p in patches:
+            p.start()
+        try:
+            start = time.process_time()
+            res = kn.simulate(system)
+            total = time.process_time() - start
+        finally:
+            for p in patches:
+                p.stop()
+        return total, res, (spent, count)
+
+
+def study(rounds):
+    ways = {"kept": compiled_module.INTEGRATORS_MOST, "64 kept": 64}
+    # a System each (each keeps its own integrators); the C code is the same, cached on disk
+    systems = {way: kn.load(MODEL).compile() for way in ways}
+    for way, most in ways.items():
+        run_once(systems[way], most)            # JIT, checks, the first integrators
+    spent = {w: [] for w in ways}
+    results = {}
+    for _ in range(rounds):
+        for way, most in ways.items():
+            cpu, results[way], _ = run_once(systems[way], most)
+            spent[way].append(cpu)
+    rows = []
+    for way, most in ways.items():
+        total, res, (parts, count) = run_once(systems[way], most, parts=True)
+        rest = total - parts["build"] - parts["integrate"] - parts["locate"]
+        rows.append([way, f"{statistics.median(spent[way]):.2f}", f"{total:.2f}",
+                     f"{count['build']}: {parts['build']:.2f}",
+                     f"{count['integrate']}: {parts['integrate']:.2f}",
+                     f"{count['locate']}: {parts['locate']:.2f}", f"{rest:.2f}",
+                     res.stats["rhs_evaluations"], len(res.stats["events"])])
+        print("  ", rows[-1], flush=True)
+    a, b = ([e["t"] for e in results[w].stats["events"]] for w in ways)
+    apart = float(np.max(np.abs(np.subtract(a, b)))) if len(a) == len(b) else float("nan")
+    return rows, apart
+
+
+def main():
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--rounds", type=int, default=5, help="interleaved rounds")
+    args = parser.parse_args()
+    start = time.perf_counter()
+    rows, apart = study(args.rounds)
+    text = "\n".join([
+        "# EngineV6 cached: where a repeated run spends its CPU time", "",
+        f"{machine()}; {load()}; {args.rounds} interleaved rounds, CPU time, medians; study "
+        f"wall time {time.perf_counter() - start:.0f} s. See ``bench/study_engine_cached.py`` "
+        "for what each column is. Phases from one more run per way, timed by parts (the "
+        "timers add a little).", "",
+        table(["integrators", "run [s] (median)", "timed run [s]", "built: [s]",
+               "integrator calls: [s]", "events located: [s]", "rest [s]",
+               "rhs evaluations", "events"], rows), "",
+        f"Event times of the two ways: largest difference {apart:.1e} s."])
+    write_markdown(NAME, text)
+    print(f"done in {time.perf_counter() - start:.0f} s", flush=True)
+
+
+if __name__ == "__main__":
+    main()
