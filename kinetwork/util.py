@@ -145,6 +145,20 @@ def cache_folder():
     return None
 
 
+def trim_least_recent(entries, limit, keep, remove):
+    """Remove the least recently used of ``entries`` ((path, bytes, mtime) of a cache's
+    files) until the rest fit in ``limit`` bytes, never ``keep`` (just written):
+    ``remove(path)`` removes one. The JIT's libraries and the kept Systems are trimmed so."""
+    ordered = sorted((mtime, size, path) for path, size, mtime in entries)
+    total = sum(size for _, size, _ in ordered)
+    for _, size, path in ordered:
+        if total <= limit:
+            break
+        if path != keep:
+            remove(path)
+            total -= size
+
+
 def callable_module(name, function):
     """Make the module ``name`` callable as ``function``: ``kn.plot(...)`` and ``kn.schema()``
     are functions named like their modules, and once a submodule is imported the package's

@@ -49,7 +49,7 @@ import numpy as np
 
 from ..errors import KinetworkWarning
 from ..graph.model import keep_topology
-from ..util import cache_folder
+from ..util import cache_folder, trim_least_recent
 from .system import System
 
 #: the layout of a file: bump when what is written changes
@@ -229,15 +229,10 @@ def clear():
 
 
 def _trim(folder, keep):
-    files = sorted((mtime, size, path) for path, size, mtime in kept(folder))
-    total = sum(size for _, size, _ in files)
-    for _, size, path in files:
-        if total <= MAX_BYTES:
-            break
-        if path != keep:
-            with contextlib.suppress(OSError):
-                path.unlink()
-            total -= size
+    def remove(path):
+        with contextlib.suppress(OSError):
+            path.unlink()
+    trim_least_recent(kept(folder), MAX_BYTES, keep, remove)
 
 
 # -- writing and reading ---------------------------------------------------------------------

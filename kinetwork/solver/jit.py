@@ -50,7 +50,6 @@ import fcntl
 import functools
 import hashlib
 import os
-import pathlib
 import re
 import shutil
 import stat
@@ -62,7 +61,7 @@ import casadi as ca
 
 from ..errors import KinetworkWarning, ModelError
 from ..equations import stored
-from ..util import cache_folder
+from ..util import cache_folder, trim_least_recent
 from . import jit_source, jit_tiers
 from .jit_build import (BUILD_PREFIX, Unavailable as _Unavailable, build, cores as _cores,
                         os_error as _os_error, record as _record, sha256 as _sha256,
@@ -439,15 +438,10 @@ def _trim(folder, keep):
     """Remove the least recently loaded libraries until kinetwork's own (:func:`recorded`)
     fit in MAX_CACHE_BYTES (never ``keep``, just built), and build folders left by killed
     processes. Files without a record are neither counted nor removed."""
-    libraries = sorted((mtime, size, lib) for lib, size, mtime in recorded(folder))
-    total = sum(size for _, size, _ in libraries)
-    for _, size, lib in libraries:
-        if total <= MAX_CACHE_BYTES:
-            break
-        if lib != keep:
-            _remove(lib)
-            _remove(_record(lib))
-            total -= size
+    def remove(lib):
+        _remove(lib)
+        _remove(_record(lib))
+    trim_least_recent(recorded(folder), MAX_CACHE_BYTES, keep, remove)
     for old in _stale_builds(folder):
         shutil.rmtree(old, ignore_errors=True)
 
