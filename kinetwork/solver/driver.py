@@ -459,14 +459,13 @@ def deferred_outputs(run, t, X):
     DEFERRED_VALUES numbers (they are copied, so that writes into ``res.states`` do not
     change the signals)."""
     system = run.system
+    size, width = _output_layout(system)
     if system.n_algebraic or system.eq.clock is not None or X.size > DEFERRED_VALUES or \
             run.deadline is not None or run.cancel is not None or run.progress is not None \
-            or len(t) > _output_layout(system)[0]:
+            or len(t) > size:
         return None
     f_out = compiled(system).outputs(run.jit)
     t, X, p = np.array(t, dtype=float), np.array(X, dtype=float), np.array(run.p, dtype=float)
-
-    width = _output_layout(system)[1]
 
     def values():
         return system.outputs_into(t, X, p, np.empty((len(t), width)), f_out)

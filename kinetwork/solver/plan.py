@@ -133,6 +133,8 @@ class Plan:
     def vector(self, params: Mapping[str, float | str] | None = None) -> np.ndarray:
         """The parameter vector p of the System for ``params`` (name -> number, or number with
         a unit), every value and every component parameter that depends on one checked."""
+        if not params:
+            return self._default_vector()
         overrides = {self.param_name(k): self.si(k, v) for k, v in (params or {}).items()}
         if self.lifted is not None:
             missing = {p: n for p, n in self.lifted.names.items() if n not in overrides}
@@ -143,6 +145,19 @@ class Plan:
                 defaults = self.lifted.defaults(env)
                 overrides.update({n: defaults[n] for n in missing.values()})
         return self.system.param_vector(overrides)
+
+    def _default_vector(self):
+        """The parameter vector of the model's own values, found once per System and values
+        (their check and conversion cost 0.1 ms, a thirtieth of a small model's run): a
+        run again with the same values gets a copy of the vector found then."""
+        system = self.system
+        try:
+            values = tuple((k, type(v), v) for k, v in system.model.parameters.items())
+            hash(values)
+        except TypeError:               # an unhashable value: checked, and refused, there
+            return system.param_vector({})
+        return compiled(system).checked(("parameters", values),
+                                        lambda: system.param_vector({})).copy()
 
     def si(self, name, value):
         """``value`` of parameter ``name`` in SI: a lifted path's quantity text ("2 kg")
@@ -229,7 +244,7 @@ class Plan:
             if cut is not None:
                 failure = f"{failure}; {cut}" if failure else cut
         if failure is None and not error_estimate:
-            record(self, run, key, stats, p)
+            record(self, run, key, stats, p, X[-1])
         results = self.finish(run, X, p, stats, key, params, outputs, failure)
         if error_estimate:
             estimate.attach(results, lambda **tighter: self.replaced(

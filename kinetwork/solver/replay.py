@@ -1,6 +1,6 @@
 """A quiet run again: what the first run of a System with the same settings and parameter
-values worked out, kept beside the System, so that a repeated run only sets its inputs, calls
-the integrator and wraps the arrays.
+values worked out, kept beside the System, so that a repeated run only calls the integrator
+and wraps the arrays.
 
 A run of a small model spends most of its own time (beside the integration) working out
 again what the last run worked out: the settings merged and checked, the start solved and
@@ -13,21 +13,36 @@ limit, ``cancel``, progress, events, loops or assemblies), auto's first choice, 
 or restart.
 
 A replay is that run and nothing else: the same integrator with the same inputs gives the
-same numbers, and the Results are built by the same code (``Plan.finish``). What a replay does
-not handle it hands back, and the run is made in full from the start: a solver failure (auto
-then tries another method; the full run fails or goes on exactly as a first run would), a
-stalled Adams, a step budget spent. A signal (SIGINT, SIGTERM) stops a replay as it stops any
-run: a SimulationError holding the outputs reached.
+same numbers, and the Results are built by the same code (``Plan.finish``). The recipe keeps
+the integrator's call ready (a CasADi ``FunctionBuffer`` bound to the start and the
+parameters, which are the recipe's own), so a replay only points it at a fresh array of
+states and calls it. Its counts (steps, evaluations) are the recorded run's when its last
+state is the recorded run's to the bit: the same compiled code with the same inputs does the
+same work, and reading them from CVODES again costs 40-70 us, more than all of a replay's
+own Python; otherwise (another build of the code swapped in, ``jit_tiers.py``) they are read
+from the solver and kept for the next replay.
+
+What a replay does not handle it hands back, and the run is made in full from the start: a
+solver failure (auto then tries another method; the full run fails or goes on exactly as a
+first run would), a step budget spent. What the solver printed is reported as in any run.
+A signal (SIGINT, SIGTERM) stops a replay as it stops any run: a SimulationError holding the
+outputs reached.
 """
 
 from __future__ import annotations
 
+import io
+import sys
+
 import numpy as np
 
-from .chunks import MAX_CHUNK, _Rows
+from .capture import SOLVER_LOCK
+from .chunks import MAX_CHUNK
 from .compiled import compiled
-from .driver import _running, _spent
-from .methods import METHODS, Failure, _CasadiRun
+from .driver import _running, budget_spent
+from .methods import (INTEGRATOR_IN, INTEGRATOR_OUT, METHODS, Interrupted, _finite_rows,
+                      shift_times)
+from .results import Results
 
 #: statistics of a run that count its work (the replay's own), not what its recipe decided
 COUNTS = ("steps", "rhs_evaluations", "jacobian_evaluations", "factorisations")
@@ -37,15 +52,30 @@ UNREPEATED = ("gave_up", "adams_failure", "switched", "restarts", "lifted", "jit
 
 
 class Recipe:
-    """What a replay needs: the method that ran, its integrator and that integrator's options,
-    auto's look budget it ran under, the run's step budget, the start, and the statistics
-    that the run's decisions wrote (the stiffness test's answer, jit)."""
+    """What a replay needs: the method that ran, its integrator, auto's look budget it ran
+    under, the run's step budget, the start, the statistics that the run's decisions wrote
+    (the stiffness test's answer, jit), and the integrator's call as the last run made it
+    (``call``: its buffer, bound to the start and the parameters; the counts and the last
+    state it reached, as bytes), and what its Results share with every replay's
+    (``Results.kept``)."""
 
-    __slots__ = ("name", "method", "integ", "opts", "look_steps", "budget", "x0", "decided")
+    __slots__ = ("name", "method", "integ", "look_steps", "budget", "x0", "decided",
+                 "dicts", "call", "counts", "last", "results")
 
-    def __init__(self, name, integ, opts, look_steps, budget, x0, decided):
-        self.name, self.method, self.integ, self.opts = name, METHODS[name], integ, opts
+    def __init__(self, name, integ, look_steps, budget, x0, decided, counts, last):
+        self.name, self.method, self.integ = name, METHODS[name], integ
         self.look_steps, self.budget, self.x0, self.decided = look_steps, budget, x0, decided
+        #: the decided statistics that are dicts: each run's Results get copies
+        self.dicts = tuple(k for k, v in decided.items() if isinstance(v, dict))
+        self.call, self.counts, self.last, self.results = None, counts, last, None
+
+    def stats(self, counts):
+        """The statistics of a replay that counted ``counts``, the Results' own."""
+        stats = dict(self.decided)
+        for k in self.dicts:
+            stats[k] = dict(stats[k])
+        stats.update(counts)
+        return stats
 
 
 def key_of(plan, p):
@@ -56,22 +86,25 @@ def key_of(plan, p):
     return plan.given, plan.jit, np.asarray(p, dtype=float).tobytes()
 
 
-def record(plan, run, name, stats, p):
-    """After a run (``run``, method ``name``) that succeeded with statistics ``stats``: keep
-    its recipe when a replay would make the very same run (see the module's docstring)."""
+def record(plan, run, name, stats, p, last):
+    """After a run (``run``, method ``name``) that succeeded with statistics ``stats``,
+    ending at the state ``last``: keep its recipe when a replay would make the very same run
+    (see the module's docstring)."""
     system, method = plan.system, METHODS.get(name)
     key = key_of(plan, p)
     if key is None or method is None or not getattr(method, "sundials", False) or method.dae \
             or not run.quiet or run.calls != 1 or run.events is not None \
             or run.signal is not None or system.n_algebraic or system.f_dependent is not None \
             or system.f_assembly_checks is not None or plan.lifted is not None \
-            or len(plan.grid) - 1 > MAX_CHUNK or any(k in stats for k in UNREPEATED):
+            or len(plan.grid) - 1 > MAX_CHUNK or any(k in stats for k in UNREPEATED) \
+            or any(k not in stats for k in COUNTS):
         return
-    integ, opts, look_steps = run.called
+    integ, _, look_steps = run.called
     decided = {k: v for k, v in stats.items() if k not in COUNTS and not k.startswith("jit")}
+    counts = {k: stats[k] for k in COUNTS}
     compiled(system).recipe(key, lambda: Recipe(
-        name, integ, opts, look_steps, run.budget(method), np.array(run.x0, dtype=float),
-        decided))
+        name, integ, look_steps, run.budget(method), np.array(run.x0, dtype=float), decided,
+        counts, np.asarray(last, dtype=float).tobytes()))
 
 
 def replay(plan, p, params, started):
@@ -82,27 +115,92 @@ def replay(plan, p, params, started):
     recipe = None if key is None else compiled(plan.system).recipe(key)
     if recipe is None:
         return None
-    grid, n, method = plan.grid, len(plan.grid), recipe.method
     run = plan.new_run(p, recipe.x0.copy(), started=started)
-    stats = {k: (dict(v) if isinstance(v, dict) else v) for k, v in recipe.decided.items()}
     with _running(run):
-        run.jit = plan.jit_options(run, stats)
-        run.quiet, run.look_steps = True, recipe.look_steps
-        stepper = _CasadiRun(method, run, grid[0], run.x0)
-        X = _Rows(run.x0, n)
-        try:
-            X.extend(stepper.call(recipe.integ, recipe.opts, grid[1:], X.slot(n - 1)))
-            steps = stepper.stats["steps"]
-            failure = _spent(run, method, {}, stepper.stats, grid[-1]) \
-                if steps > recipe.budget else None
-        except Failure as exc:
-            if exc.states is not None:
-                X.extend(exc.states)
-            failure = exc.reason
+        X, counts, failure = _call(recipe, run, plan.grid)
         if failure is not None and run.stop_reason() is None:
             return None                     # the full run: it fails, or goes on, in full
-        stats.update(stepper.stats)
-        X, outputs, cut = plan.outputs(run, X.array())
+        stats = recipe.stats(counts)
+        run.jit = plan.jit_options(run, stats)
+        run.quiet, run.look_steps = True, recipe.look_steps
+        X, outputs, cut = plan.outputs(run, X)
         if cut is not None:
             failure = f"{failure}; {cut}" if failure else cut
-    return plan.finish(run, X, p, stats, recipe.name, params, outputs, failure)
+    if failure is None and recipe.results is not None and not run.said:
+        # what Plan.finish makes of a run that said nothing and met no event, from the
+        # first replay's Results
+        stats["jit"] = bool(run.jit) and not stats.get("jit_fallback")
+        return Results.renewed(recipe.results, plan.grid.copy(), X, outputs, stats, params,
+                               plan.system)
+    results = plan.finish(run, X, p, stats, recipe.name, params, outputs, failure)
+    if failure is None and not run.said:
+        recipe.results = results.kept()
+    return results
+
+
+def _call(recipe, run, grid):
+    """(states, counts, failure or None) of the recipe's integrator called over ``grid``
+    from its start: the rows reached (all of them unless it failed), what it counted, why
+    it stopped. The call's words are caught (Python's streams: CasADi's integrators print
+    only there, ``capture.solver_output``) and join ``run.said``."""
+    x0 = recipe.x0
+    X = np.empty((len(grid), len(x0)))
+    X[0] = x0
+    X[1:] = np.nan                          # the rows a failed call did not reach
+    with SOLVER_LOCK:                       # the buffer is the recipe's: one call at a time
+        if recipe.call is None:
+            recipe.call = _bound(recipe.integ, x0, np.append(run.p_solver, grid[0]))
+        buffer, trigger = recipe.call[:2]
+        buffer.set_res(INTEGRATOR_OUT["xf"], memoryview(X[1:]))
+        streams, said = (sys.stdout, sys.stderr), io.StringIO()
+        sys.stdout = sys.stderr = said
+        run.abortable = True
+        try:
+            if run.signal is not None:      # it came before the call
+                raise Interrupted
+            trigger()
+            failure = None
+        except (RuntimeError, Interrupted):
+            failure = "the solver failed"
+        finally:
+            run.abortable = False
+            sys.stdout, sys.stderr = streams
+        reached = _finite_rows(X)
+        if failure is None and reached == len(X) and X[-1].tobytes() == recipe.last:
+            counts = recipe.counts          # the same work to the bit (module's docstring)
+        else:
+            counts = _counts(buffer)
+            if failure is None and reached == len(X):
+                recipe.counts, recipe.last = counts, X[-1].tobytes()
+    if failure is not None:
+        stop = run.stop_reason()            # stopped: what it reached is kept
+        return (X[:reached], counts, stop) if stop is not None else (X, counts, failure)
+    if reached < len(X):
+        failure = "the state became non-finite (Inf or NaN)"
+    if said.getvalue().strip():             # reported as any run's words (Plan.finish)
+        run.said.append(shift_times(said.getvalue(), float(grid[0])))
+    if failure is None and counts["steps"] > recipe.budget:
+        failure = budget_spent(recipe.budget, float(grid[-1]), counts["steps"])
+    return X, counts, failure
+
+
+def _bound(integ, x0, p):
+    """(buffer, trigger, inputs) of a call of ``integ`` from ``x0`` at parameters ``p``:
+    the buffer points at the inputs, which must live as long (they are kept with it)."""
+    buffer, trigger = integ.buffer()
+    inputs = (np.ascontiguousarray(x0, dtype=float), np.ascontiguousarray(p, dtype=float))
+    buffer.set_arg(INTEGRATOR_IN["x0"], memoryview(inputs[0]))
+    buffer.set_arg(INTEGRATOR_IN["p"], memoryview(inputs[1]))
+    return buffer, trigger, inputs
+
+
+def _counts(buffer):
+    """The steps and evaluations of the call just made by ``buffer`` (none when it failed at
+    once)."""
+    try:
+        st = buffer.stats()
+    except RuntimeError:
+        return dict.fromkeys(COUNTS, 0)
+    return {"steps": int(st["nsteps"]), "rhs_evaluations": int(st["nfevals"]),
+            "jacobian_evaluations": int(st["n_call_jacF"]),
+            "factorisations": int(st.get("nlinsetups", 0))}

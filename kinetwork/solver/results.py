@@ -92,6 +92,37 @@ class Results:
         self._pending = values if callable(values) else None
         self._split = None if callable(values) else self._columns(values)
 
+    #: what differs between two runs of the same System and settings (``kept``, ``renewed``)
+    _RUN_OWN = ("t", "states", "stats", "partial", "_pending", "_split", "_system", "_recipe")
+
+    def kept(self) -> dict:
+        """What these Results share with every run of the same System and settings (names,
+        signals, units, settings): what ``renewed`` makes a repeated run's Results of,
+        without the System (a replay's recipe keeps it beside the System: no reference
+        back)."""
+        return {k: v for k, v in self.__dict__.items() if k not in self._RUN_OWN}
+
+    @classmethod
+    def renewed(cls, kept: dict, t: np.ndarray, states: np.ndarray,
+                values: np.ndarray | Callable[[], np.ndarray], stats: dict, params,
+                system: System | None) -> Results:
+        """The Results that ``__init__`` makes of a run with the names, signals, units and
+        settings ``kept`` (``kept()`` of an earlier run's), its own grid ``t`` and ``states``
+        (float arrays of the right shape, the caller's to give away), ``values``, ``stats``
+        and ``params``: every container the Results' own, as ``__init__`` makes them, in a
+        twentieth of its time (a replay, ``replay.py``)."""
+        res = cls.__new__(cls)
+        res.__dict__.update(kept)
+        res.t, res.states = t, states
+        res.state_names, res.signals = list(kept["state_names"]), dict(kept["signals"])
+        res.units, res.probe_targets = dict(kept["units"]), dict(kept["probe_targets"])
+        res.stats = stats
+        res.settings = {**kept["settings"], "params": dict(params or {})}
+        res.partial, res.system = None, system
+        res._pending = values if callable(values) else None
+        res._split = None if callable(values) else res._columns(values)
+        return res
+
     def _columns(self, values):
         """{signal name: its values} from the table of every signal's columns."""
         out, col = {}, 0

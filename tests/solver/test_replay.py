@@ -8,6 +8,7 @@ import gc
 import signal
 from unittest import mock
 
+import casadi as ca
 import numpy as np
 import pytest
 from scenes import chains, double_pendulum
@@ -16,7 +17,9 @@ from scenes.reference import seed_reference
 import kinetwork as kn
 from kinetwork.solver import compiled as compiled_module, methods, plan, replay, stiffness
 from kinetwork.solver.compiled import compiled
-from kinetwork.solver.methods import Failure, _CasadiRun
+from kinetwork.equations.system import System
+from kinetwork.solver.methods import _CasadiRun
+from kinetwork.solver.results import Results
 
 SETTINGS = {"t_end": 2.0, "n_points": 201, "rtol": 1e-8, "atol": 1e-10}
 
@@ -48,22 +51,99 @@ def test_a_run_again_is_one_integrator_call_and_nothing_else(seed):
     kn.simulate(seed, **SETTINGS)
     first = full(seed, **SETTINGS)
     assert len(compiled(seed)._recipes) == 1
-    calls = mock.patch.object(_CasadiRun, "call", autospec=True, side_effect=_CasadiRun.call)
-    with calls as call, \
+    with mock.patch.object(replay, "_call", wraps=replay._call) as call, \
             mock.patch.object(methods.ca, "integrator", wraps=methods.ca.integrator) as build, \
             mock.patch.object(stiffness, "spectrum", wraps=stiffness.spectrum) as test, \
+            mock.patch.object(_CasadiRun, "call", autospec=True,
+                              side_effect=_CasadiRun.call) as stepped, \
             mock.patch.object(plan.Plan, "__init__", autospec=True,
                               side_effect=plan.Plan.__init__) as made, \
             mock.patch.object(plan.Plan, "start", autospec=True,
                               side_effect=plan.Plan.start) as started:
         again = [kn.simulate(seed, **SETTINGS) for _ in range(3)]
     assert call.call_count == 3 and build.call_count == 0 and test.call_count == 0
-    assert made.call_count == 0 and started.call_count == 0
+    assert stepped.call_count == made.call_count == started.call_count == 0
     for res in again:
         same(first, res)
     # and the answer is right: the closed-form reference, independent of kinetwork
     ref = seed_reference(again[0].t)
     assert np.max(np.abs(again[0].states[:, :2] - ref[:, :2])) < 1e-6
+
+
+def counted(target, name):
+    """A patch of ``target.name`` that counts its calls and does what it did."""
+    return mock.patch.object(target, name, autospec=True, side_effect=getattr(target, name))
+
+
+def test_a_repeated_run_converts_nothing_and_builds_nothing_again(seed):
+    """After the first replay, a replay sets up no integrator call (its buffer is kept,
+    bound to the recipe's start and parameters), reads no statistics from CVODES (the
+    recorded run's, its last state equal to the bit), converts no DM, checks no parameter
+    again, and makes its Results without ``Results.__init__``; the Results are a full run's
+    all the same."""
+    kn.simulate(seed, **SETTINGS)
+    first = full(seed, **SETTINGS)
+    kn.simulate(seed, **SETTINGS)                   # the first replay: binds the buffer
+    with counted(ca.Function, "buffer") as buffers, \
+            counted(ca.FunctionBuffer, "set_arg") as set_arg, \
+            counted(ca.FunctionBuffer, "set_res") as set_res, \
+            counted(ca.FunctionBuffer, "stats") as stats, \
+            counted(ca.Function, "call") as called, \
+            counted(ca.DM, "full") as dms, \
+            counted(System, "param_vector") as vectors, \
+            counted(Results, "__init__") as made:
+        again = [kn.simulate(seed, **SETTINGS) for _ in range(4)]
+    assert buffers.call_count == set_arg.call_count == stats.call_count == 0
+    assert called.call_count == dms.call_count == vectors.call_count == made.call_count == 0
+    assert set_res.call_count == 4                  # each run's own array of states
+    for res in again:
+        same(first, res)
+    assert len({id(r.states) for r in again}) == len({id(r.stats) for r in again}) == 4
+
+
+def test_replayed_results_are_their_own(seed):
+    """Each replay's Results own every container: writing into one changes no other."""
+    kn.simulate(seed, **SETTINGS)
+    a, b, c = (kn.simulate(seed, **SETTINGS) for _ in range(3))
+    b.states[:] = 0.0
+    b.t[:] = -1.0
+    b.stats["steps"] = -1
+    b.settings["rtol"] = 0.5
+    b.units[b.state_names[0]] = "furlong"
+    b.state_names.append("x")
+    b.signals.clear()
+    b.probe_targets.clear()
+    same(a, c)
+    assert c.units == a.units and c.state_names == a.state_names
+    assert c.probe_targets == a.probe_targets and c.signals.keys() == a.signals.keys()
+    name = next(iter(a.signals))
+    np.testing.assert_array_equal(a[name], c[name])
+
+
+def test_changed_code_reads_the_counts_again(seed):
+    """A replay whose last state differs from the recorded one (another build of the code
+    swapped in) reads its counts from CVODES, keeps them, and the next replay trusts them."""
+    kn.simulate(seed, **SETTINGS)
+    first = full(seed, **SETTINGS)
+    (recipe,) = compiled(seed)._recipes.values()
+    recipe.last, recipe.counts = b"another build", dict.fromkeys(replay.COUNTS, -1)
+    with counted(ca.FunctionBuffer, "stats") as stats:
+        same(first, kn.simulate(seed, **SETTINGS))
+        same(first, kn.simulate(seed, **SETTINGS))
+    assert stats.call_count == 1
+    assert recipe.last == first.states[-1].tobytes()
+
+
+def test_the_default_parameters_are_checked_again_when_they_change(seed):
+    kn.simulate(seed, **SETTINGS)
+    a = kn.simulate(seed, **SETTINGS)
+    seed.model.parameters["g"] = 5.0
+    b = kn.simulate(seed, **SETTINGS)
+    assert not np.allclose(a.states, b.states)
+    np.testing.assert_allclose(b.states, full(seed, **SETTINGS).states, rtol=0, atol=1e-12)
+    seed.model.parameters["g"] = "nine"
+    with pytest.raises(kn.ModelError):
+        kn.simulate(seed, **SETTINGS)
 
 
 def test_a_damped_chain_replays_auto_s_choice_and_its_evidence():
@@ -106,32 +186,76 @@ def test_watched_runs_are_never_replayed(seed):
     assert looked.call_count == 0
 
 
+class Tapped:
+    """A recipe's integrator call (``Recipe.call``) with ``after(states)`` run after each
+    real call, on the states array the call wrote into."""
+
+    def __init__(self, recipe, after):
+        self.buffer, self.trigger, self.inputs = recipe.call
+        self.after, self.out = after, None
+        recipe.call = (self, self.call, self.inputs)
+
+    def set_res(self, i, view):
+        self.out = view
+        self.buffer.set_res(i, view)
+
+    def stats(self):
+        return self.buffer.stats()
+
+    def call(self):
+        self.trigger()
+        self.after(np.frombuffer(self.out, dtype=float).reshape(-1, 4))
+
+
+def tapped(system, after):
+    for _ in range(2):                  # the first run keeps the recipe, a replay binds its call
+        kn.simulate(system, **SETTINGS)
+    (recipe,) = compiled(system)._recipes.values()
+    return Tapped(recipe, after)
+
+
 def test_a_failed_replay_runs_in_full_and_gives_the_full_run_s_answer(seed):
     kn.simulate(seed, **SETTINGS)
     first = full(seed, **SETTINGS)
-    original, seen = _CasadiRun.call, []
+    failures = []
 
-    def failing_once(self, *args, **kwargs):
-        seen.append(self.run)
-        if len(seen) == 1:
-            raise Failure("the solver gave up (a test)", np.zeros((0, 4)))
-        return original(self, *args, **kwargs)
-    with mock.patch.object(_CasadiRun, "call", autospec=True, side_effect=failing_once):
+    def fail(rows):
+        failures.append(rows)
+        raise RuntimeError("CVODES: the solver gave up (a test)")
+    tapped(seed, fail)
+    with mock.patch.object(_CasadiRun, "call", autospec=True,
+                           side_effect=_CasadiRun.call) as stepped:
         again = kn.simulate(seed, **SETTINGS)
-    assert len(seen) == 2 and seen[0] is not seen[1]        # the replay, then a full run
+    assert len(failures) == 1 and stepped.call_count == 1   # the replay, then a full run
     same(first, again)
 
 
-def test_a_stop_within_a_replay_keeps_what_it_reached(seed):
+def test_what_a_replay_s_solver_says_reaches_its_results(seed):
     kn.simulate(seed, **SETTINGS)
-    original = _CasadiRun.call
+    tapped(seed, lambda rows: print("CVODES: a word at t = 0.5 (a test)"))
+    res = kn.simulate(seed, **SETTINGS)
+    assert "a word at t = 0.5" in res.stats["solver_output"]
+    res = kn.simulate(seed, **SETTINGS)                     # and every time
+    assert "a word" in res.stats["solver_output"]
 
-    def interrupted(self, integ, opts, times, out=None):
-        rows = original(self, integ, opts, times, out)
-        self.run.signal = signal.SIGINT          # as the driver's handler records one
-        raise Failure(self.run.stop_reason(), rows[:50])
-    with mock.patch.object(_CasadiRun, "call", autospec=True, side_effect=interrupted), \
-            pytest.raises(kn.SimulationError) as info:
+
+def test_a_replay_past_its_step_budget_runs_in_full(seed):
+    kn.simulate(seed, **SETTINGS)
+    kn.simulate(seed, **SETTINGS)
+    (recipe,) = compiled(seed)._recipes.values()
+    recipe.budget = recipe.counts["steps"] - 1
+    with mock.patch.object(_CasadiRun, "call", autospec=True,
+                           side_effect=_CasadiRun.call) as stepped:
+        kn.simulate(seed, **SETTINGS)
+    assert stepped.call_count == 1
+
+
+def test_a_stop_within_a_replay_keeps_what_it_reached(seed):
+    def interrupted(rows):
+        rows[50:] = np.nan              # CasADi had reached t[50] when the signal came
+        signal.raise_signal(signal.SIGINT)     # the driver's handler aborts the call
+    tapped(seed, interrupted)
+    with pytest.raises(kn.SimulationError) as info:
         kn.simulate(seed, **SETTINGS)
     err = info.value
     assert err.signal == signal.SIGINT and "interrupted by SIGINT" in err.reason
