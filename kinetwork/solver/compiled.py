@@ -176,9 +176,12 @@ class Compiled:
         that never evaluates it, and that Jacobian, by finite differences of the compiled code
         over a dense pattern, grew as N^2.5 to set up (24 s per integrator at 1024 links, and a
         run makes two or three; bench/results/study_scaling_setup.md). Hidden, the set-up takes
-        0.04 s there and the run is the same to the last bit."""
+        0.04 s there and the run is the same to the last bit. Only where the Jacobian is large
+        (``jacobian_small``): the hiding node costs every evaluation of the equations 0.1-0.3
+        us in CasADi's virtual machine around the compiled code (8-10 % of the seed's run,
+        ``bench/study_overhead.py``), and a small Jacobian's set-up costs under 1 ms."""
         held = self.held
-        if not newton:
+        if not newton and not self.jacobian_small():
             x = ca.stop_diff(x, 1)
         if self.system.n_algebraic:
             f = self._external(held.f_dae, exact, jit) if jit else held.f_dae
