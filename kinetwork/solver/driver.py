@@ -464,8 +464,13 @@ def deferred_outputs(run, t, X):
             run.deadline is not None or run.cancel is not None or run.progress is not None \
             or len(t) > size:
         return None
-    f_out = compiled(system).outputs(run.jit)
-    t, X, p = np.array(t, dtype=float), np.array(X, dtype=float), np.array(run.p, dtype=float)
+    return later_outputs(system, compiled(system).outputs(run.jit), width, t, X, run.p)
+
+
+def later_outputs(system, f_out, width, t, X, p):
+    """The probe signals (``width`` columns, by ``f_out``) of states X at times t and
+    parameters p as a callable that computes them when first called, from copies."""
+    t, X, p = np.array(t, dtype=float), np.array(X, dtype=float), np.array(p, dtype=float)
 
     def values():
         return system.outputs_into(t, X, p, np.empty((len(t), width)), f_out)

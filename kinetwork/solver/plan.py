@@ -152,7 +152,8 @@ class Plan:
         run again with the same values gets a copy of the vector found then."""
         system = self.system
         try:
-            values = tuple((k, type(v), v) for k, v in system.model.parameters.items())
+            given = system.model.parameters
+            values = (tuple(given), tuple(given.values()), tuple(map(type, given.values())))
             hash(values)
         except TypeError:               # an unhashable value: checked, and refused, there
             return system.param_vector({})
@@ -480,7 +481,8 @@ def _plan(model, names, **settings):
     if not isinstance(model, System):
         return Plan(model, names=names, **settings)
     try:
-        key = ("plan", tuple(names)) + tuple((k, type(v), v) for k, v in settings.items())
+        values = tuple(settings.values())
+        key = ("plan", tuple(names), tuple(settings), values, tuple(map(type, values)))
         hash(key)
     except TypeError:               # an unhashable value: refused by the Plan
         return Plan(model, names=names, **settings)

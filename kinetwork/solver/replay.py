@@ -39,7 +39,7 @@ import numpy as np
 from .capture import SOLVER_LOCK
 from .chunks import MAX_CHUNK
 from .compiled import compiled
-from .driver import _running, budget_spent
+from .driver import _running, budget_spent, later_outputs
 from .methods import (INTEGRATOR_IN, INTEGRATOR_OUT, METHODS, Interrupted, _finite_rows,
                       shift_times)
 from .results import Results
@@ -56,11 +56,12 @@ class Recipe:
     under, the run's step budget, the start, the statistics that the run's decisions wrote
     (the stiffness test's answer, jit), and the integrator's call as the last run made it
     (``call``: its buffer, bound to the start and the parameters; the counts and the last
-    state it reached, as bytes), and what its Results share with every replay's
-    (``Results.kept``)."""
+    state it reached, as bytes), what its Results share with every replay's
+    (``Results.kept``), and the function and width of its probe signals when they are
+    computed on first read (``driver.later_outputs``)."""
 
     __slots__ = ("name", "method", "integ", "look_steps", "budget", "x0", "decided",
-                 "dicts", "call", "counts", "last", "results")
+                 "dicts", "call", "counts", "last", "results", "later")
 
     def __init__(self, name, integ, look_steps, budget, x0, decided, counts, last):
         self.name, self.method, self.integ = name, METHODS[name], integ
@@ -68,6 +69,7 @@ class Recipe:
         #: the decided statistics that are dicts: each run's Results get copies
         self.dicts = tuple(k for k, v in decided.items() if isinstance(v, dict))
         self.call, self.counts, self.last, self.results = None, counts, last, None
+        self.later = None
 
     def stats(self, counts):
         """The statistics of a replay that counted ``counts``, the Results' own."""
@@ -122,10 +124,16 @@ def replay(plan, p, params, started):
             return None                     # the full run: it fails, or goes on, in full
         stats = recipe.stats(counts)
         run.jit = plan.jit_options(run, stats)
-        run.quiet, run.look_steps = True, recipe.look_steps
-        X, outputs, cut = plan.outputs(run, X)
-        if cut is not None:
-            failure = f"{failure}; {cut}" if failure else cut
+        if failure is None and recipe.later is not None:
+            # computed when first read, as the first replay's were (``deferred_outputs``)
+            outputs = later_outputs(plan.system, *recipe.later, plan.grid, X, p)
+        else:
+            X, outputs, cut = plan.outputs(run, X)
+            if cut is not None:
+                failure = f"{failure}; {cut}" if failure else cut
+            if failure is None and callable(outputs):
+                recipe.later = (compiled(plan.system).outputs(run.jit),
+                                plan.system.f_out.size1_out(0))
     if failure is None and recipe.results is not None and not run.said:
         # what Plan.finish makes of a run that said nothing and met no event, from the
         # first replay's Results
