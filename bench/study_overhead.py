@@ -5,11 +5,11 @@ links with a damper on each joint, planar and 3-D (``scenes.chains.point_masses`
 1001 output points. Per scene and rtol (1e-4, 1e-6, 1e-9; atol = rtol * 1e-2):
 
 - kinetwork: ``kn.simulate(system, t_end, n_points, rtol, atol)`` (``auto``) on a compiled
-  System, run once beforehand (its C code, integrators, plan and the run's recipe are kept,
-  as in any later run of a session: a repeated quiet run replays the recipe,
-  ``kinetwork/solver/replay.py``);
-- its integrator call alone: the very CasADi integrator the run called, through its buffer,
-  with the run's inputs (what the run would cost with no Python around it);
+  System, run twice beforehand (its C code, integrators, plan and the run's recipe are kept,
+  as in any later run of a session: a repeated quiet run replays the recipe, its integrator
+  call bound once, ``kinetwork/solver/replay.py``);
+- its integrator call alone: the very CasADi integrator the run called, through a buffer
+  bound once to the run's inputs (what the run would cost with no Python around it);
 - the hand-written route (``peers/casadi_peer.py``: Featherstone's ABA in SX, gcc -O1,
   ``casadi.external``, CVODES Adams in one ``casadi.integrator`` call) at the solver
   tolerances kinetwork hands CVODES for that rtol (``tolerance.solver_tolerances``: the same
@@ -22,12 +22,14 @@ rtol 3e-14 on equations that share nothing with kinetwork's (the seed: its close
 Lagrange equations, ``scenes.reference``; the chains: pinocchio's ABA).
 
 Timing: CPU time (``time.process_time``), the tools interleaved in rounds in one process,
-medians over the rounds. Ratios > 1: kinetwork is faster.
+medians over the rounds, the machine's load average (1 min) at the end of each row's rounds
+beside it (the machine may be shared). Ratios > 1: kinetwork is faster.
 
 Writes ``results/study_overhead.md``. Run: ``python bench/study_overhead.py [--rounds R]``.
 """
 
 import argparse
+import os
 import statistics
 import sys
 import time
@@ -75,22 +77,22 @@ def error(q, ref):
 
 
 def integrator_call(system):
-    """The integrator the last run of ``system`` called, as a function of no arguments that
-    calls it through its buffer with that run's inputs, and its evaluations per call."""
-    table_ = compiled(system)._integrators
-    integ = next(reversed(table_.values()))
+    """The integrator that the last run of ``system`` replays (its recipe's), as a function
+    of no arguments that calls it with that run's inputs through a buffer bound once
+    (nothing but the call), and its evaluations per call."""
+    integ = next(reversed(compiled(system)._recipes.values())).integ
     x0 = np.ascontiguousarray(system.x0[:system.n_states])
     p = np.append(system.param_vector(), 0.0)
     xf = np.empty((POINTS - 1, system.n_states))
+    buf, trigger = integ.buffer()
+    buf.set_arg(integ.index_in("x0"), memoryview(x0))
+    buf.set_arg(integ.index_in("p"), memoryview(p))
+    buf.set_res(integ.index_out("xf"), memoryview(xf))
 
-    def call():
-        buf, trigger = integ.buffer()
-        buf.set_arg(integ.index_in("x0"), memoryview(x0))
-        buf.set_arg(integ.index_in("p"), memoryview(p))
-        buf.set_res(integ.index_out("xf"), memoryview(xf))
+    def call(_keep=(x0, p, xf, buf)):
         trigger()
-        return buf
-    return call, int(call().stats()["nfevals"])
+    call()
+    return call, int(buf.stats()["nfevals"])
 
 
 def bracket(ladder, target):
@@ -145,6 +147,7 @@ def study(rounds):
         for rtol in RTOLS:
             kw = {"t_end": HORIZON, "n_points": POINTS, "rtol": rtol, "atol": rtol * 1e-2}
             res = kn.simulate(system, **kw)
+            kn.simulate(system, **kw)               # the first replay binds its call
             srt, sat = solver_tolerances(adams, system, rtol, rtol * 1e-2)
             call, evals = integrator_call(system)
             casadi_peer.run(hand, t, rtol=srt, atol=sat)
@@ -166,7 +169,8 @@ def study(rounds):
                          f"{med['kinetwork'] * 1e3:.3f}", f"{med['hand'] * 1e3:.3f}",
                          f"{hand_err:.1e}", f"{med['hand'] / med['kinetwork']:.2f}",
                          f"{same_accuracy * 1e3:.3f}",
-                         f"{same_accuracy / med['kinetwork']:.2f}"])
+                         f"{same_accuracy / med['kinetwork']:.2f}",
+                         f"{os.getloadavg()[0]:.1f}"])
             counts.append([name, f"{rtol:.0e}", evals, hand_evals,
                            f"{med['call'] / evals * 1e6:.2f}",
                            f"{med['hand'] / hand_evals * 1e6:.2f}",
@@ -195,13 +199,13 @@ def main():
         "(> 1: kinetwork is faster).", "",
         table(["scene", "rtol (solver)", "auto ran", "kinetwork error", "kinetwork [ms]",
                "hand, same tolerance [ms]", "hand error", "ratio", "hand, same accuracy [ms]",
-               "ratio at same accuracy"], rows), "",
+               "ratio at same accuracy", "load (1 min)"], rows), "",
         "## Where the time goes", "",
         "Evaluations of the right-hand side per run, CPU time per evaluation (each route's "
         "integrator call divided by its evaluations: CVODES' work included), and what "
-        "kinetwork's run costs beyond its integrator call (the replay: parameters, "
-        "handlers, the solvers' words caught, the counts, Results; the probe signals are "
-        "computed when first read).", "",
+        "kinetwork's run costs beyond its integrator call (the replay: settings and "
+        "parameters looked up, signal handlers, the solvers' words caught, Results; the "
+        "probe signals are computed when first read).", "",
         table(["scene", "rtol", "kinetwork evaluations", "hand evaluations",
                "kinetwork us/evaluation", "hand us/evaluation (whole run)",
                "kinetwork per-run overhead [us]", "share of the run"], counts)])

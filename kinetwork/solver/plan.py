@@ -245,7 +245,7 @@ class Plan:
             if cut is not None:
                 failure = f"{failure}; {cut}" if failure else cut
         if failure is None and not error_estimate:
-            record(self, run, key, stats, p, X[-1])
+            record(self, run, key, stats, p)
         results = self.finish(run, X, p, stats, key, params, outputs, failure)
         if error_estimate:
             estimate.attach(results, lambda **tighter: self.replaced(

@@ -16,11 +16,12 @@ A replay is that run and nothing else: the same integrator with the same inputs 
 same numbers, and the Results are built by the same code (``Plan.finish``). The recipe keeps
 the integrator's call ready (a CasADi ``FunctionBuffer`` bound to the start and the
 parameters, which are the recipe's own), so a replay only points it at a fresh array of
-states and calls it. Its counts (steps, evaluations) are the recorded run's when its last
-state is the recorded run's to the bit: the same compiled code with the same inputs does the
-same work, and reading them from CVODES again costs 40-70 us, more than all of a replay's
-own Python; otherwise (another build of the code swapped in, ``jit_tiers.py``) they are read
-from the solver and kept for the next replay.
+states and calls it. Its counts (steps, evaluations) are read from the solver once, by the
+first replay, and kept with the last state it reached: a later replay that ends at that
+state to the bit did the same work (the same compiled code with the same inputs), and
+reading the counts from CVODES again would cost 40-70 us, more than all of a replay's own
+Python; one that ends elsewhere (another build of the code swapped in, ``jit_tiers.py``)
+reads them again and keeps them for the next.
 
 What a replay does not handle it hands back, and the run is made in full from the start: a
 solver failure (auto then tries another method; the full run fails or goes on exactly as a
@@ -55,21 +56,20 @@ class Recipe:
     """What a replay needs: the method that ran, its integrator, auto's look budget it ran
     under, the run's step budget, the start, the statistics that the run's decisions wrote
     (the stiffness test's answer, jit), and the integrator's call as the last run made it
-    (``call``: its buffer, bound to the start and the parameters; the counts and the last
-    state it reached, as bytes), what its Results share with every replay's
+    (``call``: its buffer, bound to the start and the parameters; the counts of its last
+    call and the last state it reached, as bytes), what its Results share with every replay's
     (``Results.kept``), and the function and width of its probe signals when they are
     computed on first read (``driver.later_outputs``)."""
 
     __slots__ = ("name", "method", "integ", "look_steps", "budget", "x0", "decided",
                  "dicts", "call", "counts", "last", "results", "later")
 
-    def __init__(self, name, integ, look_steps, budget, x0, decided, counts, last):
+    def __init__(self, name, integ, look_steps, budget, x0, decided):
         self.name, self.method, self.integ = name, METHODS[name], integ
         self.look_steps, self.budget, self.x0, self.decided = look_steps, budget, x0, decided
         #: the decided statistics that are dicts: each run's Results get copies
         self.dicts = tuple(k for k, v in decided.items() if isinstance(v, dict))
-        self.call, self.counts, self.last, self.results = None, counts, last, None
-        self.later = None
+        self.call = self.counts = self.last = self.results = self.later = None
 
     def stats(self, counts):
         """The statistics of a replay that counted ``counts``, the Results' own."""
@@ -88,25 +88,21 @@ def key_of(plan, p):
     return plan.given, plan.jit, np.asarray(p, dtype=float).tobytes()
 
 
-def record(plan, run, name, stats, p, last):
-    """After a run (``run``, method ``name``) that succeeded with statistics ``stats``,
-    ending at the state ``last``: keep its recipe when a replay would make the very same run
-    (see the module's docstring)."""
+def record(plan, run, name, stats, p):
+    """After a run (``run``, method ``name``) that succeeded with statistics ``stats``: keep
+    its recipe when a replay would make the very same run (see the module's docstring)."""
     system, method = plan.system, METHODS.get(name)
     key = key_of(plan, p)
     if key is None or method is None or not getattr(method, "sundials", False) or method.dae \
             or not run.quiet or run.calls != 1 or run.events is not None \
             or run.signal is not None or system.n_algebraic or system.f_dependent is not None \
             or system.f_assembly_checks is not None or plan.lifted is not None \
-            or len(plan.grid) - 1 > MAX_CHUNK or any(k in stats for k in UNREPEATED) \
-            or any(k not in stats for k in COUNTS):
+            or len(plan.grid) - 1 > MAX_CHUNK or any(k in stats for k in UNREPEATED):
         return
     integ, _, look_steps = run.called
     decided = {k: v for k, v in stats.items() if k not in COUNTS and not k.startswith("jit")}
-    counts = {k: stats[k] for k in COUNTS}
     compiled(system).recipe(key, lambda: Recipe(
-        name, integ, look_steps, run.budget(method), np.array(run.x0, dtype=float), decided,
-        counts, np.asarray(last, dtype=float).tobytes()))
+        name, integ, look_steps, run.budget(method), np.array(run.x0, dtype=float), decided))
 
 
 def replay(plan, p, params, started):

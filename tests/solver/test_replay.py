@@ -78,7 +78,7 @@ def counted(target, name):
 def test_a_repeated_run_converts_nothing_and_builds_nothing_again(seed):
     """After the first replay, a replay sets up no integrator call (its buffer is kept,
     bound to the recipe's start and parameters), reads no statistics from CVODES (the
-    recorded run's, its last state equal to the bit), converts no DM, checks no parameter
+    first replay's, its last state equal to the bit), converts no DM, checks no parameter
     again, and makes its Results without ``Results.__init__``; the Results are a full run's
     all the same."""
     kn.simulate(seed, **SETTINGS)
@@ -99,6 +99,16 @@ def test_a_repeated_run_converts_nothing_and_builds_nothing_again(seed):
     for res in again:
         same(first, res)
     assert len({id(r.states) for r in again}) == len({id(r.stats) for r in again}) == 4
+
+
+def test_the_counts_are_read_from_the_solver_once_per_recipe(seed):
+    kn.simulate(seed, **SETTINGS)
+    first = full(seed, **SETTINGS)
+    with counted(ca.FunctionBuffer, "stats") as stats:
+        again = [kn.simulate(seed, **SETTINGS) for _ in range(3)]
+    assert stats.call_count == 1
+    for res in again:
+        same(first, res)
 
 
 def test_replayed_results_are_their_own(seed):
