@@ -45,6 +45,9 @@ def same(a, b):
     for name in a.signals:
         np.testing.assert_allclose(a[name], b[name], rtol=0, atol=1e-12)
     assert a.settings == b.settings and a.stats == b.stats
+    assert a.__dict__.keys() == b.__dict__.keys() and a.units == b.units
+    assert a.state_names == b.state_names and a.probe_targets == b.probe_targets
+    assert a.system is b.system and a.partial is b.partial is None
 
 
 def test_a_run_again_is_one_integrator_call_and_nothing_else(seed):
