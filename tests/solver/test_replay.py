@@ -312,3 +312,32 @@ def test_kept_plans_and_recipes_hold_no_reference_to_their_system(seed):
     assert any(isinstance(v, dict) and "grid" in v for v in kept)      # a plan is among them
     assert len(table._recipes) == 1
     assert not any(reaches(v, seed) for v in kept)
+
+
+def test_a_model_s_run_again_goes_by_its_system_s_plan_and_recipe():
+    """``kn.simulate(model)`` repeated: the Model gives back its System, whose plan and
+    recipe serve the run (no Plan made again), with a full run's answer."""
+    model = double_pendulum()
+    kn.simulate(model, **SETTINGS)
+    first = full(model.compile(), **SETTINGS)
+    with mock.patch.object(plan.Plan, "__init__", autospec=True,
+                           side_effect=plan.Plan.__init__) as made, \
+            mock.patch.object(replay, "_call", wraps=replay._call) as call:
+        again = [kn.simulate(model, **SETTINGS) for _ in range(3)]
+    assert made.call_count == 0 and call.call_count == 3
+    for res in again:
+        same(first, res)
+    model.parameters["g"] = 5.0                 # a value changed: the same System, other p
+    assert not np.allclose(kn.simulate(model, **SETTINGS).states, first.states)
+
+
+def test_the_model_s_simulation_block_is_read_by_every_run():
+    """The block's settings are a run's defaults: changed between two runs of the same
+    System, the second runs by the new ones."""
+    model = double_pendulum()
+    system = model.compile()
+    model.simulation.update(t_end=1.0, n_points=11)
+    assert kn.simulate(system).t[-1] == 1.0 and len(kn.simulate(model).t) == 11
+    model.simulation.update(t_end=2.0, n_points=21)
+    for res in (kn.simulate(system), kn.simulate(model)):
+        assert res.t[-1] == 2.0 and len(res.t) == 21
