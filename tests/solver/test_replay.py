@@ -243,6 +243,21 @@ def test_a_failed_replay_runs_in_full_and_gives_the_full_run_s_answer(seed):
     same(first, again)
 
 
+def test_a_replay_that_reached_a_non_finite_state_runs_in_full(seed):
+    """Every row is checked, not only the last (which the counts are trusted by)."""
+    kn.simulate(seed, **SETTINGS)
+    first = full(seed, **SETTINGS)
+
+    def spoil(rows):
+        rows[100, 0] = np.nan
+    tapped(seed, spoil)
+    with mock.patch.object(_CasadiRun, "call", autospec=True,
+                           side_effect=_CasadiRun.call) as stepped:
+        again = kn.simulate(seed, **SETTINGS)
+    assert stepped.call_count == 1 and np.all(np.isfinite(again.states))
+    same(first, again)
+
+
 def test_what_a_replay_s_solver_says_reaches_its_results(seed):
     kn.simulate(seed, **SETTINGS)
     tapped(seed, lambda rows: print("CVODES: a word at t = 0.5 (a test)"))
