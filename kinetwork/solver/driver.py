@@ -45,6 +45,7 @@ from .events import EVENT_CHUNK
 from .fallback import GaveUp, Rival, Stalled, _stalled, look_budget
 from .loopwatch import Partitions, near_singular
 from .methods import LOOK, METHODS, Failure, Interrupted, budget_spent
+from .results import later_outputs
 from .stiffness import choose
 from .tolerance import step_budget
 
@@ -465,16 +466,6 @@ def deferred_outputs(run, t, X):
             or len(t) > size:
         return None
     return later_outputs(system, compiled(system).outputs(run.jit), width, t, X, run.p)
-
-
-def later_outputs(system, f_out, width, t, X, p):
-    """The probe signals (``width`` columns, by ``f_out``) of states X at times t and
-    parameters p as a callable that computes them when first called, from copies."""
-    t, X, p = np.array(t, dtype=float), np.array(X, dtype=float), np.array(p, dtype=float)
-
-    def values():
-        return system.outputs_into(t, X, p, np.empty((len(t), width)), f_out)
-    return values
 
 
 def _assembly_watch(run, X, new, failure):

@@ -147,12 +147,9 @@ class Plan:
         return self.system.param_vector(overrides)
 
     def _default_vector(self):
-        """The parameter vector of the model's own values, found once per System and values
-        (their check and conversion cost 0.1 ms, a thirtieth of a small model's run): a
-        run again with the same values gets a copy of the vector found then."""
-        system = self.system
+        """p of the model's own values, checked once per System and values (0.1 ms a run)."""
+        system, given = self.system, self.system.model.parameters
         try:
-            given = system.model.parameters
             values = (tuple(given), tuple(given.values()), tuple(map(type, given.values())))
             hash(values)
         except TypeError:               # an unhashable value: checked, and refused, there
@@ -474,23 +471,20 @@ def simulate(model: Model | System, t_end: float | None = None, n_points: int | 
 
 
 def _plan(model, names, **settings):
-    """The Plan of ``simulate``'s arguments: for a System, made once per names and settings
-    (of the same values and types) and kept with its checked settings (``Compiled.checked``):
-    a plan is not changed by its runs, and making one costs 0.06 ms, a twentieth of a small
-    model's run (a Model's, 0.3 ms: it goes by the System it compiles to, which the Model
-    keeps while its content is unchanged). The model's ``simulation`` block is in the key:
-    its settings are the run's defaults. (A plan of a lifted twin is made every time: the
-    twin is kept elsewhere.)"""
+    """The Plan of ``simulate``'s arguments: for a System (or a Model without parameter paths:
+    its System, kept by the Model while its content is unchanged), made once per names,
+    settings and ``simulation`` block (the defaults; same values and types), kept with its
+    checked settings (``Compiled.checked``): a plan is not changed by its runs (making one
+    costs 0.06 ms; a Model's, 0.3 ms). A lifted twin's is made every time."""
     from ..graph.model import Model
     if isinstance(model, Model) and not names:
         model = model.compile()
     if not isinstance(model, System):
         return Plan(model, names=names, **settings)
     try:
-        values, block = tuple(settings.values()), model.model.simulation
-        defaults = tuple(block.values())
+        values, defaults = tuple(settings.values()), tuple(model.model.simulation.items())
         key = ("plan", tuple(names), tuple(settings), values, tuple(map(type, values)),
-               tuple(block), defaults, tuple(map(type, defaults)))
+               defaults, tuple(type(v) for _, v in defaults))
         hash(key)
     except TypeError:               # an unhashable value: refused by the Plan
         return Plan(model, names=names, **settings)

@@ -40,10 +40,10 @@ import numpy as np
 from .capture import SOLVER_LOCK
 from .chunks import MAX_CHUNK
 from .compiled import compiled
-from .driver import _running, budget_spent, later_outputs
+from .driver import _running, budget_spent
 from .methods import (INTEGRATOR_IN, INTEGRATOR_OUT, METHODS, Interrupted, _finite_rows,
                       shift_times)
-from .results import Results
+from .results import Results, later_outputs
 
 #: statistics of a run that count its work (the replay's own), not what its recipe decided
 COUNTS = ("steps", "rhs_evaluations", "jacobian_evaluations", "factorisations")
@@ -59,7 +59,7 @@ class Recipe:
     (``call``: its buffer, bound to the start and the parameters; the counts of its last
     call and the last state it reached, as bytes), what its Results share with every replay's
     (``Results.kept``), and the function and width of its probe signals when they are
-    computed on first read (``driver.later_outputs``)."""
+    computed on first read (``results.later_outputs``)."""
 
     __slots__ = ("name", "method", "integ", "look_steps", "budget", "x0", "decided",
                  "dicts", "call", "counts", "last", "results", "later")

@@ -57,6 +57,17 @@ def signal_coords(signals):
     return coords
 
 
+def later_outputs(system: System, f_out, width: int, t, X, p) -> Callable[[], np.ndarray]:
+    """The probe signals (``width`` columns, by the Function ``f_out``) of states X at times
+    t and parameters p as a callable that computes them when first called (``Results``'
+    ``values``), from copies: writes into ``res.states`` do not change the signals."""
+    t, X, p = np.array(t, dtype=float), np.array(X, dtype=float), np.array(p, dtype=float)
+
+    def values():
+        return system.outputs_into(t, X, p, np.empty((len(t), width)), f_out)
+    return values
+
+
 class Results:
     """Simulation output: ``res.t``, ``res["probe1.angle"]``, ``res.states``.
 
