@@ -6,6 +6,7 @@ import numpy as np
 import pytest
 
 import kinetwork as kn
+from kinetwork.solver import methods
 from scenes import chain, spatial_fourbar, stiff
 
 
@@ -68,6 +69,63 @@ def test_a_dead_point_stops_the_run_by_name(capfd):
         assert "rocker" in err.reason and "crank" in err.reason
         assert 0.2 < err.t_reached < 0.5
         assert len(err.results.t) == round(err.t_reached / 0.01) + 1
+    out, errout = capfd.readouterr()
+    assert out == "" and errout == ""
+
+
+def test_a_dead_point_fails_in_one_step_budget(monkeypatch):
+    """The run that ends at the four-bar's dead point (t ~ 0.3232 s, Adams crawling towards
+    it in ever shorter steps) fails after one budget of steps in the interval where it
+    crawls, not after several: the look that finds the step not held by stability lets that
+    interval go on unlooked once (not again and again with twice the budget from the same
+    state), no output is integrated again after the failure, and BDF is not tried from the
+    start where stiffness is not the cause. Counted in integrator calls and their step
+    budgets (before: 7 calls, 264,380 steps of budget; now 2 calls, 68,095)."""
+    calls = []
+    call = methods._CasadiRun.call
+
+    def counted(self, integ, opts, times, out=None):
+        calls.append((self.method.plugin, opts.get("linear_multistep_method"),
+                      opts.get("max_num_steps")))
+        return call(self, integ, opts, times, out)
+    monkeypatch.setattr(methods._CasadiRun, "call", counted)
+    with pytest.raises(kn.SimulationError) as info:
+        kn.simulate(spatial_fourbar(c=0.3), t_end=2.0, n_points=201, rtol=1e-8, atol=1e-10,
+                    repartition=False)
+    err = info.value
+    assert "dead point" in err.reason and "BDF was not tried" in err.reason
+    assert err.results.method == "cvodes-adams" and 0.3 < err.t_reached < 0.33
+    assert len(calls) == 2 and all(c[1] == "adams" for c in calls)
+    assert calls[1][2] > calls[0][2]            # the look's budget, then the run's own
+    assert sum(c[2] for c in calls) < 1.2 * calls[1][2]
+
+
+def _blow_up():
+    """x' = x^2 from x = 1: the solution ends at t = 1 (x = 1 / (1 - t))."""
+    m = kn.Model("blowup")
+    for c in (kn.signals.Integrator("x", y_start=1.0), kn.signals.Product("sq")):
+        m.add(c)
+    for a, b in [("x.y", "sq.u1"), ("x.y", "sq.u2"), ("sq.y", "x.u")]:
+        m.connect(a, b)
+    return m
+
+
+@pytest.mark.parametrize("method", ["auto", "cvodes", "cvodes-adams"])
+def test_a_solution_that_ends_fails_where_the_step_can_no_longer_move_time(method, capfd):
+    """CVODES takes no step shorter than 1000 spacings of double numbers at the run's time:
+    where the solution ends, it fails there at once, in a few hundred steps (without the
+    shortest step: its whole budget of steps, each too short to move the time), naming the
+    step, the time and the state that grows. The outputs up to then are kept and right."""
+    with pytest.raises(kn.SimulationError) as info:
+        kn.simulate(_blow_up(), t_end=2.0, n_points=201, method=method)
+    err = info.value
+    assert "the step fell to 4.4e-13 s at t = 1 s" in err.reason
+    assert "the state changing fastest is x.x" in err.reason
+    assert err.results.stats["steps"] < 1000
+    res = err.results
+    assert 0.98 < res.t[-1] < 1.0
+    # (the global error grows as the solution does: 5e-5 at x = 100, rtol 1e-6)
+    np.testing.assert_allclose(res.states[:, 0], 1 / (1 - res.t), rtol=2e-4)
     out, errout = capfd.readouterr()
     assert out == "" and errout == ""
 
