@@ -41,7 +41,6 @@ import bisect
 
 import numpy as np
 
-from ..equations.pointwise import pointwise
 from .compiled import numeric
 from .explicit import rk4
 from .methods import Failure
@@ -77,6 +76,9 @@ DENSE = 32
 #: CVODES interpolates between its steps (right after a start, at order one or two, to about
 #: half its tolerances on EngineV6)
 FIT = 1.0
+#: how closely, as a fraction of the interval, the minimum of an indicator that dips is
+#: found before its value there is looked at (``_search``)
+MINIMUM = 1e-6
 #: Newton's steps at most from the time found on a curve not within FIT to the integration's
 #: own root, on the side where it has crossed
 POLISH = 4
@@ -98,6 +100,14 @@ class Events:
         self._held = None               # the held values of the start (``reset``)
         self._f_rhs = None
         self._chunk = EVENT_CHUNK
+        #: whether the curve through the two sampled rows is tried first (``_locate_dense``),
+        #: by the law in effect (the values held) and the indicators that cross: once it has
+        #: not fitted under that law, the motion there is too far from a cubic over a
+        #: sampled interval, and each try costs five evaluations of the equations for
+        #: nothing (EngineV6: 339 tries, none fitted; a ball's falls are parabolas, which
+        #: fit, its rises off the contact's spring are not)
+        self._two_fit = {}
+        self._points = {}               # _Points by their number of points
 
     @property
     def located(self):
@@ -111,11 +121,15 @@ class Events:
 
     def indicators(self, t, x):
         """(indicators, their rates) of every source at (t, x), one after the other."""
+        if len(self.sources) == 1:
+            return self.sources[0].indicators(t, x)
         parts = [s.indicators(t, x) for s in self.sources]
         return (np.concatenate([p[0] for p in parts]), np.concatenate([p[1] for p in parts]))
 
     def levels(self, t, x):
         """The indicators of every source at (t, x), without their rates."""
+        if len(self.sources) == 1:
+            return self.sources[0].levels(t, x)
         return np.concatenate([s.levels(t, x) for s in self.sources])
 
     def _which(self, i):
@@ -169,6 +183,7 @@ class Events:
         self.log = []
         self._last = (None, 0)
         self._chunk = EVENT_CHUNK
+        self._two_fit = {}
         if self.switches is not None:
             self.switches.r = self._held.copy()
             self.switches.time_events = 0
@@ -297,15 +312,18 @@ class Events:
         fun = self.run.compiled.rhs(self.run.jit, method.newton)
 
         def rates(T, X):            # the equations' rates at every (T[k], X[k]), one call
-            return pointwise(fun, np.asarray(T, dtype=float)[:, None], X,
-                             self.run.p_solver)[0]
+            points = self._points.get(len(T))
+            if points is None or points.f is not fun:
+                points = self._points[len(T)] = _Points(fun, len(T))
+            return points(T, X, self.run.p_solver)
         x0 = np.asarray(x0, dtype=float)
         tol = self._tolerance(method)
         fitted = False
-        if x1 is not None:
+        law = (tuple(crossed), tuple(dipped), self.run.p_solver.tobytes())
+        if x1 is not None and self._two_fit.get(law, True):
             T, X = np.array([t0, t1]), np.vstack([x0, x1])
             curve = _Hermite(T, X, rates(T, X))
-            fitted = curve.fits(rates, tol)
+            fitted = self._two_fit[law] = curve.fits(rates, tol)
         if not fitted:
             grid = getattr(method.start(self.run, t0, x0), "grid", None)
             rows = grid(t1, DENSE) if grid is not None else None
@@ -430,6 +448,14 @@ def _search(g, rate, t0, t1, crossed, dipped):
     for i in dipped:
         if not rate(t0, i) < 0 < rate(t1, i):     # integrated again: not quite as sampled
             continue
+        # the minimum found to MINIMUM of the interval first: the indicator is convex about
+        # it, so above its tangent there, and a minimum that stays clear of zero by the
+        # tangent's fall over that distance is decided without the last bits (most are)
+        xtol = MINIMUM * (t1 - t0)
+        t_min = brentq(rate, t0, t1, args=(i,), xtol=xtol, maxiter=200)
+        g_min = g(t_min, i)
+        if g_min > 2 * (xtol + 4 * np.finfo(float).eps * abs(t_min)) * abs(rate(t_min, i)):
+            continue                    # a minimum above zero: no event
         t_min = brentq(rate, t0, t1, args=(i,), **tight)
         if g(t_min, i) > 0:
             continue                    # a minimum above zero: no event
@@ -457,6 +483,28 @@ def _search(g, rate, t0, t1, crossed, dipped):
         if best is None or t_i < best[0]:
             best = (t_i, i)
     return best
+
+
+class _Points:
+    """A Function of (t, x, p) at n points at once: one map made once per run and size,
+    called through ``Function.buffer`` straight from and into arrays made once (a call of
+    ``pointwise`` makes them again each time: 0.3 ms of Python an event on EngineV6)."""
+
+    def __init__(self, f, n):
+        self.f = f
+        self.buffer, self.trigger = f.map(f"{f.name()}_at_{n}", "serial", n, [2], []).buffer()
+        self.t, self.x = np.zeros(n), np.zeros((n, f.size1_in(1)))
+        self.p = np.zeros(f.size1_in(2))
+        self.out = np.zeros((n, f.size1_out(0)))      # column-major (nx, n): a row a point
+        # CasADi keeps raw pointers: the arrays live as long as this object
+        for i, arr in enumerate((self.t, self.x, self.p)):
+            self.buffer.set_arg(i, memoryview(arr))
+        self.buffer.set_res(0, memoryview(self.out))
+
+    def __call__(self, T, X, p):
+        self.t[:], self.x[:], self.p[:] = T, X, p
+        self.trigger()
+        return self.out.copy()
 
 
 class _Hermite:
