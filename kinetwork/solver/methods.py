@@ -168,19 +168,6 @@ def solver_reason(message):
     return (lines or ["integrator failed"])[-1][:300]
 
 
-#: the shortest step a CVODES run may take, in units of the spacing of double numbers at the
-#: run's largest time: a step below it cannot move the time it is taken at (t + h is t, or
-#: hardly more), so a run that gets there grinds its whole step budget without moving (a
-#: solution that ends at a dead point, a force that blows up); it fails there at once instead
-MIN_STEP_ULPS = 1e3
-
-
-def min_step(run):
-    """The shortest step of a CVODES run (``MIN_STEP_ULPS``): the same for every call of the
-    run, so that its integrators are kept alike."""
-    return MIN_STEP_ULPS * np.finfo(float).eps * max(abs(run.t_start), abs(run.t_end), 1e-300)
-
-
 class Casadi(Method):
     """A CasADi integrator plugin: each ``advance`` runs in compiled code, which checks
     Python's signals at every evaluation of the equations."""
@@ -229,8 +216,6 @@ class _CasadiRun:
             opts["max_num_steps"] = run.budget(m, run.spacing)
             if run.max_step:
                 opts["max_step_size"] = float(run.max_step)
-            if m.plugin == "cvodes":        # IDAS in CasADi takes no shortest step
-                opts["min_step_size"] = min_step(run)
             if run.look_steps is not None and run.look_steps < opts["max_num_steps"]:
                 opts["max_num_steps"] = run.look_steps      # auto's look: driver.look_budget
         else:       # fixed steps: counted over the chunk; a blow-up is reported once, below
@@ -337,40 +322,13 @@ class _CasadiRun:
                 hit = _budget_hit(said)
                 run.look_hit = hit if hit is not None else float(times[len(reached)])
                 raise Failure(LOOK, reached)
-            printed = run.said[-1] if run.said else ""      # captured from the solver
             run.said.append(shift_times(solver_words(str(failed)), self.t))
             reason = solver_reason(str(failed))
-            if "hmin" in printed and "min_step_size" in opts:
-                reason += self._collapsed(printed, opts["min_step_size"],
-                                          reached[-1] if len(reached) else self.x,
-                                          float(times[len(reached) - 1]) if len(reached)
-                                          else self.t)
             raise Failure(reason, reached)
         if len(reached) < len(X):
             raise Failure("the state became non-finite (Inf or NaN)", reached)
         self.t, self.x = float(times[-1]), X[-1]
         return X
-
-    def _collapsed(self, said, h_min, x, t):
-        """Words for a call that failed with its step at the shortest (``min_step``): where,
-        and which state changes fastest at the last output it reached (``x`` at ``t``)."""
-        run = self.run
-        at = _budget_hit(said)
-        where = f" at t = {at:.10g} s" if at is not None else ""
-        words = (f"; the step fell to {h_min:.2g} s{where}, as short as the time can be "
-                 f"resolved there ({MIN_STEP_ULPS:g} spacings of double numbers)")
-        names = [*run.system.state_names, *run.system.algebraic_names]
-        nx = run.system.n_states
-        with np.errstate(all="ignore"):
-            rate = numeric(run.compiled.rhs(run.jit), self.p, nx)(t, x[:nx]) \
-                if not run.system.n_algebraic else None
-        if rate is None or not len(rate):
-            return words
-        speed = np.abs(rate) / (1.0 + np.abs(x[:nx]))
-        speed = np.where(np.isfinite(speed), speed, np.inf)
-        i = int(np.argmax(speed))
-        return words + (f"; at t = {t:.6g} s the state changing fastest is {names[i]} "
-                        f"(value {x[i]:.3g}, rate {rate[i]:.3g}/s)")
 
     def _count(self, buffer, intervals):
         """Steps and evaluations of the call just made (a fixed-step method: its steps over
