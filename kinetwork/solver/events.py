@@ -41,6 +41,7 @@ import bisect
 
 import numpy as np
 
+from .buffers import PointsBySize
 from .compiled import numeric
 from .explicit import rk4
 from .methods import Failure
@@ -107,7 +108,7 @@ class Events:
         #: nothing (EngineV6: 339 tries, none fitted; a ball's falls are parabolas, which
         #: fit, its rises off the contact's spring are not)
         self._two_fit = {}
-        self._points = {}               # _Points by their number of points
+        self._points = PointsBySize()   # the rates on the curves
 
     @property
     def located(self):
@@ -312,10 +313,7 @@ class Events:
         fun = self.run.compiled.rhs(self.run.jit, method.newton)
 
         def rates(T, X):            # the equations' rates at every (T[k], X[k]), one call
-            points = self._points.get(len(T))
-            if points is None or points.f is not fun:
-                points = self._points[len(T)] = _Points(fun, len(T))
-            return points(T, X, self.run.p_solver)
+            return self._points(fun, T, X, self.run.p_solver)
         x0 = np.asarray(x0, dtype=float)
         tol = self._tolerance(method)
         fitted = False
@@ -483,28 +481,6 @@ def _search(g, rate, t0, t1, crossed, dipped):
         if best is None or t_i < best[0]:
             best = (t_i, i)
     return best
-
-
-class _Points:
-    """A Function of (t, x, p) at n points at once: one map made once per run and size,
-    called through ``Function.buffer`` straight from and into arrays made once (a call of
-    ``pointwise`` makes them again each time: 0.3 ms of Python an event on EngineV6)."""
-
-    def __init__(self, f, n):
-        self.f = f
-        self.buffer, self.trigger = f.map(f"{f.name()}_at_{n}", "serial", n, [2], []).buffer()
-        self.t, self.x = np.zeros(n), np.zeros((n, f.size1_in(1)))
-        self.p = np.zeros(f.size1_in(2))
-        self.out = np.zeros((n, f.size1_out(0)))      # column-major (nx, n): a row a point
-        # CasADi keeps raw pointers: the arrays live as long as this object
-        for i, arr in enumerate((self.t, self.x, self.p)):
-            self.buffer.set_arg(i, memoryview(arr))
-        self.buffer.set_res(0, memoryview(self.out))
-
-    def __call__(self, T, X, p):
-        self.t[:], self.x[:], self.p[:] = T, X, p
-        self.trigger()
-        return self.out.copy()
 
 
 class _Hermite:

@@ -15,7 +15,7 @@ state itself does not jump.
 
 import numpy as np
 
-from ..equations.pointwise import pointwise
+from .buffers import Call, PointsBySize
 from .methods import Failure
 from .schedule import Schedule
 
@@ -33,6 +33,7 @@ class Switches:
         self.r = np.zeros(relations.n)
         self.time_events = 0
         self._calls = {}
+        self._rows = PointsBySize()
         self._signs = None
 
     # -- numbers ---------------------------------------------------------------------------
@@ -43,7 +44,7 @@ class Switches:
         call = self._calls.get(name)
         if call is None:
             f = self._function(name)
-            call = self._calls[name] = _Call(f, np.concatenate([self.run.p, self.r]))
+            call = self._calls[name] = Call(f, np.concatenate([self.run.p, self.r]))
         else:
             call.p[len(call.p) - len(self.r):] = self.r
         return call
@@ -94,10 +95,9 @@ class Switches:
         k = len(self.relations.state)
         if not k or not len(rows):
             return np.zeros((len(rows), k)), np.zeros((len(rows), k))
-        f = self._numeric("f_state").f
-        # straight from and into numpy arrays: a row per point, (k, 2) column-major each
-        table = pointwise(f, np.asarray(times, dtype=float)[:, None], rows,
-                          np.concatenate([self.run.p, self.r]))[0]
+        # a row per point, (k, 2) column-major each
+        table = self._rows(self._numeric("f_state").f, np.asarray(times, dtype=float),
+                           rows, np.concatenate([self.run.p, self.r]))
         sign = self._sign()[None, :]
         return sign * table[:, :k], sign * table[:, k:]
 
@@ -180,25 +180,3 @@ class Switches:
         self.run.p_solver = np.concatenate([self.run.p, self.r])
         self._signs = None
 
-
-class _Call:
-    """A Function of (t, x, p) as a fast callable of (t, x) through ``Function.buffer``, its
-    parameters ``p`` an array written in place (~2 us a call against ~16 us for a plain one,
-    and nothing made again when the values held change)."""
-
-    def __init__(self, f, p):
-        self.f = f
-        self.buffer, self.trigger = f.buffer()
-        self.t, self.x = np.zeros(1), np.zeros(f.size1_in(1))
-        self.p = np.array(p, dtype=float)
-        self.out = np.zeros(f.numel_out(0))
-        # CasADi keeps raw pointers: the arrays live as long as this object
-        for i, arr in enumerate((self.t, self.x, self.p)):
-            self.buffer.set_arg(i, memoryview(arr))
-        self.buffer.set_res(0, memoryview(self.out))
-
-    def __call__(self, t, x):
-        self.t[0] = t
-        self.x[:] = x
-        self.trigger()
-        return self.out.copy()
