@@ -77,9 +77,6 @@ DENSE = 32
 #: CVODES interpolates between its steps (right after a start, at order one or two, to about
 #: half its tolerances on EngineV6)
 FIT = 1.0
-#: how closely, as a fraction of the interval, the minimum of an indicator that dips is
-#: found before its value there is looked at (``_search``)
-MINIMUM = 1e-6
 #: Newton's steps at most from the time found on a curve not within FIT to the integration's
 #: own root, on the side where it has crossed
 POLISH = 4
@@ -446,14 +443,6 @@ def _search(g, rate, t0, t1, crossed, dipped):
     for i in dipped:
         if not rate(t0, i) < 0 < rate(t1, i):     # integrated again: not quite as sampled
             continue
-        # the minimum found to MINIMUM of the interval first: the indicator is convex about
-        # it, so above its tangent there, and a minimum that stays clear of zero by the
-        # tangent's fall over that distance is decided without the last bits (most are)
-        xtol = MINIMUM * (t1 - t0)
-        t_min = brentq(rate, t0, t1, args=(i,), xtol=xtol, maxiter=200)
-        g_min = g(t_min, i)
-        if g_min > 2 * (xtol + 4 * np.finfo(float).eps * abs(t_min)) * abs(rate(t_min, i)):
-            continue                    # a minimum above zero: no event
         t_min = brentq(rate, t0, t1, args=(i,), **tight)
         if g(t_min, i) > 0:
             continue                    # a minimum above zero: no event
