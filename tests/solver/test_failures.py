@@ -80,7 +80,7 @@ def test_a_dead_point_fails_in_one_step_budget(monkeypatch):
     interval go on unlooked once (not again and again with twice the budget from the same
     state), no output is integrated again after the failure, and BDF is not tried from the
     start where stiffness is not the cause. Counted in integrator calls and their step
-    budgets (before: 7 calls, 264,380 steps of budget; now 2 calls, 68,095)."""
+    budgets (before: 7 calls, 264,285 steps of budget; now 2 calls, 68,095)."""
     calls = []
     call = methods._CasadiRun.call
 
