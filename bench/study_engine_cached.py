@@ -17,6 +17,12 @@ the rest (indicators on the sampled rows, the loops' watch, the driver's Python)
 right-hand-side evaluations and the events. The event times of both ways agree (the largest
 difference is printed).
 
+And the work of locating, per event (the same on every machine): the integrations over a
+sampled interval (``_CasadiRun.grid``), the curves checked against the equations
+(``_Hermite.fits``: through two sampled rows, or through the 33 points of an integration),
+and the trial times of Brent's method (the indicators alone, ``Events.levels``, and with
+their rates, ``Events.indicators``, which read the whole equations).
+
 Writes ``results/study_engine_cached.md``. Run: ``python bench/study_engine_cached.py
 [--rounds R]``.
 """
@@ -36,6 +42,11 @@ import kinetwork as kn
 from kinetwork.solver import compiled as compiled_module, events, methods
 
 NAME = "study_engine_cached"
+#: what earlier rounds measured, for comparison (the same study, other code)
+HISTORY = """Earlier: 2026-11-28, load 16.8: 4.46 s (kept), locating 2.11 s, integrator calls
+0.89 s, rest 1.21 s. 2026-11-29 before the events' round (issue 30 item 6), load 4.2: 4.62 s,
+locating 2.45 s, integrator calls 1.03 s, rest 1.40 s; per event 1.00 integration over a
+sampled interval, 1.00 two-row and 1.00 33-point curves checked, 19.6 + 16.7 trial times."""
 MODEL = common.HERE.parent / "models" / "engine_v6" / "EngineV6.json"
 
 
@@ -56,7 +67,16 @@ def timed_parts():
         return mock.patch.object(owner, name, timed)
     patches = [wrap(methods.ca, "integrator", "build"),
                wrap(methods._CasadiRun, "call", "integrate"),
-               wrap(events.Events, "_locate", "locate")]
+               wrap(events.Events, "_locate", "locate"),
+               wrap(methods._CasadiRun, "grid", "grid"),
+               wrap(events.Events, "levels", "levels"),
+               wrap(events.Events, "indicators", "indicators")]
+    fits = events._Hermite.fits
+
+    def counted(self, rates, tol):
+        count["fits", len(self.T) == 2] += 1
+        return fits(self, rates, tol)
+    patches.append(mock.patch.object(events._Hermite, "fits", counted))
     return patches, spent, count
 
 
@@ -92,7 +112,7 @@ def study(rounds):
         for way, most in ways.items():
             cpu, results[way], _ = run_once(systems[way], most)
             spent[way].append(cpu)
-    rows = []
+    rows, work = [], []
     for way, most in ways.items():
         total, res, (parts, count) = run_once(systems[way], most, parts=True)
         rest = total - parts["build"] - parts["integrate"] - parts["locate"]
@@ -101,10 +121,14 @@ def study(rounds):
                      f"{count['integrate']}: {parts['integrate']:.2f}",
                      f"{count['locate']}: {parts['locate']:.2f}", f"{rest:.2f}",
                      res.stats["rhs_evaluations"], len(res.stats["events"])])
-        print("  ", rows[-1], flush=True)
+        n = max(count["locate"], 1)
+        work.append([way, count["locate"], f"{count['grid'] / n:.2f}",
+                     f"{count['fits', True] / n:.2f}", f"{count['fits', False] / n:.2f}",
+                     f"{count['levels'] / n:.1f}", f"{count['indicators'] / n:.1f}"])
+        print("  ", rows[-1], work[-1], flush=True)
     a, b = ([e["t"] for e in results[w].stats["events"]] for w in ways)
     apart = float(np.max(np.abs(np.subtract(a, b)))) if len(a) == len(b) else float("nan")
-    return rows, apart
+    return rows, work, apart
 
 
 def main():
@@ -112,7 +136,7 @@ def main():
     parser.add_argument("--rounds", type=int, default=5, help="interleaved rounds")
     args = parser.parse_args()
     start = time.perf_counter()
-    rows, apart = study(args.rounds)
+    rows, work, apart = study(args.rounds)
     text = "\n".join([
         "# EngineV6 cached: where a repeated run spends its CPU time", "",
         f"{machine()}; {load()}; {args.rounds} interleaved rounds, CPU time, medians; study "
@@ -122,7 +146,12 @@ def main():
         table(["integrators", "run [s] (median)", "timed run [s]", "built: [s]",
                "integrator calls: [s]", "events located: [s]", "rest [s]",
                "rhs evaluations", "events"], rows), "",
-        f"Event times of the two ways: largest difference {apart:.1e} s."])
+        f"Event times of the two ways: largest difference {apart:.1e} s.", "",
+        "The work of locating, per event located (counts: the same on every machine):", "",
+        table(["integrators", "events located", "integrations over a sampled interval",
+               "two-row curves checked", "33-point curves checked",
+               "indicators at trial times", "indicators with rates at trial times"], work),
+        "", HISTORY])
     write_markdown(NAME, text)
     print(f"done in {time.perf_counter() - start:.0f} s", flush=True)
 

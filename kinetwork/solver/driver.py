@@ -106,6 +106,10 @@ class Run:
         #: the time its budget ran out at (set by the method whose call it stopped)
         self.look_steps = None
         self.look_hit = None
+        #: the time of an output interval a look found not held by stability (the run went on
+        #: over it unlooked) and in which the method then failed all the same: no stiffness,
+        #: so auto's BDF is not tried after it
+        self.look_cleared = None
         self.events = None              # friction, stops, relations: events.Events
         #: the parameters of the equations the integrators see (``compiled.Held``): the
         #: model's, then the values the relations are held at (``switches.py``)
@@ -278,6 +282,12 @@ def _auto(run, stats):
             stats.update(method_stats)
             return X, failure, name
         stats["adams_failure"] = failure
+        if run.look_cleared is not None and not isinstance(failure, Stalled):
+            # it failed in an interval whose step the look found not held by stability:
+            # not stiffness, so BDF from the start would fail there too, at its own cost
+            stats.update(method_stats)
+            return X, (f"{failure}; BDF was not tried: at t = {run.look_cleared:g} s the "
+                       f"stiffness test found the step not held by stability"), name
         if isinstance(failure, Stalled):
             stats["switched"] = {"from": name, "to": names[i + 1], "at": failure.t,
                                  "why": str(failure)}
@@ -315,6 +325,7 @@ def _integrate(run, method):
         chunk = min(chunk, EVENT_CHUNK)
     k, failure = 0, None
     restart_at = None                   # with events: where the last one left the run
+    unlooked = None                     # auto's look budget, off over one interval
     while k < n - 1:
         failure = run.stop_reason()
         if failure is not None:
@@ -334,12 +345,13 @@ def _integrate(run, method):
                 new, restart_at = run.events.advance(method, stepper, times, origin, restarted)
         except Failure as exc:
             new = exc.states if exc.states is not None else np.zeros((0, len(X[0])))
+            # (a CasADi call keeps every output it reached before it failed: CasADi writes
+            # each into the rows as it gets there, so no output is integrated again)
             failure = exc.reason
-            if not len(new) and m > 1 and not method.stepper and run.events is None \
-                    and run.stop_reason() is None and failure != LOOK:
-                # CasADi keeps nothing of a failed call: go again an output at a time,
-                # to keep every output before the failure (and stop there all the same)
-                new, failure = _piecewise(run, method, grid[k], X[-1], times, failure)
+        if unlooked is not None:
+            run.look_steps, unlooked = unlooked, None
+            if failure is not None and run.stop_reason() is None:
+                run.look_cleared = float(grid[k])
         if restart_at is not None:            # an event: the method starts afresh there
             stats = _merge(stats, stepper.stats)
             try:
@@ -364,7 +376,11 @@ def _integrate(run, method):
                 except Failure as exc:
                     failure = exc.reason
                 else:
-                    chunk = min(n - 1 - k, MAX_CHUNK) if run.quiet else max(1, chunk)
+                    # the interval over with the run's own budget, unlooked: a look again in
+                    # it would begin it again from the same state, whose stability the
+                    # look has just found does not hold the step (a method crawling to a
+                    # dead point would take each doubled budget from there, in turn)
+                    unlooked, run.look_steps, chunk = run.look_steps, None, 1
                     continue
         if turn is not None and run.stop_reason() is None:
             switched = parts.switch(method, X, turn)
@@ -500,22 +516,6 @@ def _spent(run, method, stats, more, t):
     budget = run.budget(method)
     steps = stats.get("steps", 0) + more.get("steps", 0)
     return budget_spent(budget, t, steps) if steps > budget else None
-
-
-def _piecewise(run, method, t, x, times, reason):
-    """The outputs a failed chunk reached, found by integrating it an output at a time from
-    its start; the run stops at the end of them all the same (a fresh start can pass where
-    the continued run failed: that would be a silent restart)."""
-    out = []
-    try:
-        stepper = method.start(run, t, x)
-        for s in times:
-            out.append(stepper.advance(np.array([s]))[0])
-    except Failure as exc:
-        if exc.states is not None and len(exc.states):
-            out.extend(exc.states)
-        reason = exc.reason
-    return np.array(out).reshape(-1, len(x)), reason
 
 
 def _restart(run, method, X, restarts, failure):

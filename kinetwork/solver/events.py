@@ -41,7 +41,7 @@ import bisect
 
 import numpy as np
 
-from ..equations.pointwise import pointwise
+from .buffers import PointsBySize
 from .compiled import numeric
 from .explicit import rk4
 from .methods import Failure
@@ -98,6 +98,14 @@ class Events:
         self._held = None               # the held values of the start (``reset``)
         self._f_rhs = None
         self._chunk = EVENT_CHUNK
+        #: whether the curve through the two sampled rows is tried first (``_locate_dense``),
+        #: by the law in effect (the values held) and the indicators that cross: once it has
+        #: not fitted under that law, the motion there is too far from a cubic over a
+        #: sampled interval, and each try costs five evaluations of the equations for
+        #: nothing (EngineV6: 339 tries, none fitted; a ball's falls are parabolas, which
+        #: fit, its rises off the contact's spring are not)
+        self._two_fit = {}
+        self._points = PointsBySize()   # the rates on the curves
 
     @property
     def located(self):
@@ -111,11 +119,15 @@ class Events:
 
     def indicators(self, t, x):
         """(indicators, their rates) of every source at (t, x), one after the other."""
+        if len(self.sources) == 1:
+            return self.sources[0].indicators(t, x)
         parts = [s.indicators(t, x) for s in self.sources]
         return (np.concatenate([p[0] for p in parts]), np.concatenate([p[1] for p in parts]))
 
     def levels(self, t, x):
         """The indicators of every source at (t, x), without their rates."""
+        if len(self.sources) == 1:
+            return self.sources[0].levels(t, x)
         return np.concatenate([s.levels(t, x) for s in self.sources])
 
     def _which(self, i):
@@ -169,6 +181,7 @@ class Events:
         self.log = []
         self._last = (None, 0)
         self._chunk = EVENT_CHUNK
+        self._two_fit = {}
         if self.switches is not None:
             self.switches.r = self._held.copy()
             self.switches.time_events = 0
@@ -297,15 +310,15 @@ class Events:
         fun = self.run.compiled.rhs(self.run.jit, method.newton)
 
         def rates(T, X):            # the equations' rates at every (T[k], X[k]), one call
-            return pointwise(fun, np.asarray(T, dtype=float)[:, None], X,
-                             self.run.p_solver)[0]
+            return self._points(fun, T, X, self.run.p_solver)
         x0 = np.asarray(x0, dtype=float)
         tol = self._tolerance(method)
         fitted = False
-        if x1 is not None:
+        law = (tuple(crossed), tuple(dipped), self.run.p_solver.tobytes())
+        if x1 is not None and self._two_fit.get(law, True):
             T, X = np.array([t0, t1]), np.vstack([x0, x1])
             curve = _Hermite(T, X, rates(T, X))
-            fitted = curve.fits(rates, tol)
+            fitted = self._two_fit[law] = curve.fits(rates, tol)
         if not fitted:
             grid = getattr(method.start(self.run, t0, x0), "grid", None)
             rows = grid(t1, DENSE) if grid is not None else None

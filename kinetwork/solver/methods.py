@@ -114,7 +114,8 @@ SUNDIALS_FLAGS = {
                      "there, or the problem is stiff for this method",
     "TOO_MUCH_ACC": "the tolerances asked for are below machine precision",
     "ERR_FAIL": "the error test failed repeatedly: the step size collapsed",
-    "CONV_FAIL": "the Newton iteration failed to converge repeatedly: the step size collapsed",
+    "CONV_FAIL": "the corrector iteration failed to converge repeatedly: the step size "
+                 "collapsed",
     "RHSFUNC_ERR": "the right-hand side became non-finite (Inf or NaN): a force or a "
                    "parameter expression blows up",
     "RHSFUNC_FAIL": "the right-hand side became non-finite (Inf or NaN): a force or a "
@@ -322,7 +323,8 @@ class _CasadiRun:
                 run.look_hit = hit if hit is not None else float(times[len(reached)])
                 raise Failure(LOOK, reached)
             run.said.append(shift_times(solver_words(str(failed)), self.t))
-            raise Failure(solver_reason(str(failed)), reached)
+            reason = solver_reason(str(failed))
+            raise Failure(reason, reached)
         if len(reached) < len(X):
             raise Failure("the state became non-finite (Inf or NaN)", reached)
         self.t, self.x = float(times[-1]), X[-1]

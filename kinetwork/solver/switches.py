@@ -15,8 +15,7 @@ state itself does not jump.
 
 import numpy as np
 
-from ..equations.system import mapped
-from .compiled import numeric
+from .buffers import Call, PointsBySize
 from .methods import Failure
 from .schedule import Schedule
 
@@ -34,17 +33,21 @@ class Switches:
         self.r = np.zeros(relations.n)
         self.time_events = 0
         self._calls = {}
+        self._rows = PointsBySize()
+        self._signs = None
 
     # -- numbers ---------------------------------------------------------------------------
     def _numeric(self, name):
         """The Function ``name`` of the relations as a fast callable of (t, full state) at the
-        values held now (made again when they change)."""
-        key = (name, self.r.tobytes())
-        if self._calls.get(name, (None,))[0] != key:
+        values held now: made once per run, the values written into its parameters in
+        place (not made again at each event)."""
+        call = self._calls.get(name)
+        if call is None:
             f = self._function(name)
-            self._calls[name] = (key, numeric(f, np.concatenate([self.run.p, self.r]),
-                                              f.size1_in(1)))
-        return self._calls[name][1]
+            call = self._calls[name] = Call(f, np.concatenate([self.run.p, self.r]))
+        else:
+            call.p[len(call.p) - len(self.r):] = self.r
+        return call
 
     def _function(self, name):
         """The relations' Function ``name``, compiled as the run's equations are."""
@@ -61,10 +64,9 @@ class Switches:
         value it is held at is the one it has."""
         if not len(self.relations.state):
             return np.zeros(0), np.zeros(0)
-        table = self._numeric("f_state")(t, x).reshape(-1, 2)
-        g, rate = table[:, 0], table[:, 1]
-        held = self.r[self.relations.state] > 0.5
-        sign = np.where(held, 1.0, -1.0)
+        table = self._numeric("f_state")(t, x)           # (k, 2), column-major
+        g, rate = table[:len(table) // 2], table[len(table) // 2:]
+        sign = self._sign()
         # held true, a relation ends where g reaches zero (< : g <= 0; <= : g < 0); held
         # false, where g rises above zero (<: g > 0; <=: g >= 0): all crossings of zero
         return sign * g, sign * rate
@@ -74,8 +76,14 @@ class Switches:
         equations): what locating a crossing evaluates."""
         if not len(self.relations.state):
             return np.zeros(0)
-        sign = np.where(self.r[self.relations.state] > 0.5, 1.0, -1.0)
-        return sign * self._numeric("f_level")(t, x).ravel()
+        return self._sign() * self._numeric("f_level")(t, x)
+
+    def _sign(self):
+        """+1 for each relation on the states held true, -1 held false: kept until the
+        values change (each change of ``r`` ends in ``_publish``, which drops it)."""
+        if self._signs is None:
+            self._signs = np.where(self.r[self.relations.state] > 0.5, 1.0, -1.0)
+        return self._signs
 
     @property
     def count(self):
@@ -87,13 +95,11 @@ class Switches:
         k = len(self.relations.state)
         if not k or not len(rows):
             return np.zeros((len(rows), k)), np.zeros((len(rows), k))
-        f = self._function("f_state")
-        pr = np.concatenate([self.run.p, self.r])
-        table = np.asarray(mapped(f, len(rows))(np.asarray(times, dtype=float)[None, :],
-                                                np.asarray(rows, dtype=float).T, pr))
-        g, rate = table[:, 0::2], table[:, 1::2]       # (k, n) each: columns per row
-        sign = np.where(self.r[self.relations.state] > 0.5, 1.0, -1.0)[None, :]
-        return sign * g.T, sign * rate.T
+        # a row per point, (k, 2) column-major each
+        table = self._rows(self._numeric("f_state").f, np.asarray(times, dtype=float),
+                           rows, np.concatenate([self.run.p, self.r]))
+        sign = self._sign()[None, :]
+        return sign * table[:, :k], sign * table[:, k:]
 
     def chatter(self, i):
         """Why events of relation i pile up at one instant, in words."""
@@ -172,3 +178,5 @@ class Switches:
     def _publish(self):
         """The integrators' parameters with the values now held."""
         self.run.p_solver = np.concatenate([self.run.p, self.r])
+        self._signs = None
+

@@ -45,6 +45,25 @@ def test_each_contact_is_located_by_one_integration_and_a_check(reference, monke
     assert calls["grid"] <= 4 and calls["state_at"] <= 3 * 4
 
 
+def test_the_curve_through_two_rows_is_not_tried_again_where_it_did_not_fit(monkeypatch):
+    """The ball's falls are parabolas: the curve through the two sampled rows fits each.
+    Its rises off the contact's spring do not: that curve is tried on the first rise only
+    (each try costs five evaluations of the equations), the later ones go straight to the
+    one integration over the interval (before: tried on each of the four rises)."""
+    tried = []
+    fits = events_module._Hermite.fits
+
+    def counted(self, rates, tol):
+        tried.append((len(self.T), fits(self, rates, tol)))
+        return tried[-1][1]
+    monkeypatch.setattr(events_module._Hermite, "fits", counted)
+    res = kn.simulate(ball(), t_end=3.0, n_points=301, method="cvodes-adams", rtol=1e-10,
+                      atol=1e-12)
+    assert len(res.stats["events"]) == 8
+    assert tried.count((2, True)) == 4 and tried.count((2, False)) == 1
+    assert tried.count((33, True)) + tried.count((33, False)) == 4
+
+
 def test_dense_and_exact_location_agree_on_a_stop_of_friction(monkeypatch):
     """A block at 3 m/s against Coulomb friction 4 N, 2 kg: stuck from t = 1.5 s at 2.25 m,
     located on the curve as on every trial integrated (the closed form to 1e-10)."""

@@ -6,6 +6,7 @@ import numpy as np
 import pytest
 
 import kinetwork as kn
+from kinetwork.solver import methods
 from scenes import chain, spatial_fourbar, stiff
 
 
@@ -68,6 +69,69 @@ def test_a_dead_point_stops_the_run_by_name(capfd):
         assert "rocker" in err.reason and "crank" in err.reason
         assert 0.2 < err.t_reached < 0.5
         assert len(err.results.t) == round(err.t_reached / 0.01) + 1
+    out, errout = capfd.readouterr()
+    assert out == "" and errout == ""
+
+
+def test_a_dead_point_fails_in_one_step_budget(monkeypatch):
+    """The run that ends at the four-bar's dead point (t ~ 0.3232 s, Adams crawling towards
+    it in ever shorter steps) fails after one budget of steps in the interval where it
+    crawls, not after several: the look that finds the step not held by stability lets that
+    interval go on unlooked once (not again and again with twice the budget from the same
+    state), no output is integrated again after the failure, and BDF is not tried from the
+    start where stiffness is not the cause. Counted in integrator calls and their step
+    budgets (before: 7 calls, 264,285 steps of budget; now 2 calls, 68,095)."""
+    calls = []
+    call = methods._CasadiRun.call
+
+    def counted(self, integ, opts, times, out=None):
+        calls.append((self.method.plugin, opts.get("linear_multistep_method"),
+                      opts.get("max_num_steps")))
+        return call(self, integ, opts, times, out)
+    monkeypatch.setattr(methods._CasadiRun, "call", counted)
+    with pytest.raises(kn.SimulationError) as info:
+        kn.simulate(spatial_fourbar(c=0.3), t_end=2.0, n_points=201, rtol=1e-8, atol=1e-10,
+                    repartition=False)
+    err = info.value
+    assert "dead point" in err.reason and "BDF was not tried" in err.reason
+    assert err.results.method == "cvodes-adams" and 0.3 < err.t_reached < 0.33
+    assert len(calls) == 2 and all(c[1] == "adams" for c in calls)
+    assert calls[1][2] > calls[0][2]            # the look's budget, then the run's own
+    assert sum(c[2] for c in calls) < 1.2 * calls[1][2]
+
+
+def _blow_up():
+    """x' = x^2 from x = 1: the solution ends at t = 1 (x = 1 / (1 - t))."""
+    m = kn.Model("blowup")
+    for c in (kn.signals.Integrator("x", y_start=1.0), kn.signals.Product("sq")):
+        m.add(c)
+    for a, b in [("x.y", "sq.u1"), ("x.y", "sq.u2"), ("sq.y", "x.u")]:
+        m.connect(a, b)
+    return m
+
+
+def test_a_solution_that_ends_costs_auto_one_step_budget(monkeypatch, capfd):
+    """x' = x^2 ends at t = 1: auto's Adams crawls towards it; the look finds its step not
+    held by stability, lets the interval go on unlooked once, and the run fails there
+    after one budget of steps, without BDF from the start (before: the doubled look
+    budgets from the same state, the interval again output by output, then BDF: five
+    calls more). The outputs up to then are kept and right."""
+    calls = []
+    call = methods._CasadiRun.call
+
+    def counted(self, integ, opts, times, out=None):
+        calls.append(opts.get("max_num_steps"))
+        return call(self, integ, opts, times, out)
+    monkeypatch.setattr(methods._CasadiRun, "call", counted)
+    with pytest.raises(kn.SimulationError) as info:
+        kn.simulate(_blow_up(), t_end=2.0, n_points=201)
+    err = info.value
+    assert "too many steps" in err.reason and "BDF was not tried" in err.reason
+    assert err.results.method == "cvodes-adams" and len(calls) == 2
+    res = err.results
+    assert 0.98 < res.t[-1] < 1.0
+    # (the global error grows as the solution does: 5e-5 at x = 100, rtol 1e-6)
+    np.testing.assert_allclose(res.states[:, 0], 1 / (1 - res.t), rtol=2e-4)
     out, errout = capfd.readouterr()
     assert out == "" and errout == ""
 
