@@ -93,10 +93,9 @@ function Breadcrumbs() {
 /** Unsaved work of an earlier session, offered back above the diagram (not in its way). */
 function RecoveryBar() {
   const offer = useStudio((s) => s.offer);
-  // always there (a row of the centre's grid), empty when there is nothing to offer
-  if (!offer) return <div className="kn-offer-slot" />;
+  if (!offer) return null;
   return (
-    <div className="kn-offer-slot kn-offer" data-testid="recovery" role="alert">
+    <div className="kn-offer" data-testid="recovery" role="alert">
       <span>{offer.message}</span>
       <button className="kn-btn kn-primary" data-testid="choice-recover" onClick={offer.recover}>
         Recover them
@@ -112,8 +111,8 @@ function RecoveryBar() {
 const FOLD_OFFER = 24;
 
 /**
- * A long repeated pattern (a chain of 32 links) offered folded into subsystems, over the
- * diagram, until folded or dismissed.
+ * A long repeated pattern (a chain of 32 links) offered folded into subsystems, in a bar
+ * above the diagram (over it, it hid the top row), until folded or dismissed.
  * @param {{scope: any, edit: import("./hooks/useEditing.js").Edit}} props
  */
 function FoldOffer({ scope, edit }) {
@@ -253,11 +252,13 @@ export default function App() {
         {closed.palette ? <div /> : <Palette palette={palette} definitions={definitions} onAdd={edit.placeAtCentre} />}
         <Splitter pane="palette" axis="x" side="before" size={sizes.palette} label="Palette" />
         <div className="kn-center" ref={centerRef} style={{ gridTemplateRows: `auto 30px minmax(0, 1fr) ${SPLITTER}px ${sizes.results}px` }}>
-          <RecoveryBar />
-          <Breadcrumbs />
-          <Canvas nodes={diagram.nodes} edges={diagram.edges} placed={placed} edit={edit}>
+          {/* a row of the centre's grid, always there, empty when nothing is offered */}
+          <div className="kn-bars">
+            <RecoveryBar />
             <FoldOffer scope={scope} edit={edit} />
-          </Canvas>
+          </div>
+          <Breadcrumbs />
+          <Canvas nodes={diagram.nodes} edges={diagram.edges} placed={placed} edit={edit} />
           <Splitter pane="results" axis="y" side="after" size={sizes.results} label="Plots and 3-D view" />
           <div className="kn-results" style={{ gridTemplateColumns: `minmax(0, 1fr) ${SPLITTER}px ${sizes.viewer}px` }}>
             {closed.results ? null : (

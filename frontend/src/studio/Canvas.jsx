@@ -3,11 +3,12 @@
 // are and what is selected; while the mouse drags, React Flow's positions are shown, and the
 // drop commits them to the model (one undo step).
 import { useCallback, useEffect, useMemo, useRef, useState } from "react";
-import { Background, ConnectionMode, Controls, MiniMap, ReactFlow, useNodesInitialized, useReactFlow, useStoreApi } from "@xyflow/react";
+import { Background, ConnectionMode, ControlButton, Controls, MiniMap, ReactFlow, useNodesInitialized, useReactFlow, useStoreApi } from "@xyflow/react";
 import BlockNode from "./BlockNode.jsx";
 import PortNode from "./PortNode.jsx";
 import WireEdge from "./WireEdge.jsx";
 import { GRID, SCALE } from "./model.js";
+import { fitViewport } from "./fit.js";
 import { studio, useStudio } from "./store.js";
 import { edgeData } from "./hooks/useEditing.js";
 import { useWires } from "./hooks/useWires.js";
@@ -19,16 +20,17 @@ export const DRAG_MIME = "application/x-kinetwork-type";
 const CLICK_SLOP = 5;
 /** The minimap only where it leaves the diagram room: it covered half of a small canvas. */
 const MINIMAP_ROOM = { width: 700, height: 380 };
+const MIN_ZOOM = 0.1;
+const FIT_MAX_ZOOM = 1.1;
 
 function sameList(a, b) {
   return a.length === b.length && a.every((x, i) => x === b[i]);
 }
 
 /**
- * @param {{nodes: any[], edges: any[], placed: boolean, edit: import("./hooks/useEditing.js").Edit, children?: any}} props
- *   ``children``: shown over the diagram (an offer)
+ * @param {{nodes: any[], edges: any[], placed: boolean, edit: import("./hooks/useEditing.js").Edit}} props
  */
-export default function Canvas({ nodes: nodesIn, edges: edgesIn, placed, edit, children }) {
+export default function Canvas({ nodes: nodesIn, edges: edgesIn, placed, edit }) {
   const flow = useReactFlow();
   const rf = useStoreApi();
   const selection = useStudio((s) => s.selection);
@@ -39,14 +41,23 @@ export default function Canvas({ nodes: nodesIn, edges: edgesIn, placed, edit, c
   const [measured, setMeasured] = useState({});
   const box = useRef(null);
   const [roomy, setRoomy] = useState(true);
+  // the view the last fit set: while the user has not moved it, the pane's new size refits
+  const fittedView = useRef(null);
+  const refit = useRef(() => {});
   useEffect(() => {
     if (!box.current) return undefined;
+    let frame = 0;
     const ro = new ResizeObserver((entries) => {
       const r = entries[0].contentRect;
       setRoomy(r.width >= MINIMAP_ROOM.width && r.height >= MINIMAP_ROOM.height);
+      cancelAnimationFrame(frame);
+      frame = requestAnimationFrame(() => refit.current());
     });
     ro.observe(box.current);
-    return () => ro.disconnect();
+    return () => {
+      cancelAnimationFrame(frame);
+      ro.disconnect();
+    };
   }, []);
 
   const nodes = useMemo(() => {
@@ -119,17 +130,39 @@ export default function Canvas({ nodes: nodesIn, edges: edgesIn, placed, edit, c
     [edit],
   );
 
+  // the whole diagram in view, clear of the zoom buttons and the minimap
+  const fit = useCallback(() => {
+    const pane = box.current;
+    const shown = flow.getNodes();
+    if (!pane || !shown.length) return;
+    const at = pane.getBoundingClientRect();
+    const controls = [...pane.querySelectorAll(".react-flow__controls, .react-flow__minimap")].map((el) => {
+      const r = el.getBoundingClientRect();
+      return { x: r.left - at.left, y: r.top - at.top, width: r.width, height: r.height };
+    });
+    const view = fitViewport(flow.getNodesBounds(shown), { width: at.width, height: at.height }, controls, FIT_MAX_ZOOM, MIN_ZOOM);
+    flow.setViewport(view, { duration: 0 });
+    fittedView.current = flow.getViewport();
+  }, [flow]);
+  useEffect(() => {
+    refit.current = () => {
+      const was = fittedView.current;
+      const now = flow.getViewport();
+      if (was && now.x === was.x && now.y === was.y && now.zoom === was.zoom) fit();
+    };
+  }, [flow, fit]);
+
   // fit the view to a model just opened, once its blocks are measured
   const initialized = useNodesInitialized();
   const fitted = useRef(0);
   useEffect(() => {
     if (!fitRequest || fitted.current === fitRequest || !initialized || !nodes.length || !placed) return undefined;
     const id = requestAnimationFrame(() => {
-      flow.fitView({ padding: 0.03, maxZoom: 1.1, duration: 0 });
+      fit();
       fitted.current = fitRequest;
     });
     return () => cancelAnimationFrame(id);
-  }, [fitRequest, initialized, nodes, placed, flow]);
+  }, [fitRequest, initialized, nodes, placed, fit]);
 
   const isValidConnection = useCallback((c) => edit.checkConnection(`${c.source}.${c.sourceHandle}`, `${c.target}.${c.targetHandle}`) === null, [edit]);
   const onConnect = useCallback((c) => edit.connect(`${c.source}.${c.sourceHandle}`, `${c.target}.${c.targetHandle}`), [edit]);
@@ -231,16 +264,21 @@ export default function Canvas({ nodes: nodesIn, edges: edgesIn, placed, edit, c
         deleteKeyCode={null}
         disableKeyboardA11y
         zoomOnDoubleClick={false}
-        minZoom={0.1}
+        minZoom={MIN_ZOOM}
         maxZoom={3}
         connectionRadius={18}
         proOptions={{ hideAttribution: true }}
       >
         <Background gap={GRID * 2} size={1} color="#d4d8de" />
-        <Controls showInteractive={false} />
+        <Controls showInteractive={false} showFitView={false}>
+          <ControlButton className="react-flow__controls-fitview" data-testid="fit-view" title="The whole diagram" aria-label="The whole diagram" onClick={fit}>
+            <svg viewBox="0 0 32 30" aria-hidden="true">
+              <path d="M3.7 11.5V3.6h7.8M20.5 3.6h7.8v7.9M28.3 18.5v7.9h-7.8M11.5 26.4H3.7v-7.9" fill="none" stroke="currentColor" strokeWidth="3" />
+            </svg>
+          </ControlButton>
+        </Controls>
         {roomy ? <MiniMap pannable zoomable nodeStrokeWidth={2} nodeColor={(n) => (/** @type {any} */ (n.data).problems?.length ? "#e05555" : "#c9ced6")} style={{ width: 140, height: 90 }} /> : null}
       </ReactFlow>
-      {children}
     </div>
   );
 }
