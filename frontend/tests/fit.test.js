@@ -58,3 +58,17 @@ describe("block widths follow their ports' names", () => {
     expect(labelWidth("x".repeat(200))).toBe(120);
   });
 });
+
+describe("fitViewport with the blocks", () => {
+  it("leaves a control over an empty corner of the diagram where no block is under it", () => {
+    const pane = { width: 1000, height: 600 };
+    const minimap = { x: 845, y: 495, width: 140, height: 90 };
+    const bounds = { x: 0, y: 0, width: 1000, height: 600 };
+    // an L: blocks along the top and down the left, the bottom right corner empty
+    const blocks = [{ x: 0, y: 0, width: 1000, height: 100 }, { x: 0, y: 0, width: 100, height: 600 }];
+    const v = fitViewport(bounds, pane, [minimap], 1.1, 0.1, blocks);
+    expect(v.zoom).toBeCloseTo((600 - 2 * MARGIN) / 600, 9);
+    // the extent alone would have to shrink to clear it
+    expect(fitViewport(bounds, pane, [minimap], 1.1, 0.1).zoom).toBeLessThan(v.zoom);
+  });
+});

@@ -1,9 +1,10 @@
-"""Large diagrams leave room to read them (issue 29 item 4): at fit zoom no control floating
-over the diagram (the zoom buttons, the minimap) and no bar above it (the offer to fold a
-repeated chain) covers a block, at 1000x700, 1400x900 and 1920x1080, for a 32-link chain
-(flat, then folded with the mouse) and the largest examples; the fit button does the same;
-a subsystem's block is as wide as its ports' names need. Everything is read from the
-rendered boxes (getBoundingClientRect) on one page for the module."""
+"""Large diagrams leave room to read them (issue 29 item 4): at fit zoom nothing covers a
+block, at 1000x700, 1400x900 and 1920x1080, for a 32-link chain (flat, then folded with the
+mouse) and the largest examples: the zoom and fit buttons sit in the bar above the diagram,
+the minimap shows by itself only where it covers no block (the "map" button shows it on
+demand), the offer to fold a repeated chain is a bar above the diagram; the fit button does
+the same as opening; a subsystem's block is as wide as its ports' names need. Everything is
+read from the rendered boxes (getBoundingClientRect) on one page for the module."""
 
 import pytest
 
@@ -17,13 +18,18 @@ BOXES = """() => {
     return {
         blocks: [...document.querySelectorAll('.react-flow__node')].map((el) =>
             ({id: el.getAttribute('data-id'), ...box(el)})),
-        over: [...document.querySelectorAll('.react-flow__controls, .react-flow__minimap, ' +
-                                            '.kn-fold-offer, .kn-offer')].map((el) =>
-            ({what: ['react-flow__controls', 'react-flow__minimap', 'kn-fold-offer', 'kn-offer']
-                .find((c) => el.classList.contains(c)), ...box(el)})),
+        over: [...document.querySelectorAll('.react-flow__panel, .kn-fold-offer, .kn-offer, ' +
+                                            '.kn-view-tools')].map((el) =>
+            ({what: ['react-flow__minimap', 'react-flow__panel', 'kn-fold-offer', 'kn-offer',
+                     'kn-view-tools'].find((c) => el.classList.contains(c)), ...box(el)})),
         pane: box(document.querySelector('.react-flow')),
     };
 }"""
+
+
+#: the diagram's zoom
+ZOOM = "() => new DOMMatrix(getComputedStyle(document.querySelector('.react-flow__viewport'))" \
+       ".transform).a"
 
 
 def covered(page):
@@ -53,16 +59,13 @@ def test_nothing_covers_a_block_at_fit_zoom(screen, site, w, h):  # noqa: F811
         screen.locator(tid("fold-offer")).wait_for()
         over = assert_clear(screen, f"chain32 at {w}x{h}")
         screenshot(screen, f"studio-chain32-{w}x{h}.png")
-        assert "kn-fold-offer" in over
-        if w >= 1400:
-            assert "react-flow__minimap" in over          # shown where there is room, clear
-        # zoomed and panned away with the mouse, the fit button brings the whole back, clear
-        pane = screen.locator(".react-flow__pane").bounding_box()
-        screen.mouse.move(pane["x"] + pane["width"] / 2, pane["y"] + pane["height"] / 2)
-        screen.mouse.wheel(0, -600)
+        assert {"kn-fold-offer", "kn-view-tools"} <= over
+        # zoomed in with the buttons, the fit button brings the whole back, clear
+        before = screen.evaluate(ZOOM)
+        screen.locator(tid("zoom-in")).click()
+        screen.wait_for_function(f"() => ({ZOOM})() > {before}")
         screen.locator(tid("fit-view")).click()
-        screen.wait_for_function("() => new Promise((done) => requestAnimationFrame(() => "
-                                 "requestAnimationFrame(() => done(true))))")
+        screen.wait_for_function(f"() => Math.abs(({ZOOM})() - {before}) < 1e-9")
         assert_clear(screen, f"chain32 fitted by the button at {w}x{h}")
         # folded with the mouse: the bar goes, the folded chain fits clear of the controls
         screen.locator(tid("fold-accept")).click()
@@ -74,7 +77,17 @@ def test_nothing_covers_a_block_at_fit_zoom(screen, site, w, h):  # noqa: F811
         screenshot(screen, f"studio-chain32-folded-{w}x{h}.png")
         for example in ("arm_computed_torque", "robot_r3/FullRobot"):
             show(screen, site, example=example)
-            assert_clear(screen, f"{example} at {w}x{h}")
+            over = assert_clear(screen, f"{example} at {w}x{h}")
+            # the minimap on demand: the button shows it (over the diagram: the user's
+            # choice), and puts it away again
+            toggle = screen.locator(tid("minimap-toggle"))
+            for _ in range(2):
+                shown = "react-flow__minimap" in over
+                toggle.click()
+                screen.wait_for_function(f"() => !!document.querySelector('.react-flow__minimap')"
+                                         f" === {'false' if shown else 'true'}")
+                over = covered(screen)[2]
+            assert_clear(screen, f"{example} at {w}x{h} with the minimap as it was")
         assert not screen.errors, screen.errors
     finally:
         screen.set_viewport_size(SIZE)

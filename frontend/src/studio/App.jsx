@@ -2,6 +2,7 @@
 // State is in the store (store.js); the work is in hooks/ (files, definitions, validation,
 // runs, editing, keys); this component puts the pieces on the page.
 import { useCallback, useEffect, useMemo, useRef, useState } from "react";
+import { useReactFlow } from "@xyflow/react";
 import { api, EXAMPLE, OPEN } from "./api.js";
 import Canvas from "./Canvas.jsx";
 import { findRepeat } from "./fold.js";
@@ -86,7 +87,31 @@ function Breadcrumbs() {
       <span className="kn-muted kn-small kn-hint">
         drag from the palette · wire port to port · box-select by dragging · right-click for more · wheel zooms, right-drag pans · arrows move · Del · Ctrl+Z/Y · Ctrl+A/C/V/D
       </span>
+      <ViewTools />
     </div>
+  );
+}
+
+/**
+ * Zoom, fit and the minimap, in the bar above the diagram: floating over its corners they
+ * covered blocks. The minimap shows by itself only where it covers none in the fitted view.
+ */
+function ViewTools() {
+  const flow = useReactFlow();
+  const fit = useStudio((s) => s.fit);
+  const minimap = useStudio((s) => s.minimap);
+  const mapClear = useStudio((s) => s.mapClear);
+  const setMinimap = useStudio((s) => s.setMinimap);
+  const shown = minimap ?? mapClear;
+  return (
+    <span className="kn-view-tools">
+      <button className="kn-tool" data-testid="zoom-out" title="Zoom out" onClick={() => flow.zoomOut({ duration: 0 })}>−</button>
+      <button className="kn-tool" data-testid="zoom-in" title="Zoom in" onClick={() => flow.zoomIn({ duration: 0 })}>+</button>
+      <button className="kn-tool" data-testid="fit-view" title="The whole diagram" onClick={fit}>fit</button>
+      <button className={`kn-tool${shown ? " kn-on" : ""}`} data-testid="minimap-toggle" title={shown ? "Hide the minimap" : "Show the minimap"} onClick={() => setMinimap(!shown)}>
+        map
+      </button>
+    </span>
   );
 }
 

@@ -3,12 +3,12 @@
 // are and what is selected; while the mouse drags, React Flow's positions are shown, and the
 // drop commits them to the model (one undo step).
 import { useCallback, useEffect, useMemo, useRef, useState } from "react";
-import { Background, ConnectionMode, ControlButton, Controls, MiniMap, ReactFlow, useNodesInitialized, useReactFlow, useStoreApi } from "@xyflow/react";
+import { Background, ConnectionMode, MiniMap, ReactFlow, useNodesInitialized, useReactFlow, useStoreApi } from "@xyflow/react";
 import BlockNode from "./BlockNode.jsx";
 import PortNode from "./PortNode.jsx";
 import WireEdge from "./WireEdge.jsx";
 import { GRID, SCALE } from "./model.js";
-import { fitViewport } from "./fit.js";
+import { covers, fitViewport, minimapBox } from "./fit.js";
 import { studio, useStudio } from "./store.js";
 import { edgeData } from "./hooks/useEditing.js";
 import { useWires } from "./hooks/useWires.js";
@@ -18,9 +18,10 @@ const edgeTypes = { wire: WireEdge };
 export const DRAG_MIME = "application/x-kinetwork-type";
 /** A right button released this close to where it went down opens the menu (else it panned). */
 const CLICK_SLOP = 5;
-/** The minimap only where it leaves the diagram room: it covered half of a small canvas. */
+/** The minimap by itself only where it leaves the diagram room: it covered half of a small canvas. */
 const MINIMAP_ROOM = { width: 700, height: 380 };
 const MIN_ZOOM = 0.1;
+const MINIMAP = { width: 140, height: 90 };
 const FIT_MAX_ZOOM = 1.1;
 
 function sameList(a, b) {
@@ -41,6 +42,11 @@ export default function Canvas({ nodes: nodesIn, edges: edgesIn, placed, edit })
   const [measured, setMeasured] = useState({});
   const box = useRef(null);
   const [roomy, setRoomy] = useState(true);
+  const minimap = useStudio((s) => s.minimap);
+  const mapClear = useStudio((s) => s.mapClear);
+  // the minimap's corner free of blocks in the view last fitted
+  const [cornerFree, setCornerFree] = useState(true);
+  useEffect(() => studio().setMapClear(roomy && cornerFree), [roomy, cornerFree]);
   // the view the last fit set: while the user has not moved it, the pane's new size refits
   const fittedView = useRef(null);
   const refit = useRef(() => {});
@@ -135,14 +141,12 @@ export default function Canvas({ nodes: nodesIn, edges: edgesIn, placed, edit })
     const pane = box.current;
     const shown = flow.getNodes();
     if (!pane || !shown.length) return;
-    const at = pane.getBoundingClientRect();
-    const controls = [...pane.querySelectorAll(".react-flow__controls, .react-flow__minimap")].map((el) => {
-      const r = el.getBoundingClientRect();
-      return { x: r.left - at.left, y: r.top - at.top, width: r.width, height: r.height };
-    });
-    const view = fitViewport(flow.getNodesBounds(shown), { width: at.width, height: at.height }, controls, FIT_MAX_ZOOM, MIN_ZOOM);
+    const size = { width: pane.clientWidth, height: pane.clientHeight };
+    const blocks = shown.map((n) => ({ x: n.position.x, y: n.position.y, width: n.measured?.width ?? 0, height: n.measured?.height ?? 0 }));
+    const view = fitViewport(flow.getNodesBounds(shown), size, [], FIT_MAX_ZOOM, MIN_ZOOM);
     flow.setViewport(view, { duration: 0 });
     fittedView.current = flow.getViewport();
+    setCornerFree(!covers(view, blocks, minimapBox(size, MINIMAP)));
   }, [flow]);
   useEffect(() => {
     refit.current = () => {
@@ -270,14 +274,9 @@ export default function Canvas({ nodes: nodesIn, edges: edgesIn, placed, edit })
         proOptions={{ hideAttribution: true }}
       >
         <Background gap={GRID * 2} size={1} color="#d4d8de" />
-        <Controls showInteractive={false} showFitView={false}>
-          <ControlButton className="react-flow__controls-fitview" data-testid="fit-view" title="The whole diagram" aria-label="The whole diagram" onClick={fit}>
-            <svg viewBox="0 0 32 30" aria-hidden="true">
-              <path d="M3.7 11.5V3.6h7.8M20.5 3.6h7.8v7.9M28.3 18.5v7.9h-7.8M11.5 26.4H3.7v-7.9" fill="none" stroke="currentColor" strokeWidth="3" />
-            </svg>
-          </ControlButton>
-        </Controls>
-        {roomy ? <MiniMap pannable zoomable nodeStrokeWidth={2} nodeColor={(n) => (/** @type {any} */ (n.data).problems?.length ? "#e05555" : "#c9ced6")} style={{ width: 140, height: 90 }} /> : null}
+        {(minimap ?? mapClear) ? (
+          <MiniMap pannable zoomable nodeStrokeWidth={2} nodeColor={(n) => (/** @type {any} */ (n.data).problems?.length ? "#e05555" : "#c9ced6")} style={{ width: MINIMAP.width, height: MINIMAP.height }} />
+        ) : null}
       </ReactFlow>
     </div>
   );

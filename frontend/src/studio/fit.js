@@ -1,6 +1,6 @@
-// The view that shows a whole diagram: as large as the pane allows with none of it under the
-// controls that float over the pane's corners (the zoom buttons, the minimap). At 1400x900 a
-// plain fit put a 32-link chain's last row under the minimap.
+// The view that shows a whole diagram: as large as the pane allows with none of it under
+// what floats over the pane's corners; and whether the minimap's corner is free of blocks (at
+// 1400x900 a plain fit put a 32-link chain's last row under it).
 
 /** Pixels kept clear round the diagram and between it and a corner's control. */
 export const MARGIN = 12;
@@ -12,9 +12,11 @@ export const MARGIN = 12;
  * @param {Rect[]} controls what floats over the pane (px, from its top left corner)
  * @param {number} maxZoom
  * @param {number} minZoom
+ * @param {Rect[]} [blocks] the blocks (the diagram's coordinates): a control may lie over the
+ *   diagram's empty corner, not over one of these (default: over none of its extent)
  * @returns {{x: number, y: number, zoom: number}} the viewport: screen = diagram * zoom + (x, y)
  */
-export function fitViewport(bounds, pane, controls, maxZoom, minZoom) {
+export function fitViewport(bounds, pane, controls, maxZoom, minZoom, blocks = [bounds]) {
   const { width: W, height: H } = pane;
   // the room each way: the whole pane; the pane above the lowest control's top (the controls
   // sit in the bottom corners); the pane between the controls' inner edges
@@ -30,8 +32,10 @@ export function fitViewport(bounds, pane, controls, maxZoom, minZoom) {
   for (const area of areas) {
     const view = within(bounds, area, maxZoom, minZoom);
     if (!view) continue;
-    const shown = { x: bounds.x * view.zoom + view.x, y: bounds.y * view.zoom + view.y, width: bounds.width * view.zoom, height: bounds.height * view.zoom };
-    const clear = controls.every((c) => !overlap(shown, c, MARGIN / 2));
+    const clear = blocks.every((b) => {
+      const shown = { x: b.x * view.zoom + view.x, y: b.y * view.zoom + view.y, width: b.width * view.zoom, height: b.height * view.zoom };
+      return controls.every((c) => !overlap(shown, c));
+    });
     if (clear && (!best || view.zoom > best.zoom)) best = view;
   }
   // nothing clear of them (a pane smaller than its controls): the plain fit
@@ -52,7 +56,17 @@ function within(bounds, area, maxZoom, minZoom) {
   };
 }
 
-/** Whether rectangles ``a`` and ``b`` overlap by more than ``slack`` px. */
-function overlap(a, b, slack = 0) {
-  return a.x < b.x + b.width - slack && b.x < a.x + a.width - slack && a.y < b.y + b.height - slack && b.y < a.y + a.height - slack;
+/** Whether rectangles ``a`` and ``b`` overlap. */
+function overlap(a, b) {
+  return a.x < b.x + b.width && b.x < a.x + a.width && a.y < b.y + b.height && b.y < a.y + a.height;
+}
+
+/** Where React Flow puts the minimap (bottom right, 15 px in) in a pane of ``size``. */
+export function minimapBox(size, map = { width: 140, height: 90 }) {
+  return { x: size.width - 15 - map.width, y: size.height - 15 - map.height, width: map.width, height: map.height };
+}
+
+/** Whether ``box`` (pane px) lies over one of ``blocks`` (diagram coordinates) in ``view``. */
+export function covers(view, blocks, box) {
+  return blocks.some((b) => overlap({ x: b.x * view.zoom + view.x, y: b.y * view.zoom + view.y, width: b.width * view.zoom, height: b.height * view.zoom }, box));
 }
