@@ -7,17 +7,21 @@ import pytest
 from browser import browser_missing
 from scenes import double_pendulum
 
-#: the files that take longest (seconds of one run on 2 cores, 2026-11-28), longest first:
-#: pytest-xdist's ``--dist loadfile`` hands files out in collection order, so these go first
-#: and the short ones fill in around them, instead of one worker finishing a long file alone
-#: while the other waits (longest-first scheduling; a stale figure only costs balance)
+#: the files that take longest (seconds of CPU of one run, the browser's and the compiler's
+#: included, 2026-11-29), longest first: pytest-xdist's ``--dist loadfile`` hands files out in
+#: collection order, so these go first and the short ones fill in around them, instead of one
+#: worker finishing a long file alone while the other waits (longest-first scheduling; a stale
+#: figure only costs balance)
 LONG_FILES = {
-    "studio/test_e2e.py": 145, "studio/test_e2e_editing.py": 77, "scenes/test_engine_flat.py": 48,
-    "studio/test_server.py": 47, "test_models.py": 46, "test_docs.py": 42,
-    "studio/test_e2e_work.py": 41, "studio/test_e2e_analysis.py": 39, "graph/test_fuzz.py": 30,
-    "solver/test_time_events.py": 27, "solver/test_stability.py": 23,
-    "test_entry_points.py": 23, "fmu/test_export.py": 22, "test_first_answer.py": 21,
-    "equations/test_loops.py": 21, "equations/test_point_mass_chains.py": 21,
+    "studio/test_e2e_wires.py": 90, "test_models.py": 69, "studio/test_e2e_editing.py": 57,
+    "studio/test_e2e.py": 51, "studio/test_e2e_layout.py": 36, "test_entry_points.py": 31,
+    "solver/test_time_events.py": 30, "test_docs_installed.py": 30,
+    "test_docs_installed_2.py": 30, "solver/test_stability.py": 29,
+    "equations/test_point_mass_chains.py": 28, "graph/test_fuzz.py": 28,
+    "equations/test_loops.py": 27, "analysis/test_sweep.py": 27, "studio/test_server.py": 26,
+    "studio/test_e2e_work.py": 25, "test_build_cache.py": 24, "studio/test_e2e_analysis.py": 23,
+    "solver/test_driver.py": 23, "fmu/test_export.py": 22, "solver/test_methods.py": 22,
+    "test_first_answer.py": 21, "studio/test_e2e_viewer.py": 20, "solver/test_jit_tiers.py": 20,
 }
 
 

@@ -70,6 +70,12 @@ def _venv(folder, wheel):
     run([str(python), "-m", "pip", "install", "--no-deps", "--no-index", "-q", str(wheel)])
 
 
+def reader_env():
+    """This process's environment without what would point the wheel's Python elsewhere
+    (PYTHONPATH, VIRTUAL_ENV): a reader's shell."""
+    return {k: v for k, v in os.environ.items() if k not in ("PYTHONPATH", "VIRTUAL_ENV")}
+
+
 def run(argv, **kwargs):
     done = subprocess.run(argv, capture_output=True, text=True, **kwargs)
     assert done.returncode == 0, f"{argv[:4]}: {done.stdout[-2000:]}{done.stderr[-2000:]}"

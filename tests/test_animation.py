@@ -280,7 +280,10 @@ def test_the_page_plays_in_chromium(seed_page, chromium):
         page.on("pageerror", lambda exc: problems.append(str(exc)))
         page.on("request", lambda req: requests.append(req.url))
         page.goto(path.as_uri())
-        page.wait_for_function("window.kinetworkPlayer && window.kinetworkPlayer.getTime() > 0.2")
+        # a function, not an expression: Playwright polls an expression with eval, which the
+        # page's Content-Security-Policy refuses (the test failed whenever it had to poll)
+        page.wait_for_function("() => window.kinetworkPlayer && "
+                               "window.kinetworkPlayer.getTime() > 0.2")
         assert page.evaluate("window.kinetworkPlayer.isPlaying()")
         page.evaluate("window.kinetworkPlayer.pause(); window.kinetworkPlayer.setTime(0)")
         page.wait_for_timeout(200)

@@ -97,23 +97,30 @@ def run_page(page):
                 kn.loads(code)
 
 
-def run_pages(folder):
-    """Run every page that has blocks, each in a fresh subfolder of ``folder``:
-    ``{"ran": [pages], "failures": {page: the error's text}}``. What ``tests/test_docs_installed.py`` runs in a
-    virtual environment holding only the wheel."""
+def pages_of(part=0, parts=1):
+    """The pages with blocks, every ``parts``-th from ``part``: the installed-wheel run is split
+    in ``parts`` test files so that pytest-xdist's workers share it."""
+    return [page_id(p) for p in PAGES if blocks(p)][part::parts]
+
+
+def run_pages(folder, part=0, parts=1):
+    """Run the pages of ``pages_of(part, parts)``, each in a fresh subfolder of ``folder``:
+    ``{"ran": [pages], "failures": {page: the error's text}}``. What
+    ``tests/test_docs_installed.py`` runs in a virtual environment holding only the wheel."""
     import tempfile
     import traceback
     failures, ran = {}, []
     home = os.getcwd()
-    for page in [p for p in PAGES if blocks(p)]:
-        ran.append(page_id(page))
+    for name in pages_of(part, parts):
+        page = ROOT / name
+        ran.append(name)
         os.chdir(tempfile.mkdtemp(prefix=page.stem + "-", dir=folder))
         try:
             run_page(page)
         except BaseException as exc:                 # every page's failure, not the first
             if isinstance(exc, KeyboardInterrupt):
                 raise
-            failures[page_id(page)] = "".join(traceback.format_exception(exc))[-4000:]
+            failures[name] = "".join(traceback.format_exception(exc))[-4000:]
         finally:
             os.chdir(home)
     return {"ran": ran, "failures": failures}

@@ -4,17 +4,19 @@
 environment whose dependencies are this one's; there every code block of the README and the
 docs runs (``test_docs.run_pages``), one page after another in one process, each page in a
 fresh empty folder, so a snippet that needs a file of the checkout fails here. Every value a
-snippet shows in a comment is checked (``test_docs.shown``).
+snippet shows in a comment is checked (``test_docs.shown``). The pages are split in two: this
+file runs the first half, ``test_docs_installed_2.py`` the second, so the two test workers
+share them.
 """
 
 import json
-import os
 import pathlib
 import subprocess
 import zipfile
 
 import pytest
-from installed_wheel import ROOT, installed
+from installed_wheel import ROOT, installed, reader_env
+from test_docs import pages_of
 
 RUNNER = """
 import json, pathlib, sys
@@ -23,8 +25,11 @@ import kinetwork
 import test_docs
 assert pathlib.Path(kinetwork.__file__).is_relative_to({venv!r}), kinetwork.__file__
 assert not pathlib.Path(kinetwork.__file__).is_relative_to({root!r})
-print(json.dumps(test_docs.run_pages({folder!r})))
+print(json.dumps(test_docs.run_pages({folder!r}, {part}, {parts})))
 """
+
+#: the installed-wheel run of the docs is split in this many test files
+PARTS = 2
 
 
 @pytest.fixture(scope="module")
@@ -48,19 +53,32 @@ def test_the_wheel_holds_what_the_docs_use(wheel_and_python):
     assert not any(name.startswith(("models/", "tests/", "docs/")) for name in names)
 
 
-def test_every_docs_snippet_runs_against_the_installed_wheel(wheel_and_python, tmp_path):
+def test_the_parts_run_every_page_once():
+    parts = [pages_of(part, PARTS) for part in range(PARTS)]
+    every = [page for part in parts for page in part]
+    assert sorted(every) == sorted(pages_of()) and len(set(every)) == len(every)
+    assert "README.md" in every and "docs/how-to/urdf.md" in every and len(every) >= 25
+    assert all(parts)
+
+
+def run_part(wheel_and_python, tmp_path, part):
+    """Run the docs pages of ``part`` in the wheel's environment; fail with every page's
+    error."""
     _, python = wheel_and_python
     folder = tmp_path / "reader"
     folder.mkdir()
     script = RUNNER.format(tests=str(ROOT / "tests"), venv=str(python.parent.parent),
-                           root=str(ROOT), folder=str(folder))
-    env = {k: v for k, v in os.environ.items() if k not in ("PYTHONPATH", "VIRTUAL_ENV")}
+                           root=str(ROOT), folder=str(folder), part=part, parts=PARTS)
     done = subprocess.run([str(python), "-c", script], cwd=folder, capture_output=True,
-                          text=True, env={**env, "MPLBACKEND": "Agg"})
+                          text=True, env={**reader_env(), "MPLBACKEND": "Agg"})
     assert done.returncode == 0, done.stderr[-4000:]
     report = json.loads(done.stdout.strip().splitlines()[-1])
     failures = report["failures"]
-    assert "README.md" in report["ran"] and "docs/how-to/urdf.md" in report["ran"]
-    assert len(report["ran"]) >= 25
+    assert report["ran"] == pages_of(part, PARTS)
     assert not failures, "\n\n".join(f"{page}:\n{text}" for page, text in failures.items())
     assert not any(pathlib.Path(ROOT).glob("build")), "the build wrote into the checkout"
+
+
+def test_the_first_half_of_the_docs_runs_against_the_installed_wheel(wheel_and_python,
+                                                                     tmp_path):
+    run_part(wheel_and_python, tmp_path, 0)

@@ -76,7 +76,7 @@ def test_cli_lists_runs_and_copies_by_name(tmp_path, capsys, monkeypatch):
 
 def test_installed_wheel_lists_and_runs_the_examples(tmp_path, tmp_path_factory):
     """A wheel built from the tree carries the models, found without the checkout."""
-    from installed_wheel import installed
+    from installed_wheel import installed, reader_env
     built, python = installed(tmp_path_factory)
     import zipfile
     names = zipfile.ZipFile(built).namelist()
@@ -95,7 +95,7 @@ def test_installed_wheel_lists_and_runs_the_examples(tmp_path, tmp_path_factory)
               "res = kn.simulate(a, t_end=0.5)\n"
               "print(a.name, b.name, c.name, len(res.t))\n" % str(python.parent.parent))
     out = subprocess.run([str(python), "-c", script], cwd=folder, capture_output=True,
-                         text=True)
+                         text=True, env=reader_env())
     assert out.returncode == 0, out.stderr[-2000:]
     assert out.stdout.split()[:3] == ["double_pendulum", "double_pendulum", "EngineV6"]
 

@@ -122,8 +122,10 @@ def adams_floor(eigenvalues, span):
         return 0.0, 0.0
     fastest = eigenvalues[np.argmax(np.abs(eigenvalues))]
     rate = float(abs(fastest))
-    ringing = abs(fastest.imag) / rate if rate else 0.0
-    return rate, float((ADAMS_REAL + (ADAMS_IMAGINARY - ADAMS_REAL) * ringing) * rate * span)
+    ringing = float(abs(fastest.imag)) / rate if rate else 0.0
+    # Python floats: a rate near overflow (a scene about to blow up) gives inf, not numpy's
+    # RuntimeWarning in the user's output
+    return rate, (ADAMS_REAL + (ADAMS_IMAGINARY - ADAMS_REAL) * ringing) * rate * float(span)
 
 
 def rk4_choice(rhs, t0, t_end, x0, spacing, eigenvalues, rtol, atol):

@@ -1,5 +1,7 @@
 """Independent references: the seed paper's closed-form double pendulum in plain numpy."""
 
+import math
+
 import numpy as np
 from scipy.integrate import solve_ivp
 
@@ -29,14 +31,28 @@ def seed_reference(t, x0=(0.05, 0.05, 0.0, 0.0), rtol=1e-13, atol=1e-14, method=
                    **params):
     """States on ``t`` from the closed form, integrated tightly with DOP853 (or ``method``:
     Radau for the stiff variants)."""
-    p = {**PAPER, **params}
-
-    def rhs(_, x):
-        M, V, G = seed_mvg(x[:2], x[2:], **p)
-        return np.concatenate([x[2:], np.linalg.solve(M, -(V + G))])
-
+    rhs = _seed_rhs(**{**PAPER, **params})
     sol = solve_ivp(rhs, (t[0], t[-1]), x0, method=method, t_eval=t, rtol=rtol, atol=atol)
     return sol.y.T
+
+
+def _seed_rhs(L1, L2, m1, m2, c, d, g):
+    """The closed form's right-hand side on Python floats with ``math`` (``seed_mvg``'s M, V,
+    G, the 2x2 solve by Cramer's rule): numpy's small-array calls cost ten times the
+    arithmetic, and the tight references call it ~10^5 times. ``seed_mvg`` stays the one
+    statement of the equations: tests/scenes/test_reference.py checks the two agree."""
+    def rhs(_, x):
+        T1, T2, T1d, T2d = x.tolist()
+        s1, s2, s12, c2 = math.sin(T1), math.sin(T2), math.sin(T1 + T2), math.cos(T2)
+        m11 = L1 * L2 * m2 * c2 + L2**2 * m2 / 4 + L1**2 * m1 / 4 + L1**2 * m2
+        m12 = L2**2 * m2 / 4 + L1 * L2 * m2 * c2 / 2
+        m22 = L2**2 * m2 / 4
+        b1 = -(-L1 * L2 * m2 * T2d * s2 * (T1d + T2d / 2) + c * T1 + d * T1d
+               + (s12 * L2 * m2 / 2 + L1 * m1 * s1 / 2 + L1 * m2 * s1) * g)
+        b2 = -(L1 * L2 * m2 * T1d**2 * s2 / 2 + s12 * g * L2 * m2 / 2)
+        det = m11 * m22 - m12 * m12
+        return np.array([T1d, T2d, (m22 * b1 - m12 * b2) / det, (m11 * b2 - m12 * b1) / det])
+    return rhs
 
 
 def seed_energy(X, c=PAPER["c"], **params):

@@ -150,3 +150,12 @@ def test_above_dense_states_the_spectrum_costs_fewer_evaluations_than_a_jacobian
     assert 0 < len(calls) < 2 * s.n_states
     dense = np.linalg.eigvals(stiffness._jacobian_fd(f, 0.0, x0))
     assert np.max(np.abs(extreme)) == pytest.approx(np.max(np.abs(dense)), rel=1e-3)
+
+
+def test_a_mode_rate_near_overflow_gives_an_infinite_adams_floor_without_a_warning():
+    """A scene about to blow up can have eigenvalues near the float's limit: the evidence says
+    inf (Adams cannot keep up), and no numpy RuntimeWarning reaches the user's output (the
+    suite turns warnings into errors)."""
+    rate, adams = explicit.adams_floor(np.array([1e300 + 1e299j]), np.float64(1e10))
+    assert rate == pytest.approx(np.hypot(1e300, 1e299))
+    assert adams == np.inf
