@@ -42,9 +42,22 @@ describe("PixelBudget", () => {
 });
 
 describe("segments", () => {
-  it("fewer segments for many shapes, within bounds", () => {
-    expect(segments(1, 4, 12, 32)).toBe(32);
-    expect(segments(200, 4, 12, 32)).toBe(12);
-    expect(segments(32, 4, 12, 32)).toBe(32);
+  const tube = (n) => 4 * n;
+  it("as many as the size on screen needs: the polygon within a third of a pixel of the circle", () => {
+    for (const r of [2, 5, 10, 40, 150]) {
+      const n = segments(1, tube, 6, 48, r);
+      expect(r * (1 - Math.cos(Math.PI / n))).toBeLessThanOrEqual(0.35 + 1e-9);
+      // and not twice what is needed
+      const fewer = Math.ceil(n / 2);
+      if (fewer >= 6) expect(r * (1 - Math.cos(Math.PI / fewer))).toBeGreaterThan(0.35 / 8);
+    }
+    expect(segments(1, tube, 6, 48, 1)).toBe(6);
+    expect(segments(1, tube, 6, 48, 5000)).toBe(48);
+  });
+  it("fewer for many shapes: within the budget, never under the least", () => {
+    expect(segments(1, tube, 12, 32)).toBe(32);
+    expect(segments(32, tube, 12, 32)).toBe(32);
+    expect(200 * tube(segments(200, tube, 6, 32))).toBeLessThanOrEqual(8000);
+    expect(segments(5000, tube, 6, 32)).toBe(6);
   });
 });

@@ -62,3 +62,68 @@ def test_a_chain_is_drawn_in_a_few_calls_with_every_shape_on_its_frame(page, stu
         drawn = page.evaluate(f"() => window.__kinetwork.viewer().centers({kind!r})")
         assert np.allclose(drawn, expected, rtol=0, atol=1e-5 * scale), kind
     assert not page.errors, page.errors
+
+
+#: while the 3-D view plays: the animation frames, and those in which anything of the page
+#: changed (the time label, the plots' cursors), counted from the page over ``ms``
+PLAYED = """(ms) => new Promise((done) => {
+    let frames = 0, changed = 0, dirty = false, labels = new Set();
+    const seen = new MutationObserver(() => { dirty = true; });
+    seen.observe(document.body, {subtree: true, childList: true, attributes: true, characterData: true});
+    const t0 = performance.now();
+    const tick = () => {
+        frames++;
+        if (dirty) { changed++; dirty = false; }
+        labels.add(document.querySelector('.kn-time').textContent);
+        const dt = performance.now() - t0;
+        if (dt < ms) requestAnimationFrame(tick);
+        else { seen.disconnect(); done({frames, changed, labels: labels.size, ms: dt}); }
+    };
+    requestAnimationFrame(tick);
+})"""
+
+
+def test_playing_changes_the_page_ten_times_a_second_not_every_frame(page, studio):
+    """While the 3-D view plays, a frame draws the picture and nothing else: the time in its
+    bar and the plots' cursors move together at most ten times a second (any change of the
+    page repaints and re-layers the whole document, which cost half of each frame beside a
+    large diagram). Counted from the page over the seed, whose plots follow the view."""
+    from tests.studio.test_e2e import SEED
+    open_studio(page, studio, open=SEED)
+    assert run(page) == "done"
+    page.wait_for_selector(f'{tid("viewer")}[data-ready="1"]')
+    page.locator(".kn-viewer-bar .kn-play").click()
+    page.wait_for_function("() => window.__kinetwork.viewer().isPlaying()")
+    seen = page.evaluate(PLAYED, 2000)
+    page.locator(".kn-viewer-bar .kn-play").click()
+    # the page changed in at most one frame of each tenth of a second (and a spare; a
+    # machine drawing fewer than ten frames a second cannot tell), and it did change: the
+    # label counted on
+    assert seen["changed"] <= 2 + seen["ms"] / 90, seen
+    assert seen["labels"] >= 3, seen
+    # paused: the label and the plots' cursors show the time the view stopped at
+    page.wait_for_function("() => !window.__kinetwork.viewer().isPlaying()")
+    t = page.evaluate("() => window.__kinetwork.viewer().getTime()")
+    page.wait_for_function(f"() => window.__kinetwork.plotTime === {t!r}")
+    assert f"t = {t:.2f}" in page.locator(".kn-time").inner_text()
+    assert not page.errors, page.errors
+
+
+def test_round_shapes_get_the_segments_their_size_on_screen_needs(page, studio):
+    """Cylinders, spheres and rods are drawn with as many segments as their size on screen
+    needs (a software renderer pays per vertex): a 32-link chain fitted in the 3-D pane,
+    its links a few pixels wide, takes fewer triangles than at fixed segments (12 200);
+    zoomed in with the mouse wheel its shapes get rounder (more triangles); the "view" button
+    brings back the fitted view and its triangles."""
+    shown_chain(page, studio, 32)
+    info = lambda: page.evaluate("() => window.__kinetwork.viewer().renderInfo()")  # noqa: E731
+    fitted = info()["triangles"]
+    assert fitted < 8000, fitted
+    box = page.locator(".kn-viewer canvas").bounding_box()
+    page.mouse.move(box["x"] + box["width"] / 2, box["y"] + box["height"] / 2)
+    for _ in range(12):
+        page.mouse.wheel(0, -400)
+    page.wait_for_function(f"() => window.__kinetwork.viewer().renderInfo().triangles > {fitted}")
+    page.locator(".kn-viewer-bar button", has_text="view").click()
+    page.wait_for_function(f"() => window.__kinetwork.viewer().renderInfo().triangles === {fitted}")
+    assert not page.errors, page.errors

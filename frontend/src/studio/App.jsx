@@ -2,6 +2,7 @@
 // State is in the store (store.js); the work is in hooks/ (files, definitions, validation,
 // runs, editing, keys); this component puts the pieces on the page.
 import { useCallback, useEffect, useMemo, useRef, useState } from "react";
+import { useReactFlow } from "@xyflow/react";
 import { api, EXAMPLE, OPEN } from "./api.js";
 import Canvas from "./Canvas.jsx";
 import { findRepeat } from "./fold.js";
@@ -86,17 +87,40 @@ function Breadcrumbs() {
       <span className="kn-muted kn-small kn-hint">
         drag from the palette · wire port to port · box-select by dragging · right-click for more · wheel zooms, right-drag pans · arrows move · Del · Ctrl+Z/Y · Ctrl+A/C/V/D
       </span>
+      <ViewTools />
     </div>
+  );
+}
+
+/**
+ * Zoom, fit and the minimap, in the bar above the diagram: floating over its corners they
+ * covered blocks. The minimap shows by itself only where it covers none in the fitted view.
+ */
+function ViewTools() {
+  const flow = useReactFlow();
+  const fit = useStudio((s) => s.fit);
+  const minimap = useStudio((s) => s.minimap);
+  const mapClear = useStudio((s) => s.mapClear);
+  const setMinimap = useStudio((s) => s.setMinimap);
+  const shown = minimap ?? mapClear;
+  return (
+    <span className="kn-view-tools">
+      <button className="kn-tool" data-testid="zoom-out" title="Zoom out" onClick={() => flow.zoomOut({ duration: 0 })}>−</button>
+      <button className="kn-tool" data-testid="zoom-in" title="Zoom in" onClick={() => flow.zoomIn({ duration: 0 })}>+</button>
+      <button className="kn-tool" data-testid="fit-view" title="The whole diagram" onClick={fit}>fit</button>
+      <button className={`kn-tool${shown ? " kn-on" : ""}`} data-testid="minimap-toggle" title={shown ? "Hide the minimap" : "Show the minimap"} onClick={() => setMinimap(!shown)}>
+        map
+      </button>
+    </span>
   );
 }
 
 /** Unsaved work of an earlier session, offered back above the diagram (not in its way). */
 function RecoveryBar() {
   const offer = useStudio((s) => s.offer);
-  // always there (a row of the centre's grid), empty when there is nothing to offer
-  if (!offer) return <div className="kn-offer-slot" />;
+  if (!offer) return null;
   return (
-    <div className="kn-offer-slot kn-offer" data-testid="recovery" role="alert">
+    <div className="kn-offer" data-testid="recovery" role="alert">
       <span>{offer.message}</span>
       <button className="kn-btn kn-primary" data-testid="choice-recover" onClick={offer.recover}>
         Recover them
@@ -112,8 +136,8 @@ function RecoveryBar() {
 const FOLD_OFFER = 24;
 
 /**
- * A long repeated pattern (a chain of 32 links) offered folded into subsystems, over the
- * diagram, until folded or dismissed.
+ * A long repeated pattern (a chain of 32 links) offered folded into subsystems, in a bar
+ * above the diagram (over it, it hid the top row), until folded or dismissed.
  * @param {{scope: any, edit: import("./hooks/useEditing.js").Edit}} props
  */
 function FoldOffer({ scope, edit }) {
@@ -253,11 +277,13 @@ export default function App() {
         {closed.palette ? <div /> : <Palette palette={palette} definitions={definitions} onAdd={edit.placeAtCentre} />}
         <Splitter pane="palette" axis="x" side="before" size={sizes.palette} label="Palette" />
         <div className="kn-center" ref={centerRef} style={{ gridTemplateRows: `auto 30px minmax(0, 1fr) ${SPLITTER}px ${sizes.results}px` }}>
-          <RecoveryBar />
-          <Breadcrumbs />
-          <Canvas nodes={diagram.nodes} edges={diagram.edges} placed={placed} edit={edit}>
+          {/* a row of the centre's grid, always there, empty when nothing is offered */}
+          <div className="kn-bars">
+            <RecoveryBar />
             <FoldOffer scope={scope} edit={edit} />
-          </Canvas>
+          </div>
+          <Breadcrumbs />
+          <Canvas nodes={diagram.nodes} edges={diagram.edges} placed={placed} edit={edit} />
           <Splitter pane="results" axis="y" side="after" size={sizes.results} label="Plots and 3-D view" />
           <div className="kn-results" style={{ gridTemplateColumns: `minmax(0, 1fr) ${SPLITTER}px ${sizes.viewer}px` }}>
             {closed.results ? null : (

@@ -23,7 +23,7 @@ function BlockNode({ data, selected }) {
     .join(" ");
   return (
     <div className={cls} data-testid={`node-${name}`} style={{ width, height }} title={`${name}: ${type}${info ? `\n${String(info.doc || "").trim()}` : " (unknown type)"}`}>
-      <div className="kn-block-name">{name}</div>
+      <div className="kn-block-name" style={{ maxWidth: width - 12 }}>{name}</div>
       <div className={`kn-block-icon${flip ? " flipped" : ""}`}>
         <TypeIcon type={type} subsystem={subsystem} />
       </div>
@@ -35,7 +35,7 @@ function BlockNode({ data, selected }) {
       ) : (
         <div className="kn-block-type">{shortType(type, subsystem)}</div>
       )}
-      {handles.map(({ port, side, x, y }) => {
+      {handles.map(({ port, side, x, y, room }) => {
         // the name of a port on the top or bottom stands beside it, outwards (left of the
         // middle: to the left), in the margin wires keep from the block
         const beside = side === "top" || side === "bottom" ? (x < width / 2 ? "-before" : "-after") : "";
@@ -52,7 +52,9 @@ function BlockNode({ data, selected }) {
             data-testid={`handle-${name}-${port.name}`}
             title={`${name}.${port.name} (${port.domain})${port.doc ? `: ${port.doc}` : ""}`}
           >
-            <span className={`kn-port-label kn-port-label-${side}${beside}`}>{port.name}</span>
+            <span className={`kn-port-label kn-port-label-${side}${beside}`} style={room ? { maxWidth: room } : undefined}>
+              {port.name}
+            </span>
           </Handle>
         );
       })}

@@ -3,11 +3,12 @@
 // are and what is selected; while the mouse drags, React Flow's positions are shown, and the
 // drop commits them to the model (one undo step).
 import { useCallback, useEffect, useMemo, useRef, useState } from "react";
-import { Background, ConnectionMode, Controls, MiniMap, ReactFlow, useNodesInitialized, useReactFlow, useStoreApi } from "@xyflow/react";
+import { Background, ConnectionMode, MiniMap, ReactFlow, useNodesInitialized, useReactFlow, useStoreApi } from "@xyflow/react";
 import BlockNode from "./BlockNode.jsx";
 import PortNode from "./PortNode.jsx";
 import WireEdge from "./WireEdge.jsx";
 import { GRID, SCALE } from "./model.js";
+import { covers, fitViewport, minimapBox } from "./fit.js";
 import { studio, useStudio } from "./store.js";
 import { edgeData } from "./hooks/useEditing.js";
 import { useWires } from "./hooks/useWires.js";
@@ -17,18 +18,20 @@ const edgeTypes = { wire: WireEdge };
 export const DRAG_MIME = "application/x-kinetwork-type";
 /** A right button released this close to where it went down opens the menu (else it panned). */
 const CLICK_SLOP = 5;
-/** The minimap only where it leaves the diagram room: it covered half of a small canvas. */
+/** The minimap by itself only where it leaves the diagram room: it covered half of a small canvas. */
 const MINIMAP_ROOM = { width: 700, height: 380 };
+const MIN_ZOOM = 0.1;
+const MINIMAP = { width: 140, height: 90 };
+const FIT_MAX_ZOOM = 1.1;
 
 function sameList(a, b) {
   return a.length === b.length && a.every((x, i) => x === b[i]);
 }
 
 /**
- * @param {{nodes: any[], edges: any[], placed: boolean, edit: import("./hooks/useEditing.js").Edit, children?: any}} props
- *   ``children``: shown over the diagram (an offer)
+ * @param {{nodes: any[], edges: any[], placed: boolean, edit: import("./hooks/useEditing.js").Edit}} props
  */
-export default function Canvas({ nodes: nodesIn, edges: edgesIn, placed, edit, children }) {
+export default function Canvas({ nodes: nodesIn, edges: edgesIn, placed, edit }) {
   const flow = useReactFlow();
   const rf = useStoreApi();
   const selection = useStudio((s) => s.selection);
@@ -39,14 +42,28 @@ export default function Canvas({ nodes: nodesIn, edges: edgesIn, placed, edit, c
   const [measured, setMeasured] = useState({});
   const box = useRef(null);
   const [roomy, setRoomy] = useState(true);
+  const minimap = useStudio((s) => s.minimap);
+  const mapClear = useStudio((s) => s.mapClear);
+  // the minimap's corner free of blocks in the view last fitted
+  const [cornerFree, setCornerFree] = useState(true);
+  useEffect(() => studio().setMapClear(roomy && cornerFree), [roomy, cornerFree]);
+  // the view the last fit set: while the user has not moved it, the pane's new size refits
+  const fittedView = useRef(null);
+  const refit = useRef(() => {});
   useEffect(() => {
     if (!box.current) return undefined;
+    let frame = 0;
     const ro = new ResizeObserver((entries) => {
       const r = entries[0].contentRect;
       setRoomy(r.width >= MINIMAP_ROOM.width && r.height >= MINIMAP_ROOM.height);
+      cancelAnimationFrame(frame);
+      frame = requestAnimationFrame(() => refit.current());
     });
     ro.observe(box.current);
-    return () => ro.disconnect();
+    return () => {
+      cancelAnimationFrame(frame);
+      ro.disconnect();
+    };
   }, []);
 
   const nodes = useMemo(() => {
@@ -119,17 +136,37 @@ export default function Canvas({ nodes: nodesIn, edges: edgesIn, placed, edit, c
     [edit],
   );
 
+  // the whole diagram in view, clear of the zoom buttons and the minimap
+  const fit = useCallback(() => {
+    const pane = box.current;
+    const shown = flow.getNodes();
+    if (!pane || !shown.length) return;
+    const size = { width: pane.clientWidth, height: pane.clientHeight };
+    const blocks = shown.map((n) => ({ x: n.position.x, y: n.position.y, width: n.measured?.width ?? 0, height: n.measured?.height ?? 0 }));
+    const view = fitViewport(flow.getNodesBounds(shown), size, [], FIT_MAX_ZOOM, MIN_ZOOM);
+    flow.setViewport(view, { duration: 0 });
+    fittedView.current = flow.getViewport();
+    setCornerFree(!covers(view, blocks, minimapBox(size, MINIMAP)));
+  }, [flow]);
+  useEffect(() => {
+    refit.current = () => {
+      const was = fittedView.current;
+      const now = flow.getViewport();
+      if (was && now.x === was.x && now.y === was.y && now.zoom === was.zoom) fit();
+    };
+  }, [flow, fit]);
+
   // fit the view to a model just opened, once its blocks are measured
   const initialized = useNodesInitialized();
   const fitted = useRef(0);
   useEffect(() => {
     if (!fitRequest || fitted.current === fitRequest || !initialized || !nodes.length || !placed) return undefined;
     const id = requestAnimationFrame(() => {
-      flow.fitView({ padding: 0.03, maxZoom: 1.1, duration: 0 });
+      fit();
       fitted.current = fitRequest;
     });
     return () => cancelAnimationFrame(id);
-  }, [fitRequest, initialized, nodes, placed, flow]);
+  }, [fitRequest, initialized, nodes, placed, fit]);
 
   const isValidConnection = useCallback((c) => edit.checkConnection(`${c.source}.${c.sourceHandle}`, `${c.target}.${c.targetHandle}`) === null, [edit]);
   const onConnect = useCallback((c) => edit.connect(`${c.source}.${c.sourceHandle}`, `${c.target}.${c.targetHandle}`), [edit]);
@@ -231,16 +268,16 @@ export default function Canvas({ nodes: nodesIn, edges: edgesIn, placed, edit, c
         deleteKeyCode={null}
         disableKeyboardA11y
         zoomOnDoubleClick={false}
-        minZoom={0.1}
+        minZoom={MIN_ZOOM}
         maxZoom={3}
         connectionRadius={18}
         proOptions={{ hideAttribution: true }}
       >
         <Background gap={GRID * 2} size={1} color="#d4d8de" />
-        <Controls showInteractive={false} />
-        {roomy ? <MiniMap pannable zoomable nodeStrokeWidth={2} nodeColor={(n) => (/** @type {any} */ (n.data).problems?.length ? "#e05555" : "#c9ced6")} style={{ width: 140, height: 90 }} /> : null}
+        {(minimap ?? mapClear) ? (
+          <MiniMap pannable zoomable nodeStrokeWidth={2} nodeColor={(n) => (/** @type {any} */ (n.data).problems?.length ? "#e05555" : "#c9ced6")} style={{ width: MINIMAP.width, height: MINIMAP.height }} />
+        ) : null}
       </ReactFlow>
-      {children}
     </div>
   );
 }

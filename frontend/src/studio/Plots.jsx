@@ -19,6 +19,8 @@ const AXIS_FONT = "11px system-ui, -apple-system, 'Segoe UI', sans-serif";
 /** The least room between two y ticks (px): uPlot's 30 left a short plot one tick. */
 const Y_TICK_SPACE = 16;
 const TICK_LENGTH = 6;
+/** The least time (ms) between two moves of the cursors following the 3-D view. */
+const FOLLOW_MS = 90;
 const LABEL_GAP = 5;
 let measurer = null;
 
@@ -323,16 +325,26 @@ export function makeBus(cursor) {
     zooming: false,
     cursor,
     // the 3-D view playing: the plots' cursors follow at most ten times a second (moving a
-    // uPlot cursor redraws its legend: at every frame it would halve the 3-D frame rate)
+    // uPlot cursor redraws its legend: at every frame it would halve the 3-D frame rate), at
+    // once when the last move is that long ago, so that they change in the frame the viewer's
+    // time label does (one repaint of the page, not two)
     pending: null,
     timer: null,
+    last: -Infinity,
     follow(t) {
       this.pending = t;
       if (this.timer) return;
+      const wait = this.last + FOLLOW_MS - performance.now();
+      if (wait <= 0) {
+        this.last = performance.now();
+        this.setTime(t);
+        return;
+      }
       this.timer = setTimeout(() => {
         this.timer = null;
+        this.last = performance.now();
         this.setTime(this.pending);
-      }, 100);
+      }, wait);
     },
     setTime(t) {
       if (TESTING) trace.plotTime = t;

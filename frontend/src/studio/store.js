@@ -51,6 +51,10 @@ export const useStudio = create((set, get) => ({
   selection: /** @type {string[]} */ ([]),
   selectedEdges: /** @type {string[]} */ ([]),
   fitRequest: 0,
+  /** the minimap asked for (true), put away (false), or shown where it covers no block (null) */
+  minimap: /** @type {boolean | null} */ (null),
+  /** the minimap would show by itself: room for it, its corner free of blocks when fitted */
+  mapClear: true,
   validation: NO_VALIDATION,
   /** @type {RunState | null} */
   run: null,
@@ -109,6 +113,8 @@ export const useStudio = create((set, get) => ({
   select: (names, edges = []) => set({ selection: names, selectedEdges: edges }),
   setAutoPos: (key, pos) => set((s) => ({ autoPos: { ...s.autoPos, [key]: { ...(s.autoPos[key] || {}), ...pos } } })),
   fit: () => set((s) => ({ fitRequest: s.fitRequest + 1 })),
+  setMinimap: (minimap) => set({ minimap }),
+  setMapClear: (mapClear) => set({ mapClear }),
   setPointer: (pointer) => set({ pointer }),
   setMenu: (menu) => set({ menu }),
   setPanel: (panel) => set({ panel }),

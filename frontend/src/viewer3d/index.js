@@ -5,9 +5,9 @@
 //   viewer.setTime(1.5); viewer.play(); viewer.pause(); viewer.setSpeed(0.5); viewer.dispose();
 //
 // Options: controls (draw play/pause, scrub, time, speed, frames and view buttons; default
-// false), onTime(t) (called while playing and when the user scrubs; not on setTime), autoplay
-// (default false), loop (default true), speed (default 1), showFrames (the small axes on every
-// frame; default: when there are at most 24). Between samples positions are interpolated
+// false), onTime(t) (called ten times a second while playing, on pause and when the user
+// scrubs; not on setTime), autoplay (default false), loop (default true), speed (default 1),
+// showFrames (the small axes on every frame; default: when there are at most 24). Between samples positions are interpolated
 // linearly and orientations along the shorter arc, so any grid plays smoothly at any speed.
 // Besides: getTime(), isPlaying(), renderInfo() (the last frame's draw calls and triangles,
 // the renderer's name, whether it multisamples (not on a software renderer) and the pixel
@@ -22,12 +22,14 @@ import {
   DirectionalLight, Float32BufferAttribute, GridHelper, Group, InstancedMesh, Matrix4, Mesh,
   MeshBasicMaterial, MeshLambertMaterial,
   MeshStandardMaterial, PerspectiveCamera, Quaternion, Scene, SphereGeometry, TubeGeometry, Curve,
-  Vector3, WebGLRenderer,
+  Vector2, Vector3, WebGLRenderer,
 } from "three";
 import { OrbitControls } from "three/examples/jsm/controls/OrbitControls.js";
 
 const SPEEDS = [0.1, 0.25, 0.5, 1, 2, 4];
 const FRAMES_SHOWN = 24;
+/** ms between updates of the time in the bar while playing */
+const LABEL_MS = 100;
 const AXIS_COLORS = [0xdc3232, 0x28a03c, 0x3250dc];
 const Y = new Vector3(0, 1, 0);
 /** The names WebGL gives a renderer without a GPU behind it. */
@@ -58,13 +60,21 @@ export function createViewer(element, animation, options = {}) {
   injectStyle();
 
   const state = { time: data.t[0], playing: false, speed: options.speed || 1, last: null,
-                  frame: 0, pending: 0, disposed: false };
+                  frame: 0, pending: 0, shown: -Infinity, disposed: false };
   let renderer;
   const gpu = rendererName();
+  // The picture goes to the page through an OffscreenCanvas where the browser has one: its
+  // frames reach the compositor directly, so a frame drawn asks nothing of the page's own
+  // paint (a canvas of the page re-layers the whole document at every frame: ~4 ms beside a
+  // diagram of a hundred blocks in headless Chromium, and the software compositor's
+  // read-back of the picture waits on the main thread).
+  const canvas = document.createElement("canvas");
   try {
+    const offscreen = typeof canvas.transferControlToOffscreen === "function"
+      ? canvas.transferControlToOffscreen() : null;
     // multisampling doubles a software renderer's frame time (a 32-link chain in headless
     // Chromium's SwiftShader: 7.6 frames/s with it, 13.6 without); a GPU does it for free
-    renderer = new WebGLRenderer({ antialias: !SOFTWARE.test(gpu) });
+    renderer = new WebGLRenderer({ canvas: offscreen || canvas, antialias: !SOFTWARE.test(gpu) });
   } catch (err) {
     const note = document.createElement("div");
     note.className = "kn-viewer-note";
@@ -75,7 +85,7 @@ export function createViewer(element, animation, options = {}) {
   }
   const pixels = new PixelBudget(Math.min(window.devicePixelRatio || 1, 2));
   renderer.setPixelRatio(pixels.ratio);
-  root.appendChild(renderer.domElement);
+  root.appendChild(canvas);
 
   const scene = new Scene();
   scene.background = new Color(0xf4f5f7);
@@ -115,8 +125,8 @@ export function createViewer(element, animation, options = {}) {
     if (batch.small) frameAxes.push(mesh);
   }
 
-  const controls = new OrbitControls(camera, renderer.domElement);
-  controls.addEventListener("change", () => request());
+  const controls = new OrbitControls(camera, canvas);
+  controls.addEventListener("change", () => { refine(); request(); });
 
   const ui = options.controls ? buildControls() : null;
   const resize = new ResizeObserver(() => layout());
@@ -152,12 +162,12 @@ export function createViewer(element, animation, options = {}) {
     for (const { shape, object } of links) stretch(object, frames[shape.frame].position,
                                                    frames[shape.to].position);
     for (const batch of Object.values(batches)) batch.update(frames);
-    if (ui) ui.show(time);
   }
 
   function setTime(time, fromUser = false) {
     state.time = clampTime(time);
     apply(state.time);
+    if (ui) ui.show(state.time);
     if (fromUser && options.onTime) options.onTime(state.time);
     request();
   }
@@ -179,7 +189,14 @@ export function createViewer(element, animation, options = {}) {
         else state.time = t[0] + (state.time - t[0]) % span;
       }
       apply(state.time);
-      if (options.onTime) options.onTime(state.time);
+      // the time in the bar and the host's (the plots' cursors) change ten times a second,
+      // together, not every frame: any change of the page repaints and re-layers the whole
+      // document (beside a diagram of a hundred blocks: ~15 ms a frame in headless Chromium)
+      if (now - state.shown >= LABEL_MS) {
+        state.shown = now;
+        if (ui) ui.show(state.time);
+        if (options.onTime) options.onTime(state.time);
+      }
       if (pixels.frame(now)) {
         renderer.setPixelRatio(pixels.ratio);
         layout();
@@ -204,8 +221,11 @@ export function createViewer(element, animation, options = {}) {
   }
 
   function pause() {
+    const was = state.playing;
     state.playing = false;
-    if (ui) ui.playing(false);
+    state.shown = -Infinity;
+    if (ui) { ui.playing(false); ui.show(state.time); }
+    if (was && options.onTime) options.onTime(state.time);
     request();
   }
 
@@ -219,10 +239,24 @@ export function createViewer(element, animation, options = {}) {
   function layout() {
     const width = root.clientWidth || 640;
     const height = Math.max((root.clientHeight || 480) - (ui ? ui.height() : 0), 50);
-    renderer.setSize(width, height);
+    // the drawing buffer's size; the page's canvas is sized here (an OffscreenCanvas has no style)
+    renderer.setSize(width, height, false);
+    canvas.style.width = `${width}px`;
+    canvas.style.height = `${height}px`;
     camera.aspect = width / height;
     camera.updateProjectionMatrix();
+    refine();
     request();
+  }
+
+  // The round shapes' segments for their size on screen now: screen pixels a metre at the
+  // model's nearest part (the camera's distance to its target, less half the model's size).
+  function refine() {
+    const distance = camera.position.distanceTo(controls.target);
+    const near = Math.max(distance - data.scale / 2, distance / 4, 1e-9);
+    const size = renderer.getDrawingBufferSize(drawing);
+    const pixels = size.y / 2 / (near * Math.tan(camera.fov * Math.PI / 360));
+    for (const batch of Object.values(batches)) batch.refine(pixels);
   }
 
   function fitView() {
@@ -252,6 +286,7 @@ export function createViewer(element, animation, options = {}) {
     camera.updateProjectionMatrix();
     controls.target.copy(target);
     controls.update();
+    refine();
     request();
   }
 
@@ -456,6 +491,7 @@ function pose(frame, i, w, object) {
 }
 
 const direction = new Vector3();
+const drawing = new Vector2();
 
 // A shape between two frame origins: its mesh is one unit long along y, from its origin.
 function stretch(object, a, b) {
@@ -511,31 +547,52 @@ function build(shape) {
 const matrix = new Matrix4(), basis = new Matrix4(), turn = new Quaternion();
 const scaling = new Vector3(), middle = new Vector3();
 
-// Triangles a kind's instances may take together. A software renderer (headless Chromium's
-// SwiftShader) pays per vertex of every instance: 32 spheres of 32x16 segments (30 720
-// triangles) held a 32-link chain at 15 frames/s, 47 without them. Many small shapes get
-// fewer segments (a sphere a few pixels wide shows none of its 32), one shape the most.
+// Segments round a shape: as many as its size on screen needs, no more. A polygon of n sides
+// round a circle r pixels wide strays r (1 - cos(pi/n)) ~ r pi^2 / 2n^2 from it: under
+// TOLERANCE pixels with n >= pi sqrt(r / 2 TOLERANCE). A software renderer (headless
+// Chromium's SwiftShader) pays per vertex of every instance: a 32-link chain's cylinders,
+// spheres and rods at 32, 14 and 20 segments (12 200 triangles) took 29-31 ms of the GPU
+// process a frame, at 12, 8 and 8 (4 264) 15-18 ms, with no difference to see on links
+// ten pixels wide.
+const TOLERANCE = 0.35;
+const STEPS = [6, 8, 10, 12, 16, 20, 24, 32, 48];
+// Triangles a kind's instances may take together, however near the camera comes.
 const TRIANGLES = 8000;
 
-/** Segments round a kind's shapes when there are ``count`` of them: between ``lo`` and ``hi``. */
-export function segments(count, perSegment, lo, hi) {
-  return Math.max(lo, Math.min(hi, Math.floor(TRIANGLES / (perSegment * Math.max(count, 1)))));
+/**
+ * Segments round a kind's shapes: enough for the largest of them, ``radius`` pixels on
+ * screen, rounded up to one of a few steps (so zooming rebuilds the geometry seldom), between
+ * ``lo`` and ``hi``, and fewer where ``count`` shapes of ``triangles(n)`` triangles each
+ * would pass the budget.
+ * @param {number} count @param {(n: number) => number} triangles
+ * @param {number} lo @param {number} hi @param {number} [radius]
+ */
+export function segments(count, triangles, lo, hi, radius = Infinity) {
+  const need = Math.PI * Math.sqrt(Math.max(radius, 0) / (2 * TOLERANCE));
+  const step = STEPS.find(n => n >= need) ?? STEPS[STEPS.length - 1];
+  let n = Math.max(lo, Math.min(hi, step));
+  while (n > lo && Math.max(count, 1) * triangles(n) > TRIANGLES) n = STEPS.filter(k => k < n).pop() ?? lo;
+  return Math.max(lo, n);
 }
 
-// Each kind's unit geometry: a shape is this, scaled by its sizes, turned into its frame's
-// directions and moved to its place (as `build` makes one mesh of its own sizes).
-function unitGeometry(kind, count) {
+// Each kind's unit geometry at ``n`` segments round (boxes have none): a shape is this,
+// scaled by its sizes, turned into its frame's directions and moved to its place (as `build`
+// makes one mesh of its own sizes).
+function unitGeometry(kind, n) {
   if (kind === "box") return new BoxGeometry(1, 1, 1).translate(0.5, 0, 0);
-  if (kind === "cylinder") return new CylinderGeometry(0.5, 0.5, 1, segments(count, 4, 12, 32)).rotateZ(-Math.PI / 2).translate(0.5, 0, 0);
-  if (kind === "sphere") {
-    // a sphere of w x w/2 segments has about w*w triangles
-    const w = 2 * Math.max(6, Math.min(16, Math.floor(Math.sqrt(TRIANGLES / Math.max(count, 1)) / 2)));
-    return new SphereGeometry(0.5, w, w / 2).translate(0.5, 0, 0);
-  }
-  if (kind === "rod") return new CylinderGeometry(1, 1, 1, segments(count, 4, 10, 20)).translate(0, 0.5, 0);
+  if (kind === "cylinder") return new CylinderGeometry(0.5, 0.5, 1, n).rotateZ(-Math.PI / 2).translate(0.5, 0, 0);
+  if (kind === "sphere") return new SphereGeometry(0.5, n, Math.max(3, n >> 1)).translate(0.5, 0, 0);
+  if (kind === "rod") return new CylinderGeometry(1, 1, 1, n).translate(0, 0.5, 0);
   if (kind === "shaft") return new CylinderGeometry(1 / 30, 1 / 30, 0.8, 8).translate(0, 0.4, 0);
   return new ConeGeometry(2.6 / 30, 0.2, 12).translate(0, 0.9, 0);      // an arrow's head
 }
+
+// The round kinds: triangles a shape at n segments, the fewest and the most segments
+const ROUND = {
+  cylinder: [n => 4 * n, 6, 48],
+  sphere: [n => n * Math.max(3, n >> 1) * 2, 6, 32],
+  rod: [n => 4 * n, 6, 24],
+};
 
 // The shapes of one kind, drawn by one InstancedMesh: each on a frame (its matrix there,
 // `local`) or, for a rod, between two frames' origins.
@@ -559,12 +616,32 @@ class Batch {
     const paint = !this.lit ? new MeshBasicMaterial({ color: 0xffffff })
       : this.soft ? new MeshLambertMaterial({ color: 0xffffff })
         : new MeshStandardMaterial({ color: 0xffffff, roughness: 0.55, metalness: 0.1 });
-    const mesh = new InstancedMesh(unitGeometry(this.kind, this.items.length), paint, this.items.length);
+    this.segments = this.detail(Infinity);
+    const mesh = new InstancedMesh(unitGeometry(this.kind, this.segments), paint, this.items.length);
     this.items.forEach((item, i) => mesh.setColorAt(i, new Color(item.color)));
     // the instances move every frame: a bounding sphere computed once would cull them
     mesh.frustumCulled = false;
     this.mesh = mesh;
     return mesh;
+  }
+
+  /** Segments round at ``pixels`` screen pixels a metre (0 for a kind without any). */
+  detail(pixels) {
+    const round = ROUND[this.kind];
+    if (!round) return 0;
+    const radius = Math.max(...this.items.map(item => item.radius)) * pixels;
+    const [triangles, lo, hi] = round;
+    return segments(this.items.length, triangles, lo, hi, radius);
+  }
+
+  /** The geometry rebuilt for shapes seen at ``pixels`` screen pixels a metre, if need be. */
+  refine(pixels) {
+    if (!this.mesh) return;
+    const n = this.detail(pixels);
+    if (!n || n === this.segments) return;
+    this.segments = n;
+    this.mesh.geometry.dispose();
+    this.mesh.geometry = unitGeometry(this.kind, n);
   }
 
   update(frames) {
@@ -617,7 +694,8 @@ function batched(shape, batches, small) {
     const local = new Matrix4().compose(new Vector3().fromArray(shape.r_shape),
                                         new Quaternion().setFromRotationMatrix(basis),
                                         new Vector3(...sizes));
-    batches[kind].add({ frame: shape.frame, local, color: shape.color });
+    // the radius round the length: what a round kind's segments go round
+    batches[kind].add({ frame: shape.frame, local, color: shape.color, radius: (kind === "sphere" ? length : width) / 2 });
     return true;
   }
   if (kind === "rod") {
@@ -647,7 +725,7 @@ function injectStyle() {
 .kn-viewer canvas{display:block}
 .kn-viewer-title{position:absolute;top:8px;left:12px;font-weight:600;color:#555;pointer-events:none}
 .kn-viewer-note{padding:2em;color:#a33}
-.kn-viewer-bar{position:absolute;left:0;right:0;bottom:0;display:flex;flex-wrap:wrap;align-items:center;
+.kn-viewer-bar{position:absolute;left:0;right:0;bottom:0;contain:layout paint;display:flex;flex-wrap:wrap;align-items:center;
   gap:4px 8px;padding:6px 10px;background:#fff;border-top:1px solid #dde0e4}
 .kn-viewer-bar button{font:inherit;padding:2px 8px;border:1px solid #c8ccd2;border-radius:4px;
   background:#fff;cursor:pointer;min-width:2.2em}
