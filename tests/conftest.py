@@ -26,6 +26,15 @@ LONG_FILES = {
 }
 
 
+def pytest_configure(config):
+    """pytest-xdist 3.x hands out ``--dist loadfile``'s files by their number of tests, most
+    first (``--loadscope-reorder``, on by default), which undid the order below: the files
+    with few but long tests (the installed-wheel docs, the Dask sweeps, the long chains) ran
+    last, one worker alone for minutes. The order of collection is kept instead."""
+    if hasattr(config.option, "loadscopereorder"):
+        config.option.loadscopereorder = False
+
+
 def pytest_collection_modifyitems(items):
     """The long files first, longest first; each file's tests keep their order."""
     def weight(item):
