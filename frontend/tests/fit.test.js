@@ -1,5 +1,5 @@
 import { describe, expect, it } from "vitest";
-import { fitViewport, MARGIN } from "../src/studio/fit.js";
+import { diagramExtent, fitViewport, MARGIN, WIRE_PAD } from "../src/studio/fit.js";
 import { blockGeometry, BLOCK_W, labelWidth } from "../src/studio/geometry.js";
 
 const shown = (b, v) => ({ x: b.x * v.zoom + v.x, y: b.y * v.zoom + v.y, width: b.width * v.zoom, height: b.height * v.zoom });
@@ -70,5 +70,20 @@ describe("fitViewport with the blocks", () => {
     expect(v.zoom).toBeCloseTo((600 - 2 * MARGIN) / 600, 9);
     // the extent alone would have to shrink to clear it
     expect(fitViewport(bounds, pane, [minimap], 1.1, 0.1).zoom).toBeLessThan(v.zoom);
+  });
+});
+
+describe("diagramExtent", () => {
+  it("holds the blocks, what stands out of them and every wire's path", () => {
+    const blocks = { x: 0, y: 0, width: 400, height: 200 };
+    // a port name left of the first block, a wire round the top of the blocks and one below
+    const parts = [{ x: -30, y: 80, width: 25, height: 10 }];
+    const wires = [[{ x: 100, y: 0 }, { x: 100, y: -40 }, { x: 300, y: -40 }, { x: 300, y: 0 }], [{ x: 50, y: 200 }, { x: 50, y: 260 }, { x: 450, y: 260 }]];
+    const e = diagramExtent(blocks, parts, wires);
+    expect(e).toEqual({ x: -30, y: -40 - WIRE_PAD, width: 450 + WIRE_PAD + 30, height: 260 + WIRE_PAD + 40 + WIRE_PAD });
+    // fitted to it, the top wire is inside the pane, MARGIN from its edge
+    const v = fitViewport(e, { width: 1000, height: 600 }, [], 1.1, 0.1);
+    expect(-40 * v.zoom + v.y).toBeGreaterThanOrEqual(MARGIN);
+    expect(diagramExtent(blocks, [], [])).toEqual(blocks);
   });
 });

@@ -41,16 +41,39 @@ describe("RouteService", () => {
     const moved = rects.map((r) => (r.id === "b" ? { ...r, y0: r.y0 + 40, y1: r.y1 + 40 } : r));
     const w2 = [{ ...wires[0], b: { ...wires[0].b, y: 190 } }];
     for (let k = 0; k < 5; k++) s.request(moved, w2);
+    s.request(rects, wires);
+    s.request(moved, w2);
     expect(port.sent.map((m) => m.seq)).toEqual([1]);
     expect(s.pending).toBe(true);
     port.flush();
-    expect(port.sent.map((m) => m.seq)).toEqual([6]);
+    expect(port.sent.map((m) => m.seq)).toEqual([4]);
     port.flush();
-    expect(got.map((r) => r.seq)).toEqual([1, 6]);
+    expect(got.map((r) => r.seq)).toEqual([1, 4]);
     expect(got[1].where).toBe("worker");
     const pts = got[1].wires.get("w").points;
     expect(pts[pts.length - 1]).toEqual({ x: 293, y: 190 });
     expect(s.pending).toBe(false);
+  });
+
+  it("does not ask again for the diagram last asked about", () => {
+    const port = fakeWorker();
+    const got = [];
+    const s = new RouteService(port, (r) => got.push(r));
+    s.request(rects, wires);
+    port.flush();
+    // a re-render with the same places: equal, not the same, arrays
+    s.request(rects.map((r) => ({ ...r })), wires.map((w) => ({ ...w })));
+    expect(port.sent).toHaveLength(0);
+    expect(s.pending).toBe(false);
+    const moved = rects.map((r) => (r.id === "b" ? { ...r, x0: r.x0 + 20, x1: r.x1 + 20 } : r));
+    s.request(moved, wires);
+    expect(port.sent.map((m) => m.seq)).toEqual([2]);
+    port.flush();
+    // and back where it was: a new request (the last asked was the moved diagram)
+    s.request(rects, wires);
+    expect(port.sent.map((m) => m.seq)).toEqual([3]);
+    port.flush();
+    expect(got.map((r) => r.seq)).toEqual([1, 2, 3]);
   });
 
   it("holds answers back until released", () => {

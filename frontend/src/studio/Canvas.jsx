@@ -8,10 +8,11 @@ import BlockNode from "./BlockNode.jsx";
 import PortNode from "./PortNode.jsx";
 import WireEdge from "./WireEdge.jsx";
 import { GRID, SCALE } from "./model.js";
-import { covers, fitViewport, minimapBox } from "./fit.js";
+import { covers, diagramExtent, fitViewport, minimapBox } from "./fit.js";
 import { studio, useStudio } from "./store.js";
 import { edgeData } from "./hooks/useEditing.js";
 import { useWires } from "./hooks/useWires.js";
+import { TESTING, trace } from "./testing.js";
 
 const nodeTypes = { block: BlockNode, extport: PortNode };
 const edgeTypes = { wire: WireEdge };
@@ -74,8 +75,19 @@ export default function Canvas({ nodes: nodesIn, edges: edgesIn, placed, edit })
     });
   }, [nodesIn, selection, dragPos, measured]);
 
-  // wires routed around the blocks where they are shown, again as a block is dragged
-  const routed = useWires(nodes, edgesIn);
+  // wires routed around the blocks where they are shown, again as a block is dragged; the
+  // view fitted to a model just opened is fitted again when its wires are routed (they may
+  // run round the outside of the blocks), unless the user has moved it meanwhile
+  const fitWires = useRef(false);
+  const lastRouted = useRef(null);
+  const onRouted = useCallback((out) => {
+    lastRouted.current = out;
+    if (!fitWires.current) return;
+    fitWires.current = false;
+    refit.current();
+    if (TESTING) trace.fit = { ...trace.fit, wires: false };
+  }, []);
+  const routed = useWires(nodes, edgesIn, placed, onRouted);
   const edges = useMemo(() => {
     const chosen = new Set(selectedEdges);
     return routed.map((e) => (chosen.has(e.id) ? { ...e, selected: true } : e));
@@ -136,16 +148,27 @@ export default function Canvas({ nodes: nodesIn, edges: edgesIn, placed, edit })
     [edit],
   );
 
-  // the whole diagram in view, clear of the zoom buttons and the minimap
+  // the whole diagram in view, clear of the zoom buttons and the minimap: its blocks, what
+  // stands out of them (ports, their names) and its wires
   const fit = useCallback(() => {
     const pane = box.current;
     const shown = flow.getNodes();
     if (!pane || !shown.length) return;
     const size = { width: pane.clientWidth, height: pane.clientHeight };
     const blocks = shown.map((n) => ({ x: n.position.x, y: n.position.y, width: n.measured?.width ?? 0, height: n.measured?.height ?? 0 }));
-    const view = fitViewport(flow.getNodesBounds(shown), size, [], FIT_MAX_ZOOM, MIN_ZOOM);
+    const at = pane.getBoundingClientRect();
+    const now = flow.getViewport();
+    // the parts of the blocks drawn outside their boxes, from the page (diagram coordinates)
+    const parts = [...pane.querySelectorAll(".react-flow__node .kn-port, .react-flow__node .kn-port-label, .react-flow__node .kn-block-badge")].map((el) => {
+      const r = el.getBoundingClientRect();
+      return { x: (r.left - at.left - now.x) / now.zoom, y: (r.top - at.top - now.y) / now.zoom, width: r.width / now.zoom, height: r.height / now.zoom };
+    });
+    const wires = flow.getEdges().map((e) => /** @type {any} */ (e.data)?.points || []);
+    const extent = diagramExtent(flow.getNodesBounds(shown), parts.filter((r) => r.width > 0 && r.height > 0), wires);
+    const view = fitViewport(extent, size, [], FIT_MAX_ZOOM, MIN_ZOOM);
     flow.setViewport(view, { duration: 0 });
     fittedView.current = flow.getViewport();
+    if (TESTING) trace.fit = { ...trace.fit, pane: [size.width, size.height] };
     setCornerFree(!covers(view, blocks, minimapBox(size, MINIMAP)));
   }, [flow]);
   useEffect(() => {
@@ -164,9 +187,12 @@ export default function Canvas({ nodes: nodesIn, edges: edgesIn, placed, edit })
     const id = requestAnimationFrame(() => {
       fit();
       fitted.current = fitRequest;
+      // the wires drawn are not yet those of this diagram: fit again when they are
+      fitWires.current = lastRouted.current !== routed;
+      if (TESTING) trace.fit = { ...trace.fit, request: fitRequest, wires: fitWires.current };
     });
     return () => cancelAnimationFrame(id);
-  }, [fitRequest, initialized, nodes, placed, fit]);
+  }, [fitRequest, initialized, nodes, placed, fit, routed]);
 
   const isValidConnection = useCallback((c) => edit.checkConnection(`${c.source}.${c.sourceHandle}`, `${c.target}.${c.targetHandle}`) === null, [edit]);
   const onConnect = useCallback((c) => edit.connect(`${c.source}.${c.sourceHandle}`, `${c.target}.${c.targetHandle}`), [edit]);

@@ -56,6 +56,40 @@ function within(bounds, area, maxZoom, minZoom) {
   };
 }
 
+/** Diagram pixels kept round a wire's line: its stroke and the arrowhead of a signal wire. */
+export const WIRE_PAD = 8;
+
+/**
+ * What a fitted view must hold: the blocks' bounds, the parts drawn outside them (ports,
+ * port names, badges) and every wire's path (a wire may run round the outside of the blocks,
+ * above the top one); the diagram's coordinates.
+ * @param {Rect} blocks
+ * @param {Rect[]} parts
+ * @param {{x: number, y: number}[][]} wires each wire's points
+ * @returns {Rect}
+ */
+export function diagramExtent(blocks, parts, wires) {
+  let x0 = blocks.x;
+  let y0 = blocks.y;
+  let x1 = blocks.x + blocks.width;
+  let y1 = blocks.y + blocks.height;
+  for (const r of parts) {
+    x0 = Math.min(x0, r.x);
+    y0 = Math.min(y0, r.y);
+    x1 = Math.max(x1, r.x + r.width);
+    y1 = Math.max(y1, r.y + r.height);
+  }
+  for (const points of wires) {
+    for (const p of points) {
+      x0 = Math.min(x0, p.x - WIRE_PAD);
+      y0 = Math.min(y0, p.y - WIRE_PAD);
+      x1 = Math.max(x1, p.x + WIRE_PAD);
+      y1 = Math.max(y1, p.y + WIRE_PAD);
+    }
+  }
+  return { x: x0, y: y0, width: x1 - x0, height: y1 - y0 };
+}
+
 /** Whether rectangles ``a`` and ``b`` overlap. */
 function overlap(a, b) {
   return a.x < b.x + b.width && b.x < a.x + a.width && a.y < b.y + b.height && b.y < a.y + a.height;

@@ -27,6 +27,13 @@ export function installTestHook(store) {
     wires: () => trace.wires,
     /** the wires drawn are routed for the diagram as shown (no routing outstanding) */
     routed: () => !!trace.wires && trace.wires.asked === trace.wires.answered,
+    /** the diagram shown is fitted as its opening (or the fit button) asked, wires included,
+     * to the pane as it is now (a new window size refits a view the user has not moved) */
+    fitted: () => {
+      const f = trace.fit;
+      const pane = document.querySelector('[data-testid="canvas"]');
+      return !!f && !!pane && f.request === get().fitRequest && !f.wires && !!f.pane && f.pane[0] === pane.clientWidth && f.pane[1] === pane.clientHeight;
+    },
   };
   for (const [key, read] of Object.entries(view)) Object.defineProperty(K, key, { get: read, enumerable: true });
   Object.defineProperty(K, "lastSave", {

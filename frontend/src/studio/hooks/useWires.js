@@ -77,8 +77,13 @@ function joins(points, a, b) {
  * The edges with their routes in ``data.points``.
  * @param {any[]} nodes as shown (dragged positions, measured sizes)
  * @param {any[]} edges
+ * @param {boolean} [placed] every block has its place: until then (blocks the layout has not
+ *   yet placed stand at the origin) nothing is routed, as a pile of blocks at one point is
+ *   the slowest diagram to route (1.7 s of arm_computed_torque's opening went there)
+ * @param {(edges: any[]) => void} [onRouted] called with the edges once the routes of the
+ *   diagram as shown are drawn (no routing outstanding)
  */
-export function useWires(nodes, edges) {
+export function useWires(nodes, edges, placed = true, onRouted = undefined) {
   const [routes, setRoutes] = useState(() => /** @type {any} */ ({ seq: 0, wires: new Map(), routed: 0, ms: 0, where: null }));
   const [service] = useState(() => new RouteService(startWorker(), (r) => setRoutes(r)));
   useEffect(() => () => service.stop(), [service]);
@@ -94,7 +99,9 @@ export function useWires(nodes, edges) {
     });
     return { rects: [...shape.values()].map((s) => s.rect), wires };
   }, [nodes, edges]);
-  useEffect(() => service.request(asked.rects, asked.wires), [service, asked]);
+  useEffect(() => {
+    if (placed) service.request(asked.rects, asked.wires);
+  }, [service, asked, placed]);
   const out = useMemo(() => {
     const ends = new Map(asked.wires.map((w) => [w.id, w]));
     return edges.map((e) => {
@@ -109,5 +116,8 @@ export function useWires(nodes, edges) {
     trace.wires = { rects: asked.rects, wires: asked.wires, routed: routes.routed, ms: routes.ms, where: routes.where, asked: service.seq, answered: routes.seq };
     trace.routing = service;
   }, [asked, routes, service]);
+  useEffect(() => {
+    if (onRouted && routes.seq > 0 && routes.seq === service.seq && !service.pending) onRouted(out);
+  }, [routes, out, service, onRouted]);
   return out;
 }
