@@ -149,6 +149,28 @@ def open_file(page, path):
         page.wait_for_selector(tid(f"node-{comp}"))
 
 
+def open_in_page(page, **query):
+    """Open a model in the page already loaded, the user's way: the Open dialog, an example
+    (``example=name``) or a file of the studio's folder (``open=path``), discarding unsaved
+    changes when the page asks; wait until its blocks are drawn. The same document, fit and
+    routing as loading the page's address with that query, without loading the page again
+    (~1 s of the browser's CPU each time)."""
+    (key, value), = query.items()
+    field = {"open": "path", "example": "example"}[key]
+    asked = K(page, "K.store.getState().fitRequest")
+    page.click(tid("open"))
+    page.click(tid(f"{'file' if key == 'open' else 'example'}-{value}"))
+    page.wait_for_function(f"() => window.__kinetwork.store.getState().fitRequest > {asked} || "
+                           f"!!document.querySelector('[data-testid=confirm-discard]')")
+    if page.locator(tid("confirm-discard")).count():
+        page.click(tid("choice-discard"))
+    page.wait_for_selector(tid("open-dialog"), state="detached")
+    page.wait_for_function(f"() => window.__kinetwork.file.{field} === {json.dumps(value)} && "
+                           f"window.__kinetwork.store.getState().fitRequest > {asked}")
+    for comp in K(page, "K.doc.components.map(c => c.name)"):
+        page.wait_for_selector(tid(f"node-{comp}"))
+
+
 def run(page, timeout=RUN_TIMEOUT):
     """Press Run, wait for the run to end; its final state."""
     n = K(page, "(K.runs || []).length ? K.runs[0].n : 0")

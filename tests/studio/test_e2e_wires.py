@@ -18,8 +18,8 @@ import pytest
 from browser import browser_missing
 
 from tests.studio.conftest import E2E_TOKEN, REPO, Studio, _why_not, npm_installed
-from tests.studio.helpers import (K, open_studio, screenshot, serving, set_field, tid,
-                                  wait_validated)
+from tests.studio.helpers import (K, open_in_page, open_studio, screenshot, serving, set_field,
+                                  tid, wait_validated)
 
 SIZE = {"width": 1400, "height": 900}
 TOL = 1.0            # px: collinear within it, and overlapping by more than it, is one track
@@ -118,6 +118,29 @@ def faults(page):
             "zoom": drawn["zoom"], "wires": len(drawn["wires"]), "segments": len(segs)}
 
 
+#: what is drawn of the diagram that lies outside the diagram's pane, from rendered boxes
+OUTSIDE = """() => {
+    const p = document.querySelector('.react-flow').getBoundingClientRect();
+    const parts = [...document.querySelectorAll('.react-flow__edge-path, .react-flow__node, ' +
+        '.react-flow__node .kn-port, .react-flow__node .kn-port-label, .kn-extport')];
+    return parts.map((el) => {
+        const b = el.getBoundingClientRect();
+        const what = el.closest('.react-flow__edge, .react-flow__node');
+        return {what: `${el.getAttribute('class').split(' ')[0]} of ${what && what.getAttribute('data-id')}`,
+                out: Math.max(p.left - b.left, p.top - b.top, b.right - p.right, b.bottom - p.bottom)};
+    }).filter((x) => x.out > 0.5);
+}"""
+
+
+def assert_fitted_whole(page, what):
+    """The fitted view holds every wire's path, every block and every port and port name
+    (read from their rendered boxes), not only the blocks: a wire routed round the top block
+    was cut by the pane's edge."""
+    out = page.evaluate(OUTSIDE)
+    assert not out, f"{what}: {len(out)} parts outside the pane at fit: " \
+                    f"{[(x['what'], round(x['out'], 1)) for x in out[:6]]}"
+
+
 def assert_readable(found, what, fit=True):
     assert found["wires"] > 0, f"{what}: no wire drawn"
     assert not found["slanted"], f"{what}: wires not orthogonal: {found['slanted'][:5]}"
@@ -160,18 +183,19 @@ def screen(chromium, site):
 
 
 def show(page, site, **query):
-    """Open a model (an example by name, or a file of the studio's folder) and wait until it
-    is drawn, fitted and its wires are routed."""
-    open_studio(page, site, **query)
+    """Open a model (an example by name, or a file of the studio's folder) through the Open
+    dialog of the page already loaded, and wait until it is drawn, fitted and its wires are
+    routed."""
+    open_in_page(page, **query)
     settle(page)
 
 
 def settle(page):
-    """Wait until the diagram shown is drawn, fitted and its wires are routed."""
-    page.wait_for_function("() => { const v = document.querySelector('.react-flow__viewport');"
-                           " return v && v.style.transform && document.querySelectorAll("
-                           "'.react-flow__edge-path').length > 0; }")
-    # the fit runs once the blocks are measured: wait for the zoom to settle on two frames
+    """Wait until the diagram shown is drawn, its wires routed, and fitted (wires included)
+    to the pane as it is now; then until nothing moves on two frames."""
+    page.wait_for_function("() => document.querySelectorAll('.react-flow__edge-path').length > 0")
+    wait_routed(page)
+    page.wait_for_function("() => window.__kinetwork.fitted")
     page.wait_for_function("""() => new Promise((done) => {
         const z = () => document.querySelector('.react-flow__viewport').style.transform;
         const a = z(); requestAnimationFrame(() => requestAnimationFrame(() => done(a === z())));
@@ -205,6 +229,7 @@ def test_every_example_readable_at_1400x900(screen, site, name):
         screen.screenshot(path=f"{stem}.png")
         pathlib.Path(f"{stem}.json").write_text(json.dumps(K(screen, "K.wires")))
     assert_readable(faults(screen), name)
+    assert_fitted_whole(screen, name)
     assert not screen.errors, screen.errors
 
 
@@ -314,17 +339,32 @@ def test_wires_rerouted_when_a_block_is_dragged(screen, site, model, block):
     assert not screen.errors, screen.errors
 
 
-@pytest.mark.parametrize("w, h", [(1000, 700), (1400, 900), (1920, 1080)])
-@pytest.mark.parametrize("model", ["double_pendulum", "arm_computed_torque"])
-def test_screenshots(screen, site, model, w, h):
-    """The seed and arm_computed_torque at the three window sizes, for the docs."""
-    screen.set_viewport_size({"width": w, "height": h})
+#: the window sizes a diagram must read at: one page resized to each
+SIZES = [(1000, 700), (1400, 900), (1920, 1080)]
+
+
+def at_sizes(page):
+    """Resize ``page`` to each of SIZES in turn (yielding the size), the diagram refitted to
+    it; back to SIZE at the end."""
     try:
-        show(screen, site, example=model)
+        for w, h in SIZES:
+            page.set_viewport_size({"width": w, "height": h})
+            settle(page)
+            yield w, h
+    finally:
+        page.set_viewport_size(SIZE)
+        settle(page)
+
+
+@pytest.mark.parametrize("model", ["double_pendulum", "arm_computed_torque"])
+def test_screenshots(screen, site, model):
+    """The seed and arm_computed_torque at the three window sizes, for the docs: opened
+    once, the window resized (the view refits itself, as on opening at that size)."""
+    show(screen, site, example=model)
+    for w, h in at_sizes(screen):
         screenshot(screen, f"studio-diagram-{model}-{w}x{h}.png")
         assert_readable(faults(screen), f"{model} at {w}x{h}", fit=False)
-    finally:
-        screen.set_viewport_size(SIZE)
+        assert_fitted_whole(screen, f"{model} at {w}x{h}")
 
 
 def test_page_answers_while_wires_are_routed(screen, site):
