@@ -120,23 +120,98 @@ def pytest_runtest_makereport(item, call):
     setattr(item, f"report_{call.when}", outcome.get_result())
 
 
+class Tab:
+    """A module's browser tab, handed to its tests one after the other: a new tab costs
+    Chromium ~3 s of CPU (a renderer process started, the studio's scripts compiled afresh),
+    a tab reused ~1 s. Each test's studio has its own server on its own port, so its own
+    origin: nothing of the page's (storage, scripts, workers) survives from the last test.
+    A tab is reused only after a test that passed and left it as it got it (no listener of
+    its own left on it, the page and its context open, back on a blank page); otherwise the
+    next test gets a new context, as every test used to."""
+
+    EVENTS = ("console", "pageerror", "dialog", "download", "popup", "request", "response",
+              "requestfailed", "requestfinished", "close", "crash", "load",
+              "domcontentloaded", "frameattached", "framedetached", "framenavigated",
+              "filechooser", "websocket", "worker")
+
+    def __init__(self, browser):
+        self.browser, self.context, self.page, self.counts = browser, None, None, None
+
+    def listeners(self):
+        impl = self.page._impl_obj
+        return {e: impl.listener_count(e) for e in self.EVENTS}
+
+    def take(self):
+        """The tab, reset for a test: the window size, the timeout, an empty error list."""
+        if self.page is None:
+            self.context = self.browser.new_context(viewport=VIEWPORT)
+            pg = self.context.new_page()
+            pg.errors = []
+            pg.on("console", lambda m: m.type == "error" and pg.errors.append(f"console: {m.text}"))
+            pg.on("pageerror", lambda e: pg.errors.append(f"uncaught: {e}"))
+            self.page, self.counts = pg, None
+            self.counts = self.listeners()
+        pg = self.page
+        pg.errors.clear()
+        pg.set_viewport_size(VIEWPORT)
+        pg.set_default_timeout(30_000)
+        return pg
+
+    def give_back(self, passed):
+        """Keep the tab for the next test if it is as it was handed out; else drop it."""
+        pg, keep = self.page, passed
+        try:
+            keep = keep and not pg.is_closed() and self.listeners() == self.counts
+            if keep:
+                # away from the studio (its server is stopped), accepting "leave the page?"
+                def leave(dialog):
+                    dialog.accept()
+                pg.on("dialog", leave)
+                try:
+                    pg.goto("about:blank")
+                finally:
+                    pg.remove_listener("dialog", leave)
+                keep = pg.url == "about:blank"
+        except Exception:       # a context the test closed, a page that would not leave
+            keep = False
+        if not keep:
+            self.close()
+
+    def close(self):
+        context, self.context, self.page = self.context, None, None
+        if context is not None:
+            try:
+                context.close()
+            except Exception:   # closed by the test already
+                pass
+
+
+@pytest.fixture(scope="module")
+def tab(chromium):
+    """One browser tab for the module's tests that take ``page`` (see Tab)."""
+    why = _why_not()
+    if why:
+        browser_missing(why)
+    t = Tab(chromium)
+    yield t
+    t.close()
+
+
 @pytest.fixture
-def page(browser, request):
-    """A fresh page (its own context) that records console errors and uncaught exceptions in
-    ``page.errors``; when the test fails, a screenshot goes to $KINETWORK_E2E_SHOTS (if
-    set) to show why."""
-    context = browser.new_context(viewport=VIEWPORT)
-    pg = context.new_page()
-    pg.errors = []
-    pg.on("console", lambda m: m.type == "error" and pg.errors.append(f"console: {m.text}"))
-    pg.on("pageerror", lambda e: pg.errors.append(f"uncaught: {e}"))
-    pg.set_default_timeout(30_000)
+def page(tab, request):
+    """The module's tab (see Tab), at the default window size, recording console errors and
+    uncaught exceptions in ``page.errors``; when the test fails, a screenshot goes to
+    $KINETWORK_E2E_SHOTS (if set) to show why."""
+    pg = tab.take()
+    passed = False
     try:
         yield pg
+        report = getattr(request.node, "report_call", None)
+        passed = report is not None and report.passed
     finally:
         report = getattr(request.node, "report_call", None)
         shots = os.environ.get("KINETWORK_E2E_SHOTS")
-        if shots and report is not None and report.failed:
+        if shots and report is not None and report.failed and not pg.is_closed():
             os.makedirs(shots, exist_ok=True)
             pg.screenshot(path=os.path.join(shots, f"{request.node.name}.png"))
-        context.close()
+        tab.give_back(passed)
