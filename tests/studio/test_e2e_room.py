@@ -7,8 +7,8 @@ the same as opening; a subsystem's block is as wide as its ports' names need. Ev
 read from the rendered boxes (getBoundingClientRect) on one page for the module."""
 
 from tests.studio.helpers import K, screenshot, set_field, tid
-from tests.studio.test_e2e_wires import (SIZES, assert_fitted_whole, at_sizes, screen, settle,  # noqa: F401
-                                         show, site)
+from tests.studio.test_e2e_wires import (DRAWN, SIZES, assert_fitted_whole, at_sizes,  # noqa: F401
+                                         polyline, screen, settle, show, site)
 
 #: the blocks' boxes and those of whatever may lie over the diagram, in page pixels
 BOXES = """() => {
@@ -32,12 +32,25 @@ ZOOM = "() => new DOMMatrix(getComputedStyle(document.querySelector('.react-flow
 
 
 def covered(page):
-    """What covers a block, and the blocks not wholly in the diagram's pane."""
+    """What covers a block (and the minimap over a wire), and the blocks not wholly in the
+    diagram's pane."""
     d = page.evaluate(BOXES)
     p = d["pane"]
     hits = [f"{o['what']} over {b['id']}" for o in d["over"] for b in d["blocks"]
             if o["w"] and o["h"] and b["x"] < o["x"] + o["w"] and o["x"] < b["x"] + b["w"]
             and b["y"] < o["y"] + o["h"] and o["y"] < b["y"] + b["h"]]
+    # the minimap, shown by itself, hides no wire either (the user's minimap may)
+    drawn = page.evaluate(DRAWN)
+    z, tx, ty, q = drawn["zoom"], drawn["tx"], drawn["ty"], drawn["pane"]
+    for o in d["over"]:
+        if o["what"] != "react-flow__minimap" or not o["w"] or not o["h"]:
+            continue
+        for w in drawn["wires"]:
+            pts = [(q["x"] + tx + x * z, q["y"] + ty + y * z) for x, y in polyline(w["d"])]
+            if any(min(a[0], b[0]) < o["x"] + o["w"] and o["x"] < max(a[0], b[0])
+                   and min(a[1], b[1]) < o["y"] + o["h"] and o["y"] < max(a[1], b[1])
+                   for a, b in zip(pts, pts[1:])):
+                hits.append(f"minimap over the wire {w['id']}")
     out = [b["id"] for b in d["blocks"] if b["x"] < p["x"] - 0.5 or b["y"] < p["y"] - 0.5
            or b["x"] + b["w"] > p["x"] + p["w"] + 0.5 or b["y"] + b["h"] > p["y"] + p["h"] + 0.5]
     return hits, out, {o["what"] for o in d["over"]}

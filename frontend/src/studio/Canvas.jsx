@@ -169,7 +169,12 @@ export default function Canvas({ nodes: nodesIn, edges: edgesIn, placed, edit })
     flow.setViewport(view, { duration: 0 });
     fittedView.current = flow.getViewport();
     if (TESTING) trace.fit = { ...trace.fit, pane: [size.width, size.height] };
-    setCornerFree(!covers(view, blocks, minimapBox(size, MINIMAP)));
+    // the minimap by itself only where it hides no block and no wire
+    const segments = wires.flatMap((pts) => pts.slice(1).map((q, i) => {
+      const p = pts[i];
+      return { x: Math.min(p.x, q.x) - 2, y: Math.min(p.y, q.y) - 2, width: Math.abs(q.x - p.x) + 4, height: Math.abs(q.y - p.y) + 4 };
+    }));
+    setCornerFree(!covers(view, [...blocks, ...segments], minimapBox(size, MINIMAP)));
   }, [flow]);
   useEffect(() => {
     refit.current = () => {
