@@ -293,24 +293,3 @@ def test_a_built_model_keeps_its_parameters_through_the_json_view(page, studio):
     built = kn.loads(json.dumps(model), validate=False)
     assert set(built.components) == {"ground", "joint"}
     assert not page.errors, page.errors
-
-
-def test_the_seed_builds_by_mouse_at_1400x900_and_runs(browser, studio):
-    """At the window size of the hidden check: every step of building the seed by drag and
-    drop works, and it runs."""
-    from tests.studio.test_e2e import build_seed
-    context = browser.new_context(viewport={"width": 1400, "height": 900})
-    page = context.new_page()
-    errors = []
-    page.on("pageerror", lambda e: errors.append(str(e)))
-    try:
-        page.set_default_timeout(30_000)
-        open_studio(page, studio)
-        build_seed(page)
-        wait_validated(page)
-        assert K(page, "K.validation.ok"), K(page, "K.validation.problems")
-        assert run(page) == "done"
-        assert K(page, "K.lastRun.signals.length") == 8
-    finally:
-        context.close()
-    assert not errors, errors
