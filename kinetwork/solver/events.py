@@ -80,6 +80,12 @@ FIT = 1.0
 #: Newton's steps at most from the time found on a curve not within FIT to the integration's
 #: own root, on the side where it has crossed
 POLISH = 4
+#: a chunk reaches this many times as far as the indicators, each going on as fast as now,
+#: foresee the next crossing (``Events.chunk``): most approach zero slowing down (a piston
+#: nearing its dead centre). On EngineV6, rhs evaluations and integrator calls by factor:
+#: 1.0: 53249, 644; 1.25: 45914, 508; 1.5: 39580, 375; 1.6: 39012, 351; 2: 43887, 351;
+#: 3: 54390, 351; without: 72186, 351
+FORESEE = 1.6
 
 
 class Events:
@@ -106,6 +112,10 @@ class Events:
         #: fit, its rises off the contact's spring are not)
         self._two_fit = {}
         self._points = PointsBySize()   # the rates on the curves
+        #: (t, x, p) -> indicators and rates where the run goes on from, and the time the
+        #: next crossing is foreseen at from there (``chunk``)
+        self._at = None
+        self._foreseen = None
 
     @property
     def located(self):
@@ -139,11 +149,20 @@ class Events:
             i -= k
         raise IndexError(i)
 
-    def chunk(self, chunk, event):
+    def chunk(self, chunk, event, t=None):
         """Output intervals of the next chunk of a run with state events, at most ``chunk``:
-        EVENT_CHUNK after an ``event``, else twice the last, up to MAX_EVENT_CHUNK."""
+        EVENT_CHUNK after an ``event``, else twice the last, up to MAX_EVENT_CHUNK; and, from
+        the output time ``t`` the chunk starts after, no more than reach the next crossing
+        the indicators foresee (``_foresee``): what a chunk integrates past its first event
+        is integrated again (EngineV6: two thirds of its evaluations, when each chunk after
+        an event went EVENT_CHUNK intervals and its events come every three)."""
         self._chunk = EVENT_CHUNK if event else min(2 * self._chunk, MAX_EVENT_CHUNK)
-        return min(chunk, self._chunk)
+        chunk = min(chunk, self._chunk)
+        if t is not None and self._foreseen is not None and self._foreseen > t:
+            spacing = self.run.spacing
+            reach = int(np.ceil((self._foreseen - t) / spacing - 1e-9))
+            chunk = max(1, min(chunk, reach))
+        return chunk
 
     def bound(self, t):
         """The time a method started at t must not step past: the next time event, or the
@@ -182,6 +201,7 @@ class Events:
         self._last = (None, 0)
         self._chunk = EVENT_CHUNK
         self._two_fit = {}
+        self._at = self._foreseen = None
         if self.switches is not None:
             self.switches.r = self._held.copy()
             self.switches.time_events = 0
@@ -232,7 +252,7 @@ class Events:
         (a gap just closed, a speed just zero) that count as positive: they leave zero
         rising, and one that is at or below zero at the next output fell back in between."""
         t_prev, x_prev = before
-        g_first, r_first = self.indicators(t_prev, x_prev)
+        g_first, r_first = self._indicators_at(t_prev, x_prev)
         if restarted:
             g_first = np.where(g_first <= 0, np.inf, g_first)
         G, R = self._rows(times, rows)
@@ -250,12 +270,34 @@ class Events:
                 t_ev, x_ev, i = found
                 after = self.apply(t_ev, x_ev, i)
                 if t_ev >= t:                 # at the output time itself: it shows the after
-                    return np.vstack([rows[:j], after[None, :]]), (t, after)
-                if j > 0 and t_ev - t_prev <= SAME_INSTANT:
+                    restart = (t, after)
+                    rows = np.vstack([rows[:j], after[None, :]])
+                elif j > 0 and t_ev - t_prev <= SAME_INSTANT:
                     # at the sampled point before, to rounding: that one shows the after
-                    return np.vstack([rows[:j - 1], after[None, :]]), (t_ev, after)
-                return rows[:j], (t_ev, after)
+                    restart = (t_ev, after)
+                    rows = np.vstack([rows[:j - 1], after[None, :]])
+                else:
+                    restart, rows = (t_ev, after), rows[:j]
+                self._foresee(restart[0], *self._indicators_at(*restart))
+                return rows, restart
+        self._foresee(times[-1], G[-1], R[-1])
         return rows, None
+
+    def _indicators_at(self, t, x):
+        """``indicators`` at (t, x), kept for the point the run goes on from (asked for again
+        when the next chunk begins there)."""
+        key = (float(t), np.asarray(x, dtype=float).tobytes(), self.run.p_solver.tobytes())
+        if self._at is None or self._at[0] != key:
+            self._at = (key, self.indicators(t, x))
+        return self._at[1]
+
+    def _foresee(self, t, g, rate):
+        """The time of the next crossing as the indicators at t (``g``, falling at ``rate``)
+        foresee it, each going on as fast as now (None: none is falling). Only the chunks'
+        lengths read it: events are looked for wherever it says."""
+        falling = (g > 0) & (rate < 0) & np.isfinite(g)
+        self._foreseen = float(t + FORESEE * np.min(g[falling] / -rate[falling])) \
+            if np.any(falling) else None
 
     def _rows(self, times, rows):
         """(indicators, rates), (len(rows), k) each, at each row."""
