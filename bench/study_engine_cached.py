@@ -73,9 +73,9 @@ def timed_parts():
                wrap(events.Events, "indicators", "indicators")]
     fits = events._Hermite.fits
 
-    def counted(self, rates, tol):
+    def counted(self, rates, tol, step=None):
         count["fits", len(self.T) == 2] += 1
-        return fits(self, rates, tol)
+        return fits(self, rates, tol, step)
     patches.append(mock.patch.object(events._Hermite, "fits", counted))
     return patches, spent, count
 

@@ -416,6 +416,8 @@ def _integrate(run, method):
             run.stop_reason() is None and "singular" not in failure:
         failure += near_singular(run, X.array(), grid)
     stats = _merge(stats, stepper.stats)
+    if run.events is not None:              # the integrations that located its events
+        stats = _merge(stats, run.events.spent)
     if restarts:
         stats["restarts"] = [{"t": r["t"], "after": r["after"]} for r in restarts]
     stats.update(parts.done())

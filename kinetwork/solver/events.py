@@ -44,7 +44,7 @@ import numpy as np
 from .buffers import PointsBySize
 from .compiled import numeric
 from .explicit import rk4
-from .methods import Failure
+from .methods import Failure, _add_counts
 from .modechange import ModeChanges
 from .switches import Switches
 from .tolerance import solver_tolerances
@@ -80,6 +80,8 @@ FIT = 1.0
 #: Newton's steps at most from the time found on a curve not within FIT to the integration's
 #: own root, on the side where it has crossed
 POLISH = 4
+#: Newton's steps at most on an indicator along a curve's step (``Events._root``)
+ROOT_STEPS = 8
 #: a chunk reaches this many times as far as the indicators, each going on as fast as now,
 #: foresee the next crossing (``Events.chunk``): most approach zero slowing down (a piston
 #: nearing its dead centre). On EngineV6, rhs evaluations and integrator calls by factor:
@@ -116,6 +118,10 @@ class Events:
         #: next crossing is foreseen at from there (``chunk``)
         self._at = None
         self._foreseen = None
+        #: the runs of the method started to locate an event, and the counts of the work
+        #: they did (``spent``: the run's statistics hold it)
+        self._trials = []
+        self.spent = {}
 
     @property
     def located(self):
@@ -202,6 +208,7 @@ class Events:
         self._chunk = EVENT_CHUNK
         self._two_fit = {}
         self._at = self._foreseen = None
+        self._trials, self.spent = [], {}
         if self.switches is not None:
             self.switches.r = self._held.copy()
             self.switches.time_events = 0
@@ -308,6 +315,21 @@ class Events:
         """The earliest crossing in (t0, t1]: (time, state, element). ``dipped``: elements
         above zero at both ends with a minimum between, which cross if it reaches zero.
         ``x1``: the state at t1, when known."""
+        try:
+            return self._locate_by(method, t0, x0, t1, crossed, dipped, x1)
+        finally:
+            for trial in self._trials:
+                _add_counts(self.spent, trial.stats)
+            self._trials = []
+
+    def _start(self, method, t, x):
+        """A run of ``method`` from (t, x) for locating an event, its work counted."""
+        trial = method.start(self.run, t, x)
+        self._trials.append(trial)
+        return trial
+
+    def _locate_by(self, method, t0, x0, t1, crossed, dipped, x1):
+        """``_locate``'s answer: on the curve when it can, else on integrated states."""
         if not self.run.system.n_algebraic and not method.fixed and \
                 t1 - t0 >= SHORT * max(1.0, abs(t0)):
             found = self._locate_dense(method, t0, x0, t1, x1, crossed, dipped)
@@ -326,11 +348,11 @@ class Events:
                     cache[t] = self._rk4(t0, x0, t - t0)
                 elif method.trial_states:       # one integration for every trial time
                     if not from_t0:
-                        from_t0.append(method.start(self.run, t0, x0))
+                        from_t0.append(self._start(method, t0, x0))
                     cache[t] = from_t0[0].state_at(t)
                 else:
-                    cache[t] = method.start(self.run, t0, x0).advance(np.array([t]),
-                                                                      exact=True)[0]
+                    cache[t] = self._start(method, t0, x0).advance(np.array([t]),
+                                                                   exact=True)[0]
             return cache[t]
 
         best = _search(lambda t, i: self.levels(t, state(t))[i],
@@ -361,19 +383,23 @@ class Events:
             T, X = np.array([t0, t1]), np.vstack([x0, x1])
             curve = _Hermite(T, X, rates(T, X))
             fitted = self._two_fit[law] = curve.fits(rates, tol)
-        if not fitted:
-            grid = getattr(method.start(self.run, t0, x0), "grid", None)
+        if fitted:
+            best = _search(lambda t, i: self.levels(t, curve(t))[i],
+                           lambda t, i: self.indicators(t, curve(t))[1][i],
+                           t0, t1, crossed, dipped)
+        else:
+            grid = getattr(self._start(method, t0, x0), "grid", None)
             rows = grid(t1, DENSE) if grid is not None else None
             if rows is None:
                 return _UNSURE
             T = np.concatenate([[t0], t0 + (t1 - t0) * np.arange(1, DENSE + 1) / DENSE])
             T[-1] = t1
             X = np.vstack([x0[None, :], rows])
-            curve = _Hermite(T, X, rates(T, X))
-            fitted = curve.fits(rates, tol)
-        best = _search(lambda t, i: self.levels(t, curve(t))[i],
-                       lambda t, i: self.indicators(t, curve(t))[1][i],
-                       t0, t1, crossed, dipped)
+            curve = _Steps(T, X, rates)
+            best = self._search_steps(curve, T, X, crossed, dipped)
+            # the curve is checked where the time found is read off it, on that step alone
+            # (its points are the integration's: elsewhere it decides nothing)
+            fitted = best is not None and curve.fits(rates, tol, curve.step(best[0]))
         if best is None:
             return None
         t_i, i = best
@@ -384,7 +410,7 @@ class Events:
             j = max(0, int(np.searchsorted(T, t, side="right")) - 1)
             if t - T[j] < SHORT * max(1.0, abs(T[j])):
                 return self._rk4(T[j], X[j], t - T[j])
-            return method.start(self.run, T[j], X[j]).state_at(t)
+            return self._start(method, T[j], X[j]).state_at(t)
 
         # Newton on the integration from the curve's root (off by the curve's error): to
         # the integration's own root, on the side where the indicator has crossed
@@ -403,6 +429,75 @@ class Events:
             t_i = min(t1, max(t0, t_i + dt + (tiny * max(1.0, abs(t_i)) if g_i > 0 else 0)))
             x_i = exact(t_i)
         return crossed_at if crossed_at is not None else _UNSURE
+
+    def _search_steps(self, curve, T, X, crossed, dipped):
+        """``_search`` along ``curve`` through the points (T, X) of one integration, each
+        indicator on the step its values and rates at the points (one mapped call for all)
+        bracket: a crossing on the step where it is first at or below zero, from the root
+        of the cubic through its values and rates there (``_root``); a dip, where it is
+        lowest, only when that cubic reaches zero there (else it stays above: no event).
+        An indicator at or below zero at T[0] (a restart's) is searched over the whole."""
+        G, R = self._rows(T, X)
+        best = None
+        for i, dip in [*((i, False) for i in crossed), *((i, True) for i in dipped)]:
+            below = np.flatnonzero(G[1:, i] <= 0)
+            got = None
+            if G[0, i] <= 0:
+                got = _search(lambda t, k: self.levels(t, curve(t))[k],
+                              lambda t, k: self.indicators(t, curve(t))[1][k], T[0], T[-1],
+                              *(([], [i]) if dip else ([i], [])))
+            elif len(below):
+                j = below[0]
+                if best is None or T[j] < best[0]:
+                    got = (self._root(curve, T, G[:, i], R[:, i], j, i), i)
+            elif dip:
+                low = int(np.argmin(G[:, i]))
+                a, b = max(low - 1, 0), min(low + 1, len(T) - 1)
+                if min(_cubic_low(T, G[:, i], R[:, i], j) for j in range(a, b)) <= 0 and \
+                        (best is None or T[a] < best[0]):
+                    got = _search(lambda t, k: self.levels(t, curve(t))[k],
+                                  lambda t, k: self.indicators(t, curve(t))[1][k],
+                                  T[a], T[b], [], [i])
+            if got is not None and (best is None or got[0] < best[0]):
+                best = got
+        return best
+
+    def _root(self, curve, T, g, rate, j, i):
+        """The time indicator i crosses zero on ``curve``'s step j (above zero at T[j], at or
+        below at T[j + 1]; values ``g`` and rates ``rate`` at the points), on the side where
+        it has crossed: from the root of the cubic through those values and rates (off the
+        indicator's own by about h^4 times its fourth derivative, on a step of h), Newton's
+        steps on the indicator along the curve with that cubic's slope, bracketed; Brent's
+        method if they do not settle."""
+        a, b = float(T[j]), float(T[j + 1])
+        h = b - a
+        c = _cubic(g[j], g[j + 1], rate[j] * h, rate[j + 1] * h)
+        t = a + h * _cubic_root(c, g[j] / (g[j] - g[j + 1]))
+        tiny = 4 * np.finfo(float).eps * max(1.0, abs(b))
+        for _ in range(ROOT_STEPS):
+            level = self.levels(t, curve(t))[i]
+            if level <= 0:
+                b = t
+            else:
+                a = t
+            if b - a <= 2 * tiny:
+                return b
+            u = (t - T[j]) / h
+            slope = (c[1] + u * (2 * c[2] + 3 * u * c[3])) / h
+            step = -level / slope if slope < 0 else np.nan
+            if level <= 0 and -step <= tiny:
+                return b                        # at the root, to rounding
+            t = t + step + (tiny if level > 0 else 0.0)
+            if not a < t < b:
+                t = (a + b) / 2
+
+        def level(t):
+            return self.levels(t, curve(t))[i]
+        if not level(a) > 0 >= level(b):
+            return b
+        from scipy.optimize import brentq
+        t = brentq(level, a, b, xtol=1e-15, rtol=4 * np.finfo(float).eps, maxiter=200)
+        return t if level(t) <= 0 else min(b, t + tiny)
 
     def _tolerance(self, method):
         """(rtol, atol) the method's solver is given for this run (``tolerance.py``)."""
@@ -473,6 +568,49 @@ def _refined(t0, times, spacing=None):
 _UNSURE = object()
 
 
+def _cubic(g0, g1, r0, r1):
+    """The coefficients (of 1, s, s^2, s^3) of the cubic in s in [0, 1] with values g0, g1
+    and slopes r0, r1 (per unit of s) at its ends."""
+    return (g0, r0, 3 * (g1 - g0) - 2 * r0 - r1, 2 * (g0 - g1) + r0 + r1)
+
+
+def _cubic_low(T, g, rate, j):
+    """The lowest value on step j of the cubic through values ``g`` and rates ``rate`` at
+    the points T."""
+    h = T[j + 1] - T[j]
+    c = _cubic(g[j], g[j + 1], rate[j] * h, rate[j + 1] * h)
+    # where its slope c1 + 2 c2 u + 3 c3 u^2 is zero (numpy's roots: 0.2 ms a call)
+    A, B, C = 3 * c[3], 2 * c[2], c[1]
+    if A:
+        disc = B * B - 4 * A * C
+        inner = [] if disc < 0 else [(-B + r) / (2 * A) for r in (disc ** 0.5, -disc ** 0.5)]
+    else:
+        inner = [-C / B] if B else []
+    return min(g[j], g[j + 1], *(c[0] + u * (c[1] + u * (c[2] + u * c[3]))
+                                 for u in inner if 0 < u < 1))
+
+
+def _cubic_root(c, s):
+    """A root in [0, 1] of the cubic of coefficients ``c`` (``_cubic``), positive at 0 and
+    at or below zero at 1: Newton's steps from ``s`` (the straight line's root), kept within
+    the bracket that narrows as they go."""
+    lo, hi = 0.0, 1.0
+    for _ in range(ROOT_STEPS):
+        value = c[0] + s * (c[1] + s * (c[2] + s * c[3]))
+        if value > 0:
+            lo = s
+        else:
+            hi = s
+        slope = c[1] + s * (2 * c[2] + 3 * s * c[3])
+        nxt = s - value / slope if slope else (lo + hi) / 2
+        if not lo <= nxt <= hi:
+            nxt = (lo + hi) / 2
+        if abs(nxt - s) <= 1e-15:
+            return nxt
+        s = nxt
+    return s
+
+
 def _search(g, rate, t0, t1, crossed, dipped):
     """The earliest crossing in (t0, t1] of the indicators ``g(t, i)``, with rates
     ``rate(t, i)``: (time, element) or None. ``crossed``: elements at or below zero at t1;
@@ -514,6 +652,34 @@ def _search(g, rate, t0, t1, crossed, dipped):
     return best
 
 
+class _Steps:
+    """The cubic Hermite curve through states X at times T (the points of one integration),
+    made a step at a time where it is read: each step's two rates in one call of
+    ``rates(T, X)``, not those of every point."""
+
+    def __init__(self, T, X, rates):
+        self.T, self.X, self.rates = [float(t) for t in T], X, rates
+        self._made = {}
+
+    def piece(self, j):
+        """The curve's step j, as a ``_Hermite``."""
+        if j not in self._made:
+            T, X = np.asarray(self.T[j:j + 2]), self.X[j:j + 2]
+            self._made[j] = _Hermite(T, X, self.rates(T, X))
+        return self._made[j]
+
+    def step(self, t):
+        """The step the curve's time ``t`` is on."""
+        return min(max(bisect.bisect_right(self.T, t) - 1, 0), len(self.T) - 2)
+
+    def __call__(self, t):
+        return self.piece(self.step(t))(t)
+
+    def fits(self, rates, tol, step):
+        """``_Hermite.fits`` on the one ``step``."""
+        return self.piece(step).fits(rates, tol)
+
+
 class _Hermite:
     """The cubic Hermite curve through states X at times T with rates F, as a cubic in
     s = (t - T[j]) / h on each step h. Its error, h^4/384 |d4x/dt4| at most, is read off
@@ -526,25 +692,31 @@ class _Hermite:
         self.cubic = (x0, f0, 3 * (x1 - x0) - 2 * f0 - f1, 2 * (x0 - x1) + f0 + f1)
         self.scale = np.max(np.abs(X), axis=0)
 
+    def step(self, t):
+        """The step the curve's time ``t`` is on."""
+        return min(max(bisect.bisect_right(self.T, t) - 1, 0), len(self.T) - 2)
+
     def _step(self, t):
-        T = self.T
-        j = min(max(bisect.bisect_right(T, t) - 1, 0), len(T) - 2)
-        return j, (t - T[j]) / (T[j + 1] - T[j])
+        j = self.step(t)
+        return j, (t - self.T[j]) / (self.T[j + 1] - self.T[j])
 
     def __call__(self, t):
         j, s = self._step(t)
         a, b, c, d = (k[j] for k in self.cubic)
         return a + s * (b + s * (c + s * d))
 
-    def fits(self, rates, tol):
+    def fits(self, rates, tol, step=None):
         """Whether the curve is within FIT of the tolerances ``tol`` = (rtol, atol) of the
         solution through its points: its error at most h/6 times its rate's distance from
         the equations' (``rates(T, X)``, at many points at once) at a quarter, half and three
         quarters of each step (a quartic error's, largest at the middle, is h/6 times its
-        rate's at the quarters)."""
+        rate's at the quarters); of the one ``step`` when given."""
         rtol, atol = tol
         a, b, c, d = self.cubic
         T = np.asarray(self.T)
+        if step is not None:
+            a, b, c, d = (k[step:step + 1] for k in self.cubic)
+            T = T[step:step + 2]
         h = np.diff(T)[:, None]
         points, defects = [], []
         for s in (0.25, 0.5, 0.75):
