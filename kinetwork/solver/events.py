@@ -432,35 +432,50 @@ class Events:
 
     def _search_steps(self, curve, T, X, crossed, dipped):
         """``_search`` along ``curve`` through the points (T, X) of one integration, each
-        indicator on the step its values and rates at the points (one mapped call for all)
-        bracket: a crossing on the step where it is first at or below zero, from the root
-        of the cubic through its values and rates there (``_root``); a dip, where it is
-        lowest, only when that cubic reaches zero there (else it stays above: no event).
+        indicator on the step its values at the points (one mapped call of the indicators
+        alone) bracket: a crossing on the step where it is first at or below zero, from the
+        root of the cubic through its values and rates there (``_root``); a dip, where it is
+        lowest, only when that cubic reaches zero there (else it stays above: no event). The
+        rates, which read the whole equations, at those steps' points alone (one more call).
         An indicator at or below zero at T[0] (a restart's) is searched over the whole."""
-        G, R = self._rows(T, X)
-        best = None
+        G = self._level_rows(T, X)
+        windows = []                            # (indicator, a dip, first point, last point)
         for i, dip in [*((i, False) for i in crossed), *((i, True) for i in dipped)]:
             below = np.flatnonzero(G[1:, i] <= 0)
-            got = None
             if G[0, i] <= 0:
-                got = _search(lambda t, k: self.levels(t, curve(t))[k],
-                              lambda t, k: self.indicators(t, curve(t))[1][k], T[0], T[-1],
-                              *(([], [i]) if dip else ([i], [])))
+                windows.append((i, dip, 0, len(T) - 1))
             elif len(below):
-                j = below[0]
-                if best is None or T[j] < best[0]:
-                    got = (self._root(curve, T, G[:, i], R[:, i], j, i), i)
+                windows.append((i, False, below[0], below[0] + 1))
             elif dip:
                 low = int(np.argmin(G[:, i]))
-                a, b = max(low - 1, 0), min(low + 1, len(T) - 1)
-                if min(_cubic_low(T, G[:, i], R[:, i], j) for j in range(a, b)) <= 0 and \
-                        (best is None or T[a] < best[0]):
-                    got = _search(lambda t, k: self.levels(t, curve(t))[k],
-                                  lambda t, k: self.indicators(t, curve(t))[1][k],
-                                  T[a], T[b], [], [i])
+                windows.append((i, True, max(low - 1, 0), min(low + 1, len(T) - 1)))
+        steps = [w for w in windows if w[3] - w[2] <= 2]
+        points = sorted({k for w in steps for k in range(w[2], w[3] + 1)})
+        R = np.full(G.shape, np.nan)
+        if points:
+            R[points] = self._rows(T[points], X[points])[1]
+        best = None
+        for i, dip, a, b in sorted(windows, key=lambda w: w[2]):
+            if best is not None and T[a] >= best[0]:
+                break
+            got = None
+            if b - a > 2:                       # the whole interval, after a restart
+                got = _search(lambda t, k: self.levels(t, curve(t))[k],
+                              lambda t, k: self.indicators(t, curve(t))[1][k], T[a], T[b],
+                              *(([], [i]) if dip else ([i], [])))
+            elif not dip:
+                got = (self._root(curve, T, G[:, i], R[:, i], a, i), i)
+            elif min(_cubic_low(T, G[:, i], R[:, i], j) for j in range(a, b)) <= 0:
+                got = _search(lambda t, k: self.levels(t, curve(t))[k],
+                              lambda t, k: self.indicators(t, curve(t))[1][k],
+                              T[a], T[b], [], [i])
             if got is not None and (best is None or got[0] < best[0]):
                 best = got
         return best
+
+    def _level_rows(self, times, rows):
+        """The indicators alone, (len(rows), k), at each row."""
+        return np.hstack([s.level_rows(times, rows) for s in self.sources])
 
     def _root(self, curve, T, g, rate, j, i):
         """The time indicator i crosses zero on ``curve``'s step j (above zero at T[j], at or
