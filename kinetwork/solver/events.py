@@ -118,6 +118,7 @@ class Events:
         #: next crossing is foreseen at from there (``chunk``)
         self._at = None
         self._foreseen = None
+        self._cut = 0                   # the last chunk's length, when the forecast cut it
         #: the runs of the method started to locate an event, and the counts of the work
         #: they did (``spent``: the run's statistics hold it)
         self._trials = []
@@ -161,13 +162,19 @@ class Events:
         the output time ``t`` the chunk starts after, no more than reach the next crossing
         the indicators foresee (``_foresee``): what a chunk integrates past its first event
         is integrated again (EngineV6: two thirds of its evaluations, when each chunk after
-        an event went EVENT_CHUNK intervals and its events come every three)."""
+        an event went EVENT_CHUNK intervals and its events come every three). A chunk the
+        forecast cut short that met no event makes the next one at least twice as long: an
+        indicator that keeps nearing zero without crossing it (a tangency, a stuck friction's
+        margin at rest) costs a few short chunks, not one per output interval."""
         self._chunk = EVENT_CHUNK if event else min(2 * self._chunk, MAX_EVENT_CHUNK)
-        chunk = min(chunk, self._chunk)
+        chunk, cut = min(chunk, self._chunk), self._cut
+        self._cut = 0
         if t is not None and self._foreseen is not None and self._foreseen > t:
-            spacing = self.run.spacing
-            reach = int(np.ceil((self._foreseen - t) / spacing - 1e-9))
-            chunk = max(1, min(chunk, reach))
+            reach = int(np.ceil((self._foreseen - t) / self.run.spacing - 1e-9))
+            if not event:
+                reach = max(reach, 2 * cut)
+            if reach < chunk:
+                chunk = self._cut = max(1, reach)
         return chunk
 
     def bound(self, t):
@@ -208,6 +215,7 @@ class Events:
         self._chunk = EVENT_CHUNK
         self._two_fit = {}
         self._at = self._foreseen = None
+        self._cut = 0
         self._trials, self.spent = [], {}
         if self.switches is not None:
             self.switches.r = self._held.copy()

@@ -108,3 +108,22 @@ def test_event_times_agree_with_a_run_a_thousand_times_tighter(counted, engine):
     a, b = instants(res), instants(tight)
     assert len(a) == len(b)
     np.testing.assert_allclose(a, b, rtol=0, atol=1e-8)
+
+
+def test_a_forecast_that_keeps_falling_short_does_not_cut_every_chunk():
+    """An indicator nearing zero without crossing it (a tangency, a stuck friction's margin
+    at rest) foresees a crossing one output interval ahead at every chunk: the chunks the
+    forecast cuts short, meeting no event, double (1, 2, 4, ... up to the rule's own),
+    so such a stretch costs a few integrator calls, not one per interval; after an event the
+    forecast holds again."""
+    ev = events_module.Events.__new__(events_module.Events)
+    ev.run = type("Run", (), {"spacing": 0.01})()
+    ev._chunk, ev._cut = events_module.EVENT_CHUNK, 0
+    lengths, t = [], 0.0
+    for _ in range(8):
+        ev._foreseen = t + 0.005                 # always half an interval ahead
+        lengths.append(ev.chunk(1000, False, t))
+        t += lengths[-1] * 0.01
+    assert lengths == [1, 2, 4, 8, 16, 32, 64, 128]
+    ev._foreseen = t + 0.025
+    assert ev.chunk(1000, True, t) == 3
