@@ -42,7 +42,7 @@ import common
 from common import load, machine, table, write_markdown
 
 import kinetwork as kn
-from kinetwork.solver import compiled as compiled_module, events, methods
+from kinetwork.solver import compiled as compiled_module, curves, events, methods
 
 NAME = "study_engine_cached"
 #: what earlier rounds measured, for comparison (the same study, other code)
@@ -80,7 +80,7 @@ def timed_parts():
                wrap(methods._CasadiRun, "grid", "grid"),
                wrap(events.Events, "levels", "levels"),
                wrap(events.Events, "indicators", "indicators")]
-    fits, dense_fits = events._Hermite.fits, events._Steps.fits
+    fits, dense_fits = curves.Hermite.fits, curves.Steps.fits
     inside = []
 
     def counted(self, rates, tol, step=None):
@@ -95,8 +95,8 @@ def timed_parts():
             return dense_fits(self, rates, tol, step)
         finally:
             inside.pop()
-    patches += [mock.patch.object(events._Hermite, "fits", counted),
-                mock.patch.object(events._Steps, "fits", counted_dense)]
+    patches += [mock.patch.object(curves.Hermite, "fits", counted),
+                mock.patch.object(curves.Steps, "fits", counted_dense)]
     return patches, spent, count
 
 

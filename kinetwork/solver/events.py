@@ -14,18 +14,21 @@ SAMPLES - 1 points between each two, or more, so that they are looked at LATTICE
 at least whatever its output grid. An event is an indicator going from positive to zero or
 below between two of those points, or one above zero at both but falling, then rising, whose
 minimum between them (where its rate is zero) reaches zero: a friction sticking for less
-than the sampled interval, a contact shorter than it. It is located by Brent's method on the
-indicator along the cubic Hermite curve through states and their rates, so that the trial
-times cost no integration: the curve through the two sampled rows, else through DENSE points
-of one integration of the same method from the row before, whichever is within FIT of the
-solver's tolerances (its rate checked against the equations' at three points of each step).
-On a curve that is not, Newton's steps on the integration from the point before take the time
-found to the integration's own root (a method without that one integration, IDAS or fixed
-steps, and a crossing the curve sees and the integration does not: every trial time
-integrated from the row before). The time is as exact as the integration, to about 1e-14 s
-in the bracketing itself; the source applies the event, and the method starts afresh there.
-Events are logged (time,
-component, kind) for ``res.stats["events"]``; time events are counted
+than the sampled interval, a contact shorter than it. It is located on the indicator along
+the cubic Hermite curve through states and their rates, so that the trial times cost no
+integration: by Brent's method on the curve through the two sampled rows when that is within
+FIT (``curves.py``) of the solver's tolerances (its rate checked against the equations' at
+three points), else on the curve through DENSE points of one integration of the same method
+from the row before: the indicators' values there (one mapped call) bracket the crossing to
+one step, the cubic through the indicator's values and rates at its two points gives the
+root, Newton's steps along the curve settle it (``curves.root``), and the curve is checked on
+that step alone. On a curve that is not within FIT, Newton's steps on the integration from
+the point before take the time found to the integration's own root (a method without that
+one integration, IDAS or fixed steps, and a crossing the curve sees and the integration does
+not: every trial time integrated from the row before). The time is as exact as the
+integration, to about 1e-14 s in the bracketing itself; the source applies the event, and
+the method starts afresh there. Events are logged (time, component, kind) for
+``res.stats["events"]``; time events are counted
 (``res.stats["time_events"]``).
 
 Two crossings between two sampled points, which cancel out, are seen when the indicator has
@@ -33,16 +36,17 @@ one minimum between them, not when it also has a maximum there (right after an e
 indicator at zero counts as positive, so a bounce within the first interval is found). Runs
 with state events go in chunks of EVENT_CHUNK output intervals after an event, as what
 follows an event in a chunk is computed again, twice as many after each chunk without one, up
-to MAX_EVENT_CHUNK (each chunk restarts a multistep method); a fixed-step method steps each
-sampled interval, so its steps are SAMPLES times shorter than without them.
+to MAX_EVENT_CHUNK (each chunk restarts a multistep method), and no further than FORESEE
+times the time the indicators' rates foresee the next crossing at (``Events.chunk``); a
+fixed-step method steps each sampled interval, so its steps are SAMPLES times shorter than
+without them. The integrations that locate events are counted in the run's statistics.
 """
-
-import bisect
 
 import numpy as np
 
 from .buffers import PointsBySize
 from .compiled import numeric
+from .curves import Hermite, Steps, cubic_low, root, search
 from .explicit import rk4
 from .methods import Failure, _add_counts
 from .modechange import ModeChanges
@@ -66,22 +70,12 @@ SAME_INSTANT = 1e-13
 ZENO_LIMIT = 200
 #: trial intervals shorter than this (relative to the time) are stepped by RK4 directly
 SHORT = 1e-6
-#: where, as fractions of the interval, an indicator that starts at zero after a restart is
-#: looked for above zero (it leaves zero rising: first right after the start)
-SCAN = np.array([1e-12, 1e-9, 1e-6, 1e-3, *np.arange(1, 16) / 16])
 #: points of the one integration over a sampled interval an event is located on (between
 #: them, a cubic Hermite curve)
 DENSE = 32
-#: how close to the solution, as a fraction of the solver's tolerances, a curve is taken as it
-#: is (its states are the event's): as close as the integration's own points are, which
-#: CVODES interpolates between its steps (right after a start, at order one or two, to about
-#: half its tolerances on EngineV6)
-FIT = 1.0
 #: Newton's steps at most from the time found on a curve not within FIT to the integration's
 #: own root, on the side where it has crossed
 POLISH = 4
-#: Newton's steps at most on an indicator along a curve's step (``Events._root``)
-ROOT_STEPS = 8
 #: a chunk reaches this many times as far as the indicators, each going on as fast as now,
 #: foresee the next crossing (``Events.chunk``): most approach zero slowing down (a piston
 #: nearing its dead centre). On EngineV6, rhs evaluations and integrator calls by factor:
@@ -363,7 +357,7 @@ class Events:
                                                                    exact=True)[0]
             return cache[t]
 
-        best = _search(lambda t, i: self.levels(t, state(t))[i],
+        best = search(lambda t, i: self.levels(t, state(t))[i],
                        lambda t, i: self.indicators(t, state(t))[1][i],
                        t0, t1, crossed, dipped)
         if best is None:
@@ -389,10 +383,10 @@ class Events:
         law = (tuple(crossed), tuple(dipped), self.run.p_solver.tobytes())
         if x1 is not None and self._two_fit.get(law, True):
             T, X = np.array([t0, t1]), np.vstack([x0, x1])
-            curve = _Hermite(T, X, rates(T, X))
+            curve = Hermite(T, X, rates(T, X))
             fitted = self._two_fit[law] = curve.fits(rates, tol)
         if fitted:
-            best = _search(lambda t, i: self.levels(t, curve(t))[i],
+            best = search(lambda t, i: self.levels(t, curve(t))[i],
                            lambda t, i: self.indicators(t, curve(t))[1][i],
                            t0, t1, crossed, dipped)
         else:
@@ -403,7 +397,7 @@ class Events:
             T = np.concatenate([[t0], t0 + (t1 - t0) * np.arange(1, DENSE + 1) / DENSE])
             T[-1] = t1
             X = np.vstack([x0[None, :], rows])
-            curve = _Steps(T, X, rates)
+            curve = Steps(T, X, rates)
             best = self._search_steps(curve, T, X, crossed, dipped)
             # the curve is checked where the time found is read off it, on that step alone
             # (its points are the integration's: elsewhere it decides nothing)
@@ -439,11 +433,11 @@ class Events:
         return crossed_at if crossed_at is not None else _UNSURE
 
     def _search_steps(self, curve, T, X, crossed, dipped):
-        """``_search`` along ``curve`` through the points (T, X) of one integration, each
+        """``search`` along ``curve`` through the points (T, X) of one integration, each
         indicator on the step its values at the points (one mapped call of the indicators
         alone) bracket: a crossing on the step where it is first at or below zero, from the
-        root of the cubic through its values and rates there (``_root``); a dip, where it is
-        lowest, only when that cubic reaches zero there (else it stays above: no event). The
+        root of the cubic through its values and rates there (``curves.root``); a dip, where
+        it is lowest, only when that cubic reaches zero there (else it stays above). The
         rates, which read the whole equations, at those steps' points alone (one more call).
         An indicator at or below zero at T[0] (a restart's) is searched over the whole."""
         G = self._level_rows(T, X)
@@ -468,15 +462,16 @@ class Events:
                 break
             got = None
             if b - a > 2:                       # the whole interval, after a restart
-                got = _search(lambda t, k: self.levels(t, curve(t))[k],
-                              lambda t, k: self.indicators(t, curve(t))[1][k], T[a], T[b],
-                              *(([], [i]) if dip else ([i], [])))
+                got = search(lambda t, k: self.levels(t, curve(t))[k],
+                             lambda t, k: self.indicators(t, curve(t))[1][k], T[a], T[b],
+                             *(([], [i]) if dip else ([i], [])))
             elif not dip:
-                got = (self._root(curve, T, G[:, i], R[:, i], a, i), i)
-            elif min(_cubic_low(T, G[:, i], R[:, i], j) for j in range(a, b)) <= 0:
-                got = _search(lambda t, k: self.levels(t, curve(t))[k],
-                              lambda t, k: self.indicators(t, curve(t))[1][k],
-                              T[a], T[b], [], [i])
+                got = (root(lambda t, i=i: self.levels(t, curve(t))[i], T, G[:, i], R[:, i],
+                            a), i)
+            elif min(cubic_low(T, G[:, i], R[:, i], j) for j in range(a, b)) <= 0:
+                got = search(lambda t, k: self.levels(t, curve(t))[k],
+                             lambda t, k: self.indicators(t, curve(t))[1][k],
+                             T[a], T[b], [], [i])
             if got is not None and (best is None or got[0] < best[0]):
                 best = got
         return best
@@ -484,43 +479,6 @@ class Events:
     def _level_rows(self, times, rows):
         """The indicators alone, (len(rows), k), at each row."""
         return np.hstack([s.level_rows(times, rows) for s in self.sources])
-
-    def _root(self, curve, T, g, rate, j, i):
-        """The time indicator i crosses zero on ``curve``'s step j (above zero at T[j], at or
-        below at T[j + 1]; values ``g`` and rates ``rate`` at the points), on the side where
-        it has crossed: from the root of the cubic through those values and rates (off the
-        indicator's own by about h^4 times its fourth derivative, on a step of h), Newton's
-        steps on the indicator along the curve with that cubic's slope, bracketed; Brent's
-        method if they do not settle."""
-        a, b = float(T[j]), float(T[j + 1])
-        h = b - a
-        c = _cubic(g[j], g[j + 1], rate[j] * h, rate[j + 1] * h)
-        t = a + h * _cubic_root(c, g[j] / (g[j] - g[j + 1]))
-        tiny = 4 * np.finfo(float).eps * max(1.0, abs(b))
-        for _ in range(ROOT_STEPS):
-            level = self.levels(t, curve(t))[i]
-            if level <= 0:
-                b = t
-            else:
-                a = t
-            if b - a <= 2 * tiny:
-                return b
-            u = (t - T[j]) / h
-            slope = (c[1] + u * (2 * c[2] + 3 * u * c[3])) / h
-            step = -level / slope if slope < 0 else np.nan
-            if level <= 0 and -step <= tiny:
-                return b                        # at the root, to rounding
-            t = t + step + (tiny if level > 0 else 0.0)
-            if not a < t < b:
-                t = (a + b) / 2
-
-        def level(t):
-            return self.levels(t, curve(t))[i]
-        if not level(a) > 0 >= level(b):
-            return b
-        from scipy.optimize import brentq
-        t = brentq(level, a, b, xtol=1e-15, rtol=4 * np.finfo(float).eps, maxiter=200)
-        return t if level(t) <= 0 else min(b, t + tiny)
 
     def _tolerance(self, method):
         """(rtol, atol) the method's solver is given for this run (``tolerance.py``)."""
@@ -589,164 +547,3 @@ def _refined(t0, times, spacing=None):
 
 #: what ``_locate_dense`` answers when the exact search must decide
 _UNSURE = object()
-
-
-def _cubic(g0, g1, r0, r1):
-    """The coefficients (of 1, s, s^2, s^3) of the cubic in s in [0, 1] with values g0, g1
-    and slopes r0, r1 (per unit of s) at its ends."""
-    return (g0, r0, 3 * (g1 - g0) - 2 * r0 - r1, 2 * (g0 - g1) + r0 + r1)
-
-
-def _cubic_low(T, g, rate, j):
-    """The lowest value on step j of the cubic through values ``g`` and rates ``rate`` at
-    the points T."""
-    h = T[j + 1] - T[j]
-    c = _cubic(g[j], g[j + 1], rate[j] * h, rate[j + 1] * h)
-    # where its slope c1 + 2 c2 u + 3 c3 u^2 is zero (numpy's roots: 0.2 ms a call)
-    A, B, C = 3 * c[3], 2 * c[2], c[1]
-    if A:
-        disc = B * B - 4 * A * C
-        inner = [] if disc < 0 else [(-B + r) / (2 * A) for r in (disc ** 0.5, -disc ** 0.5)]
-    else:
-        inner = [-C / B] if B else []
-    return min(g[j], g[j + 1], *(c[0] + u * (c[1] + u * (c[2] + u * c[3]))
-                                 for u in inner if 0 < u < 1))
-
-
-def _cubic_root(c, s):
-    """A root in [0, 1] of the cubic of coefficients ``c`` (``_cubic``), positive at 0 and
-    at or below zero at 1: Newton's steps from ``s`` (the straight line's root), kept within
-    the bracket that narrows as they go."""
-    lo, hi = 0.0, 1.0
-    for _ in range(ROOT_STEPS):
-        value = c[0] + s * (c[1] + s * (c[2] + s * c[3]))
-        if value > 0:
-            lo = s
-        else:
-            hi = s
-        slope = c[1] + s * (2 * c[2] + 3 * s * c[3])
-        nxt = s - value / slope if slope else (lo + hi) / 2
-        if not lo <= nxt <= hi:
-            nxt = (lo + hi) / 2
-        if abs(nxt - s) <= 1e-15:
-            return nxt
-        s = nxt
-    return s
-
-
-def _search(g, rate, t0, t1, crossed, dipped):
-    """The earliest crossing in (t0, t1] of the indicators ``g(t, i)``, with rates
-    ``rate(t, i)``: (time, element) or None. ``crossed``: elements at or below zero at t1;
-    ``dipped``: above zero at both ends with a minimum between, which cross if it reaches
-    zero. The time is on the side of the root where the indicator has crossed."""
-    from scipy.optimize import brentq          # 0.3 s to import: only with events
-
-    tight = dict(xtol=1e-15, rtol=4 * np.finfo(float).eps, maxiter=200)
-    best = None
-    for i in dipped:
-        if not rate(t0, i) < 0 < rate(t1, i):     # integrated again: not quite as sampled
-            continue
-        t_min = brentq(rate, t0, t1, args=(i,), **tight)
-        if g(t_min, i) > 0:
-            continue                    # a minimum above zero: no event
-        t_i = brentq(g, t0, t_min, args=(i,), **tight)
-        if g(t_i, i) > 0:
-            t_i = min(t_min, t_i + max(abs(t_i), 1.0) * 4 * np.finfo(float).eps)
-        if best is None or t_i < best[0]:
-            best = (t_i, i)
-    for i in crossed:
-        start = t0
-        if g(t0, i) <= 0:         # at zero after a restart: where it was above zero
-            start = next((t for t in t0 + (t1 - t0) * SCAN if g(t, i) > 0), None)
-            if start is None:     # it fell back at once: an event where it started
-                if best is None or t0 < best[0]:
-                    best = (t0, i)
-                continue
-        if g(t1, i) >= 0.0:
-            # at t1 itself, or (integrated again from t0) just short of crossing there
-            t_i = t1
-        else:
-            t_i = brentq(g, start, t1, args=(i,), **tight)
-            # the side of the root where the indicator has crossed
-            if g(t_i, i) > 0:
-                t_i = min(t1, t_i + max(abs(t_i), 1.0) * 4 * np.finfo(float).eps)
-        if best is None or t_i < best[0]:
-            best = (t_i, i)
-    return best
-
-
-class _Steps:
-    """The cubic Hermite curve through states X at times T (the points of one integration),
-    made a step at a time where it is read: each step's two rates in one call of
-    ``rates(T, X)``, not those of every point."""
-
-    def __init__(self, T, X, rates):
-        self.T, self.X, self.rates = [float(t) for t in T], X, rates
-        self._made = {}
-
-    def piece(self, j):
-        """The curve's step j, as a ``_Hermite``."""
-        if j not in self._made:
-            T, X = np.asarray(self.T[j:j + 2]), self.X[j:j + 2]
-            self._made[j] = _Hermite(T, X, self.rates(T, X))
-        return self._made[j]
-
-    def step(self, t):
-        """The step the curve's time ``t`` is on."""
-        return min(max(bisect.bisect_right(self.T, t) - 1, 0), len(self.T) - 2)
-
-    def __call__(self, t):
-        return self.piece(self.step(t))(t)
-
-    def fits(self, rates, tol, step):
-        """``_Hermite.fits`` on the one ``step``."""
-        return self.piece(step).fits(rates, tol)
-
-
-class _Hermite:
-    """The cubic Hermite curve through states X at times T with rates F, as a cubic in
-    s = (t - T[j]) / h on each step h. Its error, h^4/384 |d4x/dt4| at most, is read off
-    the equations: the curve's rate less the equations' at points of each step."""
-
-    def __init__(self, T, X, F):
-        self.T = [float(t) for t in T]
-        h = np.diff(T)[:, None]
-        x0, x1, f0, f1 = X[:-1], X[1:], h * F[:-1], h * F[1:]
-        self.cubic = (x0, f0, 3 * (x1 - x0) - 2 * f0 - f1, 2 * (x0 - x1) + f0 + f1)
-        self.scale = np.max(np.abs(X), axis=0)
-
-    def step(self, t):
-        """The step the curve's time ``t`` is on."""
-        return min(max(bisect.bisect_right(self.T, t) - 1, 0), len(self.T) - 2)
-
-    def _step(self, t):
-        j = self.step(t)
-        return j, (t - self.T[j]) / (self.T[j + 1] - self.T[j])
-
-    def __call__(self, t):
-        j, s = self._step(t)
-        a, b, c, d = (k[j] for k in self.cubic)
-        return a + s * (b + s * (c + s * d))
-
-    def fits(self, rates, tol, step=None):
-        """Whether the curve is within FIT of the tolerances ``tol`` = (rtol, atol) of the
-        solution through its points: its error at most h/6 times its rate's distance from
-        the equations' (``rates(T, X)``, at many points at once) at a quarter, half and three
-        quarters of each step (a quartic error's, largest at the middle, is h/6 times its
-        rate's at the quarters); of the one ``step`` when given."""
-        rtol, atol = tol
-        a, b, c, d = self.cubic
-        T = np.asarray(self.T)
-        if step is not None:
-            a, b, c, d = (k[step:step + 1] for k in self.cubic)
-            T = T[step:step + 2]
-        h = np.diff(T)[:, None]
-        points, defects = [], []
-        for s in (0.25, 0.5, 0.75):
-            points.append((T[:-1] + s * h[:, 0], a + s * (b + s * (c + s * d))))
-            defects.append((b + s * (2 * c + 3 * s * d)) / h)
-        times = np.concatenate([p[0] for p in points])
-        states = np.vstack([p[1] for p in points])
-        defect = np.vstack(defects) - rates(times, states)
-        error = np.abs(defect) * np.tile(h, (3, 1)) / 6
-        return bool(np.all(error <= FIT * (atol + rtol * self.scale)))

@@ -7,6 +7,7 @@ import numpy as np
 import pytest
 
 import kinetwork as kn
+from kinetwork.solver import curves
 from kinetwork.solver import events as events_module
 from kinetwork.solver import methods
 from scenes.bumps import ball, ball_reference
@@ -52,7 +53,7 @@ def test_the_curve_through_two_rows_is_not_tried_again_where_it_did_not_fit(monk
     one integration over the interval (before: tried on each of the four rises), whose
     curve is checked on the one step the contact time is read off."""
     tried, dense = [], []
-    fits, dense_fits = events_module._Hermite.fits, events_module._Steps.fits
+    fits, dense_fits = curves.Hermite.fits, curves.Steps.fits
 
     def counted(self, rates, tol, step=None):
         ok = fits(self, rates, tol, step)
@@ -65,8 +66,8 @@ def test_the_curve_through_two_rows_is_not_tried_again_where_it_did_not_fit(monk
         ok = dense_fits(self, rates, tol, step)
         dense[-1] = len(self.T)
         return ok
-    monkeypatch.setattr(events_module._Hermite, "fits", counted)
-    monkeypatch.setattr(events_module._Steps, "fits", counted_dense)
+    monkeypatch.setattr(curves.Hermite, "fits", counted)
+    monkeypatch.setattr(curves.Steps, "fits", counted_dense)
     res = kn.simulate(ball(), t_end=3.0, n_points=301, method="cvodes-adams", rtol=1e-10,
                       atol=1e-12)
     assert len(res.stats["events"]) == 8
