@@ -192,6 +192,7 @@ class Events:
         re-partitioned): the relations as that System's equations hold them, read there."""
         if self.switches is None:
             return
+        self._at = None                 # read by the other System's relations from here
         count = self.switches.time_events
         relations = self.run.system.relations
         self.switches = Switches(self, self.run, relations) if relations is not None else None
