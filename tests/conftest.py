@@ -58,6 +58,11 @@ def jit_cache(tmp_path_factory):
     else:
         folder = tmp_path_factory.mktemp("kinetwork-cache")
     mp.setenv("KINETWORK_CACHE", str(folder))
+    # a large function stays at its quick library: no optimised build in a background process
+    # that outlives the test which started it (one 3-D 128-link right-hand side is ~35 s of
+    # compiler time, unseen by the test's own accounting, the whole run long); the tiers are
+    # tested where they are the subject (tests/solver/test_jit_tiers.py)
+    mp.setenv("KINETWORK_JIT_LEVEL", "quick")
     yield
     mp.undo()
 

@@ -23,6 +23,12 @@ from kinetwork.solver.compiled import numeric
 pytestmark = pytest.mark.skipif(jit.compiler() is None, reason="no C compiler")
 
 
+@pytest.fixture(autouse=True)
+def tiered(monkeypatch):
+    """The default tiers (the suite runs at the quick level: tests/conftest.py)."""
+    monkeypatch.setenv("KINETWORK_JIT_LEVEL", "tiered")
+
+
 @pytest.fixture
 def cache(tmp_path, monkeypatch):
     monkeypatch.setenv("KINETWORK_CACHE", str(tmp_path / "cache"))
