@@ -98,6 +98,51 @@ def root(level, T, g, rate, j):
     return t if level(t) <= 0 else min(b, t + tiny)
 
 
+def search_steps(events, curve, T, X, crossed, dipped):
+    """``search`` for ``events`` (an ``events.Events``) along ``curve`` through the points
+    (T, X) of one integration, each indicator on the step its values at the points (one
+    mapped call of the indicators alone) bracket: a crossing on the step where it is first at or below zero, from the
+    root of the cubic through its values and rates there (``curves.root``); a dip, where
+    it is lowest, only when that cubic reaches zero there (else it stays above). The
+    rates, which read the whole equations, at those steps' points alone (one more call).
+    An indicator at or below zero at T[0] (a restart's) is searched over the whole."""
+    G = events._level_rows(T, X)
+    windows = []                            # (indicator, a dip, first point, last point)
+    for i, dip in [*((i, False) for i in crossed), *((i, True) for i in dipped)]:
+        below = np.flatnonzero(G[1:, i] <= 0)
+        if G[0, i] <= 0:
+            windows.append((i, dip, 0, len(T) - 1))
+        elif len(below):
+            windows.append((i, False, below[0], below[0] + 1))
+        elif dip:
+            low = int(np.argmin(G[:, i]))
+            windows.append((i, True, max(low - 1, 0), min(low + 1, len(T) - 1)))
+    steps = [w for w in windows if w[3] - w[2] <= 2]
+    points = sorted({k for w in steps for k in range(w[2], w[3] + 1)})
+    R = np.full(G.shape, np.nan)
+    if points:
+        R[points] = events._rows(T[points], X[points])[1]
+    best = None
+    for i, dip, a, b in sorted(windows, key=lambda w: w[2]):
+        if best is not None and T[a] >= best[0]:
+            break
+        got = None
+        if b - a > 2:                       # the whole interval, after a restart
+            got = search(lambda t, k: events.levels(t, curve(t))[k],
+                         lambda t, k: events.indicators(t, curve(t))[1][k], T[a], T[b],
+                         *(([], [i]) if dip else ([i], [])))
+        elif not dip:
+            got = (root(lambda t, i=i: events.levels(t, curve(t))[i], T, G[:, i], R[:, i],
+                        a), i)
+        elif min(cubic_low(T, G[:, i], R[:, i], j) for j in range(a, b)) <= 0:
+            got = search(lambda t, k: events.levels(t, curve(t))[k],
+                         lambda t, k: events.indicators(t, curve(t))[1][k],
+                         T[a], T[b], [], [i])
+        if got is not None and (best is None or got[0] < best[0]):
+            best = got
+    return best
+
+
 def search(g, rate, t0, t1, crossed, dipped):
     """The earliest crossing in (t0, t1] of the indicators ``g(t, i)``, with rates
     ``rate(t, i)``: (time, element) or None. ``crossed``: elements at or below zero at t1;

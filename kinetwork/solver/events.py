@@ -46,7 +46,7 @@ import numpy as np
 
 from .buffers import PointsBySize
 from .compiled import numeric
-from .curves import Hermite, Steps, cubic_low, root, search
+from .curves import Hermite, Steps, search, search_steps
 from .explicit import rk4
 from .methods import Failure, _add_counts
 from .modechange import ModeChanges
@@ -399,7 +399,7 @@ class Events:
             T[-1] = t1
             X = np.vstack([x0[None, :], rows])
             curve = Steps(T, X, rates)
-            best = self._search_steps(curve, T, X, crossed, dipped)
+            best = search_steps(self, curve, T, X, crossed, dipped)
             # the curve is checked where the time found is read off it, on that step alone
             # (its points are the integration's: elsewhere it decides nothing)
             fitted = best is not None and curve.fits(rates, tol, curve.step(best[0]))
@@ -432,50 +432,6 @@ class Events:
             t_i = min(t1, max(t0, t_i + dt + (tiny * max(1.0, abs(t_i)) if g_i > 0 else 0)))
             x_i = exact(t_i)
         return crossed_at if crossed_at is not None else _UNSURE
-
-    def _search_steps(self, curve, T, X, crossed, dipped):
-        """``search`` along ``curve`` through the points (T, X) of one integration, each
-        indicator on the step its values at the points (one mapped call of the indicators
-        alone) bracket: a crossing on the step where it is first at or below zero, from the
-        root of the cubic through its values and rates there (``curves.root``); a dip, where
-        it is lowest, only when that cubic reaches zero there (else it stays above). The
-        rates, which read the whole equations, at those steps' points alone (one more call).
-        An indicator at or below zero at T[0] (a restart's) is searched over the whole."""
-        G = self._level_rows(T, X)
-        windows = []                            # (indicator, a dip, first point, last point)
-        for i, dip in [*((i, False) for i in crossed), *((i, True) for i in dipped)]:
-            below = np.flatnonzero(G[1:, i] <= 0)
-            if G[0, i] <= 0:
-                windows.append((i, dip, 0, len(T) - 1))
-            elif len(below):
-                windows.append((i, False, below[0], below[0] + 1))
-            elif dip:
-                low = int(np.argmin(G[:, i]))
-                windows.append((i, True, max(low - 1, 0), min(low + 1, len(T) - 1)))
-        steps = [w for w in windows if w[3] - w[2] <= 2]
-        points = sorted({k for w in steps for k in range(w[2], w[3] + 1)})
-        R = np.full(G.shape, np.nan)
-        if points:
-            R[points] = self._rows(T[points], X[points])[1]
-        best = None
-        for i, dip, a, b in sorted(windows, key=lambda w: w[2]):
-            if best is not None and T[a] >= best[0]:
-                break
-            got = None
-            if b - a > 2:                       # the whole interval, after a restart
-                got = search(lambda t, k: self.levels(t, curve(t))[k],
-                             lambda t, k: self.indicators(t, curve(t))[1][k], T[a], T[b],
-                             *(([], [i]) if dip else ([i], [])))
-            elif not dip:
-                got = (root(lambda t, i=i: self.levels(t, curve(t))[i], T, G[:, i], R[:, i],
-                            a), i)
-            elif min(cubic_low(T, G[:, i], R[:, i], j) for j in range(a, b)) <= 0:
-                got = search(lambda t, k: self.levels(t, curve(t))[k],
-                             lambda t, k: self.indicators(t, curve(t))[1][k],
-                             T[a], T[b], [], [i])
-            if got is not None and (best is None or got[0] < best[0]):
-                best = got
-        return best
 
     def _level_rows(self, times, rows):
         """The indicators alone, (len(rows), k), at each row."""
