@@ -14,14 +14,17 @@ Per way, what the run spent: integrators built and the time to build them, the i
 calls over the chunks (``_CasadiRun.call``), the locating of the events (``Events._locate``:
 the curves, their checks on the equations, Brent's method, the integrations to 32 points),
 the rest (indicators on the sampled rows, the loops' watch, the driver's Python), the
-right-hand-side evaluations and the events. The event times of both ways agree (the largest
+right-hand-side evaluations (those of the integrations that locate events included) and the
+events. The event times of both ways agree (the largest
 difference is printed).
 
-And the work of locating, per event (the same on every machine): the integrations over a
-sampled interval (``_CasadiRun.grid``), the curves checked against the equations
-(``_Hermite.fits``: through two sampled rows, or through the 33 points of an integration),
-and the trial times of Brent's method (the indicators alone, ``Events.levels``, and with
-their rates, ``Events.indicators``, which read the whole equations).
+And the work, the same on every machine: the model time the integrator calls go over (the
+run's 1.01 s and what is integrated again after an event), and per event located the
+integrations over a sampled interval (``_CasadiRun.grid``), the curves checked against the
+equations (``_Hermite.fits`` through two sampled rows; ``_Steps.fits``, the one step of the
+curve through the 33 points of an integration the time is read off), and the indicators
+evaluated one point at a time (alone, ``Events.levels``, and with their rates,
+``Events.indicators``, which read the whole equations).
 
 Writes ``results/study_engine_cached.md``. Run: ``python bench/study_engine_cached.py
 [--rounds R]``.
@@ -39,14 +42,18 @@ import common
 from common import load, machine, table, write_markdown
 
 import kinetwork as kn
-from kinetwork.solver import compiled as compiled_module, events, methods
+from kinetwork.solver import compiled as compiled_module, curves, events, methods
 
 NAME = "study_engine_cached"
 #: what earlier rounds measured, for comparison (the same study, other code)
 HISTORY = """Earlier: 2026-11-28, load 16.8: 4.46 s (kept), locating 2.11 s, integrator calls
 0.89 s, rest 1.21 s. 2026-11-29 before the events' round (issue 30 item 6), load 4.2: 4.62 s,
 locating 2.45 s, integrator calls 1.03 s, rest 1.40 s; per event 1.00 integration over a
-sampled interval, 1.00 two-row and 1.00 33-point curves checked, 19.6 + 16.7 trial times."""
+sampled interval, 1.00 two-row and 1.00 33-point curves checked, 19.6 + 16.7 trial times.
+2026-11-29 after that round, load 5.3: 3.88 s (kept), locating 1.85 s (339 events), integrator
+calls 1.07 s (351, 72186 evaluations, the 13962 of the locating integrations not counted),
+rest 0.98 s; the calls covered 2.95 s of model time (each chunk after an event went 8 output
+intervals; the next event came after about 3): two thirds of the integration thrown away."""
 MODEL = common.HERE.parent / "models" / "engine_v6" / "EngineV6.json"
 
 
@@ -58,6 +65,8 @@ def timed_parts():
         original = getattr(owner, name)
 
         def timed(*args, **kwargs):
+            if label == "integrate":        # the model time the call goes over
+                count["covered"] += float(args[3][-1]) - args[0].t
             start = time.process_time()
             try:
                 return original(*args, **kwargs)
@@ -71,12 +80,23 @@ def timed_parts():
                wrap(methods._CasadiRun, "grid", "grid"),
                wrap(events.Events, "levels", "levels"),
                wrap(events.Events, "indicators", "indicators")]
-    fits = events._Hermite.fits
+    fits, dense_fits = curves.Hermite.fits, curves.Steps.fits
+    inside = []
 
-    def counted(self, rates, tol):
-        count["fits", len(self.T) == 2] += 1
-        return fits(self, rates, tol)
-    patches.append(mock.patch.object(events._Hermite, "fits", counted))
+    def counted(self, rates, tol, step=None):
+        if not inside:                  # a curve through two sampled rows
+            count["fits", True] += 1
+        return fits(self, rates, tol, step)
+
+    def counted_dense(self, rates, tol, step):
+        count["fits", False] += 1      # a step of the curve through an integration's points
+        inside.append(True)
+        try:
+            return dense_fits(self, rates, tol, step)
+        finally:
+            inside.pop()
+    patches += [mock.patch.object(curves.Hermite, "fits", counted),
+                mock.patch.object(curves.Steps, "fits", counted_dense)]
     return patches, spent, count
 
 
@@ -122,7 +142,7 @@ def study(rounds):
                      f"{count['locate']}: {parts['locate']:.2f}", f"{rest:.2f}",
                      res.stats["rhs_evaluations"], len(res.stats["events"])])
         n = max(count["locate"], 1)
-        work.append([way, count["locate"], f"{count['grid'] / n:.2f}",
+        work.append([way, count["locate"], f"{count['covered']:.2f}", f"{count['grid'] / n:.2f}",
                      f"{count['fits', True] / n:.2f}", f"{count['fits', False] / n:.2f}",
                      f"{count['levels'] / n:.1f}", f"{count['indicators'] / n:.1f}"])
         print("  ", rows[-1], work[-1], flush=True)
@@ -148,9 +168,10 @@ def main():
                "rhs evaluations", "events"], rows), "",
         f"Event times of the two ways: largest difference {apart:.1e} s.", "",
         "The work of locating, per event located (counts: the same on every machine):", "",
-        table(["integrators", "events located", "integrations over a sampled interval",
-               "two-row curves checked", "33-point curves checked",
-               "indicators at trial times", "indicators with rates at trial times"], work),
+        table(["integrators", "events located", "model time the integrator calls cover [s]",
+               "integrations over a sampled interval", "two-row curves checked",
+               "steps of 33-point curves checked", "indicators at trial times",
+               "indicators with rates"], work),
         "", HISTORY])
     write_markdown(NAME, text)
     print(f"done in {time.perf_counter() - start:.0f} s", flush=True)

@@ -407,7 +407,7 @@ def _integrate(run, method):
             chunk = min(_next_chunk(run, m, _work(run, stepper.stats) - work_before,
                                     n - 1 - k), MAX_CHUNK)
             if run.events is not None and run.events.located:
-                chunk = run.events.chunk(chunk, restart_at is not None)
+                chunk = run.events.chunk(chunk, restart_at is not None, grid[k])
             chunk = parts.limit(chunk)
         elif run.events is not None and run.events.located:
             # a stepper goes on between chunks: they bound what an event makes it do again
@@ -416,6 +416,8 @@ def _integrate(run, method):
             run.stop_reason() is None and "singular" not in failure:
         failure += near_singular(run, X.array(), grid)
     stats = _merge(stats, stepper.stats)
+    if run.events is not None:              # the integrations that located its events
+        stats = _merge(stats, run.events.spent)
     if restarts:
         stats["restarts"] = [{"t": r["t"], "after": r["after"]} for r in restarts]
     stats.update(parts.done())

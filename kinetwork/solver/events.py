@@ -14,18 +14,21 @@ SAMPLES - 1 points between each two, or more, so that they are looked at LATTICE
 at least whatever its output grid. An event is an indicator going from positive to zero or
 below between two of those points, or one above zero at both but falling, then rising, whose
 minimum between them (where its rate is zero) reaches zero: a friction sticking for less
-than the sampled interval, a contact shorter than it. It is located by Brent's method on the
-indicator along the cubic Hermite curve through states and their rates, so that the trial
-times cost no integration: the curve through the two sampled rows, else through DENSE points
-of one integration of the same method from the row before, whichever is within FIT of the
-solver's tolerances (its rate checked against the equations' at three points of each step).
-On a curve that is not, Newton's steps on the integration from the point before take the time
-found to the integration's own root (a method without that one integration, IDAS or fixed
-steps, and a crossing the curve sees and the integration does not: every trial time
-integrated from the row before). The time is as exact as the integration, to about 1e-14 s
-in the bracketing itself; the source applies the event, and the method starts afresh there.
-Events are logged (time,
-component, kind) for ``res.stats["events"]``; time events are counted
+than the sampled interval, a contact shorter than it. It is located on the indicator along
+the cubic Hermite curve through states and their rates, so that the trial times cost no
+integration: by Brent's method on the curve through the two sampled rows when that is within
+FIT (``curves.py``) of the solver's tolerances (its rate checked against the equations' at
+three points), else on the curve through DENSE points of one integration of the same method
+from the row before: the indicators' values there (one mapped call) bracket the crossing to
+one step, the cubic through the indicator's values and rates at its two points gives the
+root, Newton's steps along the curve settle it (``curves.root``), and the curve is checked on
+that step alone. On a curve that is not within FIT, Newton's steps on the integration from
+the point before take the time found to the integration's own root (a method without that
+one integration, IDAS or fixed steps, and a crossing the curve sees and the integration does
+not: every trial time integrated from the row before). The time is as exact as the
+integration, to about 1e-14 s in the bracketing itself; the source applies the event, and
+the method starts afresh there. Events are logged (time, component, kind) for
+``res.stats["events"]``; time events are counted
 (``res.stats["time_events"]``).
 
 Two crossings between two sampled points, which cancel out, are seen when the indicator has
@@ -33,18 +36,19 @@ one minimum between them, not when it also has a maximum there (right after an e
 indicator at zero counts as positive, so a bounce within the first interval is found). Runs
 with state events go in chunks of EVENT_CHUNK output intervals after an event, as what
 follows an event in a chunk is computed again, twice as many after each chunk without one, up
-to MAX_EVENT_CHUNK (each chunk restarts a multistep method); a fixed-step method steps each
-sampled interval, so its steps are SAMPLES times shorter than without them.
+to MAX_EVENT_CHUNK (each chunk restarts a multistep method), and no further than FORESEE
+times the time the indicators' rates foresee the next crossing at (``Events.chunk``); a
+fixed-step method steps each sampled interval, so its steps are SAMPLES times shorter than
+without them. The integrations that locate events are counted in the run's statistics.
 """
-
-import bisect
 
 import numpy as np
 
 from .buffers import PointsBySize
 from .compiled import numeric
+from .curves import Hermite, Steps, search, search_steps
 from .explicit import rk4
-from .methods import Failure
+from .methods import Failure, _add_counts
 from .modechange import ModeChanges
 from .switches import Switches
 from .tolerance import solver_tolerances
@@ -66,20 +70,18 @@ SAME_INSTANT = 1e-13
 ZENO_LIMIT = 200
 #: trial intervals shorter than this (relative to the time) are stepped by RK4 directly
 SHORT = 1e-6
-#: where, as fractions of the interval, an indicator that starts at zero after a restart is
-#: looked for above zero (it leaves zero rising: first right after the start)
-SCAN = np.array([1e-12, 1e-9, 1e-6, 1e-3, *np.arange(1, 16) / 16])
 #: points of the one integration over a sampled interval an event is located on (between
 #: them, a cubic Hermite curve)
 DENSE = 32
-#: how close to the solution, as a fraction of the solver's tolerances, a curve is taken as it
-#: is (its states are the event's): as close as the integration's own points are, which
-#: CVODES interpolates between its steps (right after a start, at order one or two, to about
-#: half its tolerances on EngineV6)
-FIT = 1.0
 #: Newton's steps at most from the time found on a curve not within FIT to the integration's
 #: own root, on the side where it has crossed
 POLISH = 4
+#: a chunk reaches this many times as far as the indicators, each going on as fast as now,
+#: foresee the next crossing (``Events.chunk``): most approach zero slowing down (a piston
+#: nearing its dead centre). On EngineV6, rhs evaluations and integrator calls by factor:
+#: 1.0: 53249, 644; 1.25: 45914, 508; 1.5: 39580, 375; 1.6: 39012, 351; 2: 43887, 351;
+#: 3: 54390, 351; without: 72186, 351
+FORESEE = 1.6
 
 
 class Events:
@@ -106,6 +108,15 @@ class Events:
         #: fit, its rises off the contact's spring are not)
         self._two_fit = {}
         self._points = PointsBySize()   # the rates on the curves
+        #: (t, x, p) -> indicators and rates where the run goes on from, and the time the
+        #: next crossing is foreseen at from there (``chunk``)
+        self._at = None
+        self._foreseen = None
+        self._cut = 0                   # the last chunk's length, when the forecast cut it
+        #: the runs of the method started to locate an event, and the counts of the work
+        #: they did (``spent``: the run's statistics hold it)
+        self._trials = []
+        self.spent = {}
 
     @property
     def located(self):
@@ -139,11 +150,26 @@ class Events:
             i -= k
         raise IndexError(i)
 
-    def chunk(self, chunk, event):
+    def chunk(self, chunk, event, t=None):
         """Output intervals of the next chunk of a run with state events, at most ``chunk``:
-        EVENT_CHUNK after an ``event``, else twice the last, up to MAX_EVENT_CHUNK."""
+        EVENT_CHUNK after an ``event``, else twice the last, up to MAX_EVENT_CHUNK; and, from
+        the output time ``t`` the chunk starts after, no more than reach the next crossing
+        the indicators foresee (``_foresee``): what a chunk integrates past its first event
+        is integrated again (EngineV6: two thirds of its evaluations, when each chunk after
+        an event went EVENT_CHUNK intervals and its events come every three). A chunk the
+        forecast cut short that met no event makes the next one at least twice as long: an
+        indicator that keeps nearing zero without crossing it (a tangency, a stuck friction's
+        margin at rest) costs a few short chunks, not one per output interval."""
         self._chunk = EVENT_CHUNK if event else min(2 * self._chunk, MAX_EVENT_CHUNK)
-        return min(chunk, self._chunk)
+        chunk, cut = min(chunk, self._chunk), self._cut
+        self._cut = 0
+        if t is not None and self._foreseen is not None and self._foreseen > t:
+            reach = int(np.ceil((self._foreseen - t) / self.run.spacing - 1e-9))
+            if not event:
+                reach = max(reach, 2 * cut)
+            if reach < chunk:
+                chunk = self._cut = max(1, reach)
+        return chunk
 
     def bound(self, t):
         """The time a method started at t must not step past: the next time event, or the
@@ -166,6 +192,7 @@ class Events:
         re-partitioned): the relations as that System's equations hold them, read there."""
         if self.switches is None:
             return
+        self._at = None                 # read by the other System's relations from here
         count = self.switches.time_events
         relations = self.run.system.relations
         self.switches = Switches(self, self.run, relations) if relations is not None else None
@@ -182,6 +209,9 @@ class Events:
         self._last = (None, 0)
         self._chunk = EVENT_CHUNK
         self._two_fit = {}
+        self._at = self._foreseen = None
+        self._cut = 0
+        self._trials, self.spent = [], {}
         if self.switches is not None:
             self.switches.r = self._held.copy()
             self.switches.time_events = 0
@@ -232,7 +262,7 @@ class Events:
         (a gap just closed, a speed just zero) that count as positive: they leave zero
         rising, and one that is at or below zero at the next output fell back in between."""
         t_prev, x_prev = before
-        g_first, r_first = self.indicators(t_prev, x_prev)
+        g_first, r_first = self._indicators_at(t_prev, x_prev)
         if restarted:
             g_first = np.where(g_first <= 0, np.inf, g_first)
         G, R = self._rows(times, rows)
@@ -250,12 +280,34 @@ class Events:
                 t_ev, x_ev, i = found
                 after = self.apply(t_ev, x_ev, i)
                 if t_ev >= t:                 # at the output time itself: it shows the after
-                    return np.vstack([rows[:j], after[None, :]]), (t, after)
-                if j > 0 and t_ev - t_prev <= SAME_INSTANT:
+                    restart = (t, after)
+                    rows = np.vstack([rows[:j], after[None, :]])
+                elif j > 0 and t_ev - t_prev <= SAME_INSTANT:
                     # at the sampled point before, to rounding: that one shows the after
-                    return np.vstack([rows[:j - 1], after[None, :]]), (t_ev, after)
-                return rows[:j], (t_ev, after)
+                    restart = (t_ev, after)
+                    rows = np.vstack([rows[:j - 1], after[None, :]])
+                else:
+                    restart, rows = (t_ev, after), rows[:j]
+                self._foresee(restart[0], *self._indicators_at(*restart))
+                return rows, restart
+        self._foresee(times[-1], G[-1], R[-1])
         return rows, None
+
+    def _indicators_at(self, t, x):
+        """``indicators`` at (t, x), kept for the point the run goes on from (asked for again
+        when the next chunk begins there)."""
+        key = (float(t), np.asarray(x, dtype=float).tobytes(), self.run.p_solver.tobytes())
+        if self._at is None or self._at[0] != key:
+            self._at = (key, self.indicators(t, x))
+        return self._at[1]
+
+    def _foresee(self, t, g, rate):
+        """The time of the next crossing as the indicators at t (``g``, falling at ``rate``)
+        foresee it, each going on as fast as now (None: none is falling). Only the chunks'
+        lengths read it: events are looked for wherever it says."""
+        falling = (g > 0) & (rate < 0) & np.isfinite(g)
+        self._foreseen = float(t + FORESEE * np.min(g[falling] / -rate[falling])) \
+            if np.any(falling) else None
 
     def _rows(self, times, rows):
         """(indicators, rates), (len(rows), k) each, at each row."""
@@ -266,6 +318,21 @@ class Events:
         """The earliest crossing in (t0, t1]: (time, state, element). ``dipped``: elements
         above zero at both ends with a minimum between, which cross if it reaches zero.
         ``x1``: the state at t1, when known."""
+        try:
+            return self._locate_by(method, t0, x0, t1, crossed, dipped, x1)
+        finally:
+            for trial in self._trials:
+                _add_counts(self.spent, trial.stats)
+            self._trials = []
+
+    def _start(self, method, t, x):
+        """A run of ``method`` from (t, x) for locating an event, its work counted."""
+        trial = method.start(self.run, t, x)
+        self._trials.append(trial)
+        return trial
+
+    def _locate_by(self, method, t0, x0, t1, crossed, dipped, x1):
+        """``_locate``'s answer: on the curve when it can, else on integrated states."""
         if not self.run.system.n_algebraic and not method.fixed and \
                 t1 - t0 >= SHORT * max(1.0, abs(t0)):
             found = self._locate_dense(method, t0, x0, t1, x1, crossed, dipped)
@@ -284,14 +351,14 @@ class Events:
                     cache[t] = self._rk4(t0, x0, t - t0)
                 elif method.trial_states:       # one integration for every trial time
                     if not from_t0:
-                        from_t0.append(method.start(self.run, t0, x0))
+                        from_t0.append(self._start(method, t0, x0))
                     cache[t] = from_t0[0].state_at(t)
                 else:
-                    cache[t] = method.start(self.run, t0, x0).advance(np.array([t]),
-                                                                      exact=True)[0]
+                    cache[t] = self._start(method, t0, x0).advance(np.array([t]),
+                                                                   exact=True)[0]
             return cache[t]
 
-        best = _search(lambda t, i: self.levels(t, state(t))[i],
+        best = search(lambda t, i: self.levels(t, state(t))[i],
                        lambda t, i: self.indicators(t, state(t))[1][i],
                        t0, t1, crossed, dipped)
         if best is None:
@@ -317,21 +384,25 @@ class Events:
         law = (tuple(crossed), tuple(dipped), self.run.p_solver.tobytes())
         if x1 is not None and self._two_fit.get(law, True):
             T, X = np.array([t0, t1]), np.vstack([x0, x1])
-            curve = _Hermite(T, X, rates(T, X))
+            curve = Hermite(T, X, rates(T, X))
             fitted = self._two_fit[law] = curve.fits(rates, tol)
-        if not fitted:
-            grid = getattr(method.start(self.run, t0, x0), "grid", None)
+        if fitted:
+            best = search(lambda t, i: self.levels(t, curve(t))[i],
+                           lambda t, i: self.indicators(t, curve(t))[1][i],
+                           t0, t1, crossed, dipped)
+        else:
+            grid = getattr(self._start(method, t0, x0), "grid", None)
             rows = grid(t1, DENSE) if grid is not None else None
             if rows is None:
                 return _UNSURE
             T = np.concatenate([[t0], t0 + (t1 - t0) * np.arange(1, DENSE + 1) / DENSE])
             T[-1] = t1
             X = np.vstack([x0[None, :], rows])
-            curve = _Hermite(T, X, rates(T, X))
-            fitted = curve.fits(rates, tol)
-        best = _search(lambda t, i: self.levels(t, curve(t))[i],
-                       lambda t, i: self.indicators(t, curve(t))[1][i],
-                       t0, t1, crossed, dipped)
+            curve = Steps(T, X, rates)
+            best = search_steps(self, curve, T, X, crossed, dipped)
+            # the curve is checked where the time found is read off it, on that step alone
+            # (its points are the integration's: elsewhere it decides nothing)
+            fitted = best is not None and curve.fits(rates, tol, curve.step(best[0]))
         if best is None:
             return None
         t_i, i = best
@@ -342,7 +413,7 @@ class Events:
             j = max(0, int(np.searchsorted(T, t, side="right")) - 1)
             if t - T[j] < SHORT * max(1.0, abs(T[j])):
                 return self._rk4(T[j], X[j], t - T[j])
-            return method.start(self.run, T[j], X[j]).state_at(t)
+            return self._start(method, T[j], X[j]).state_at(t)
 
         # Newton on the integration from the curve's root (off by the curve's error): to
         # the integration's own root, on the side where the indicator has crossed
@@ -361,6 +432,10 @@ class Events:
             t_i = min(t1, max(t0, t_i + dt + (tiny * max(1.0, abs(t_i)) if g_i > 0 else 0)))
             x_i = exact(t_i)
         return crossed_at if crossed_at is not None else _UNSURE
+
+    def _level_rows(self, times, rows):
+        """The indicators alone, (len(rows), k), at each row."""
+        return np.hstack([s.level_rows(times, rows) for s in self.sources])
 
     def _tolerance(self, method):
         """(rtol, atol) the method's solver is given for this run (``tolerance.py``)."""
@@ -429,87 +504,3 @@ def _refined(t0, times, spacing=None):
 
 #: what ``_locate_dense`` answers when the exact search must decide
 _UNSURE = object()
-
-
-def _search(g, rate, t0, t1, crossed, dipped):
-    """The earliest crossing in (t0, t1] of the indicators ``g(t, i)``, with rates
-    ``rate(t, i)``: (time, element) or None. ``crossed``: elements at or below zero at t1;
-    ``dipped``: above zero at both ends with a minimum between, which cross if it reaches
-    zero. The time is on the side of the root where the indicator has crossed."""
-    from scipy.optimize import brentq          # 0.3 s to import: only with events
-
-    tight = dict(xtol=1e-15, rtol=4 * np.finfo(float).eps, maxiter=200)
-    best = None
-    for i in dipped:
-        if not rate(t0, i) < 0 < rate(t1, i):     # integrated again: not quite as sampled
-            continue
-        t_min = brentq(rate, t0, t1, args=(i,), **tight)
-        if g(t_min, i) > 0:
-            continue                    # a minimum above zero: no event
-        t_i = brentq(g, t0, t_min, args=(i,), **tight)
-        if g(t_i, i) > 0:
-            t_i = min(t_min, t_i + max(abs(t_i), 1.0) * 4 * np.finfo(float).eps)
-        if best is None or t_i < best[0]:
-            best = (t_i, i)
-    for i in crossed:
-        start = t0
-        if g(t0, i) <= 0:         # at zero after a restart: where it was above zero
-            start = next((t for t in t0 + (t1 - t0) * SCAN if g(t, i) > 0), None)
-            if start is None:     # it fell back at once: an event where it started
-                if best is None or t0 < best[0]:
-                    best = (t0, i)
-                continue
-        if g(t1, i) >= 0.0:
-            # at t1 itself, or (integrated again from t0) just short of crossing there
-            t_i = t1
-        else:
-            t_i = brentq(g, start, t1, args=(i,), **tight)
-            # the side of the root where the indicator has crossed
-            if g(t_i, i) > 0:
-                t_i = min(t1, t_i + max(abs(t_i), 1.0) * 4 * np.finfo(float).eps)
-        if best is None or t_i < best[0]:
-            best = (t_i, i)
-    return best
-
-
-class _Hermite:
-    """The cubic Hermite curve through states X at times T with rates F, as a cubic in
-    s = (t - T[j]) / h on each step h. Its error, h^4/384 |d4x/dt4| at most, is read off
-    the equations: the curve's rate less the equations' at points of each step."""
-
-    def __init__(self, T, X, F):
-        self.T = [float(t) for t in T]
-        h = np.diff(T)[:, None]
-        x0, x1, f0, f1 = X[:-1], X[1:], h * F[:-1], h * F[1:]
-        self.cubic = (x0, f0, 3 * (x1 - x0) - 2 * f0 - f1, 2 * (x0 - x1) + f0 + f1)
-        self.scale = np.max(np.abs(X), axis=0)
-
-    def _step(self, t):
-        T = self.T
-        j = min(max(bisect.bisect_right(T, t) - 1, 0), len(T) - 2)
-        return j, (t - T[j]) / (T[j + 1] - T[j])
-
-    def __call__(self, t):
-        j, s = self._step(t)
-        a, b, c, d = (k[j] for k in self.cubic)
-        return a + s * (b + s * (c + s * d))
-
-    def fits(self, rates, tol):
-        """Whether the curve is within FIT of the tolerances ``tol`` = (rtol, atol) of the
-        solution through its points: its error at most h/6 times its rate's distance from
-        the equations' (``rates(T, X)``, at many points at once) at a quarter, half and three
-        quarters of each step (a quartic error's, largest at the middle, is h/6 times its
-        rate's at the quarters)."""
-        rtol, atol = tol
-        a, b, c, d = self.cubic
-        T = np.asarray(self.T)
-        h = np.diff(T)[:, None]
-        points, defects = [], []
-        for s in (0.25, 0.5, 0.75):
-            points.append((T[:-1] + s * h[:, 0], a + s * (b + s * (c + s * d))))
-            defects.append((b + s * (2 * c + 3 * s * d)) / h)
-        times = np.concatenate([p[0] for p in points])
-        states = np.vstack([p[1] for p in points])
-        defect = np.vstack(defects) - rates(times, states)
-        error = np.abs(defect) * np.tile(h, (3, 1)) / 6
-        return bool(np.all(error <= FIT * (atol + rtol * self.scale)))

@@ -255,10 +255,17 @@ class Partitions:
         f = run.system.f_dependent
         n = f.size1_out(0)
         J = pointwise(f, rows, run.p)[0].reshape(len(rows), n, n).transpose(0, 2, 1)
+        # block by block (its singular values are the blocks', its determinant their
+        # product): EngineV6's 18 x 18 is six loops' 3 x 3, 36 times fewer operations
+        high, low, det = np.zeros(len(rows)), np.full(len(rows), np.inf), np.ones(len(rows))
         with np.errstate(all="ignore"):
-            s = np.linalg.svd(J, compute_uv=False)
-            cond = np.where(s[:, -1] > 0, s[:, 0] / s[:, -1], np.inf)
-            det = np.linalg.det(J)
+            for idx in _blocks(run.system):        # (blocks, size): those of one size
+                part = J[:, idx[:, :, None], idx[:, None, :]]       # (rows, blocks, k, k)
+                s = np.linalg.svd(part, compute_uv=False)
+                high = np.maximum(high, s[..., 0].max(axis=1))
+                low = np.minimum(low, s[..., -1].min(axis=1))
+                det = det * np.prod(np.linalg.det(part), axis=1)
+            cond = np.where(low > 0, high / low, np.inf)
         return cond, det
 
     def _near(self, cond, det, i):
@@ -412,3 +419,22 @@ def convert(a, b, t, X, p):
         else:
             columns.append(X[:, names_a.index(name)])
     return np.column_stack(columns) if columns else np.zeros((len(X), 0))
+
+
+def _blocks(system):
+    """The blocks of the Jacobian in the dependent speeds (``system.f_dependent``): index sets
+    that its sparsity keeps apart (the rows and columns of each kinematic loop), as one
+    (blocks, size) array per size, found once per System."""
+    def find():
+        import networkx as nx
+        # the expression's own sparsity (the Function's output is densified)
+        pattern = system.eq.dependent_jacobian.sparsity()
+        graph = nx.Graph()
+        graph.add_nodes_from(range(pattern.size1()))
+        rows, cols = pattern.get_triplet()
+        graph.add_edges_from(zip(rows, cols))
+        sizes = {}
+        for c in nx.connected_components(graph):
+            sizes.setdefault(len(c), []).append(sorted(c))
+        return [np.array(blocks) for _, blocks in sorted(sizes.items())]
+    return compiled(system).memo("dependent blocks", find)

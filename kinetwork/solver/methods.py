@@ -295,13 +295,7 @@ class _CasadiRun:
         else:
             xf = np.full((len(times), nx), np.nan)
         zf = np.full((len(times), nz), np.nan)
-        buffer, evaluate = integ.buffer()
-        for name, value in (("x0", x0), ("z0", z0), ("p", p)):
-            if value.size:
-                buffer.set_arg(INTEGRATOR_IN[name], memoryview(value))
-        for name, value in (("xf", xf), ("zf", zf)):
-            if value.size:
-                buffer.set_res(INTEGRATOR_OUT[name], memoryview(value))
+        buffer, evaluate = _bound(integ, x0, z0, p, xf, zf)
         try:
             with run.solver_section(self.t, descriptors=False), run.interruptible():
                 evaluate()
@@ -331,11 +325,11 @@ class _CasadiRun:
         return X
 
     def _count(self, buffer, intervals):
-        """Steps and evaluations of the call just made (a fixed-step method: its steps over
-        the ``intervals`` it covered)."""
+        """Steps and evaluations of the call just made through ``buffer`` (a fixed-step
+        method: its steps over the ``intervals`` it covered)."""
         run = self.run
         if self.method.sundials:
-            with contextlib.suppress(RuntimeError):       # none if it failed at once
+            with contextlib.suppress(RuntimeError, KeyError):   # none if it failed at once
                 st = buffer.stats()
                 self.stats["steps"] += int(st["nsteps"])
                 self.stats["rhs_evaluations"] += int(st["nfevals"])
@@ -376,32 +370,36 @@ class _CasadiRun:
         integ = run.compiled.integrator(key, lambda: ca.integrator(
             "locate", m.plugin, run.compiled.dae_scaled(run.jit, m.newton), 0.0,
             list(np.arange(1, k + 1) / k), opts))
+        # through its buffer interface, as ``call``: no DM made or read (a dict call of the
+        # 33-point stretch an event is located on spent a third of its time converting)
+        p = np.concatenate([self.p, [self.t, t - self.t]])
+        x0, z0 = np.ascontiguousarray(self.x[:nx]), np.ascontiguousarray(self.x[nx:])
+        xf, zf = np.full((k, nx), np.nan), np.full((k, len(z0)), np.nan)
+        buffer, evaluate = _bound(integ, x0, z0, p, xf, zf)
         try:
             with run.solver_section(self.t, descriptors=False):
-                out = integ(x0=self.x[:nx], z0=self.x[nx:],
-                            p=np.concatenate([self.p, [self.t, t - self.t]]))
+                evaluate()
         except RuntimeError as exc:
             run.said.append(shift_times(solver_words(str(exc)), self.t))
             raise Failure(solver_reason(str(exc))) from None
-        self._count_call(integ)
-        rows = np.hstack([np.asarray(out["xf"]).reshape(nx, k).T,
-                          np.asarray(out["zf"]).reshape(-1, k).T])
+        self._count(buffer, 1)
+        rows = np.hstack([xf, zf]) if len(z0) else xf
         if not np.all(np.isfinite(rows)):
             raise Failure("the state became non-finite (Inf or NaN)")
         return rows
 
-    def _count_call(self, integ):
-        """Steps and evaluations of the plain call of ``integ`` just made."""
-        if self.method.sundials:
-            with contextlib.suppress(RuntimeError, KeyError):
-                st = integ.stats()
-                self.stats["steps"] += int(st["nsteps"])
-                self.stats["rhs_evaluations"] += int(st["nfevals"])
-                self.stats["jacobian_evaluations"] += int(st["n_call_jacF"])
-                self.stats["factorisations"] += int(st.get("nlinsetups", 0))
-        else:
-            self.stats["steps"] += self.run.steps_per_interval
-            self.stats["step"] = self.run.spacing / self.run.steps_per_interval
+
+def _bound(integ, x0, z0, p, xf, zf):
+    """(buffer, evaluate) of the integrator ``integ`` reading its inputs from and writing its
+    outputs into these arrays (CasADi keeps raw pointers: they must outlive the call)."""
+    buffer, evaluate = integ.buffer()
+    for name, value in (("x0", x0), ("z0", z0), ("p", p)):
+        if value.size:
+            buffer.set_arg(INTEGRATOR_IN[name], memoryview(value))
+    for name, value in (("xf", xf), ("zf", zf)):
+        if value.size:
+            buffer.set_res(INTEGRATOR_OUT[name], memoryview(value))
+    return buffer, evaluate
 
 
 def _equal_step(times, t0, spacing):

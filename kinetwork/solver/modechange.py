@@ -66,6 +66,10 @@ class ModeChanges:
             self.run.p)).reshape(k, len(rows), -1)
         return table[:, :, 0].T, table[:, :, RATE].T
 
+    def level_rows(self, times, rows):
+        """``levels`` at each of ``rows`` (at ``times``): a (len(rows), k) array."""
+        return self.indicator_rows(times, rows)[0]
+
     def chatter(self, i):
         """Why events of element i pile up at one instant, in words."""
         return f"the modes of {self.modes.comps[i].name} chatter"

@@ -34,6 +34,7 @@ class Switches:
         self.time_events = 0
         self._calls = {}
         self._rows = PointsBySize()
+        self._level_maps = PointsBySize()   # the indicators alone, at many points
         self._signs = None
 
     # -- numbers ---------------------------------------------------------------------------
@@ -100,6 +101,15 @@ class Switches:
                            rows, np.concatenate([self.run.p, self.r]))
         sign = self._sign()[None, :]
         return sign * table[:, :k], sign * table[:, k:]
+
+    def level_rows(self, times, rows):
+        """``levels`` at each of ``rows`` (at ``times``): a (len(rows), k) array."""
+        k = len(self.relations.state)
+        if not k or not len(rows):
+            return np.zeros((len(rows), k))
+        table = self._level_maps(self._numeric("f_level").f, np.asarray(times, dtype=float),
+                           rows, np.concatenate([self.run.p, self.r]))
+        return self._sign()[None, :] * table
 
     def chatter(self, i):
         """Why events of relation i pile up at one instant, in words."""

@@ -7,6 +7,7 @@ import numpy as np
 import pytest
 
 import kinetwork as kn
+from kinetwork.solver import curves
 from kinetwork.solver import events as events_module
 from kinetwork.solver import methods
 from scenes.bumps import ball, ball_reference
@@ -49,19 +50,29 @@ def test_the_curve_through_two_rows_is_not_tried_again_where_it_did_not_fit(monk
     """The ball's falls are parabolas: the curve through the two sampled rows fits each.
     Its rises off the contact's spring do not: that curve is tried on the first rise only
     (each try costs five evaluations of the equations), the later ones go straight to the
-    one integration over the interval (before: tried on each of the four rises)."""
-    tried = []
-    fits = events_module._Hermite.fits
+    one integration over the interval (before: tried on each of the four rises), whose
+    curve is checked on the one step the contact time is read off."""
+    tried, dense = [], []
+    fits, dense_fits = curves.Hermite.fits, curves.Steps.fits
 
-    def counted(self, rates, tol):
-        tried.append((len(self.T), fits(self, rates, tol)))
-        return tried[-1][1]
-    monkeypatch.setattr(events_module._Hermite, "fits", counted)
+    def counted(self, rates, tol, step=None):
+        ok = fits(self, rates, tol, step)
+        if not dense or dense[-1] is not None:
+            tried.append(ok)                # a curve through two sampled rows
+        return ok
+
+    def counted_dense(self, rates, tol, step):
+        dense.append(None)                  # its step's own check is not a two-row curve's
+        ok = dense_fits(self, rates, tol, step)
+        dense[-1] = len(self.T)
+        return ok
+    monkeypatch.setattr(curves.Hermite, "fits", counted)
+    monkeypatch.setattr(curves.Steps, "fits", counted_dense)
     res = kn.simulate(ball(), t_end=3.0, n_points=301, method="cvodes-adams", rtol=1e-10,
                       atol=1e-12)
     assert len(res.stats["events"]) == 8
-    assert tried.count((2, True)) == 4 and tried.count((2, False)) == 1
-    assert tried.count((33, True)) + tried.count((33, False)) == 4
+    assert tried.count(True) == 4 and tried.count(False) == 1
+    assert dense == [33] * 4
 
 
 def test_dense_and_exact_location_agree_on_a_stop_of_friction(monkeypatch):
