@@ -28,13 +28,16 @@ demo: $(VENV)/.core
 	@echo "probe plots written to $(OUT)/"
 
 # the front end first: its packages from the lockfile, ESLint (with React's rules of hooks)
-# and the type check, then its unit tests (Vitest); then two pytest workers (pytest-xdist),
-# each taking whole test files so module fixtures are built once; the browser tests need
-# Debian's Chromium, installed here where it is missing (as root)
+# and the type check, then its unit tests (Vitest); then three pytest workers (pytest-xdist) on
+# the two cores, each taking whole test files so module fixtures are built once, the files
+# that drive Chromium all on one of them (tests/conftest.py): the third fills the time the
+# others wait on browsers, compilers and subprocesses (2026-11-29, idle 2-core machine:
+# 633 s, 950 s of CPU); the browser tests need Debian's Chromium, installed here where it is
+# missing (as root)
 test: $(VENV)/.installed
 	@.ci/chromium
 	cd frontend && npm ci --no-audit --no-fund && npm run lint && npm test
-	$(PY) -m pytest -q -n 2 --dist loadfile
+	$(PY) -m pytest -q -n 3 --dist loadfile
 
 # the documentation site in site/, every warning an error (its code blocks run in make test)
 docs: $(VENV)/.installed

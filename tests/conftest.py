@@ -35,12 +35,53 @@ def pytest_configure(config):
         config.option.loadscopereorder = False
 
 
-def pytest_collection_modifyitems(items):
+#: the test files that drive Chromium (checked at collection: ``browser_files_named``)
+BROWSER_FILES = ("tests/studio/test_e2e", "tests/test_animation.py")
+
+
+def is_browser_file(path):
+    """Whether the test file at ``path`` (relative to the checkout) drives Chromium."""
+    return path.startswith(BROWSER_FILES)
+
+
+def pytest_xdist_make_scheduler(config, log):
+    """``--dist loadfile``, except that the files which drive Chromium go to one worker, one
+    after another: two software-rendering browsers at once on two cores slow each other's
+    pages (and the tests' waits on them) instead of filling the time the other workers wait.
+    (pytest-xdist's own ``loadgroup`` cannot be used: it renames test ids through a field
+    pytest 9 no longer reads.)"""
+    if config.getvalue("dist") != "loadfile":
+        return None
+    from xdist.scheduler import LoadFileScheduling
+
+    class BrowserFilesTogether(LoadFileScheduling):
+        def _split_scope(self, nodeid):
+            path = nodeid.split("::", 1)[0]
+            return "chromium" if is_browser_file(path) else path
+
+    return BrowserFilesTogether(config, log)
+
+
+def pytest_collection_modifyitems(config, items):
     """The long files first, longest first; each file's tests keep their order."""
     def weight(item):
         path = item.path.as_posix()
         return next((-w for name, w in LONG_FILES.items() if path.endswith("tests/" + name)), 0)
     items.sort(key=weight)             # stable: files stay whole, in their order otherwise
+    browser_files_named(config, items)
+
+
+def browser_files_named(config, items):
+    """Every file that uses the ``chromium`` fixture is one ``BROWSER_FILES`` names, and the
+    other way round (the scheduler above sees test ids only)."""
+    uses = {item.path.relative_to(config.rootpath).as_posix()
+            for item in items if "chromium" in item.fixturenames}
+    named = {item.path.relative_to(config.rootpath).as_posix() for item in items
+             if is_browser_file(item.path.relative_to(config.rootpath).as_posix())}
+    if uses != named:
+        raise pytest.UsageError(f"tests/conftest.py BROWSER_FILES: files that drive Chromium "
+                                f"{sorted(uses - named)} are not named, files named do not "
+                                f"{sorted(named - uses)}")
 
 
 @pytest.fixture(autouse=True, scope="session")

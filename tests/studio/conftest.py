@@ -163,6 +163,7 @@ class Tab:
         try:
             keep = keep and not pg.is_closed() and self.listeners() == self.counts
             if keep:
+                origin = pg.evaluate("() => location.origin")
                 # away from the studio (its server is stopped), accepting "leave the page?"
                 def leave(dialog):
                     dialog.accept()
@@ -172,6 +173,15 @@ class Tab:
                 finally:
                     pg.remove_listener("dialog", leave)
                 keep = pg.url == "about:blank"
+                # what the page kept in the browser for its origin (the panes' sizes...): a
+                # later test's server may get the same port, so the same origin
+                if keep and origin.startswith("http"):
+                    cdp = self.context.new_cdp_session(pg)
+                    try:
+                        cdp.send("Storage.clearDataForOrigin",
+                                 {"origin": origin, "storageTypes": "all"})
+                    finally:
+                        cdp.detach()
         except Exception:       # a context the test closed, a page that would not leave
             keep = False
         if not keep:
