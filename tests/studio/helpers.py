@@ -137,16 +137,8 @@ def set_field(page, testid, text):
 def open_file(page, path):
     """Open ``path`` through the Open dialog's file list (discarding unsaved changes when
     the page asks); wait for its blocks."""
-    page.click(tid("open"))
-    page.click(tid(f"file-{path}"))
-    page.wait_for_function(f"() => window.__kinetwork.file.path === {json.dumps(path)} || "
-                           f"!!document.querySelector('[data-testid=confirm-discard]')")
-    if page.locator(tid("confirm-discard")).count():
-        page.click(tid("choice-discard"))
-    page.wait_for_selector(tid("open-dialog"), state="detached")
-    page.wait_for_function(f"() => window.__kinetwork.file.path === {json.dumps(path)}")
-    for comp in K(page, "K.doc.components.map(c => c.name)"):
-        page.wait_for_selector(tid(f"node-{comp}"))
+    _open_by_dialog(page, f"file-{path}",
+                    f"window.__kinetwork.file.path === {json.dumps(path)}")
 
 
 def open_in_page(page, **query):
@@ -158,15 +150,23 @@ def open_in_page(page, **query):
     (key, value), = query.items()
     field = {"open": "path", "example": "example"}[key]
     asked = K(page, "K.store.getState().fitRequest")
+    _open_by_dialog(page, f"{'file' if key == 'open' else 'example'}-{value}",
+                    f"window.__kinetwork.file.{field} === {json.dumps(value)} && "
+                    f"window.__kinetwork.store.getState().fitRequest > {asked}")
+
+
+def _open_by_dialog(page, item, opened):
+    """Open, then ``item`` (a test id) in the dialog's list; discard unsaved changes when
+    the page asks; wait until ``opened`` (a JavaScript condition) holds and the model's
+    blocks are drawn."""
     page.click(tid("open"))
-    page.click(tid(f"{'file' if key == 'open' else 'example'}-{value}"))
-    page.wait_for_function(f"() => window.__kinetwork.store.getState().fitRequest > {asked} || "
+    page.click(tid(item))
+    page.wait_for_function(f"() => ({opened}) || "
                            f"!!document.querySelector('[data-testid=confirm-discard]')")
     if page.locator(tid("confirm-discard")).count():
         page.click(tid("choice-discard"))
     page.wait_for_selector(tid("open-dialog"), state="detached")
-    page.wait_for_function(f"() => window.__kinetwork.file.{field} === {json.dumps(value)} && "
-                           f"window.__kinetwork.store.getState().fitRequest > {asked}")
+    page.wait_for_function(f"() => {opened}")
     for comp in K(page, "K.doc.components.map(c => c.name)"):
         page.wait_for_selector(tid(f"node-{comp}"))
 
