@@ -149,7 +149,7 @@ class Tab:
             pg.errors = []
             pg.on("console", lambda m: m.type == "error" and pg.errors.append(f"console: {m.text}"))
             pg.on("pageerror", lambda e: pg.errors.append(f"uncaught: {e}"))
-            self.page, self.counts = pg, None
+            self.page = pg
             self.counts = self.listeners()
         pg = self.page
         pg.errors.clear()
