@@ -291,6 +291,7 @@ def every_view_whole(page, width, height, seen):
     page.wait_for_function(f"() => window.__kinetwork.file.path === {json.dumps(LONG)}")
     set_field(page, "param-c", "2")
     page.wait_for_selector(tid("dirty"))
+    page.wait_for_selector(f'{tid("problems")}[data-count="0"]')
     bar = whole(page, "a long file name, unsaved", wrong)["panes"]["bar"]
     title = page.get_attribute(tid("file"), "title")
     if not (LONG in title and "double_pendulum" in title and "unsaved" in title):
@@ -307,6 +308,8 @@ def every_view_whole(page, width, height, seen):
     page.click(tid("toggle-viewer"))
     page.wait_for_selector(tid("viewer"), state="detached")
     whole(page, "the side panel and the 3-D view collapsed", wrong)
+    while page.locator(tid("toast")).count():       # "saved ...": not in the docs' picture
+        page.locator(tid("toast")).first.click()
     screenshot(page, f"studio-{width}x{height}-collapsed.png")
     return wrong[len(seen):]
 

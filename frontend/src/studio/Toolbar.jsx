@@ -82,11 +82,15 @@ export default function Toolbar({ files, edit, runner, onOpen }) {
         </span>
       </div>
       {/* the name never gives way to the path, nor the unsaved mark to either: what is cut
-          ends in "…", and the whole is the title */}
+          shows "…", and the whole is the title */}
       <div className="kn-file" data-testid="file" title={`${name} · ${where}${files.dirty ? " · unsaved changes" : ""}`}>
         {busy ? <span className="kn-muted kn-file-busy">{busy}</span> : null}
         <b className="kn-file-name">{name}</b>
-        <span className="kn-muted kn-file-path">· {where}</span>
+        <span className="kn-muted">·</span>
+        {/* cut at its start, so that the file's own name shows */}
+        <span className="kn-muted kn-file-path">
+          <bdi>{where}</bdi>
+        </span>
         {files.dirty ? (
           <span className="kn-dirty" data-testid="dirty" title="unsaved changes">
             ●
