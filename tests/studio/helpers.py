@@ -208,7 +208,8 @@ PANES = {"bar": ".kn-bar", "palette": tid("palette"), "diagram": ".kn-crumbs, " 
 #: box must not be cut by an ancestor that clips (overflow other than visible) unless that
 #: ancestor scrolls along that axis with a scrollbar to say so (the user scrolls to it: the
 #: ancestor is what must then be in view) or the text is elided on purpose (text-overflow:
-#: ellipsis on the clipping box and the full text in a title on the element or above it).
+#: ellipsis on the clipping box and the full text in a title on the element or above it);
+#: an empty field's hint (placeholder) fits its field or is elided so, whole in a title.
 #: Hidden elements (display, visibility, opacity) and the diagram's pan-and-zoom layer (the
 #: user pans to its blocks) are not checked.
 PLACES = """(panes) => {
@@ -266,6 +267,7 @@ PLACES = """(panes) => {
             out.wrong.push(`${name}: ${JSON.stringify(label(el))} at ${where(r)} outside its pane ${where(p)}`);
     };
     const every = Object.values(panes).join(", ");
+    const pen = document.createElement("canvas").getContext("2d");
     for (const [name, sel] of Object.entries(panes)) {
         for (const [i, pane] of [...document.querySelectorAll(sel)].entries()) {
             if (hidden(pane)) continue;
@@ -281,6 +283,16 @@ PLACES = """(panes) => {
                 if (!texts.length && !click) continue;
                 if (click) (out.controls[key] = out.controls[key] || []).push(label(el));
                 if (click) check(key, pane, el, rect(el.getBoundingClientRect()), false, null);
+                // an empty field's hint: as wide as the field, or elided and whole in a title
+                if (el.matches("input") && el.placeholder && !el.value) {
+                    const s = getComputedStyle(el);
+                    pen.font = `${s.fontStyle} ${s.fontWeight} ${s.fontSize} ${s.fontFamily}`;
+                    const room = el.clientWidth - parseFloat(s.paddingLeft) - parseFloat(s.paddingRight);
+                    if (pen.measureText(el.placeholder).width > room + SLACK &&
+                            !(s.textOverflow === "ellipsis" && titled(el, pane, flat(el.placeholder))))
+                        out.wrong.push(`${key}: ${JSON.stringify(label(el))}'s hint ` +
+                            `${JSON.stringify(el.placeholder)} cut by its field (${Math.round(room)} px)`);
+                }
                 for (const t of texts) {
                     const range = document.createRange();
                     range.selectNodeContents(t);
