@@ -140,10 +140,10 @@ def whole(page, what, wrong):
 
 def every_view_whole(page, width, height, seen):
     """What the user opens over the seed, each in turn whole and in the window: a palette
-    type's card, the Open dialog, the larger plot, the signals' list, the right-click menu, the JSON view, the
-    Analysis tab's forms, a long problem, the Save as prompt, a long file name with unsaved
-    changes, and the page with the side panel and the 3-D view collapsed: the list of what
-    is wrong, beyond what is already ``seen``."""
+    type's card, the Open dialog, the larger plot, the signals' list, the right-click menu,
+    the JSON view, the Analysis tab's forms, a long problem, the Save as prompt, a long file
+    name with unsaved changes, New asking about them, and the page with the side panel and
+    the 3-D view collapsed: the list of what is wrong, beyond what is already ``seen``."""
     wrong = list(seen)
     page.hover(tid("palette-multibody.BodyShape"))    # a long card: doc, ports, 12 parameters
     page.wait_for_selector(f'{tid("palette-info")} .kn-typeinfo-params')
@@ -203,6 +203,11 @@ def every_view_whole(page, width, height, seen):
     if page.evaluate("() => { const b = document.querySelector('[data-testid=file] b');"
                      " return b.scrollWidth > b.clientWidth && b.clientWidth > 0; }"):
         wrong.append("the model's name is elided beside its path")
+    page.click(tid("new"))                          # unsaved changes: the page asks
+    page.wait_for_selector(tid("confirm-discard"))
+    whole(page, "New asking about unsaved changes", wrong)
+    page.click(tid("choice-cancel"))
+    page.wait_for_selector(tid("confirm-discard"), state="detached")
     page.click(tid("toggle-side"))
     page.wait_for_selector(".kn-right", state="detached")
     page.click(tid("toggle-viewer"))
