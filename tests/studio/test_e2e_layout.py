@@ -162,6 +162,12 @@ def every_view_whole(page, width, height, seen):
         page.click(tid("plot-signals"))
         page.wait_for_selector(tid("plot-signals-list"))
         whole(page, "the signals' list", wrong)
+        # its chips work as in a row: a signal hidden, and shown again
+        chip = f'{tid("plot-signals-list")} {tid("plot-toggle-probe1.angle")}'
+        page.click(chip)
+        page.wait_for_selector(f'{tid("plot-signals")}:text("signals 7/8")')
+        page.click(chip)
+        page.wait_for_selector(f'{tid("plot-signals")}:text("signals 8/8")')
         page.click(tid("plot-signals"))
         page.wait_for_selector(tid("plot-signals-list"), state="detached")
     x, y = center(page, tid("node-mass2"))
@@ -213,6 +219,9 @@ def every_view_whole(page, width, height, seen):
     page.click(tid("toggle-viewer"))
     page.wait_for_selector(tid("viewer"), state="detached")
     whole(page, "the side panel and the 3-D view collapsed", wrong)
+    if width >= 1400:           # the plots now as wide as the window: the chips back in a row
+        page.wait_for_selector(f'{tid("plots")} .kn-chips {tid("plot-toggle-probe2.torque")}')
+        assert not page.locator(tid("plot-signals")).count()
     while page.locator(tid("toast")).count():       # "saved ...": not in the docs' picture
         page.locator(tid("toast")).first.click()
     screenshot(page, f"studio-{width}x{height}-collapsed.png")
