@@ -195,3 +195,123 @@ def leave(page, url):
         page.goto(url)
     finally:
         page.remove_listener("dialog", accept)
+
+
+#: the page's panes, each holding its controls
+PANES = {"bar": ".kn-bar", "palette": tid("palette"), "diagram": ".kn-crumbs, " + tid("canvas"),
+         "bars": ".kn-bars", "plots": tid("plots"), "viewer": tid("viewer"), "side": ".kn-right",
+         "dialog": ".kn-modal", "menu": ".kn-menu", "toast": ".kn-toast"}
+
+#: what is wrong with where things are, from the page's element rectangles: every pane must
+#: lie in the window; every element a user reads (one with text of its own) or clicks (a
+#: control, a role of one, or the pointer cursor) must lie within its pane, and its text and
+#: box must not be cut by an ancestor that clips (overflow other than visible) unless that
+#: ancestor scrolls along that axis with a scrollbar to say so (the user scrolls to it: the
+#: ancestor is what must then be in view) or the text is elided on purpose (text-overflow:
+#: ellipsis on the clipping box and the full text in a title on the element or above it);
+#: an empty field's hint (placeholder) fits its field or is elided so, whole in a title.
+#: Hidden elements (display, visibility, opacity) and the diagram's pan-and-zoom layer (the
+#: user pans to its blocks) are not checked.
+PLACES = """(panes) => {
+    const SLACK = 1;
+    const rect = (r) => ({x0: r.left, y0: r.top, x1: r.right, y1: r.bottom});
+    const flat = (s) => s.replace(/\\s+/g, " ").trim();
+    const hidden = (el) => { const s = getComputedStyle(el);
+        return !el.getClientRects().length || s.visibility === "hidden" || s.opacity === "0"; };
+    const clickable = (el) => el.matches("button, input, select, textarea, a[href], [role=tab], " +
+            "[role=button], [role=menuitem]") || (getComputedStyle(el).cursor === "pointer" &&
+            !(el.parentElement && getComputedStyle(el.parentElement).cursor === "pointer"));
+    const ownText = (el) => [...el.childNodes].filter((n) => n.nodeType === 3 && n.textContent.trim());
+    const titled = (el, upto, text) => { for (let e = el; e; e = e.parentElement) {
+            if (e.title && flat(e.title).includes(text)) return true;
+            if (e === upto) break; } return false; };
+    const out = {viewport: {x0: 0, y0: 0, x1: innerWidth, y1: innerHeight}, panes: {},
+                 wrong: [], controls: {}};
+    const label = (el) => el.dataset.testid || flat(el.title || "").slice(0, 30) ||
+            flat(el.textContent).slice(0, 30) || el.tagName.toLowerCase() + "." + el.className;
+    const where = (b) => `[${Math.round(b.x0)},${Math.round(b.y0)} ${Math.round(b.x1)},${Math.round(b.y1)}]`;
+    // what clips ``r`` between ``el`` (itself included when ``self``) and the pane
+    const check = (name, pane, el, r, self, text) => {
+        r = {...r};
+        for (let a = self ? el : el.parentElement; a; a = a.parentElement) {
+            const s = getComputedStyle(a);
+            const c = rect(a.getBoundingClientRect());
+            for (const k of ["x", "y"]) {
+                const overflow = k === "x" ? s.overflowX : s.overflowY;
+                if (overflow === "visible") continue;
+                const cut = r[k + "0"] < c[k + "0"] - SLACK || r[k + "1"] > c[k + "1"] + SLACK;
+                const long = k === "x" ? a.scrollWidth > a.clientWidth + 1 : a.scrollHeight > a.clientHeight + 1;
+                // (sideways only a scrollbar that takes room says there is more: overlay
+                // scrollbars, the default of many systems and of headless Chromium, do not)
+                const bar = k === "y" || a.offsetHeight - a.clientHeight > 2 * parseFloat(s.borderBottomWidth) + 1;
+                if (/auto|scroll/.test(overflow) && long && bar) {
+                    // reached by scrolling this box: from here up, it is the box that counts
+                    r[k + "0"] = Math.max(r[k + "0"], c[k + "0"]); r[k + "1"] = Math.min(r[k + "1"], c[k + "1"]);
+                    if (r[k + "1"] < r[k + "0"]) { r[k + "0"] = c[k + "0"]; r[k + "1"] = c[k + "1"]; }
+                    continue;
+                }
+                if (!cut) continue;
+                if (k === "x" && text && s.textOverflow === "ellipsis" && titled(el, pane, text)) {
+                    r.x0 = Math.max(r.x0, c.x0); r.x1 = Math.min(r.x1, c.x1);
+                    continue;
+                }
+                out.wrong.push(`${name}: ${JSON.stringify(label(el))} at ${where(r)} cut along ${k} ` +
+                    `by ${a.tagName.toLowerCase()}.${String(a.className).split(" ")[0]} ${where(c)}` +
+                    (text && s.textOverflow === "ellipsis" ? " (elided, but no title holds its text)" : ""));
+                return;
+            }
+            if (a === pane) break;
+        }
+        const p = out.panes[name];
+        if (!(r.x0 >= p.x0 - SLACK && r.x1 <= p.x1 + SLACK && r.y0 >= p.y0 - SLACK && r.y1 <= p.y1 + SLACK))
+            out.wrong.push(`${name}: ${JSON.stringify(label(el))} at ${where(r)} outside its pane ${where(p)}`);
+    };
+    const every = Object.values(panes).join(", ");
+    const pen = document.createElement("canvas").getContext("2d");
+    for (const [name, sel] of Object.entries(panes)) {
+        for (const [i, pane] of [...document.querySelectorAll(sel)].entries()) {
+            if (hidden(pane)) continue;
+            const key = i ? `${name}${i}` : name;
+            out.panes[key] = rect(pane.getBoundingClientRect());
+            for (const el of pane.querySelectorAll("*")) {
+                // a pane's own (a dialog opened from a pane is a pane of its own)
+                if (el.closest(every) !== pane) continue;
+                if (el.closest("svg, .react-flow__viewport") || el.parentElement.closest("select") ||
+                        hidden(el)) continue;
+                const texts = ownText(el);
+                const click = clickable(el);
+                if (!texts.length && !click) continue;
+                if (click) (out.controls[key] = out.controls[key] || []).push(label(el));
+                if (click) check(key, pane, el, rect(el.getBoundingClientRect()), false, null);
+                // an empty field's hint: as wide as the field, or elided and whole in a title
+                if (el.matches("input") && el.placeholder && !el.value) {
+                    const s = getComputedStyle(el);
+                    pen.font = `${s.fontStyle} ${s.fontWeight} ${s.fontSize} ${s.fontFamily}`;
+                    const room = el.clientWidth - parseFloat(s.paddingLeft) - parseFloat(s.paddingRight);
+                    if (pen.measureText(el.placeholder).width > room + SLACK &&
+                            !(s.textOverflow === "ellipsis" && titled(el, pane, flat(el.placeholder))))
+                        out.wrong.push(`${key}: ${JSON.stringify(label(el))}'s hint ` +
+                            `${JSON.stringify(el.placeholder)} cut by its field (${Math.round(room)} px)`);
+                }
+                for (const t of texts) {
+                    const range = document.createRange();
+                    range.selectNodeContents(t);
+                    const b = range.getBoundingClientRect();
+                    if (b.width && b.height) check(key, pane, el, rect(b), true, flat(t.textContent));
+                }
+            }
+        }
+    }
+    for (const [name, b] of Object.entries(out.panes))
+        if (!(b.x0 >= -SLACK && b.y0 >= -SLACK && b.x1 <= innerWidth + SLACK && b.y1 <= innerHeight + SLACK))
+            out.wrong.push(`pane ${name} ${where(b)} outside the window`);
+    return out;
+}"""
+
+
+def misplaced(page):
+    """Every pane outside the window, and everything a user reads or clicks that is outside
+    its pane or cut (PLACES): the list of what is wrong, and the panes' rectangles and
+    controls."""
+    places = page.evaluate(PLACES, PANES)
+    return places["wrong"], places

@@ -6,74 +6,18 @@ real mouse events where the user would act."""
 
 import csv
 import io
+import json
 import pathlib
 import xml.etree.ElementTree as ET
 
 import numpy as np
 import pytest
 
-from tests.studio.helpers import K, open_studio, run, screenshot, select, set_field, tid
+from tests.studio.helpers import (K, center, misplaced, open_studio, run, screenshot, select,
+                                  set_field, tid)
 
 SEED = "models/double_pendulum.json"
 SIZES = [(1000, 700), (1400, 900), (1920, 1080)]
-#: the page's panes, each holding its controls
-PANES = {"bar": ".kn-bar", "palette": tid("palette"), "diagram": tid("canvas"),
-         "plots": tid("plots"), "viewer": tid("viewer"), "side": ".kn-right"}
-
-#: where each control is, from the page's element rectangles: its pane, its own rectangle,
-#: and the scrolling box (below the pane) it may lie in; controls hidden by display or a
-#: closed pane are not there to click
-PLACES = """(panes) => {
-    const box = (el) => { const r = el.getBoundingClientRect();
-        return {x0: r.left, y0: r.top, x1: r.right, y1: r.bottom}; };
-    const scrolls = (el) => { const s = getComputedStyle(el);
-        return {x: /auto|scroll/.test(s.overflowX) && el.scrollWidth > el.clientWidth,
-                y: /auto|scroll/.test(s.overflowY) && el.scrollHeight > el.clientHeight}; };
-    const out = {viewport: {x0: 0, y0: 0, x1: innerWidth, y1: innerHeight}, panes: {}, controls: []};
-    for (const [name, sel] of Object.entries(panes)) {
-        const pane = document.querySelector(sel);
-        if (!pane) continue;
-        out.panes[name] = box(pane);
-        const controls = pane.querySelectorAll("button, input, select, textarea, [role=tab]");
-        for (const c of controls) {
-            if (!c.getClientRects().length || getComputedStyle(c).visibility === "hidden") continue;
-            let scroller = null;
-            for (let up = c.parentElement; up && up !== pane; up = up.parentElement) {
-                const s = scrolls(up);
-                if (s.x || s.y) { scroller = {box: box(up), ...s}; break; }
-            }
-            const label = c.dataset.testid || c.title || c.textContent.trim().slice(0, 20) || c.tagName;
-            out.controls.push({pane: name, label, box: box(c), scroller});
-        }
-    }
-    return out;
-}"""
-
-
-def inside(a, b, along="xy", slack=0.5):
-    """Whether the rectangle ``a`` lies in ``b`` along the axes named."""
-    return all(a[f"{k}0"] >= b[f"{k}0"] - slack and a[f"{k}1"] <= b[f"{k}1"] + slack
-               for k in along)
-
-
-def misplaced(page):
-    """Every pane outside the window, and every control outside its pane: a control in a
-    box that scrolls is reached by scrolling along that box's scrolling axis, and must lie
-    within it along the other."""
-    places = page.evaluate(PLACES, PANES)
-    wrong = [f"pane {name} {b}" for name, b in places["panes"].items()
-             if not inside(b, places["viewport"])]
-    for c in places["controls"]:
-        pane = places["panes"][c["pane"]]
-        s = c["scroller"]
-        if s is None:
-            ok = inside(c["box"], pane)
-        else:
-            fixed = "".join(k for k in "xy" if not s[k])
-            ok = inside(s["box"], pane) and inside(c["box"], s["box"], fixed)
-        if not ok:
-            wrong.append(f"{c['pane']}: {c['label']!r} at {c['box']}")
-    return wrong, places
 
 
 def plot_axes_wrong(page, key_prefix=""):
@@ -157,9 +101,8 @@ def test_every_control_lies_in_its_pane_and_every_plot_has_three_ticks(page, stu
     page.wait_for_selector(".kn-viewer-bar")
     page.wait_for_function("() => Object.keys(window.__kinetwork.plotAxes).length >= 3")
     wrong, places = misplaced(page)
-    assert not wrong, wrong
     assert {"bar", "palette", "diagram", "plots", "viewer", "side"} <= set(places["panes"])
-    viewer_buttons = [c["label"] for c in places["controls"] if c["pane"] == "viewer"]
+    viewer_buttons = places["controls"]["viewer"]
     assert len(viewer_buttons) >= 5, viewer_buttons            # play, time, speed, frames, view
     name = page.locator(f'{tid("file")} b').bounding_box()
     assert name["width"] > 50 and name["x"] + name["width"] <= width
@@ -174,7 +117,115 @@ def test_every_control_lies_in_its_pane_and_every_plot_has_three_ticks(page, stu
         mini = minimap.bounding_box()
         assert mini["width"] * mini["height"] < 0.12 * canvas["width"] * canvas["height"]
     screenshot(page, f"studio-{width}x{height}.png")
+    wrong = [f"the seed run: {w}" for w in wrong]
+    if width < 1920:
+        wrong += every_view_whole(page, width, height, wrong)
+    assert not wrong, "\n".join(wrong)
     assert not page.errors, page.errors
+
+
+#: a file name longer than the bar has room for beside the name of the model
+LONG = "models/my_very_long_model_name_for_the_arm.json"
+#: a value whose problem is a long message
+UNKNOWN = "spring_constant_of_the_shoulder_that_nobody_defined * 2"
+
+
+def whole(page, what, wrong):
+    """What is misplaced or cut (``misplaced``) while ``what`` is on screen, added to
+    ``wrong`` (where it is not already); the panes' rectangles and controls."""
+    found, places = misplaced(page)
+    wrong += [f"{what}: {w}" for w in found if not any(seen.endswith(f": {w}") for seen in wrong)]
+    return places
+
+
+def every_view_whole(page, width, height, seen):
+    """What the user opens over the seed, each in turn whole and in the window: a palette
+    type's card, the Open dialog, the larger plot, the signals' list, the right-click menu,
+    the JSON view, the Analysis tab's forms, a long problem, the Save as prompt, a long file
+    name with unsaved changes, New asking about them, and the page with the side panel and
+    the 3-D view collapsed: the list of what is wrong, beyond what is already ``seen``."""
+    wrong = list(seen)
+    page.hover(tid("palette-multibody.BodyShape"))    # a long card: doc, ports, 12 parameters
+    page.wait_for_selector(f'{tid("palette-info")} .kn-typeinfo-params')
+    whole(page, "the palette's card of BodyShape", wrong)
+    page.click(tid("open"))
+    page.wait_for_selector(tid(f"file-{SEED}"))
+    whole(page, "the Open dialog", wrong)
+    page.keyboard.press("Escape")
+    page.wait_for_selector(tid("open-dialog"), state="detached")
+    page.click(tid("plot-angle-enlarge"))
+    page.wait_for_function("() => window.__kinetwork.plotAxes['big:angle'] !== undefined")
+    whole(page, "the larger plot", wrong)
+    page.keyboard.press("Escape")
+    page.wait_for_selector(tid("plot-dialog"), state="detached")
+    if page.locator(tid("plot-signals")).count():       # the chips folded: their list
+        page.click(tid("plot-signals"))
+        page.wait_for_selector(tid("plot-signals-list"))
+        whole(page, "the signals' list", wrong)
+        # its chips work as in a row: a signal hidden, and shown again
+        chip = f'{tid("plot-signals-list")} {tid("plot-toggle-probe1.angle")}'
+        page.click(chip)
+        page.wait_for_selector(f'{tid("plot-signals")}:text("signals 7/8")')
+        page.click(chip)
+        page.wait_for_selector(f'{tid("plot-signals")}:text("signals 8/8")')
+        page.click(tid("plot-signals"))
+        page.wait_for_selector(tid("plot-signals-list"), state="detached")
+    x, y = center(page, tid("node-mass2"))
+    page.mouse.click(x, y, button="right")
+    page.wait_for_selector(tid("context-menu"))
+    whole(page, "the right-click menu", wrong)
+    page.keyboard.press("Escape")
+    page.wait_for_selector(tid("context-menu"), state="detached")
+    page.click(tid("tab-json"))
+    page.wait_for_selector(tid("json-text"))
+    whole(page, "the JSON view", wrong)
+    page.click(tid("tab-analysis"))
+    page.wait_for_selector(tid("linearize-form"))
+    whole(page, "the Analysis tab", wrong)
+    page.click(tid("sweep-kind-random"))
+    page.wait_for_selector(tid("sweep-dist-0"))
+    whole(page, "the Analysis tab, a random sweep", wrong)
+    page.click(tid("tab-params"))
+    select(page, "spring")
+    set_field(page, "param-c", UNKNOWN)
+    page.wait_for_selector(f'{tid("problems")}:not([data-count="0"])')
+    whole(page, "a long problem", wrong)
+    page.click(tid("save-as"))
+    page.wait_for_selector(tid("save-path"))
+    whole(page, "the Save as prompt", wrong)
+    set_field(page, "save-path", LONG)
+    page.wait_for_function(f"() => window.__kinetwork.file.path === {json.dumps(LONG)}")
+    set_field(page, "param-c", "2")
+    page.wait_for_selector(tid("dirty"))
+    page.wait_for_selector(f'{tid("problems")}[data-count="0"]')
+    bar = whole(page, "a long file name, unsaved", wrong)["panes"]["bar"]
+    title = page.get_attribute(tid("file"), "title")
+    if not (LONG in title and "double_pendulum" in title and "unsaved" in title):
+        wrong.append(f"the file's title {title!r} lacks its path, name or state")
+    for part in (f'{tid("file")} b', tid("dirty")):     # the name and the mark whole, in the bar
+        box = page.locator(part).bounding_box()
+        if not bar["x0"] <= box["x"] <= box["x"] + box["width"] <= bar["x1"]:
+            wrong.append(f"{part} at {box} outside the bar {bar}")
+    if page.evaluate("() => { const b = document.querySelector('[data-testid=file] b');"
+                     " return b.scrollWidth > b.clientWidth && b.clientWidth > 0; }"):
+        wrong.append("the model's name is elided beside its path")
+    page.click(tid("new"))                          # unsaved changes: the page asks
+    page.wait_for_selector(tid("confirm-discard"))
+    whole(page, "New asking about unsaved changes", wrong)
+    page.click(tid("choice-cancel"))
+    page.wait_for_selector(tid("confirm-discard"), state="detached")
+    page.click(tid("toggle-side"))
+    page.wait_for_selector(".kn-right", state="detached")
+    page.click(tid("toggle-viewer"))
+    page.wait_for_selector(tid("viewer"), state="detached")
+    whole(page, "the side panel and the 3-D view collapsed", wrong)
+    if width >= 1400:           # the plots now as wide as the window: the chips back in a row
+        page.wait_for_selector(f'{tid("plots")} .kn-chips {tid("plot-toggle-probe2.torque")}')
+        assert not page.locator(tid("plot-signals")).count()
+    while page.locator(tid("toast")).count():       # "saved ...": not in the docs' picture
+        page.locator(tid("toast")).first.click()
+    screenshot(page, f"studio-{width}x{height}-collapsed.png")
+    return wrong[len(seen):]
 
 
 def width_of(page, testid_or_css):

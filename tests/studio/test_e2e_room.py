@@ -3,10 +3,11 @@ block, at 1000x700, 1400x900 and 1920x1080, for a 32-link chain (flat, then fold
 mouse) and the largest examples: the zoom and fit buttons sit in the bar above the diagram,
 the minimap shows by itself only where it covers no block (the "map" button shows it on
 demand), the offer to fold a repeated chain is a bar above the diagram; the fit button does
-the same as opening; a subsystem's block is as wide as its ports' names need. Everything is
+the same as opening; a subsystem's block is as wide as its ports' names need; the bars and
+panes around the diagram whole at every size (helpers.misplaced). Everything is
 read from the rendered boxes (getBoundingClientRect) on one page for the module."""
 
-from tests.studio.helpers import K, screenshot, set_field, tid
+from tests.studio.helpers import K, misplaced, screenshot, set_field, tid
 from tests.studio.test_e2e_wires import (DRAWN, SIZES, assert_fitted_whole, at_sizes,  # noqa: F401
                                          polyline, screen, settle, show, site)
 
@@ -61,6 +62,8 @@ def assert_clear(page, what):
     hits, out, over = covered(page)
     assert not hits, f"{what}: {len(hits)} blocks covered: {hits[:6]}"
     assert not out, f"{what}: blocks outside the pane at fit zoom: {out[:6]}"
+    wrong, _ = misplaced(page)                  # the fold bar, the bars and panes whole
+    assert not wrong, f"{what}:\n" + "\n".join(wrong)
     return over
 
 

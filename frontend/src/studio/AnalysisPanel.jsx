@@ -62,10 +62,10 @@ function SweepForm({ runner, params, limits }) {
             ))}
           </select>
           {kind === "grid" ? (
-            <input className="kn-input" placeholder="1, 2, 3  or  1 .. 3 / 5" value={r.text} data-testid={`sweep-values-${i}`} onChange={(e) => setRow(i, { text: e.target.value })} />
+            <input className="kn-input" placeholder="1, 2, 3  or  1 .. 3 / 5" title="1, 2, 3  or  1 .. 3 / 5: the values, or n of them from a to b (a .. b / n)" value={r.text} data-testid={`sweep-values-${i}`} onChange={(e) => setRow(i, { text: e.target.value })} />
           ) : (
             <>
-              <select className="kn-input" value={r.dist} data-testid={`sweep-dist-${i}`} onChange={(e) => setRow(i, { dist: e.target.value })}>
+              <select className="kn-input" value={r.dist} title="the distribution: uniform from low to high, or normal with mean and std" data-testid={`sweep-dist-${i}`} onChange={(e) => setRow(i, { dist: e.target.value })}>
                 <option value="uniform">uniform</option>
                 <option value="normal">normal</option>
               </select>

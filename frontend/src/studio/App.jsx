@@ -67,6 +67,9 @@ function useServerFacts() {
   }, []);
 }
 
+/** How the diagram is worked, above it: elided where the bar is short, whole in its title. */
+const HINT = "drag from the palette · wire port to port · box-select by dragging · right-click for more · wheel zooms, right-drag pans · arrows move · Del · Ctrl+Z/Y · Ctrl+A/C/V/D";
+
 function Breadcrumbs() {
   const name = useStudio((s) => s.hist.present.name);
   const scopes = useStudio((s) => s.scopes);
@@ -84,8 +87,8 @@ function Breadcrumbs() {
           </button>
         </span>
       ))}
-      <span className="kn-muted kn-small kn-hint">
-        drag from the palette · wire port to port · box-select by dragging · right-click for more · wheel zooms, right-drag pans · arrows move · Del · Ctrl+Z/Y · Ctrl+A/C/V/D
+      <span className="kn-muted kn-small kn-hint" title={HINT}>
+        {HINT}
       </span>
       <ViewTools />
     </div>

@@ -50,6 +50,7 @@ export default function JsonView() {
   const text = draft ?? shown;
   const edited = draft !== null && draft !== shown;
   const bad = !!check.error;
+  const state = !edited ? "the model as saved in its file" : check.error ? check.error : check.checking ? "checking…" : check.problems && check.problems.length ? `${check.problems.length} problem${check.problems.length > 1 ? "s" : ""}` : "valid";
   return (
     <div className="kn-json" data-testid="json-view">
       <textarea
@@ -69,8 +70,8 @@ export default function JsonView() {
         }}
       />
       <div className="kn-json-bar">
-        <span className={`kn-json-state ${bad ? "bad" : ""}`} data-testid="json-state">
-          {!edited ? "the model as saved in its file" : check.error ? check.error : check.checking ? "checking…" : check.problems && check.problems.length ? `${check.problems.length} problem${check.problems.length > 1 ? "s" : ""}` : "valid"}
+        <span className={`kn-json-state ${bad ? "bad" : ""}`} data-testid="json-state" title={state}>
+          {state}
         </span>
         <button
           className="kn-btn"

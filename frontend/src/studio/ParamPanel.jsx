@@ -57,13 +57,14 @@ function ParamRow({ p, value, problems, onSet }) {
       </select>
     );
   } else {
+    const hint = p.required ? "required" : formatValue(p.default) || "none";
     input = (
       <Field
         value={formatValue(value)}
-        placeholder={p.required ? "required" : formatValue(p.default) || "none"}
+        placeholder={hint}
         testid={`param-${p.name}`}
         bad={bad}
-        title={p.time ? "a number, or an expression in the model's parameters and time t" : "a number, or an expression in the model's parameters"}
+        title={`${p.required ? hint : `default ${hint}`}: a number, or an expression in the model's parameters${p.time ? " and time t" : ""}`}
         onCommit={(text) => onSet(parseValue(text))}
       />
     );

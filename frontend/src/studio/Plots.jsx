@@ -361,6 +361,75 @@ export function makeBus(cursor) {
   };
 }
 
+/** What the head says of the runs plotted: the latest's name, points, whether partial, the older ones. */
+function runInfo(latest, runs) {
+  const one = latest.kind !== "sweep";
+  return (
+    latest.label +
+    (one ? ` · ${latest.results.t.length} points` : "") +
+    (one && latest.results.partial ? ` · partial, to t = ${Number(latest.results.partial.t_reached).toPrecision(4)} s` : "") +
+    (runs.length > 1 ? ` · dashed: ${runs.slice(1, OVERLAY).map((r) => r.label).join("; ")}` : "")
+  );
+}
+
+/**
+ * A chip per signal, to hide or show it: in a row at the head's end while the row fits the
+ * head, else folded into a "signals" button that opens them as a list (cut at the pane's
+ * edge, the row hid the last chips and half of one).
+ */
+function SignalChips({ names, hidden, setHidden, head, height }) {
+  const [folded, setFolded] = useState(false);
+  const [open, setOpen] = useState(false);
+  const pop = useRef(null);
+  // measured as the head's size changes (a new run mounts this afresh, in a row)
+  useEffect(() => {
+    const el = head.current;
+    if (!el) return undefined;
+    let need = 0; // the head's width with the chips in a row
+    let fold = false;
+    const ro = new ResizeObserver(() => {
+      if (!fold) {
+        need = el.scrollWidth;
+        fold = el.scrollWidth > el.clientWidth + 1;
+      } else fold = el.clientWidth < need;
+      setFolded(fold);
+    });
+    ro.observe(el);
+    return () => ro.disconnect();
+  }, [head]);
+  useEffect(() => {
+    if (!open) return undefined;
+    const away = (e) => pop.current && !pop.current.contains(e.target) && setOpen(false);
+    document.addEventListener("mousedown", away);
+    return () => document.removeEventListener("mousedown", away);
+  }, [open]);
+  const toggle = (n) =>
+    setHidden((h) => {
+      const next = new Set(h);
+      if (next.has(n)) next.delete(n);
+      else next.add(n);
+      return next;
+    });
+  const chips = names.map((n) => (
+    <button key={n} className={`kn-chip ${hidden.has(n) ? "" : "on"}`} data-testid={`plot-toggle-${n}`} title={hidden.has(n) ? "show it" : "hide it"} onClick={() => toggle(n)}>
+      {n}
+    </button>
+  ));
+  if (!folded) return <div className="kn-chips">{chips}</div>;
+  return (
+    <span className="kn-chips-fold" ref={pop}>
+      <button className="kn-chip on" data-testid="plot-signals" aria-haspopup="true" aria-expanded={open} title="Show or hide each signal" onClick={() => setOpen(!open)}>
+        signals {names.filter((n) => !hidden.has(n)).length}/{names.length} ▾
+      </button>
+      {open ? (
+        <div className="kn-chips-pop" data-testid="plot-signals-list" style={{ maxHeight: Math.max(60, height - 4) }}>
+          {chips}
+        </div>
+      ) : null}
+    </span>
+  );
+}
+
 export default function Plots({ runs, bus, running, progress, status }) {
   const wrap = useRef(null);
   const [width, setWidth] = useState(600);
@@ -368,6 +437,7 @@ export default function Plots({ runs, bus, running, progress, status }) {
   const [hidden, setHidden] = useState(() => new Set());
   const [byQuantity, setByQuantity] = useState(true);
   const [enlarged, setEnlarged] = useState(null);
+  const head = useRef(null);
   useEffect(() => {
     if (!wrap.current) return undefined;
     const ro = new ResizeObserver((entries) => {
@@ -403,14 +473,12 @@ export default function Plots({ runs, bus, running, progress, status }) {
   const big = enlarged && panels.find((p) => p.title === enlarged);
   return (
     <div className="kn-plots" data-testid="plots" data-runs={runs.length}>
-      <div className="kn-plots-head">
+      <div className="kn-plots-head" ref={head}>
         <span className="kn-panel-title-inline">Probes</span>
         {latest ? (
-          <span className="kn-muted kn-small kn-runinfo" data-testid="plot-runs">
+          <span className="kn-muted kn-small kn-runinfo" data-testid="plot-runs" title={runInfo(latest, runs)}>
             <b>{latest.label}</b>
-            {latest.kind !== "sweep" ? ` · ${latest.results.t.length} points` : ""}
-            {latest.kind !== "sweep" && latest.results.partial ? ` · partial, to t = ${Number(latest.results.partial.t_reached).toPrecision(4)} s` : ""}
-            {runs.length > 1 ? ` · dashed: ${runs.slice(1, OVERLAY).map((r) => r.label).join("; ")}` : ""}
+            {runInfo(latest, runs).slice(latest.label.length)}
           </span>
         ) : null}
         {latest ? (
@@ -418,26 +486,7 @@ export default function Plots({ runs, bus, running, progress, status }) {
             {byQuantity ? "by quantity" : "by signal"}
           </button>
         ) : null}
-        <div className="kn-chips">
-          {names.map((n) => (
-            <button
-              key={n}
-              className={`kn-chip ${hidden.has(n) ? "" : "on"}`}
-              data-testid={`plot-toggle-${n}`}
-              title={hidden.has(n) ? "show it" : "hide it"}
-              onClick={() =>
-                setHidden((h) => {
-                  const next = new Set(h);
-                  if (next.has(n)) next.delete(n);
-                  else next.add(n);
-                  return next;
-                })
-              }
-            >
-              {n}
-            </button>
-          ))}
-        </div>
+        <SignalChips key={latest ? `${latest.kind}-${latest.id}` : "none"} names={names} hidden={hidden} setHidden={setHidden} head={head} height={height} />
       </div>
       <div className="kn-plots-grid" ref={wrap} style={{ gridTemplateColumns: `repeat(${cols}, 1fr)` }}>
         {!latest && (

@@ -40,6 +40,7 @@ export default function Toolbar({ files, edit, runner, onOpen }) {
   const redo = useStudio((s) => s.redo);
   const going = runner.going;
   const cancelling = run && run.state === "cancelling";
+  const where = file.path || (file.example ? `example ${file.example}` : "not saved");
   return (
     <header className="kn-bar">
       <div className="kn-brand" title="kinetwork studio">
@@ -80,13 +81,19 @@ export default function Toolbar({ files, edit, runner, onOpen }) {
           {runStatus(run)}
         </span>
       </div>
-      <div className="kn-file" data-testid="file" title={file.path || "not saved yet"}>
-        {busy ? <span className="kn-muted">{busy} </span> : null}
-        <b>{name}</b>
-        <span className="kn-muted"> · {file.path || (file.example ? `example ${file.example}` : "not saved")}</span>
+      {/* the name never gives way to the path, nor the unsaved mark to either: what is cut
+          shows "…", and the whole is the title */}
+      <div className="kn-file" data-testid="file" title={`${name} · ${where}${files.dirty ? " · unsaved changes" : ""}`}>
+        {busy ? <span className="kn-muted kn-file-busy">{busy}</span> : null}
+        <b className="kn-file-name">{name}</b>
+        <span className="kn-muted">·</span>
+        {/* cut at its start, so that the file's own name shows */}
+        <span className="kn-muted kn-file-path">
+          <bdi>{where}</bdi>
+        </span>
         {files.dirty ? (
           <span className="kn-dirty" data-testid="dirty" title="unsaved changes">
-            {" "}●
+            ●
           </span>
         ) : null}
       </div>
