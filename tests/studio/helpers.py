@@ -2,9 +2,11 @@
 waits on the page's state (the test build's window.__kinetwork), never on time."""
 
 import contextlib
+import functools
 import json
 import os
 import pathlib
+import re
 import tempfile
 import threading
 import time
@@ -43,9 +45,19 @@ def serving(app):
 
 
 def screenshot(page, name):
-    """The page as it is now, as ``IMAGES/name``."""
-    IMAGES.mkdir(parents=True, exist_ok=True)
-    page.screenshot(path=str(IMAGES / name))
+    """The page (or one of its elements, a locator) as it is now, as ``IMAGES/name``; a picture no page of docs/ shows goes to
+    ``IMAGES/unshown/``, so that refreshing the docs' folder adds nothing they do not use."""
+    folder = IMAGES if name in _shown_in_docs() else IMAGES / "unshown"
+    folder.mkdir(parents=True, exist_ok=True)
+    page.screenshot(path=str(folder / name))
+
+
+@functools.cache
+def _shown_in_docs():
+    """The names of the pictures the pages of docs/ show (``images/NAME``)."""
+    docs = pathlib.Path(__file__).resolve().parents[2] / "docs"
+    return {m.group(1) for page in docs.rglob("*.md")
+            for m in re.finditer(r"images/([\w.-]+\.png)", page.read_text(encoding="utf-8"))}
 
 
 def tid(name):

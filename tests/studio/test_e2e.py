@@ -14,8 +14,9 @@ import numpy as np
 import pytest
 
 import kinetwork as kn
-from tests.studio.helpers import (IMAGES, RUN_TIMEOUT, K, center, deselect, open_file, open_studio,
-                                  place, run, select, set_field, tid, wait_validated, wire)
+from tests.studio.helpers import (RUN_TIMEOUT, K, center, deselect, open_file, open_studio,
+                                  place, run, screenshot, select, set_field, tid, wait_validated,
+                                  wire)
 
 REPO = pathlib.Path(__file__).resolve().parents[2]
 SEED = "models/double_pendulum.json"
@@ -195,8 +196,7 @@ def test_a_subsystem_opens_to_its_definition_and_back(page, studio):
         page.wait_for_selector(tid(f"node-{comp}"))
     assert not K(page, "K.dirty")                 # looking changes nothing
     select(page, "pid")
-    IMAGES.mkdir(parents=True, exist_ok=True)
-    page.screenshot(path=str(IMAGES / "studio-subsystem.png"))
+    screenshot(page, "studio-subsystem.png")
     # an edit inside a definition read from a file writes it inline, as kn's writer does
     set_field(page, "param-k", "2*k")
     page.wait_for_function("() => window.__kinetwork.doc.definitions.Axis.components")
@@ -323,8 +323,7 @@ def test_a_wrong_wire_and_a_bad_parameter_show_their_message(page, studio):
     assert "bad" not in page.locator(tid("node-mass2")).get_attribute("class")
     wire(page, "shoulder.axis", "link1.frame_a")       # the toast again, for the picture
     toast.wait_for()
-    IMAGES.mkdir(parents=True, exist_ok=True)
-    page.screenshot(path=str(IMAGES / "studio-problems.png"))
+    screenshot(page, "studio-problems.png")
     # fixed: the message goes
     set_field(page, "param-mass", "m1")
     message.wait_for(state="detached")
@@ -397,8 +396,7 @@ def test_screenshot_of_the_seed_with_plots_and_3d_view(page, studio):
     page.wait_for_selector(f'{tid("viewer")}[data-ready="1"]')
     page.evaluate("() => window.__kinetwork.setTime(2.6)")
     page.wait_for_timeout(600)
-    IMAGES.mkdir(parents=True, exist_ok=True)
-    page.screenshot(path=str(IMAGES / "studio.png"))
+    screenshot(page, "studio.png")
     print(f"\nstudio load (navigation to palette ready): {load:.2f} s; Run to plotted "
           f"results: {K(page, 'K.timings.runToPlot'):.2f} s")
     assert not page.errors, page.errors

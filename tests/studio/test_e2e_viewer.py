@@ -4,7 +4,7 @@ pose puts it (the poses the server sent, turned by hand here: an independent rec
 
 import numpy as np
 
-from tests.studio.helpers import IMAGES, K, open_studio, run, tid
+from tests.studio.helpers import K, open_studio, run, screenshot, tid
 
 
 def rotate(q, v):
@@ -39,8 +39,7 @@ def test_a_chain_is_drawn_in_a_few_calls_with_every_shape_on_its_frame(page, stu
     # many shapes of a kind are drawn with fewer segments (8000 triangles a kind at most):
     # 32 spheres of 32x16 segments alone were 30 720 triangles, a third of the frame rate
     assert info["triangles"] < 16000, info
-    IMAGES.mkdir(parents=True, exist_ok=True)
-    page.locator(tid("viewer")).screenshot(path=str(IMAGES / "studio-chain32-3d.png"))
+    screenshot(page.locator(tid("viewer")), "studio-chain32-3d.png")
 
     animation = K(page, "K.runs[0].results.animation")
     t = animation["t"]
