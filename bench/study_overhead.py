@@ -9,7 +9,9 @@ links with a damper on each joint, planar and 3-D (``scenes.chains.point_masses`
   as in any later run of a session: a repeated quiet run replays the recipe, its integrator
   call bound once, ``kinetwork/solver/replay.py``);
 - its integrator call alone: the very CasADi integrator the run called, through a buffer
-  bound once to the run's inputs (what the run would cost with no Python around it);
+  bound once to the run's inputs (what the run would cost with no Python around it), with
+  CasADi's per-evaluation clock made cheap as in a run (``kinetwork/solver/casadi_clock.py``)
+  and with CasADi's own (``clock()``, a system call, twice per evaluation);
 - the hand-written route (``peers/casadi_peer.py``: Featherstone's ABA in SX, gcc -O1,
   ``casadi.external``, CVODES Adams in one ``casadi.integrator`` call) at the solver
   tolerances kinetwork hands CVODES for that rtol (``tolerance.solver_tolerances``: the same
@@ -24,6 +26,12 @@ Lagrange equations, ``scenes.reference``; the chains: pinocchio's ABA).
 Timing: CPU time (``time.process_time``), the tools interleaved in rounds in one process,
 medians over the rounds, the machine's load average (1 min) at the end of each row's rounds
 beside it (the machine may be shared). Ratios > 1: kinetwork is faster.
+
+Where a run's time goes (one scene and rtol per row, ``breakdown``): CPU time of the thread
+(``time.thread_time``) inside the replay's integrator call, inside the rest of the replay's
+call (the states' array, the solvers' words caught, the rows checked), and around it (the
+settings looked up, the recipe found, the run's signal handlers, the Results built), over
+many runs.
 
 Writes ``results/study_overhead.md``. Run: ``python bench/study_overhead.py [--rounds R]``.
 """
@@ -46,6 +54,8 @@ import casadi_peer
 import pinocchio_peer
 
 import kinetwork as kn
+from kinetwork.solver import replay
+from kinetwork.solver.casadi_clock import cheap
 from kinetwork.solver.compiled import compiled
 from kinetwork.solver.tolerance import solver_tolerances
 
@@ -79,7 +89,7 @@ def error(q, ref):
 def integrator_call(system):
     """The integrator that the last run of ``system`` replays (its recipe's), as a function
     of no arguments that calls it with that run's inputs through a buffer bound once
-    (nothing but the call), and its evaluations per call."""
+    (nothing but the call, CasADi's own clock), and its evaluations per call."""
     integ = next(reversed(compiled(system)._recipes.values())).integ
     x0 = np.ascontiguousarray(system.x0[:system.n_states])
     p = np.append(system.param_vector(), 0.0)
@@ -93,6 +103,45 @@ def integrator_call(system):
         trigger()
     call()
     return call, int(buf.stats()["nfevals"])
+
+
+def cheap_clock(call):
+    """``call`` with CasADi's clock made cheap, as a run makes its integrator calls."""
+    def cheap_call():
+        with cheap():
+            call()
+    return cheap_call
+
+
+def breakdown(system, kw, runs):
+    """Microseconds of the thread's CPU per run of ``system`` (its recipe kept) over ``runs``
+    runs: (whole run, integrator call, rest of the replay's call, the run around it)."""
+    recipe = next(reversed(compiled(system)._recipes.values()))
+    buffer, trigger, *rest = recipe.call
+    spent = {"call": 0.0, "_call": 0.0}
+
+    def timed_trigger():
+        start = time.thread_time()
+        trigger()
+        spent["call"] += time.thread_time() - start
+    inner = replay._call
+
+    def timed(*args):
+        start = time.thread_time()
+        out = inner(*args)
+        spent["_call"] += time.thread_time() - start
+        return out
+    recipe.call, replay._call = (buffer, timed_trigger, *rest), timed
+    try:
+        start = time.thread_time()
+        for _ in range(runs):
+            kn.simulate(system, **kw)
+        whole = time.thread_time() - start
+    finally:
+        recipe.call, replay._call = (buffer, trigger, *rest), inner
+    us = 1e6 / runs
+    return (whole * us, spent["call"] * us, (spent["_call"] - spent["call"]) * us,
+            (whole - spent["_call"]) * us)
 
 
 def bracket(ladder, target):
@@ -131,7 +180,7 @@ def cpu(fn, rounds_out, key):
 def study(rounds):
     t = np.linspace(0.0, HORIZON, POINTS)
     adams = kn.METHODS["cvodes-adams"]
-    rows, counts = [], []
+    rows, counts, where = [], [], []
     for name, (make, spec_of) in SCENES.items():
         spec, system = spec_of(), make().compile()
         n = spec.n
@@ -149,7 +198,8 @@ def study(rounds):
             res = kn.simulate(system, **kw)
             kn.simulate(system, **kw)               # the first replay binds its call
             srt, sat = solver_tolerances(adams, system, rtol, rtol * 1e-2)
-            call, evals = integrator_call(system)
+            own_clock, evals = integrator_call(system)
+            call = cheap_clock(own_clock)
             casadi_peer.run(hand, t, rtol=srt, atol=sat)
             hand_evals = int(casadi_peer.integrator(hand, t, srt, sat).stats()["nfevals"])
             err = error(chains.joint_angles(res), ref)
@@ -159,6 +209,7 @@ def study(rounds):
             for _ in range(rounds):
                 cpu(lambda: kn.simulate(system, **kw), spent, "kinetwork")
                 cpu(call, spent, "call")
+                cpu(own_clock, spent, "own clock")
                 cpu(lambda: casadi_peer.run(hand, t, rtol=srt, atol=sat), spent, "hand")
                 for r in neighbours:
                     cpu(lambda r=r: casadi_peer.run(hand, t, rtol=r), spent, r)
@@ -173,11 +224,15 @@ def study(rounds):
                          f"{os.getloadavg()[0]:.1f}"])
             counts.append([name, f"{rtol:.0e}", evals, hand_evals,
                            f"{med['call'] / evals * 1e6:.2f}",
+                           f"{med['own clock'] / evals * 1e6:.2f}",
                            f"{med['hand'] / hand_evals * 1e6:.2f}",
                            f"{(med['kinetwork'] - med['call']) * 1e6:.0f}",
                            f"{(med['kinetwork'] - med['call']) / med['kinetwork'] * 100:.0f} %"])
-            print("  ", rows[-1], counts[-1][2:], flush=True)
-    return rows, counts
+            parts = breakdown(system, kw, 10 * rounds)
+            where.append([name, f"{rtol:.0e}", *(f"{v:.0f}" for v in parts),
+                          f"{os.getloadavg()[0]:.1f}"])
+            print("  ", rows[-1], counts[-1][2:], where[-1][2:], flush=True)
+    return rows, counts, where
 
 
 def main():
@@ -185,7 +240,7 @@ def main():
     parser.add_argument("--rounds", type=int, default=41, help="interleaved rounds per row")
     args = parser.parse_args()
     start = time.perf_counter()
-    rows, counts = study(args.rounds)
+    rows, counts, where = study(args.rounds)
     text = "\n".join([
         "# Per-run overhead: the quiet run of a small model against the hand-written route",
         "",
@@ -202,13 +257,25 @@ def main():
                "ratio at same accuracy", "load (1 min)"], rows), "",
         "## Where the time goes", "",
         "Evaluations of the right-hand side per run, CPU time per evaluation (each route's "
-        "integrator call divided by its evaluations: CVODES' work included), and what "
+        "integrator call divided by its evaluations: CVODES' work included; kinetwork's "
+        "with CasADi's clock made cheap as its runs make it, ``casadi_clock.py``, and with "
+        "CasADi's own, a system call twice per evaluation, as the hand route runs), and what "
         "kinetwork's run costs beyond its integrator call (the replay: settings and "
         "parameters looked up, signal handlers, the solvers' words caught, Results; the "
         "probe signals are computed when first read).", "",
         table(["scene", "rtol", "kinetwork evaluations", "hand evaluations",
-               "kinetwork us/evaluation", "hand us/evaluation (whole run)",
-               "kinetwork per-run overhead [us]", "share of the run"], counts)])
+               "kinetwork us/evaluation", "the same call, CasADi's own clock",
+               "hand us/evaluation (whole run)",
+               "kinetwork per-run overhead [us]", "share of the run"], counts), "",
+        "## Where a run's microseconds go", "",
+        f"CPU time of the thread per run (``time.thread_time``, {10 * args.rounds} runs in a "
+        "row after the rounds): the whole ``kn.simulate`` call; its integrator call (CVODES "
+        "and the compiled equations); the rest of the replay's call (the states' array, the "
+        "solvers' words caught, the rows checked, the counts); the run around it (settings "
+        "and the recipe looked up, the run's signal handlers, the Results). Probe signals "
+        "are computed when first read: not in a run.", "",
+        table(["scene", "rtol", "whole run [us]", "integrator call [us]",
+               "rest of the call [us]", "around the call [us]", "load (1 min)"], where)])
     write_markdown(NAME, text)
     print(f"done in {time.perf_counter() - start:.0f} s", flush=True)
 
