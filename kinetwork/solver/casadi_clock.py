@@ -67,6 +67,21 @@ class cheap:                                # noqa: N801 -- read as ``with cheap
         return False
 
 
+def _forked():
+    """In a child forked within a section (a sweep's process pool): the child's own
+    sections start from none, with libc's clock in the slot and a lock of its own."""
+    global _GUARD
+    _GUARD = threading.Lock()
+    _DEPTH[0] = 0
+    found = _FOUND
+    if found and found[0].value == found[2]:
+        found[0].value = found[1]
+
+
+if hasattr(os, "register_at_fork"):
+    os.register_at_fork(after_in_child=_forked)
+
+
 def active():
     """Whether CasADi's clock is the replacement now (for the tests)."""
     found = _FOUND

@@ -3,12 +3,14 @@
 every way out, nothing changed where the slot cannot be found for certain."""
 
 import ctypes
+import os
 import platform
 import re
 import shutil
 import subprocess
 import sys
 import time
+import warnings
 
 import numpy as np
 import pytest
@@ -122,3 +124,24 @@ def test_nothing_is_changed_when_asked_not_to(monkeypatch):
     monkeypatch.setattr(casadi_clock, "_FOUND", None)
     with casadi_clock.cheap():
         assert casadi_clock._FOUND is False and not casadi_clock.active()
+
+
+def test_a_child_forked_within_a_section_starts_with_libcs_clock():
+    found()
+    read, write = os.pipe()
+    with casadi_clock.cheap(), warnings.catch_warnings():
+        warnings.simplefilter("ignore", DeprecationWarning)     # 3.12: fork with threads
+        pid = os.fork()
+        if pid == 0:                                    # the child: say what it has, go
+            ok = not casadi_clock.active() and casadi_clock._DEPTH[0] == 0
+            with casadi_clock.cheap():
+                ok = ok and casadi_clock.active()
+            ok = ok and not casadi_clock.active()
+            os.write(write, b"1" if ok else b"0")
+            os._exit(0)
+        assert casadi_clock.active()                    # the parent's section goes on
+    os.waitpid(pid, 0)
+    assert os.read(read, 1) == b"1"
+    os.close(read)
+    os.close(write)
+    assert not casadi_clock.active()
