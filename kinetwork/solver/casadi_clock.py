@@ -2,50 +2,48 @@
 
 CasADi times every evaluation that an integrator makes of its equations, for its statistics
 ``t_proc_*`` and ``t_wall_*`` (``OracleFunction::calc_function``: ``std::clock()`` before and
-after). ``clock()`` reads CLOCK_PROCESS_CPUTIME_ID, a system call that the vDSO never serves:
-0.5 us on the bench's machine, two per evaluation, 1.2 of the 1.9 us that an evaluation of a
-2-link chain costs inside CVODES (``bench/results/study_overhead.md``). kinetwork never reads
-those statistics. So while one of its solver sections runs (``capture.Section``, a replay's
-call), CasADi's slot for ``clock`` in libcasadi's procedure linkage table points at a clock of
-the monotonic clock (the vDSO's: no system call), and is put back on the way out. The solver's
-arithmetic never reads the clock: the numbers are the same to the bit; CasADi's ``t_proc_*``
-of what ran meanwhile (in any thread) count wall time instead of CPU time.
+after, with no option to turn it off). ``clock()`` reads CLOCK_PROCESS_CPUTIME_ID, a system
+call that the vDSO never serves: 0.5 us on the bench's machine, two per evaluation, 1.2 of the
+1.9 us that an evaluation of a 2-link chain costs inside CVODES
+(``bench/results/study_overhead.md``). kinetwork never reads those statistics. So while one of
+its solver sections runs (``capture.Section``, a replay's call), CasADi's slot for ``clock``
+in libcasadi's procedure linkage table points at a function that returns 0 at once, and libc's
+``clock`` is put back on the way out. The solver's arithmetic never reads the clock: the
+numbers are the same to the bit; CasADi's ``t_proc_*`` do not grow by what ran meanwhile (in
+any thread), its ``t_wall_*`` (another clock) do.
 
-Done only where it is certain, else nothing is changed: Linux, libcasadi a 64-bit
-little-endian x86-64 ELF shared object whose relocation for ``clock`` is found, its slot in a
-writable mapping of that file and holding libc's ``clock`` when a section starts; a C compiler
-for the replacement (the JIT's cache keeps it); ``KINETWORK_CASADI_CLOCK`` not 1.
+The function is three bytes of x86-64 (``xor eax, eax; ret``) in a page of its own, written
+and then made read-and-execute only: no compiler, no file. Done only where it is certain, else
+nothing is changed: Linux on x86-64, libcasadi a little-endian x86-64 ELF shared object whose
+jump-slot relocation for ``clock`` is found, its slot in a writable mapping of that file and
+holding libc's ``clock`` when a section starts, the page made executable (a system that
+refuses, SELinux's execmem, keeps CasADi's clock); ``KINETWORK_CASADI_CLOCK`` not 1.
 """
 
 from __future__ import annotations
 
 import ctypes
+import mmap
 import os
+import platform
 import re
 import struct
 import sys
 import threading
 
-#: the replacement: CLOCKS_PER_SEC ticks of the monotonic clock (vDSO), as clock() counts
-SOURCE = """#include <time.h>
-clock_t kinetwork_clock(void) {
-  struct timespec t;
-  clock_gettime(CLOCK_MONOTONIC, &t);
-  return (clock_t)t.tv_sec * CLOCKS_PER_SEC
-         + (clock_t)(t.tv_nsec / (1000000000L / CLOCKS_PER_SEC));
-}
-"""
+#: the replacement, x86-64: ``xor eax, eax; ret`` (a clock_t of 0)
+ZERO = b"\x31\xc0\xc3"
 _LIBCASADI = re.compile(r"/libcasadi\.so(\.\d+)*$")
 _GUARD = threading.Lock()
 #: the slot (a ctypes pointer cell), libc's clock and the replacement, once found; False: not
 #: to be done in this process
 _FOUND: tuple | bool | None = None
 _DEPTH = [0]
-_LIBRARY = []                               # the replacement's library, loaded for good
+_PAGE = []                                  # the replacement's page, kept for good
 
 
 class cheap:                                # noqa: N801 -- read as ``with cheap():``
-    """Within, CasADi's clock is the monotonic one (see the module's docstring); nested and
+    """Within, CasADi's clock returns 0 at once (see the module's docstring); nested and
     concurrent sections share one change, undone when the last leaves. A class: a run enters
     one or two, and a generator's machinery costs more than what it does."""
 
@@ -94,8 +92,8 @@ def _find():
     global _FOUND
     _FOUND = False
     if os.environ.get("KINETWORK_CASADI_CLOCK", "").strip() == "1" \
-            or not sys.platform.startswith("linux") or struct.calcsize("P") != 8 \
-            or sys.byteorder != "little":
+            or not sys.platform.startswith("linux") or platform.machine() != "x86_64" \
+            or struct.calcsize("P") != 8:
         return _FOUND
     try:
         mapped = _mappings()
@@ -112,16 +110,28 @@ def _find():
         if not any(start <= slot and slot + 8 <= end and perms.startswith("rw")
                    for start, end, _, perms in regions):
             return _FOUND
-        libc_clock = ctypes.cast(ctypes.CDLL(None).clock, ctypes.c_void_p).value
-        from .jit import library_of_c
-        lib = ctypes.CDLL(str(library_of_c("kinetwork_clock", SOURCE)))
-        replacement = ctypes.cast(lib.kinetwork_clock, ctypes.c_void_p).value
+        libc = ctypes.CDLL(None, use_errno=True)
+        libc_clock = ctypes.cast(libc.clock, ctypes.c_void_p).value
+        replacement = _zero(libc)
     except (OSError, ValueError, AttributeError, struct.error):
-        # ``jit_build.Unavailable`` is a ModelError, a ValueError: no compiler, no cache
         return _FOUND
-    _LIBRARY.append(lib)
+    if replacement is None:
+        return _FOUND
     _FOUND = (ctypes.c_void_p.from_address(slot), libc_clock, replacement)
     return _FOUND
+
+
+def _zero(libc):
+    """The address of ZERO in a page of its own made read-and-execute, or None when the
+    system refuses."""
+    page = mmap.mmap(-1, mmap.PAGESIZE, prot=mmap.PROT_READ | mmap.PROT_WRITE)
+    page.write(ZERO)
+    address = ctypes.addressof(ctypes.c_char.from_buffer(page))
+    libc.mprotect.argtypes = (ctypes.c_void_p, ctypes.c_size_t, ctypes.c_int)
+    if libc.mprotect(address, mmap.PAGESIZE, mmap.PROT_READ | mmap.PROT_EXEC) != 0:
+        return None
+    _PAGE.append(page)          # never unmapped: the slot may point here at any time
+    return address
 
 
 def _mappings():

@@ -249,25 +249,6 @@ def external(f, jacobian=False, stats=None, required=False, deadline=None, cance
         return f
 
 
-def library_of_c(name, text):
-    """The path of a shared library compiled from the C ``text`` (one file, -O2), kept in
-    the cache under ``name`` and the hash of the text and the compiler. Raises
-    ``jit_build.Unavailable`` (a ModelError) saying why when it cannot be had."""
-    cc = compiler()
-    if cc is None:
-        raise _Unavailable("no-compiler", "jit: no C compiler found")
-    key = hashlib.sha256("\0".join([text, cc, *CFLAGS]).encode()).hexdigest()[:20]
-    with _LOCK:
-        lib = _folder() / f"{name}_{key}.so"
-        if _verified(lib):
-            _touch(lib)
-        else:
-            build(cc, {f"{name}_main.c": (text, ["-O2", *CFLAGS])}, lib,
-                  timeout=COMPILE_TIMEOUT)
-            _trim(lib.parent, keep=lib)
-    return lib
-
-
 def wait(timeout=None):
     """Wait until every optimised library this process waits for is built and swapped in
     (at most ``timeout`` s each); return {quick library: ``optimised``, or why not}."""
