@@ -105,6 +105,37 @@ def integrator_call(system):
     return call, int(buf.stats()["nfevals"])
 
 
+def equations_alone(system, calls=2000, rounds=7):
+    """CPU microseconds per evaluation, each through a buffer bound once, of the compiled
+    right-hand side alone and of the integrators' DAE Function around it (CasADi's MX
+    wrapper: the time shifted by the chunk's start, the parameters split), least of
+    ``rounds``; a loop that calls nothing is taken off."""
+    table = compiled(system)._cache
+    rhs = table[("rhs", False)]
+    dae = next(v for k, v in table.items() if isinstance(k, tuple) and k[0] == "dae")
+    n, p = system.n_states, system.param_vector()
+    x = np.ascontiguousarray(system.x0[:n], dtype=float)
+    keep, triggers = [], {}
+    for name, f, args in (("rhs", rhs, {0: np.zeros(1), 1: x, 2: np.array(p, dtype=float)}),
+                          ("dae", dae, {0: np.zeros(1), 1: x, 3: np.append(p, 0.0)})):
+        buf, trigger = f.buffer()
+        for i, value in args.items():
+            buf.set_arg(i, memoryview(value))
+        out = np.empty(n)
+        buf.set_res(0, memoryview(out))
+        keep.append((buf, args, out))
+        triggers[name] = trigger
+
+    def loop(trigger):
+        start = time.process_time()
+        for _ in range(calls):
+            trigger()
+        return time.process_time() - start
+    best = {k: min(loop(t) for _ in range(rounds)) for k, t in triggers.items()}
+    empty = min(loop(lambda: None) for _ in range(rounds))
+    return {k: (v - empty) / calls * 1e6 for k, v in best.items()}
+
+
 def cheap_clock(call):
     """``call`` with CasADi's clock made cheap, as a run makes its integrator calls."""
     def cheap_call():
@@ -229,6 +260,8 @@ def study(rounds):
                            f"{(med['kinetwork'] - med['call']) * 1e6:.0f}",
                            f"{(med['kinetwork'] - med['call']) / med['kinetwork'] * 100:.0f} %"])
             parts = breakdown(system, kw, 10 * rounds)
+            alone = equations_alone(system)
+            counts[-1][6:6] = [f"{alone['dae']:.2f}", f"{alone['rhs']:.2f}"]
             where.append([name, f"{rtol:.0e}", *(f"{v:.0f}" for v in parts),
                           f"{os.getloadavg()[0]:.1f}"])
             print("  ", rows[-1], counts[-1][2:], where[-1][2:], flush=True)
@@ -259,12 +292,16 @@ def main():
         "Evaluations of the right-hand side per run, CPU time per evaluation (each route's "
         "integrator call divided by its evaluations: CVODES' work included; kinetwork's "
         "with CasADi's clock made cheap as its runs make it, ``casadi_clock.py``, and with "
-        "CasADi's own, a system call twice per evaluation, as the hand route runs), and what "
+        "CasADi's own, a system call twice per evaluation, as the hand route runs; then one "
+        "evaluation outside the integrator of the DAE Function it calls, CasADi's MX wrapper "
+        "around the compiled equations, and of the compiled equations alone, each through a "
+        "buffer bound once), and what "
         "kinetwork's run costs beyond its integrator call (the replay: settings and "
         "parameters looked up, signal handlers, the solvers' words caught, Results; the "
         "probe signals are computed when first read).", "",
         table(["scene", "rtol", "kinetwork evaluations", "hand evaluations",
                "kinetwork us/evaluation", "the same call, CasADi's own clock",
+               "the DAE Function alone [us]", "its compiled equations alone [us]",
                "hand us/evaluation (whole run)",
                "kinetwork per-run overhead [us]", "share of the run"], counts), "",
         "## Where a run's microseconds go", "",

@@ -8,7 +8,10 @@ damper of 0.1 N m s/rad on each joint, about z (planar) or about z and x in turn
 
 Timing: CPU time (``time.process_time``) of one run, the least of REPEATS, the curves' runs of
 one setting taken in turn (interleaved: a shared machine's load falls on every tool alike);
-every model is built and every integrator called once first. A curve stops after a run over
+every model is built and every integrator called once first, and kinetwork's optimised
+library is in (``jit.wait``: a large model's first runs call a quick -O0 build while the
+optimised one is made in the background, ``kinetwork/solver/jit.py``; what that first
+answer costs is ``study_scaling``'s). A curve stops after a run over
 CAP s of CPU or once its error is below FLOOR. Time to an accuracy: log-log interpolation on
 each curve's Pareto front (``study_work_precision.time_to``).
 
@@ -22,6 +25,7 @@ import time
 import numpy as np
 
 import kinetwork as kn
+from kinetwork.solver import jit
 
 import common
 from common import machine, max_error, table, write_csv, write_markdown
@@ -119,6 +123,7 @@ def study(quick=False):
             curves, details, hand = curves_of(spec, system, t, quick)
             for settings, run in curves.values():           # JIT, integrators, first calls
                 cpu(run, settings[0])
+            jit.wait()                                      # the optimised library swapped in
             agree = max_error(casadi_peer.run(hand, t, rtol=1e-12), ref)
             notes.append(f"{scene}: the hand-written route at rtol 1e-12 is {agree:.1e} rad "
                          f"from the reference")
