@@ -76,10 +76,6 @@ def _forked():
         found[0].value = found[1]
 
 
-if hasattr(os, "register_at_fork"):
-    os.register_at_fork(after_in_child=_forked)
-
-
 def active():
     """Whether CasADi's clock is the replacement now (for the tests)."""
     found = _FOUND
@@ -118,6 +114,7 @@ def _find():
     if replacement is None:
         return _FOUND
     _FOUND = (ctypes.c_void_p.from_address(slot), libc_clock, replacement)
+    os.register_at_fork(after_in_child=_forked)        # from the first change on
     return _FOUND
 
 
