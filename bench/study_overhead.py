@@ -29,9 +29,9 @@ beside it (the machine may be shared). Ratios > 1: kinetwork is faster.
 
 Where a run's time goes (one scene and rtol per row, ``breakdown``): CPU time of the thread
 (``time.thread_time``) inside the replay's integrator call, inside the rest of the replay's
-call (the states' array, the solvers' words caught, the rows checked), and around it (the
-settings looked up, the recipe found, the run's signal handlers, the Results built), over
-many runs.
+call (the states' array, the solvers' words caught, the rows checked), in setting up the probe
+signals' deferred computation, in building the Results, and in the rest of the run (the
+settings looked up, the recipe found, the run and its signal handlers), over many runs.
 
 Writes ``results/study_overhead.md``. Run: ``python bench/study_overhead.py [--rounds R]``.
 """
@@ -57,6 +57,7 @@ import kinetwork as kn
 from kinetwork.solver import replay
 from kinetwork.solver.casadi_clock import cheap
 from kinetwork.solver.compiled import compiled
+from kinetwork.solver.results import Results
 from kinetwork.solver.tolerance import solver_tolerances
 
 NAME = "study_overhead"
@@ -146,33 +147,37 @@ def cheap_clock(call):
 
 def breakdown(system, kw, runs):
     """Microseconds of the thread's CPU per run of ``system`` (its recipe kept) over ``runs``
-    runs: (whole run, integrator call, rest of the replay's call, the run around it)."""
+    runs: (whole run, integrator call, rest of the replay's call, the probe signals' deferred
+    computation set up, the Results built, the rest of the run around the call: settings and
+    recipe looked up, the run and its signal handlers)."""
     recipe = next(reversed(compiled(system)._recipes.values()))
     buffer, trigger, *rest = recipe.call
-    spent = {"call": 0.0, "_call": 0.0}
+    spent = dict.fromkeys(("call", "_call", "outputs", "results"), 0.0)
 
-    def timed_trigger():
-        start = time.thread_time()
-        trigger()
-        spent["call"] += time.thread_time() - start
-    inner = replay._call
-
-    def timed(*args):
-        start = time.thread_time()
-        out = inner(*args)
-        spent["_call"] += time.thread_time() - start
-        return out
-    recipe.call, replay._call = (buffer, timed_trigger, *rest), timed
+    def timed(fn, key):
+        def wrapper(*args):
+            start = time.thread_time()
+            try:
+                return fn(*args)
+            finally:
+                spent[key] += time.thread_time() - start
+        return wrapper
+    inner, later, renewed = replay._call, replay.later_outputs, Results.__dict__["renewed"]
+    recipe.call = (buffer, timed(trigger, "call"), *rest)
+    replay._call, replay.later_outputs = timed(inner, "_call"), timed(later, "outputs")
+    Results.renewed = classmethod(timed(renewed.__func__, "results"))
     try:
         start = time.thread_time()
         for _ in range(runs):
             kn.simulate(system, **kw)
         whole = time.thread_time() - start
     finally:
-        recipe.call, replay._call = (buffer, trigger, *rest), inner
+        recipe.call, replay._call, replay.later_outputs = (buffer, trigger, *rest), inner, later
+        Results.renewed = renewed
     us = 1e6 / runs
+    around = whole - spent["_call"] - spent["outputs"] - spent["results"]
     return (whole * us, spent["call"] * us, (spent["_call"] - spent["call"]) * us,
-            (whole - spent["_call"]) * us)
+            spent["outputs"] * us, spent["results"] * us, around * us)
 
 
 def bracket(ladder, target):
@@ -308,11 +313,13 @@ def main():
         f"CPU time of the thread per run (``time.thread_time``, {10 * args.rounds} runs in a "
         "row after the rounds): the whole ``kn.simulate`` call; its integrator call (CVODES "
         "and the compiled equations); the rest of the replay's call (the states' array, the "
-        "solvers' words caught, the rows checked, the counts); the run around it (settings "
-        "and the recipe looked up, the run's signal handlers, the Results). Probe signals "
-        "are computed when first read: not in a run.", "",
+        "solvers' words caught, the rows checked, the counts); the probe signals' computation "
+        "set up (copies of the states, computed when first read: not in a run); the Results "
+        "built; the rest of the run around the call (settings and the recipe looked up, the "
+        "run, its signal handlers, its statistics).", "",
         table(["scene", "rtol", "whole run [us]", "integrator call [us]",
-               "rest of the call [us]", "around the call [us]", "load (1 min)"], where)])
+               "rest of the call [us]", "probe signals set up [us]", "Results [us]",
+               "rest of the run [us]", "load (1 min)"], where)])
     write_markdown(NAME, text)
     print(f"done in {time.perf_counter() - start:.0f} s", flush=True)
 
