@@ -1,6 +1,6 @@
-"""CasADi's per-evaluation clock is the monotonic one while kinetwork's solver sections run
+"""CasADi's per-evaluation clock returns 0 at once while kinetwork's solver sections run
 (``kinetwork/solver/casadi_clock.py``): the same numbers, libc's clock back in its slot on
-every way out, nothing changed where the slot cannot be found for certain."""
+every way out (a failure, a fork), nothing changed when asked not to."""
 
 import ctypes
 import os
