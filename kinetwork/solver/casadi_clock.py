@@ -2,15 +2,15 @@
 
 CasADi times every evaluation that an integrator makes of its equations, for its statistics
 ``t_proc_*`` and ``t_wall_*`` (``OracleFunction::calc_function``: ``std::clock()`` before and
-after, with no option to turn it off). ``clock()`` reads CLOCK_PROCESS_CPUTIME_ID, a system
-call that the vDSO never serves: 0.5 us on the bench's machine, two per evaluation, 1.2 of the
-1.9 us that an evaluation of a 2-link chain costs inside CVODES
-(``bench/results/study_overhead.md``). kinetwork never reads those statistics. So while one of
-its solver sections runs (``capture.Section``, a replay's call), CasADi's slot for ``clock``
-in libcasadi's procedure linkage table points at a function that returns 0 at once, and libc's
-``clock`` is put back on the way out. The solver's arithmetic never reads the clock: the
-numbers are the same to the bit; CasADi's ``t_proc_*`` do not grow by what ran meanwhile (in
-any thread), its ``t_wall_*`` (another clock) do.
+after; its ``record_time`` option does not reach there, casadi/casadi issue #2703, open).
+``clock()`` reads CLOCK_PROCESS_CPUTIME_ID, a system call that the vDSO never serves: 0.5 us on
+the bench's machine, two per evaluation, 1.2 of the 1.9 us that an evaluation of a 2-link
+chain costs inside CVODES (``bench/results/study_overhead.md``). kinetwork never reads those
+statistics. So while one of its solver sections runs (``capture.Section``, a replay's call),
+CasADi's slot for ``clock`` in libcasadi's procedure linkage table points at a function that
+returns 0 at once, and libc's ``clock`` is put back on the way out. The solver's arithmetic
+never reads the clock: the numbers are the same to the bit; CasADi's ``t_proc_*`` do not grow
+by what ran meanwhile (in any thread), its ``t_wall_*`` (another clock) do.
 
 The function is three bytes of x86-64 (``xor eax, eax; ret``) in a page of its own, written
 and then made read-and-execute only: no compiler, no file. Done only where it is certain, else
