@@ -9,7 +9,9 @@ links with a damper on each joint, planar and 3-D (``scenes.chains.point_masses`
   as in any later run of a session: a repeated quiet run replays the recipe, its integrator
   call bound once, ``kinetwork/solver/replay.py``);
 - its integrator call alone: the very CasADi integrator the run called, through a buffer
-  bound once to the run's inputs (what the run would cost with no Python around it);
+  bound once to the run's inputs (what the run would cost with no Python around it), with
+  CasADi's per-evaluation clock made cheap as in a run (``kinetwork/solver/casadi_clock.py``)
+  and with CasADi's own (``clock()``, a system call, twice per evaluation);
 - the hand-written route (``peers/casadi_peer.py``: Featherstone's ABA in SX, gcc -O1,
   ``casadi.external``, CVODES Adams in one ``casadi.integrator`` call) at the solver
   tolerances kinetwork hands CVODES for that rtol (``tolerance.solver_tolerances``: the same
@@ -24,6 +26,12 @@ Lagrange equations, ``scenes.reference``; the chains: pinocchio's ABA).
 Timing: CPU time (``time.process_time``), the tools interleaved in rounds in one process,
 medians over the rounds, the machine's load average (1 min) at the end of each row's rounds
 beside it (the machine may be shared). Ratios > 1: kinetwork is faster.
+
+Where a run's time goes (one scene and rtol per row, ``breakdown``): CPU time of the thread
+(``time.thread_time``) inside the replay's integrator call, inside the rest of the replay's
+call (the states' array, the solvers' words caught, the rows checked), in setting up the probe
+signals' deferred computation, in building the Results, and in the rest of the run (the
+settings looked up, the recipe found, the run and its signal handlers), over many runs.
 
 Writes ``results/study_overhead.md``. Run: ``python bench/study_overhead.py [--rounds R]``.
 """
@@ -46,7 +54,10 @@ import casadi_peer
 import pinocchio_peer
 
 import kinetwork as kn
+from kinetwork.solver import replay
+from kinetwork.solver.casadi_clock import cheap
 from kinetwork.solver.compiled import compiled
+from kinetwork.solver.results import Results
 from kinetwork.solver.tolerance import solver_tolerances
 
 NAME = "study_overhead"
@@ -79,7 +90,7 @@ def error(q, ref):
 def integrator_call(system):
     """The integrator that the last run of ``system`` replays (its recipe's), as a function
     of no arguments that calls it with that run's inputs through a buffer bound once
-    (nothing but the call), and its evaluations per call."""
+    (nothing but the call, CasADi's own clock), and its evaluations per call."""
     integ = next(reversed(compiled(system)._recipes.values())).integ
     x0 = np.ascontiguousarray(system.x0[:system.n_states])
     p = np.append(system.param_vector(), 0.0)
@@ -93,6 +104,80 @@ def integrator_call(system):
         trigger()
     call()
     return call, int(buf.stats()["nfevals"])
+
+
+def equations_alone(system, calls=2000, rounds=7):
+    """CPU microseconds per evaluation, each through a buffer bound once, of the compiled
+    right-hand side alone and of the integrators' DAE Function around it (CasADi's MX
+    wrapper: the time shifted by the chunk's start, the parameters split), least of
+    ``rounds``; a loop that calls nothing is taken off."""
+    table = compiled(system)._cache
+    rhs = table[("rhs", False)]
+    dae = next(v for k, v in table.items() if isinstance(k, tuple) and k[0] == "dae")
+    n, p = system.n_states, system.param_vector()
+    x = np.ascontiguousarray(system.x0[:n], dtype=float)
+    keep, triggers = [], {}
+    for name, f, args in (("rhs", rhs, {0: np.zeros(1), 1: x, 2: np.array(p, dtype=float)}),
+                          ("dae", dae, {0: np.zeros(1), 1: x, 3: np.append(p, 0.0)})):
+        buf, trigger = f.buffer()
+        for i, value in args.items():
+            buf.set_arg(i, memoryview(value))
+        out = np.empty(n)
+        buf.set_res(0, memoryview(out))
+        keep.append((buf, args, out))
+        triggers[name] = trigger
+
+    def loop(trigger):
+        start = time.process_time()
+        for _ in range(calls):
+            trigger()
+        return time.process_time() - start
+    best = {k: min(loop(t) for _ in range(rounds)) for k, t in triggers.items()}
+    empty = min(loop(lambda: None) for _ in range(rounds))
+    return {k: (v - empty) / calls * 1e6 for k, v in best.items()}
+
+
+def cheap_clock(call):
+    """``call`` with CasADi's clock made cheap, as a run makes its integrator calls."""
+    def cheap_call():
+        with cheap():
+            call()
+    return cheap_call
+
+
+def breakdown(system, kw, runs):
+    """Microseconds of the thread's CPU per run of ``system`` (its recipe kept) over ``runs``
+    runs: (whole run, integrator call, rest of the replay's call, the probe signals' deferred
+    computation set up, the Results built, the rest of the run around the call: settings and
+    recipe looked up, the run and its signal handlers)."""
+    recipe = next(reversed(compiled(system)._recipes.values()))
+    buffer, trigger, *rest = recipe.call
+    spent = dict.fromkeys(("call", "_call", "outputs", "results"), 0.0)
+
+    def timed(fn, key):
+        def wrapper(*args):
+            start = time.thread_time()
+            try:
+                return fn(*args)
+            finally:
+                spent[key] += time.thread_time() - start
+        return wrapper
+    inner, later, renewed = replay._call, replay.later_outputs, Results.__dict__["renewed"]
+    recipe.call = (buffer, timed(trigger, "call"), *rest)
+    replay._call, replay.later_outputs = timed(inner, "_call"), timed(later, "outputs")
+    Results.renewed = classmethod(timed(renewed.__func__, "results"))
+    try:
+        start = time.thread_time()
+        for _ in range(runs):
+            kn.simulate(system, **kw)
+        whole = time.thread_time() - start
+    finally:
+        recipe.call, replay._call, replay.later_outputs = (buffer, trigger, *rest), inner, later
+        Results.renewed = renewed
+    us = 1e6 / runs
+    around = whole - spent["_call"] - spent["outputs"] - spent["results"]
+    return (whole * us, spent["call"] * us, (spent["_call"] - spent["call"]) * us,
+            spent["outputs"] * us, spent["results"] * us, around * us)
 
 
 def bracket(ladder, target):
@@ -131,7 +216,7 @@ def cpu(fn, rounds_out, key):
 def study(rounds):
     t = np.linspace(0.0, HORIZON, POINTS)
     adams = kn.METHODS["cvodes-adams"]
-    rows, counts = [], []
+    rows, counts, where = [], [], []
     for name, (make, spec_of) in SCENES.items():
         spec, system = spec_of(), make().compile()
         n = spec.n
@@ -149,7 +234,8 @@ def study(rounds):
             res = kn.simulate(system, **kw)
             kn.simulate(system, **kw)               # the first replay binds its call
             srt, sat = solver_tolerances(adams, system, rtol, rtol * 1e-2)
-            call, evals = integrator_call(system)
+            own_clock, evals = integrator_call(system)
+            call = cheap_clock(own_clock)
             casadi_peer.run(hand, t, rtol=srt, atol=sat)
             hand_evals = int(casadi_peer.integrator(hand, t, srt, sat).stats()["nfevals"])
             err = error(chains.joint_angles(res), ref)
@@ -159,6 +245,7 @@ def study(rounds):
             for _ in range(rounds):
                 cpu(lambda: kn.simulate(system, **kw), spent, "kinetwork")
                 cpu(call, spent, "call")
+                cpu(own_clock, spent, "own clock")
                 cpu(lambda: casadi_peer.run(hand, t, rtol=srt, atol=sat), spent, "hand")
                 for r in neighbours:
                     cpu(lambda r=r: casadi_peer.run(hand, t, rtol=r), spent, r)
@@ -173,11 +260,17 @@ def study(rounds):
                          f"{os.getloadavg()[0]:.1f}"])
             counts.append([name, f"{rtol:.0e}", evals, hand_evals,
                            f"{med['call'] / evals * 1e6:.2f}",
+                           f"{med['own clock'] / evals * 1e6:.2f}",
                            f"{med['hand'] / hand_evals * 1e6:.2f}",
                            f"{(med['kinetwork'] - med['call']) * 1e6:.0f}",
                            f"{(med['kinetwork'] - med['call']) / med['kinetwork'] * 100:.0f} %"])
-            print("  ", rows[-1], counts[-1][2:], flush=True)
-    return rows, counts
+            parts = breakdown(system, kw, 10 * rounds)
+            alone = equations_alone(system)
+            counts[-1][6:6] = [f"{alone['dae']:.2f}", f"{alone['rhs']:.2f}"]
+            where.append([name, f"{rtol:.0e}", *(f"{v:.0f}" for v in parts),
+                          f"{os.getloadavg()[0]:.1f}"])
+            print("  ", rows[-1], counts[-1][2:], where[-1][2:], flush=True)
+    return rows, counts, where
 
 
 def main():
@@ -185,7 +278,7 @@ def main():
     parser.add_argument("--rounds", type=int, default=41, help="interleaved rounds per row")
     args = parser.parse_args()
     start = time.perf_counter()
-    rows, counts = study(args.rounds)
+    rows, counts, where = study(args.rounds)
     text = "\n".join([
         "# Per-run overhead: the quiet run of a small model against the hand-written route",
         "",
@@ -202,13 +295,31 @@ def main():
                "ratio at same accuracy", "load (1 min)"], rows), "",
         "## Where the time goes", "",
         "Evaluations of the right-hand side per run, CPU time per evaluation (each route's "
-        "integrator call divided by its evaluations: CVODES' work included), and what "
+        "integrator call divided by its evaluations: CVODES' work included; kinetwork's "
+        "with CasADi's clock made cheap as its runs make it, ``casadi_clock.py``, and with "
+        "CasADi's own, a system call twice per evaluation, as the hand route runs; then one "
+        "evaluation outside the integrator of the DAE Function it calls, CasADi's MX wrapper "
+        "around the compiled equations, and of the compiled equations alone, each through a "
+        "buffer bound once), and what "
         "kinetwork's run costs beyond its integrator call (the replay: settings and "
         "parameters looked up, signal handlers, the solvers' words caught, Results; the "
         "probe signals are computed when first read).", "",
         table(["scene", "rtol", "kinetwork evaluations", "hand evaluations",
-               "kinetwork us/evaluation", "hand us/evaluation (whole run)",
-               "kinetwork per-run overhead [us]", "share of the run"], counts)])
+               "kinetwork us/evaluation", "the same call, CasADi's own clock",
+               "the DAE Function alone [us]", "its compiled equations alone [us]",
+               "hand us/evaluation (whole run)",
+               "kinetwork per-run overhead [us]", "share of the run"], counts), "",
+        "## Where a run's microseconds go", "",
+        f"CPU time of the thread per run (``time.thread_time``, {10 * args.rounds} runs in a "
+        "row after the rounds): the whole ``kn.simulate`` call; its integrator call (CVODES "
+        "and the compiled equations); the rest of the replay's call (the states' array, the "
+        "solvers' words caught, the rows checked, the counts); the probe signals' computation "
+        "set up (copies of the states, computed when first read: not in a run); the Results "
+        "built; the rest of the run around the call (settings and the recipe looked up, the "
+        "run, its signal handlers, its statistics).", "",
+        table(["scene", "rtol", "whole run [us]", "integrator call [us]",
+               "rest of the call [us]", "probe signals set up [us]", "Results [us]",
+               "rest of the run [us]", "load (1 min)"], where)])
     write_markdown(NAME, text)
     print(f"done in {time.perf_counter() - start:.0f} s", flush=True)
 

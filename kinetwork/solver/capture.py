@@ -9,6 +9,7 @@ import os
 import tempfile
 
 from ..util import SOLVER_LOCK, last_words, solver_output  # noqa: F401
+from .casadi_clock import cheap
 from .methods import shift_times
 
 _SINK = {}
@@ -39,6 +40,7 @@ class Section:
     def __init__(self, run, t0, descriptors):
         self.run, self.t0, self.descriptors = run, t0, descriptors
         self.capture = self.box = None
+        self.clock = cheap()                    # CasADi's clock (casadi_clock.py)
 
     def __enter__(self):
         SOLVER_LOCK.acquire()
@@ -49,9 +51,11 @@ class Section:
         except BaseException:
             SOLVER_LOCK.release()
             raise
+        self.clock.__enter__()
 
     def __exit__(self, *exc):
         try:
+            self.clock.__exit__(*exc)
             self.capture.__exit__(*exc)
         finally:
             SOLVER_LOCK.release()
