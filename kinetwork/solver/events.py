@@ -76,6 +76,12 @@ SHORT = 1e-6
 #: that interval. The chunk's cost EngineV6 no evaluation more and about 0.1 us a point;
 #: an integration of the interval for each event cost 13946 of its 52863 evaluations
 DENSE = 32
+#: a chunk gets those points from its own integration when they are at most DENSE_MOST (its
+#: integrator, kept for the next run, holds ~8 bytes a point: 37 kB with 16 points, 170 kB
+#: with 16000) and DENSE_VALUES numbers (the states at them); past either, an event is
+#: located on an integration of its interval
+DENSE_MOST = 4096
+DENSE_VALUES = 1_000_000
 #: Newton's steps at most from the time found on a curve not within FIT to the integration's
 #: own root, on the side where it has crossed
 POLISH = 4
@@ -245,7 +251,7 @@ class Events:
         if at is not None and not at_output:
             output[-1] = False               # the event's instant is no output time
         points, sampled = fine, None
-        if self.located and self._dense_chunks(method):
+        if self.located and self._dense_chunks(method, len(fine)):
             # DENSE points in each sampled interval from the chunk's own integration: its
             # solver interpolates them (no evaluation more), and an event is located on
             # them, not on an integration of its own
@@ -314,12 +320,15 @@ class Events:
         self._foresee(times[-1], G[-1], R[-1])
         return rows, None
 
-    def _dense_chunks(self, method):
-        """Whether the method's run gives the states at DENSE points in each sampled interval
-        in the same call, interpolated by its solver (CVODES: its steps are the same
-        whatever the output grid), for ``_locate_dense``'s curve."""
+    def _dense_chunks(self, method, n):
+        """Whether the method's run over ``n`` sampled points gives the states at DENSE
+        points in each sampled interval in the same call, interpolated by its solver (CVODES:
+        its steps are the same whatever the output grid), for ``_locate_dense``'s curve:
+        while they are few enough (DENSE_MOST, DENSE_VALUES)."""
+        points = n * DENSE
         return getattr(method, "plugin", None) == "cvodes" and not method.fixed and \
-            not self.run.system.n_algebraic
+            not self.run.system.n_algebraic and points <= DENSE_MOST and \
+            points * self.run.system.n_states <= DENSE_VALUES
 
     def _indicators_at(self, t, x):
         """``indicators`` at (t, x), kept for the point the run goes on from (asked for again

@@ -46,6 +46,28 @@ def test_each_contact_is_located_on_the_runs_points_and_a_check(reference, monke
     assert calls["grid"] == 0 and calls["state_at"] <= 3 * 4
 
 
+def test_a_chunk_with_too_many_points_locates_on_an_integration_of_its_interval(
+        reference, monkeypatch):
+    """Over 3 output points the ball's chunks sample 500 points an interval (the events'
+    lattice): 32 points in each from the chunk's own integration would be 16000, more than
+    DENSE_MOST (its integrator, kept, would hold 170 kB). Each rise is then located on one
+    integration of its sampled interval, at the reference's contact times as well."""
+    grids = []
+    original = methods._CasadiRun.grid
+
+    def counted(self, *args):
+        grids.append(args)
+        return original(self, *args)
+    monkeypatch.setattr(methods._CasadiRun, "grid", counted)
+    _, contacts = reference
+    res = kn.simulate(ball(), t_end=3.0, n_points=3, method="cvodes-adams", rtol=1e-10,
+                      atol=1e-12)
+    times = [e["t"] for e in res.stats["events"]]
+    assert len(times) == len(contacts) == 8
+    np.testing.assert_allclose(times, contacts, atol=1e-9)
+    assert 1 <= len(grids) <= 8
+
+
 def test_the_statistics_count_the_integrations_that_locate_events(monkeypatch):
     """``rhs_evaluations`` holds the evaluations of the integrations over the chunks and of
     those from the point before a contact time found (the ball's rises)."""
