@@ -72,7 +72,7 @@ ZENO_LIMIT = 200
 #: trial intervals shorter than this (relative to the time) are stepped by RK4 directly
 SHORT = 1e-6
 #: points of the integration over a sampled interval an event is located on (between them,
-#: a cubic Hermite curve): the chunk's own (``Events._dense_chunks``), or one integration of
+#: a cubic Hermite curve): the chunk's own (``_dense_chunks``), or one integration of
 #: that interval. The chunk's cost EngineV6 no evaluation more and about 0.1 us a point;
 #: an integration of the interval for each event cost 13946 of its 52863 evaluations
 DENSE = 32
@@ -251,7 +251,7 @@ class Events:
         if at is not None and not at_output:
             output[-1] = False               # the event's instant is no output time
         points, sampled = fine, None
-        if self.located and self._dense_chunks(method, len(fine)):
+        if self.located and _dense_chunks(self.run, method, len(fine)):
             # DENSE points in each sampled interval from the chunk's own integration: its
             # solver interpolates them (no evaluation more), and an event is located on
             # them, not on an integration of its own
@@ -319,16 +319,6 @@ class Events:
                 return rows, restart
         self._foresee(times[-1], G[-1], R[-1])
         return rows, None
-
-    def _dense_chunks(self, method, n):
-        """Whether the method's run over ``n`` sampled points gives the states at DENSE
-        points in each sampled interval in the same call, interpolated by its solver (CVODES:
-        its steps are the same whatever the output grid), for ``_locate_dense``'s curve:
-        while they are few enough (DENSE_MOST, DENSE_VALUES)."""
-        points = n * DENSE
-        return getattr(method, "plugin", None) == "cvodes" and not method.fixed and \
-            not self.run.system.n_algebraic and points <= DENSE_MOST and \
-            points * self.run.system.n_states <= DENSE_VALUES
 
     def _indicators_at(self, t, x):
         """``indicators`` at (t, x), kept for the point the run goes on from (asked for again
@@ -451,29 +441,7 @@ class Events:
         if fitted:
             return t_i, curve(t_i), i
 
-        def exact(t):
-            j = max(0, int(np.searchsorted(T, t, side="right")) - 1)
-            if t - T[j] < SHORT * max(1.0, abs(T[j])):
-                return self._rk4(T[j], X[j], t - T[j])
-            return self._start(method, T[j], X[j]).state_at(t)
-
-        # Newton on the integration from the curve's root (off by the curve's error): to
-        # the integration's own root, on the side where the indicator has crossed
-        tiny = 4 * np.finfo(float).eps
-        x_i, crossed_at = exact(t_i), None
-        for _ in range(POLISH):
-            g_i = self.levels(t_i, x_i)[i]
-            if g_i <= 0:
-                crossed_at = (t_i, x_i, i)
-            rate = self.indicators(t_i, x_i)[1][i]
-            if not rate < 0:
-                break
-            dt = g_i / -rate
-            if g_i <= 0 and -dt <= tiny * max(1.0, abs(t_i)):
-                break                       # at the root, to rounding
-            t_i = min(t1, max(t0, t_i + dt + (tiny * max(1.0, abs(t_i)) if g_i > 0 else 0)))
-            x_i = exact(t_i)
-        return crossed_at if crossed_at is not None else _UNSURE
+        return _polished(self, method, T, X, t0, t1, t_i, i)
 
     def _level_rows(self, times, rows):
         """The indicators alone, (len(rows), k), at each row."""
@@ -517,6 +485,47 @@ class Events:
             raise Failure(f"{ZENO_LIMIT} events at t = {t:.15g} s without time passing: "
                           f"{source.chatter(k)}")
         return source.apply(t, x, k)
+
+
+def _polished(events, method, T, X, t0, t1, t_i, i):
+    """``Events._locate_dense``'s time t_i of indicator i, found on a curve through the
+    points (T, X) that is not within FIT, taken by Newton's steps on states integrated from
+    the point before it to the integration's own root, on the side where the indicator has
+    crossed: (time, state, i), or _UNSURE."""
+    def exact(t):
+        j = max(0, int(np.searchsorted(T, t, side="right")) - 1)
+        if t - T[j] < SHORT * max(1.0, abs(T[j])):
+            return events._rk4(T[j], X[j], t - T[j])
+        return events._start(method, T[j], X[j]).state_at(t)
+
+    # Newton on the integration from the curve's root (off by the curve's error): to
+    # the integration's own root, on the side where the indicator has crossed
+    tiny = 4 * np.finfo(float).eps
+    x_i, crossed_at = exact(t_i), None
+    for _ in range(POLISH):
+        g_i = events.levels(t_i, x_i)[i]
+        if g_i <= 0:
+            crossed_at = (t_i, x_i, i)
+        rate = events.indicators(t_i, x_i)[1][i]
+        if not rate < 0:
+            break
+        dt = g_i / -rate
+        if g_i <= 0 and -dt <= tiny * max(1.0, abs(t_i)):
+            break                       # at the root, to rounding
+        t_i = min(t1, max(t0, t_i + dt + (tiny * max(1.0, abs(t_i)) if g_i > 0 else 0)))
+        x_i = exact(t_i)
+    return crossed_at if crossed_at is not None else _UNSURE
+
+
+def _dense_chunks(run, method, n):
+    """Whether ``method``'s run over ``n`` sampled points gives the states at DENSE points in
+    each sampled interval in the same call, interpolated by its solver (CVODES: its steps
+    are the same whatever the output grid), for ``Events._locate_dense``'s curve: while they
+    are few enough (DENSE_MOST, DENSE_VALUES)."""
+    points = n * DENSE
+    return getattr(method, "plugin", None) == "cvodes" and not method.fixed and \
+        not run.system.n_algebraic and points <= DENSE_MOST and \
+        points * run.system.n_states <= DENSE_VALUES
 
 
 def _gap(t):
