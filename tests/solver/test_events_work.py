@@ -71,18 +71,19 @@ def counted(engine):
 
 
 def test_each_event_is_located_on_the_runs_own_points_and_a_few_indicator_values(counted):
-    """Per event located: no integration of its own (the chunk's integration gives DENSE
-    points in each sampled interval, interpolated by CVODES at no evaluation more; before,
-    one integration over the sampled interval cost 41 evaluations an event, 26 % of the
-    run's), none from the point before (the curve fits on the step the time is read off),
-    and fewer than four evaluations of the indicators (a Brent search on the whole interval
-    took 19.6, and 16.7 of the indicators with their rates, which read the whole
-    equations)."""
+    """Per event located: no integration of its own (the chunks after an event or cut short
+    where the indicators foresee one give DENSE points in each sampled interval,
+    interpolated by CVODES at no evaluation more; before, one integration over the sampled
+    interval cost 41 evaluations an event, 26 % of the run's), but in the first chunk, which
+    starts at no event; none from the point before (the curve fits on the step the time is
+    read off), and fewer than four evaluations of the indicators (a Brent search on the
+    whole interval took 19.6, and 16.7 of the indicators with their rates, which read the
+    whole equations). The run's statistics count the evaluations of both kinds."""
     res, count, evaluations = counted
     located = count["located"]
     assert len(instants(res)) > 300 and located >= len(res.stats["events"]) - 10
-    assert count["grids"] == 0 and count["state_at"] == 0
-    assert res.stats["rhs_evaluations"] == evaluations["call"]
+    assert count["grids"] <= 2 and count["state_at"] == 0
+    assert res.stats["rhs_evaluations"] == evaluations["call"] + evaluations["grid"]
     assert count["levels"] <= 4 * located
     # the indicators with rates: once where the run goes on after each event, and about ten
     # for each dip searched by Brent's method on its rate (one or two a run)
