@@ -66,12 +66,12 @@ calls 1.07 s (351, 72186 evaluations, the 13962 of the locating integrations not
 rest 0.98 s; the calls covered 2.95 s of model time (each chunk after an event went 8 output
 intervals; the next event came after about 3): two thirds of the integration thrown away.
 2026-11-29, last round's code, load 1.0: 1.59 s (kept), on another machine (the machine line
-did not name the processor then): the same code on AMD EPYC family 26 model 2, load 4.2-4.8,
-alternating processes of 7 runs, 4 each: 0.61 s (medians 0.586-0.622; 52863 evaluations, 352
-integrator calls and 339 over a sampled interval), this round's 0.53 s (0.494-0.547; 38932
-evaluations, 349 calls: the events located on the chunks' own points, the loops' watch
-compiled). The studio's child then: 1.67 s (integrating 0.97), load 4.9; its warm-up had
-failed since simulate moved to solver/plan.py (children started cold)."""
+did not name the processor then): the same code on AMD EPYC family 26 model 2, load 3.6-4.3,
+alternating processes of 7 runs, 4 each: 0.57 s (medians 0.547-0.613; 52863 evaluations, 352
+integrator calls and 339 over a sampled interval), this round's 0.48 s (0.474-0.516; 38997
+evaluations, 349 calls, 1 over a sampled interval: the events located on the chunks' own
+points, the loops' watch compiled). The studio's child then: 1.67 s (integrating 0.97), load
+4.9; its warm-up had failed since simulate moved to solver/plan.py (children started cold)."""
 MODEL = common.HERE.parent / "models" / "engine_v6" / "EngineV6.json"
 
 
