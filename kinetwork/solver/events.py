@@ -19,17 +19,17 @@ the cubic Hermite curve through states and their rates, so that the trial times 
 integration: by Brent's method on the curve through the two sampled rows when that is within
 FIT (``curves.py``) of the solver's tolerances (its rate checked against the equations' at
 three points), else on the curve through DENSE points of the interval: the run's own (CVODES
-interpolates them in the chunk's call, at no evaluation more), or one integration of the same
-method from the row before (other methods). The indicators' values there (one mapped call) bracket the crossing to
-one step, the cubic through the indicator's values and rates at its two points gives the
-root, Newton's steps along the curve settle it (``curves.root``), and the curve is checked on
-that step alone. On a curve that is not within FIT, Newton's steps on the integration from
-the point before take the time found to the integration's own root (a method without that
-one integration, IDAS or fixed steps, and a crossing the curve sees and the integration does
-not: every trial time integrated from the row before). The time is as exact as the
-integration, to about 1e-14 s in the bracketing itself; the source applies the event, and
-the method starts afresh there. Events are logged (time, component, kind) for
-``res.stats["events"]``; time events are counted
+interpolates them in the chunk's call, at no evaluation more), or one integration of the
+same method from the row before (other methods). The indicators' values there (one mapped
+call) bracket the crossing to one step, the cubic through the indicator's values and rates
+at its two points gives the root, Newton's steps along the curve settle it
+(``curves.root``), and the curve is checked on that step alone. On a curve that is not
+within FIT, Newton's steps on the integration from the point before take the time found to
+the integration's own root (a method without that one integration, IDAS or fixed steps, and
+a crossing the curve sees and the integration does not: every trial time integrated from the
+row before). The time is as exact as the integration, to about 1e-14 s in the bracketing
+itself; the source applies the event, and the method starts afresh there. Events are logged
+(time, component, kind) for ``res.stats["events"]``; time events are counted
 (``res.stats["time_events"]``).
 
 Two crossings between two sampled points, which cancel out, are seen when the indicator has

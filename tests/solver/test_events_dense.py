@@ -23,9 +23,9 @@ def test_each_contact_is_located_on_the_runs_points_and_a_check(reference, monke
     fall onto the contact is a parabola, which the cubic through the sampled points and
     their rates is: located on it with no integration at all. Each rise off it (the
     contact's spring, stiff) is located on the run's own points in its sampled interval (no
-    integration over it) and costs two or three integrations from the point before the
-    time found (Newton's steps from the curve's root to the integration's). The contact times agree with the reference's root finder
-    to 1e-9 s."""
+    integration over it) and costs two or three integrations from the point before the time
+    found (Newton's steps from the curve's root to the integration's). The contact times
+    agree with the reference's root finder to 1e-9 s."""
     calls = {"grid": 0, "state_at": 0}
     for name in calls:
         original = getattr(methods._CasadiRun, name)
