@@ -26,12 +26,23 @@ curve through the 33 points of an integration the time is read off), and the ind
 evaluated one point at a time (alone, ``Events.levels``, and with their rates,
 ``Events.indicators``, which read the whole equations).
 
+And the studio's run of the same model (``studio/work.run``, what ``POST /api/run`` has a
+child do): each in a child forked from this process once it is warmed as the studio's
+forkserver is (``jobs.PRELOAD`` imported, which runs ``warm``) and before it compiles EngineV6
+itself, so that the child has only what a studio child has; the first child fills the JIT
+cache on disk and is not counted. Its CPU time by phases: checking the model, compiling it
+(the C code from the cache), integrating, writing the results (the probes' signals, the 3-D
+view's poses, the JSON the page reads).
+
 Writes ``results/study_engine_cached.md``. Run: ``python bench/study_engine_cached.py
 [--rounds R]``.
 """
 
 import argparse
 import collections
+import importlib
+import json
+import os
 import statistics
 import time
 from unittest import mock
@@ -53,7 +64,14 @@ sampled interval, 1.00 two-row and 1.00 33-point curves checked, 19.6 + 16.7 tri
 2026-11-29 after that round, load 5.3: 3.88 s (kept), locating 1.85 s (339 events), integrator
 calls 1.07 s (351, 72186 evaluations, the 13962 of the locating integrations not counted),
 rest 0.98 s; the calls covered 2.95 s of model time (each chunk after an event went 8 output
-intervals; the next event came after about 3): two thirds of the integration thrown away."""
+intervals; the next event came after about 3): two thirds of the integration thrown away.
+2026-11-29, last round's code, load 1.0: 1.59 s (kept), on another machine (the machine line
+did not name the processor then): the same code on AMD EPYC family 26 model 2, load 3.6-4.3,
+alternating processes of 7 runs, 4 each: 0.57 s (medians 0.547-0.613; 52863 evaluations, 352
+integrator calls and 339 over a sampled interval), this round's 0.48 s (0.474-0.516; 38997
+evaluations, 349 calls, 1 over a sampled interval: the events located on the chunks' own
+points, the loops' watch compiled). The studio's child then: 1.67 s (integrating 0.97), load
+4.9; its warm-up had failed since simulate moved to solver/plan.py (children started cold)."""
 MODEL = common.HERE.parent / "models" / "engine_v6" / "EngineV6.json"
 
 
@@ -120,6 +138,62 @@ def run_once(system, most, parts=False):
         return total, res, (spent, count)
 
 
+class _Channel:
+    """What a studio child reports through (``jobs.Channel``), kept: the CPU time at which
+    each phase begins."""
+
+    def __init__(self):
+        self.start, self.phases = time.process_time(), []
+
+    def enter(self, phase):
+        self.phases.append((phase, time.process_time() - self.start))
+
+    def report(self, fraction):
+        pass
+
+    def cancelled(self):
+        return False
+
+
+def studio_runs(rounds):
+    """The studio's run of EngineV6, ``rounds`` + 1 times, each in a child forked from this
+    process warmed as the studio's forkserver is: [{phase: CPU s, "total": CPU s}]."""
+    from kinetwork.studio import jobs, work
+    for name in jobs.PRELOAD:           # what the forkserver imports (and ``warm`` runs)
+        importlib.import_module(name)
+    data = json.loads(MODEL.read_text())
+    spent = []
+    for _ in range(rounds + 1):
+        read, write = os.pipe()
+        pid = os.fork()
+        if pid == 0:                    # the child: one run, its phases' CPU time sent back
+            code = 1
+            try:
+                channel = _Channel()
+                state, _ = work.run(data, {}, str(MODEL.parent), [], channel)
+                channel.enter("end")
+                os.write(write, json.dumps([state, channel.phases]).encode())
+                code = 0
+            finally:
+                os._exit(code)
+        os.close(write)
+        with os.fdopen(read, "rb") as answer:
+            got = answer.read()
+        _, status = os.waitpid(pid, 0)
+        if status or not got:
+            raise RuntimeError(f"the studio's run in a child failed (status {status})")
+        state, phases = json.loads(got)
+        if state != "done":
+            raise RuntimeError(f"the studio's run ended {state}")
+        times = dict(phases)
+        by = {}
+        for (name, begun), (_, ended) in zip(phases, phases[1:]):
+            by[name] = by.get(name, 0.0) + ended - begun
+        by["total"] = times["end"]
+        spent.append(by)
+    return spent[1:]
+
+
 def study(rounds):
     ways = {"kept": compiled_module.INTEGRATORS_MOST, "64 kept": 64}
     # a System each (each keeps its own integrators); the C code is the same, cached on disk
@@ -156,6 +230,11 @@ def main():
     parser.add_argument("--rounds", type=int, default=5, help="interleaved rounds")
     args = parser.parse_args()
     start = time.perf_counter()
+    studio = studio_runs(args.rounds)   # first: this process has not compiled EngineV6 yet
+    phases = ["checking", "compiling", "integrating", "writing results", "total"]
+    studio_row = [[f"{statistics.median(r.get(p, 0.0) for r in studio):.2f}"
+                   for p in phases]]
+    print("   studio", studio_row, flush=True)
     rows, work, apart = study(args.rounds)
     text = "\n".join([
         "# EngineV6 cached: where a repeated run spends its CPU time", "",
@@ -172,7 +251,9 @@ def main():
                "integrations over a sampled interval", "two-row curves checked",
                "steps of 33-point curves checked", "indicators at trial times",
                "indicators with rates"], work),
-        "", HISTORY])
+        "", f"The studio's run (``studio/work.run``) in a child warmed as the studio's are, "
+        f"CPU time by phases [s], medians of {args.rounds} children:", "",
+        table(phases, studio_row), "", HISTORY])
     write_markdown(NAME, text)
     print(f"done in {time.perf_counter() - start:.0f} s", flush=True)
 

@@ -28,7 +28,7 @@ MODEL = {
 
 def warm():
     """One model through every step a child takes: check, compile, run, encode."""
-    from ..solver.driver import simulate
+    from ..solver.plan import simulate
     from .checks import build, context, validate
     from .results import encode, results_json
     ctx = context(None, [])

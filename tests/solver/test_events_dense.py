@@ -1,5 +1,5 @@
-"""How state events are located (``solver/events.py``): on one integration over a sampled
-interval and the Hermite curve through its points, then checked on the integration; and a
+"""How state events are located (``solver/events.py``): on the run's own points over a
+sampled interval and the Hermite curve through them, then checked on the integration; and a
 relation the equations compute twice is one event (``equations/relations.py``). Against the
 event-to-event DOP853 reference of ``scenes/bumps.py`` and closed forms."""
 
@@ -18,14 +18,14 @@ def reference():
     return ball_reference(np.linspace(0.0, 3.0, 301))
 
 
-def test_each_contact_is_located_by_one_integration_and_a_check(reference, monkeypatch):
+def test_each_contact_is_located_on_the_runs_points_and_a_check(reference, monkeypatch):
     """No event of the ball's if_else contact costs an integration per trial time. Each
     fall onto the contact is a parabola, which the cubic through the sampled points and
     their rates is: located on it with no integration at all. Each rise off it (the
-    contact's spring, stiff) costs at most one integration over its sampled interval and
-    two or three from the point before the time found (Newton's steps from the curve's
-    root to the integration's). The contact times agree with the reference's root finder
-    to 1e-9 s."""
+    contact's spring, stiff) is located on the run's own points in its sampled interval (no
+    integration over it) and costs two or three integrations from the point before the time
+    found (Newton's steps from the curve's root to the integration's). The contact times
+    agree with the reference's root finder to 1e-9 s."""
     calls = {"grid": 0, "state_at": 0}
     for name in calls:
         original = getattr(methods._CasadiRun, name)
@@ -43,14 +43,56 @@ def test_each_contact_is_located_by_one_integration_and_a_check(reference, monke
     times = [e["t"] for e in res.stats["events"]]
     assert len(times) == len(contacts) == 8 and not exact
     np.testing.assert_allclose(times, contacts, atol=1e-9)
-    assert calls["grid"] <= 4 and calls["state_at"] <= 3 * 4
+    assert calls["grid"] == 0 and calls["state_at"] <= 3 * 4
+
+
+def test_a_chunk_with_too_many_points_locates_on_an_integration_of_its_interval(
+        reference, monkeypatch):
+    """Over 3 output points the ball's chunks sample 500 points an interval (the events'
+    lattice): 32 points in each from the chunk's own integration would be 16000, more than
+    DENSE_MOST (its integrator, kept, would hold 170 kB). Each rise is then located on one
+    integration of its sampled interval, at the reference's contact times as well."""
+    grids = []
+    original = methods._CasadiRun.grid
+
+    def counted(self, *args):
+        grids.append(args)
+        return original(self, *args)
+    monkeypatch.setattr(methods._CasadiRun, "grid", counted)
+    _, contacts = reference
+    res = kn.simulate(ball(), t_end=3.0, n_points=3, method="cvodes-adams", rtol=1e-10,
+                      atol=1e-12)
+    times = [e["t"] for e in res.stats["events"]]
+    assert len(times) == len(contacts) == 8
+    np.testing.assert_allclose(times, contacts, atol=1e-9)
+    assert 1 <= len(grids) <= 8
+
+
+def test_the_statistics_count_the_integrations_that_locate_events(monkeypatch):
+    """``rhs_evaluations`` holds the evaluations of the integrations over the chunks and of
+    those from the point before a contact time found (the ball's rises)."""
+    spent = {"call": 0, "state_at": 0}
+    for name in spent:
+        original = getattr(methods._CasadiRun, name)
+
+        def tallied(self, *args, _original=original, _name=name):
+            before = self.stats["rhs_evaluations"]
+            try:
+                return _original(self, *args)
+            finally:
+                spent[_name] += self.stats["rhs_evaluations"] - before
+        monkeypatch.setattr(methods._CasadiRun, name, tallied)
+    res = kn.simulate(ball(), t_end=3.0, n_points=301, method="cvodes-adams", rtol=1e-10,
+                      atol=1e-12)
+    assert spent["state_at"] > 0
+    assert res.stats["rhs_evaluations"] == spent["call"] + spent["state_at"]
 
 
 def test_the_curve_through_two_rows_is_not_tried_again_where_it_did_not_fit(monkeypatch):
     """The ball's falls are parabolas: the curve through the two sampled rows fits each.
     Its rises off the contact's spring do not: that curve is tried on the first rise only
     (each try costs five evaluations of the equations), the later ones go straight to the
-    one integration over the interval (before: tried on each of the four rises), whose
+    run's own points over the interval (before: tried on each of the four rises), whose
     curve is checked on the one step the contact time is read off."""
     tried, dense = [], []
     fits, dense_fits = curves.Hermite.fits, curves.Steps.fits

@@ -1,7 +1,7 @@
 """The work of a run with many state events (``solver/events.py``), counted, not timed:
 EngineV6 (MSL's six-cylinder engine, six loops, 18 relations on the pistons' positions:
-about 330 event instants in its 1.01 s), where each event is located on one integration
-over its sampled interval and the chunks of the run end near the next event; and its event
+about 330 event instants in its 1.01 s), where each event is located on the points of the
+chunk's own integration and the chunks of the run end near the next event; and its event
 times against a run at a tolerance a thousand times tighter."""
 
 import collections
@@ -70,18 +70,24 @@ def counted(engine):
     return res, count, evaluations
 
 
-def test_each_event_is_located_on_one_integration_and_a_few_indicator_values(counted):
-    """Per event located: one integration over its sampled interval (33 points), none from
-    the point before (the curve fits on the step the time is read off), and fewer than four
-    evaluations of the indicators (a Brent search on the whole interval took 19.6, and 16.7
-    of the indicators with their rates, which read the whole equations)."""
-    res, count, _ = counted
+def test_each_event_is_located_on_the_runs_own_points_and_a_few_indicator_values(counted):
+    """Per event located: no integration of its own (the chunks after an event or cut short
+    where the indicators foresee one give DENSE points in each sampled interval,
+    interpolated by CVODES at no evaluation more; before, one integration over the sampled
+    interval cost 41 evaluations an event, 26 % of the run's), but in the first chunk, which
+    starts at no event; none from the point before (the curve fits on the step the time is
+    read off), and fewer than four evaluations of the indicators (a Brent search on the
+    whole interval took 19.6, and 16.7 of the indicators with their rates, which read the
+    whole equations). The run's statistics count the evaluations of both kinds."""
+    res, count, evaluations = counted
     located = count["located"]
     assert len(instants(res)) > 300 and located >= len(res.stats["events"]) - 10
-    assert count["grids"] == located and count["state_at"] == 0
+    assert count["grids"] <= 2 and count["state_at"] == 0
+    assert res.stats["rhs_evaluations"] == evaluations["call"] + evaluations["grid"]
     assert count["levels"] <= 4 * located
-    # the indicators with rates: once where the run goes on after each event
-    assert count["indicators"] <= located + 20
+    # the indicators with rates: once where the run goes on after each event, and about ten
+    # for each dip searched by Brent's method on its rate (one or two a run)
+    assert count["indicators"] <= located + 30
 
 
 def test_chunks_end_near_the_next_event(counted):
@@ -92,14 +98,6 @@ def test_chunks_end_near_the_next_event(counted):
     res, count, _ = counted
     assert count["covered"] <= 1.5 * 1.01
     assert count["calls"] <= 1.1 * len(res.stats["events"])
-
-
-def test_the_statistics_count_the_integrations_that_locate_events(counted):
-    """``rhs_evaluations`` holds the evaluations of the integrations over the chunks and of
-    those over the sampled intervals events are located in."""
-    res, _, evaluations = counted
-    assert evaluations["grid"] > 0
-    assert res.stats["rhs_evaluations"] == evaluations["call"] + evaluations["grid"]
 
 
 def test_event_times_agree_with_a_run_a_thousand_times_tighter(counted, engine):
