@@ -131,6 +131,23 @@ def test_resampled_to_frames_per_second(seed_run):
         animation_data(res, fps=0, model=m)
 
 
+
+
+def test_poses_rounded_for_a_player(seed_run):
+    """With a resolution, every position is within half of its power of ten times the scale
+    of the exact pose and every quaternion within half of it; the JSON is far shorter."""
+    m, res = seed_run
+    exact = animation_data(res, model=m)
+    rounded = animation_data(res, model=m, resolution=1e-7)
+    step = 10.0 ** np.floor(np.log10(1e-7 * exact["scale"]))     # 1e-7 m for the 2 m seed
+    assert step <= 1e-7 * exact["scale"]
+    for a, b in zip(exact["frames"], rounded["frames"]):
+        for key, tol in (("position", step), ("quaternion", 1e-7)):
+            diff = np.abs(np.array(a[key]) - np.array(b[key]))
+            assert diff.max() <= tol / 2 * (1 + 1e-9), (a["name"], key, diff.max())
+    assert {k: v for k, v in rounded.items() if k != "frames"} == \
+        {k: v for k, v in exact.items() if k != "frames"}
+    assert len(json.dumps(rounded)) < 0.7 * len(json.dumps(exact))
 def shapes_of(anim, component):
     return [s for s in anim["shapes"] if s["component"] == component]
 

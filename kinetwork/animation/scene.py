@@ -21,7 +21,7 @@ RUNAWAY = 8.0
 _X, _Y, _Z = np.eye(3)
 
 
-def animation_data(results, fps=None, model=None):
+def animation_data(results, fps=None, model=None, resolution=None):
     """The Animation of ``results``: the scene and the poses of its frames (the format is in
     ``kinetwork.animation``).
 
@@ -33,6 +33,10 @@ def animation_data(results, fps=None, model=None):
         orientations along the shorter arc); default: the results' own grid.
     model : kinetwork.Model or kinetwork.System, optional
         What made the results, when they do not say (``results.system``).
+    resolution : float, optional
+        Round positions to this fraction of ``scale`` and quaternions to this much, at a
+        power of ten (1e-7: far below a pixel at any zoom), for a player that draws them: the
+        JSON is half as long and twice as fast to write; default: every digit.
 
     Raises
     ------
@@ -65,6 +69,9 @@ def animation_data(results, fps=None, model=None):
     kept = _framed(positions)
     scale = _scale(positions[kept], values)
     lo, hi = positions[kept].reshape(-1, 3).min(axis=0), positions[kept].reshape(-1, 3).max(axis=0)
+    if resolution is not None and 0 < resolution * scale < math.inf:    # (a run away: inf)
+        positions = np.round(positions, _decimals(resolution * scale))
+        quats = np.round(quats, _decimals(resolution))
     for frame, pos, quat in zip(frames, positions, quats):
         still = np.all(pos == pos[0]) and np.all(quat == quat[0])
         frame["position"] = (pos[:1] if still else pos).tolist()
@@ -83,6 +90,11 @@ def animation_data(results, fps=None, model=None):
             "scale": scale, "bounds": [lo.tolist(), hi.tolist()],
             "view": {"up": up.tolist(), "target": ((lo + hi) / 2).tolist(),
                      "direction": _direction(up, hi - lo).tolist(), "fov": 35}}
+
+
+def _decimals(step):
+    """The decimals of the largest power of ten not above ``step`` (> 0)."""
+    return int(-math.floor(math.log10(step)))
 
 
 def _between(t, fps):
