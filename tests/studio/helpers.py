@@ -92,8 +92,27 @@ def wait_validated(page):
     page.wait_for_function("() => window.__kinetwork.validated")
 
 
+#: where an element is once it has stopped moving: its rectangle the same over three frames
+#: in a row (a diagram just opened is still being fitted into view, a pane resized)
+SETTLED = """(sel) => new Promise((done) => {
+    let last = null, same = 0, frames = 0;
+    const look = () => {
+        const el = document.querySelector(sel);
+        const r = el && el.getBoundingClientRect();
+        const now = r && [r.left, r.top, r.width, r.height].join();
+        same = now && now === last ? same + 1 : 0;
+        last = now;
+        if (same >= 3 || ++frames > 300) done(r && {x: r.left, y: r.top, width: r.width, height: r.height});
+        else requestAnimationFrame(look);
+    };
+    look();
+})"""
+
+
 def center(page, selector):
-    box = page.locator(selector).bounding_box()
+    """The middle of the element ``selector`` on screen, once it stands still (a click
+    computed while the view still moves would land beside it)."""
+    box = page.evaluate(SETTLED, selector)
     assert box, f"{selector} is not on screen"
     return box["x"] + box["width"] / 2, box["y"] + box["height"] / 2
 
