@@ -13,8 +13,8 @@ Curves: ``auto``; kinetwork's ``cvodes`` (BDF, Newton with a dense LU), ``dop853
 ``rk45`` (scipy's, on kinetwork's compiled equations) and ``rk`` (CasADi's fixed-step RK4 at
 steps 1e-2 .. 2.5e-3 s); CVODES Adams as ``auto`` runs it (functional iteration: no Jacobian,
 no factorisation) with one option changed: ``max_order`` (CVODE's maximum order, 12 by
-default), ``nonlin_conv_coeff`` (the convergence test of the corrector iteration, 0.1 by
-default), ``step0`` (the first step, CVODES's own estimate by default); and pinocchio +
+default), ``nonlin_conv_coeff`` (the convergence test of the corrector iteration: CVODES's
+0.1, or ``tolerance.LOOSE_CORRECTOR`` as auto sets it on large equations), ``step0`` (the first step, CVODES's own estimate by default); and pinocchio +
 DOP853. The Adams variants are entries added to ``methods.METHODS`` in this process only.
 
 Per curve and accuracy: the CPU time to reach it on the Pareto front (log-log interpolation,
@@ -49,6 +49,7 @@ RTOLS = tuple(10.0 ** (-k / 2) for k in range(2, 15))
 STEPS = (1e-2, 5e-3, 2.5e-3)
 #: CVODES Adams as ``cvodes-adams`` is, with one option more
 VARIANTS = {"adams max_order 3": {"max_order": 3.0}, "adams max_order 4": {"max_order": 4.0},
+            "adams nonlin_conv_coeff 0.1": {"nonlin_conv_coeff": 0.1},
             "adams nonlin_conv_coeff 0.3": {"nonlin_conv_coeff": 0.3},
             "adams nonlin_conv_coeff 0.5": {"nonlin_conv_coeff": 0.5},
             "adams step0 1e-3": {"step0": 1e-3}}
