@@ -83,18 +83,19 @@ def curves_of(spec, system, t, quick):
     return curves, details, hand
 
 
-def sweep(curves, ref):
-    """Interleaved: every curve's k-th setting in turn, REPEATS times, and up to MOST_REPEATS
-    while a curve has spent under SMALL s on it; rows per curve."""
+def sweep(curves, ref, repeats=REPEATS, cap=CAP, floor=FLOOR):
+    """Interleaved: every curve's k-th setting in turn, ``repeats`` times, and up to
+    MOST_REPEATS while a curve has spent under SMALL s on it; rows per curve. A curve stops
+    after a run over ``cap`` s or an error below ``floor``."""
     rows = {label: [] for label in curves}
     active = set(curves)
     for k in range(max(len(s) for s, _ in curves.values())):
         best, value, spent = {}, {}, {}
-        for r in range(MOST_REPEATS):
+        for r in range(max(MOST_REPEATS, repeats)):
             for label in curves:
                 settings, run = curves[label]
                 if label in active and k < len(settings) and \
-                        (r < REPEATS or spent[label] < SMALL):
+                        (r < repeats or spent[label] < SMALL):
                     took, value[label] = cpu(run, settings[k])
                     best[label] = min(best.get(label, math.inf), took)
                     spent[label] = spent.get(label, 0.0) + took
@@ -104,7 +105,7 @@ def sweep(curves, ref):
             rows[label].append({"setting": curves[label][0][k], "cpu_s": took, "error": error,
                                 "status": f"failed: {str(v)[:120]}"
                                 if isinstance(v, Exception) else "ok"})
-            if took > CAP or error < FLOOR:
+            if took > cap or error < floor:
                 active.discard(label)
     return rows
 

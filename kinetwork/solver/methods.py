@@ -20,7 +20,7 @@ import numpy as np
 
 from ..errors import ModelError
 from .compiled import numeric
-from .tolerance import solver_tolerances
+from .tolerance import corrector_test, solver_tolerances
 
 
 class Failure(Exception):
@@ -211,6 +211,7 @@ class _CasadiRun:
         if m.sundials:      # tighter than asked: see tolerance.py
             opts.update(zip(("reltol", "abstol"), solver_tolerances(
                 m, run.system, run.rtol, run.atol, run.t_end - run.t_start)))
+            opts.update(corrector_test(m, run.instructions))
             # SUNDIALS' budget is per output interval: the share of the run's of an interval
             # of the grid (tolerance.step_budget); the driver counts the run's after each call
             opts["max_num_steps"] = run.budget(m, run.spacing)

@@ -84,6 +84,29 @@ def tightening(method, system, horizon=HORIZON):
     return factor * _length(horizon) ** 2
 
 
+#: CVODES Adams's corrector (functional iteration: an evaluation of the equations each
+#: iteration) stops when its estimated error is within this fraction of the step's error
+#: tolerance, on equations of more than LOOSE_CORRECTOR_ABOVE instructions; CVODES's own 0.1
+#: below. At 0.1 a step usually takes two iterations; at 0.3 many take one: fewer
+#: evaluations, a few more steps. Measured (bench/work_precision_options.py; CPU time to the
+#: same joint-angle error, 9 interleaved runs): on the 128-link point-mass chains (18k and
+#: 54k instructions) 3-23 % less to 1e-4..1e-6 (3-D to 1e-4 on decades of rtol: 28 ms
+#: against 46), within -7..+8 % to 1e-7..1e-10 with as many evaluations or fewer; on 16-link
+#: ones (2k, 6k) up to 15 % more, a step's own cost there being near an evaluation's
+LOOSE_CORRECTOR, LOOSE_CORRECTOR_ABOVE = 0.3, 15_000
+
+
+def corrector_test(method, instructions):
+    """CVODES options of ``method`` (a ``methods.Casadi``) for its corrector's convergence
+    test on equations of ``instructions`` instructions: none but for Adams's functional
+    iteration on large equations (LOOSE_CORRECTOR), and none where ``method`` sets it."""
+    opts = method.options
+    if opts.get("nonlinear_solver_iteration") != "functional" or "nonlin_conv_coeff" in opts \
+            or instructions <= LOOSE_CORRECTOR_ABOVE:
+        return {}
+    return {"nonlin_conv_coeff": LOOSE_CORRECTOR}
+
+
 def step_budget(method, system, horizon, interval=None):
     """The steps a run of ``method`` on ``system`` over ``horizon`` [s] may take: RUN_STEPS
     per HORIZON of its length (at least one HORIZON's), times the growth of the steps at the

@@ -60,6 +60,35 @@ def test_global_error_within_100_rtol(request, scene, names, rtol):
             tolerance.ENABLED = True
 
 
+def test_adams_corrector_is_looser_on_large_equations_and_keeps_the_error(seed_large,
+                                                                          monkeypatch):
+    """CVODES Adams's corrector stops at LOOSE_CORRECTOR of the step's tolerance on equations
+    over LOOSE_CORRECTOR_ABOVE instructions (fewer evaluations on 128-link chains:
+    bench/work_precision_options.py), at CVODES's own test below, and BDF's Newton iteration
+    is left alone. The seed made to count as large: CVODES gets the option (other
+    evaluations) and the global error is still within 100 x rtol of the closed form."""
+    adams, above = METHODS["cvodes-adams"], tolerance.LOOSE_CORRECTOR_ABOVE
+    assert tolerance.corrector_test(adams, above) == {}
+    assert tolerance.corrector_test(adams, above + 1) == {
+        "nonlin_conv_coeff": tolerance.LOOSE_CORRECTOR}
+    assert tolerance.corrector_test(METHODS["cvodes"], 10 * above) == {}
+    reference = seed_large[1]
+
+    def run():      # a System of its own: a run again replays the last one's integrator
+        res = kn.simulate(chains.seed(q0=(2.5, 2.0)).compile(), t_end=T_END,
+                          n_points=N_POINTS, rtol=1e-6, atol=1e-8, jit=False)
+        error = np.max(np.abs(np.column_stack([res["shoulder.q"], res["elbow.q"]])
+                              - reference))
+        return res.method, res.stats["rhs_evaluations"], error
+
+    method, evaluations, _ = run()
+    assert method == "cvodes-adams"
+    monkeypatch.setattr(tolerance, "LOOSE_CORRECTOR_ABOVE", 0)
+    method, loose, error = run()
+    assert method == "cvodes-adams" and loose != evaluations
+    assert error <= 100 * 1e-6
+
+
 def test_solver_tolerances_tighten_and_stop_at_the_floor(seed_large, four_bar):
     tree, loops = seed_large[0], four_bar[0]
     adams, idas = METHODS["cvodes-adams"], METHODS["idas"]
