@@ -60,6 +60,7 @@ from scenes import reference_loops as rl
 from scenes.reference import seed_reference
 
 import kinetwork as kn
+from kinetwork.solver.compiled import compiled
 from kinetwork.solver import tolerance
 from kinetwork.solver.plan import Plan
 
@@ -182,6 +183,10 @@ def measure(system, reference, names, rtol, enabled, estimate=False, horizon_rul
     its tightening past ``tolerance.HORIZON``."""
     tolerance.ENABLED = enabled
     calibrated = tolerance.HORIZON
+    # the map is changed under the System: a run of the same settings must not replay the
+    # last one's integrator (kinetwork/solver/replay.py keys it by settings and parameters,
+    # which the map's switches are not)
+    compiled(system)._recipes.clear()
     if not horizon_rule:
         tolerance.HORIZON = math.inf
     try:
