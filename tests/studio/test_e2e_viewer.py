@@ -28,10 +28,11 @@ def test_a_chain_is_drawn_in_a_few_calls_with_every_shape_on_its_frame(page, stu
     few = shown_chain(page, studio, 16)
     calls = shown_chain(page, studio, 32)
     # the frames' axes hidden (33 and 65 of them), as the "frames" button says; the ground's
-    # grid, and one call for each kind: cylinders, spheres, rods, the world's axes (shafts
-    # and heads), whatever the number of links
+    # grid, and one call for each kind: cylinders, spheres, rods, the world's axes (an arrow
+    # each, shaft and head: a software renderer pays ~0.7 ms for every call), whatever the
+    # number of links
     assert page.locator(".kn-viewer-bar button.kn-on").count() == 0
-    assert calls == few and calls <= 6, (few, calls)
+    assert calls == few and calls <= 5, (few, calls)
     info = page.evaluate("() => window.__kinetwork.viewer().renderInfo()")
     # headless Chromium draws with SwiftShader: no multisampling there, which halves its frames
     if "SwiftShader" in info["gpu"]:
