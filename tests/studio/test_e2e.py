@@ -511,6 +511,14 @@ def test_the_palette_searches_and_describes_types(page, studio):
     info = page.locator(tid("palette-info")).inner_text()
     assert "rotational.SpringDamper" in info and "N*m/rad" in info and "flange_a" in info
     # double-click places one too, with a fresh name
+    # docstrings' literals read as code, not with their backticks: BodyShape's "moved by ``r``"
+    page.fill(tid("palette-search"), "BodyShape")
+    page.click(tid("palette-multibody.BodyShape"))
+    card = page.locator(tid("palette-info"))
+    assert "moved by r" in card.inner_text() and "`" not in card.inner_text()
+    assert "r" in card.locator(".kn-typeinfo-doc code").all_inner_texts()
+    assert "`" not in page.locator(tid("palette-multibody.BodyShape")).inner_text()
+    page.fill(tid("palette-search"), "")
     page.dblclick(tid("palette-rotational.SpringDamper"))
     page.dblclick(tid("palette-rotational.SpringDamper"))
     page.wait_for_selector(tid("node-spring2"))
