@@ -300,13 +300,17 @@ export function createViewer(element, animation, options = {}) {
   function buildControls() {
     const bar = document.createElement("div");
     bar.className = "kn-viewer-bar";
-    const button = (label, title, onClick) => {
+    // the view's own buttons sit in its top right corner, off the bar: with them the bar
+    // took two rows in a 3-D pane 333 px wide (a 1400x900 studio)
+    const tools = document.createElement("div");
+    tools.className = "kn-viewer-tools";
+    const button = (label, title, onClick, into = bar) => {
       const b = document.createElement("button");
       b.type = "button";
       b.textContent = label;
       b.title = title;
       b.addEventListener("click", onClick);
-      bar.appendChild(b);
+      into.appendChild(b);
       return b;
     };
     const playButton = button("\u25B6", "Play (space)", () => (state.playing ? pause() : play()));
@@ -333,13 +337,13 @@ export function createViewer(element, animation, options = {}) {
     speed.addEventListener("change", () => setSpeed(Number(speed.value)));
     bar.appendChild(speed);
     const framesButton = button("frames", "Show or hide the axes of every frame",
-                                () => setFramesVisible(!framesButton.classList.contains("kn-on")));
-    button("view", "Back to the first view", () => fitView());
+                                () => setFramesVisible(!framesButton.classList.contains("kn-on")), tools);
+    button("view", "Back to the first view", () => fitView(), tools);
     const title = document.createElement("div");
     title.className = "kn-viewer-title";
     title.textContent = animation.name || "";
-    root.appendChild(title);
-    root.appendChild(bar);
+    title.title = animation.name || "";
+    root.append(title, tools, bar);
     const end = data.t[data.t.length - 1];
     const digits = end - data.t[0] >= 100 ? 1 : 2;
     return {
@@ -551,15 +555,17 @@ function injectStyle() {
 .kn-viewer{position:relative;width:100%;height:100%;overflow:hidden;outline:none;
   font:13px system-ui,-apple-system,"Segoe UI",sans-serif;color:#333;background:#f4f5f7}
 .kn-viewer canvas{display:block}
-.kn-viewer-title{position:absolute;top:8px;left:12px;font-weight:600;color:#555;pointer-events:none}
+.kn-viewer-title{position:absolute;top:8px;left:12px;max-width:calc(100% - 140px);overflow:hidden;
+  text-overflow:ellipsis;white-space:nowrap;font-weight:600;color:#555;pointer-events:none}
+.kn-viewer-tools{position:absolute;top:6px;right:8px;display:flex;gap:4px}
 .kn-viewer-note{padding:2em;color:#a33}
 .kn-viewer-bar{position:absolute;left:0;right:0;bottom:0;contain:layout paint;display:flex;flex-wrap:wrap;align-items:center;
   gap:4px 8px;padding:6px 10px;background:#fff;border-top:1px solid #dde0e4}
-.kn-viewer-bar button{font:inherit;padding:2px 8px;border:1px solid #c8ccd2;border-radius:4px;
+.kn-viewer-bar button,.kn-viewer-tools button{font:inherit;padding:2px 8px;border:1px solid #c8ccd2;border-radius:4px;
   background:#fff;cursor:pointer;min-width:2.2em}
 .kn-viewer-bar button.kn-play{width:2.8em}
-.kn-viewer-bar button:hover{background:#eef1f5}
-.kn-viewer-bar button.kn-on{background:#dbe8fb;border-color:#8fb3e6}
+.kn-viewer-bar button:hover,.kn-viewer-tools button:hover{background:#eef1f5}
+.kn-viewer-tools button.kn-on{background:#dbe8fb;border-color:#8fb3e6}
 .kn-viewer-bar input[type=range]{flex:1 1 60px;min-width:60px}
 .kn-viewer-bar select{font:inherit}
 .kn-time{font-variant-numeric:tabular-nums;white-space:nowrap}`;
