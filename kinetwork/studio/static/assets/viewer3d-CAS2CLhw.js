@@ -4230,7 +4230,7 @@ void main() {
   text-overflow:ellipsis;white-space:nowrap;font-weight:600;color:#555;pointer-events:none}
 .kn-viewer-tools{position:absolute;top:6px;right:8px;display:flex;gap:4px}
 .kn-viewer-note{padding:2em;color:#a33}
-.kn-viewer-bar{position:absolute;left:0;right:0;bottom:0;contain:layout paint;display:flex;flex-wrap:wrap;align-items:center;
+.kn-viewer-bar{position:absolute;left:0;right:0;bottom:0;contain:layout paint;will-change:transform;display:flex;flex-wrap:wrap;align-items:center;
   gap:4px 8px;padding:6px 10px;background:#fff;border-top:1px solid #dde0e4}
 .kn-viewer-bar button,.kn-viewer-tools button{font:inherit;padding:2px 8px;border:1px solid #c8ccd2;border-radius:4px;
   background:#fff;cursor:pointer;min-width:2.2em}
