@@ -391,17 +391,20 @@ export function createViewer(element, animation, options = {}) {
   };
 }
 
-// The pixel ratio while playing, from the time between frames: lowered by steps (to half the
-// screen's at most) while frames come slower than SLOW, kept lower only where that made them
-// faster (a renderer held back by its vertices, not its pixels, keeps its picture), raised
-// again once they come faster than FAST for a while.
+// The pixel ratio while playing, from the time between frames: lowered one step (to three
+// quarters of the screen's, no lower) while frames come slower than SLOW, kept lower only where
+// that made them faster (a renderer held back by its vertices, not its pixels, keeps its
+// picture), raised again once they come faster than FAST for a while. Not two steps: a
+// 32-link chain at load 8 went to 0.56, a picture that looks poor, where the pixels were ~1 ms
+// of a 7 ms frame (SwiftShader, ratio 1 against 0.5) and the machine's load, not the picture,
+// made frames slow (the time between frames cannot tell the two apart).
 const SLOW = 1000 / 45, FAST = 1000 / 57, STEP = 0.75, SETTLE = 30, RISE = 120;
 
 export class PixelBudget {
   constructor(base) {
     this.base = base;
     this.ratio = base;
-    this.floor = base * 0.5;
+    this.floor = base * STEP;
     this.cap = base;
     this.rose = false;
     this.trial = null;
