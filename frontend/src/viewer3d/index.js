@@ -344,7 +344,6 @@ export function createViewer(element, animation, options = {}) {
     const title = document.createElement("div");
     title.className = "kn-viewer-title";
     title.textContent = animation.name || "";
-    title.title = animation.name || "";
     root.append(title, tools, bar);
     const end = data.t[data.t.length - 1];
     const digits = end - data.t[0] >= 100 ? 1 : 2;
