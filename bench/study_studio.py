@@ -33,13 +33,15 @@ read from /proc while it played, and the view's shapes hidden kind by kind:
   draw it. The page's own work in a plain frame is 0.5-0.9 ms (`tick`: poses, batches,
   `render` calls). So a plain frame takes ~6-7 ms of the 16.7 ms, and the machine's other
   load decides whether it fits.
-- **SwiftShader pays ~0.7 ms per draw call, whatever it draws**: the world's three arrow
-  shafts (96 triangles) cost as much as their three heads; 32 spheres of 120 triangles
-  2.7 ms, 32 cylinders 1.7 ms, 32 rods 1.5 ms, the ground's grid 0.5 ms, the whole
-  pixel budget (ratio 1 to 0.5) ~1 ms. Merging the instances of a kind into one mesh moved
-  in JavaScript made no difference (5.5 against 5.7 ms of the GPU process) and cost the page
-  1 ms a frame: instancing is not what costs. Shafts and heads became one arrow: 6 -> 5 draw
-  calls, the GPU process 6.2-7.4 -> 5.5-5.8 ms a frame.
+- **The GPU process's 5.5-6.5 ms a frame are the shapes' triangles and pixels, not their
+  draw calls.** Hiding kinds in turn: nothing drawn 0.9 ms, the ground's grid alone 1.4 ms,
+  everything 5.5-6.5 ms; ratio 0.5 instead of 1 saves ~1 ms. The number of calls made no
+  difference, measured A/B in alternate browser sessions (CPU ms of the GPU process a frame,
+  4 x 4 s each): 6 calls (arrow shafts and heads apart) 5.46 against 5 calls 5.45; the lit
+  kinds in one call (a shader fetching each shape's matrix from a texture; not kept) 5.67
+  against 5.81; each kind's instances merged into one mesh moved in JavaScript (not kept)
+  5.5 against 5.7, for 1 ms more of the page's time. (A first reading, kinds hidden one after
+  another while the load changed, had put ~0.7 ms on every call: the A/B runs disprove it.)
 - **The frames that change the page are the long ones.** Ten times a second the time label
   and the plots' cursors move (together, one frame in six): that frame adds style and
   layout 0.7 ms, paint 1.8 ms, layerization 2.0-2.5 ms and commit 0.3-1.8 ms, and came

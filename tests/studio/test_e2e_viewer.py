@@ -29,8 +29,7 @@ def test_a_chain_is_drawn_in_a_few_calls_with_every_shape_on_its_frame(page, stu
     calls = shown_chain(page, studio, 32)
     # the frames' axes hidden (33 and 65 of them), as the "frames" button says; the ground's
     # grid, and one call for each kind: cylinders, spheres, rods, the world's axes (an arrow
-    # each, shaft and head: a software renderer pays ~0.7 ms for every call), whatever the
-    # number of links
+    # each, shaft and head), whatever the number of links
     assert page.locator(".kn-viewer-tools button.kn-on").count() == 0
     assert calls == few and calls <= 5, (few, calls)
     info = page.evaluate("() => window.__kinetwork.viewer().renderInfo()")

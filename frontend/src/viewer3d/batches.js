@@ -1,13 +1,13 @@
 // The 3-D viewer's shapes of one kind (boxes, cylinders, spheres, rods, the axes' arrows),
-// each kind one InstancedMesh: a unit geometry scaled, placed and coloured per shape.
+// each kind one InstancedMesh: a unit geometry scaled, placed and coloured per shape; an
+// axis is one arrow, shaft and head.
 //
 // What a frame costs a software renderer (headless Chromium's SwiftShader, a 32-link chain in
-// a 403x272 pane, CPU time of the GPU process a frame, measured by hiding each kind in turn):
-// about 0.7 ms for every draw call whatever it draws (the world's 3 arrow shafts, 96
-// triangles, cost as much as their 3 heads), then its triangles and pixels (32 spheres of
-// 120 triangles: 2.7 ms). So kinds that can share a draw share it: an axis is one arrow,
-// shaft and head. Drawing the instances as one merged mesh moved in JavaScript made no
-// difference to the GPU process (5.5 against 5.7 ms) and cost the page 1 ms a frame.
+// a 403x272 pane): the shapes' triangles and pixels, not the number of draw calls. Measured
+// as CPU time of the GPU process a frame, A/B in alternate browser sessions: 6 calls (shafts
+// and heads apart) 5.46 ms, 5 calls 5.45 ms; the lit kinds in one call (a shader fetching each
+// shape's matrix from a texture) 5.67 against 5.81 ms; each kind's instances merged into one
+// mesh moved in JavaScript 5.5 against 5.7 ms, and 1 ms more of the page's time a frame.
 import {
   BoxGeometry, Color, ConeGeometry, CylinderGeometry, InstancedMesh, Matrix4,
   MeshBasicMaterial, MeshLambertMaterial, MeshStandardMaterial, Quaternion, SphereGeometry,
