@@ -22,7 +22,7 @@ TEST = "tests/studio/test_e2e.py::test_measure_load_run_and_3d_frame_rate"
 
 #: what a frame of the 32-link chain costs, and what drops frames: a study of this round
 #: (not measured again by this script; its figures above are)
-COSTS = """## What a frame of the playing chain costs (study of 2026-11-29, load 2.5-5)
+COSTS = """## What a frame of the playing chain costs (study of 2026-11-29, load 1.6-8.7)
 
 From Chrome traces of the chain playing (2-2.5 s each), CPU time of Chromium's processes
 read from /proc while it played, and the view's shapes hidden kind by kind:
@@ -46,15 +46,16 @@ read from /proc while it played, and the view's shapes hidden kind by kind:
   and the plots' cursors move (together, one frame in six): that frame adds style and
   layout 0.7 ms, paint 1.8 ms, layerization 2.0-2.5 ms and commit 0.3-1.8 ms, and came
   19.5-21 ms after the one before. With the cursors and the bar on layers of their own
-  (`will-change`), their layerization is 1.0 ms and they come 16.8-18 ms apart. The legend's
-  values changing made no measurable difference.
+  (`will-change`), their layerization is 1.0 ms and they come 16.8-18 ms apart (three traces
+  each, alternated). Hiding the legends changed nothing measurable (one trace).
 - **Not garbage collection, not the pixel budget.** The page's heap grew 136 KB a second
   (~2 KB a frame, the trace's heap counters) and was not collected in the 2 s traced; the
   pixel ratio stayed 1 while frames kept up (it settles at 0.75 when they come slower than
   45 a second), and 0.5 instead of 1 saves only ~1 ms of the GPU process.
 - **Dropped frames come in bursts with the machine's load**, not with the view: an idle
-  moment plays 240 of 240 frames; under load 3-5 two to nine gaps of two frames in 4 s, and
-  an empty page in the same browser keeps 60.
+  moment plays 240 of 240 frames; under load 3-5 two to nine gaps of two frames in 4 s while
+  an empty page in the same browser keeps 60; at load 8.7 the empty page itself fell to 52.8
+  frames/s and the chain played 55.0.
 
 What is left: the main thread waits for the picture every frame. Drawing in a worker
 (`OffscreenCanvas` transferred to it) would take that wait off the page's frames; the
