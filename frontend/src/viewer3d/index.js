@@ -344,6 +344,8 @@ export function createViewer(element, animation, options = {}) {
     const title = document.createElement("div");
     title.className = "kn-viewer-title";
     title.textContent = animation.name || "";
+    // elided beside the buttons in a narrow pane: the whole name on hover
+    title.title = animation.name || "";
     root.append(title, tools, bar);
     const end = data.t[data.t.length - 1];
     const digits = end - data.t[0] >= 100 ? 1 : 2;
@@ -560,7 +562,7 @@ function injectStyle() {
   font:13px system-ui,-apple-system,"Segoe UI",sans-serif;color:#333;background:#f4f5f7}
 .kn-viewer canvas{display:block}
 .kn-viewer-title{position:absolute;top:8px;left:12px;max-width:calc(100% - 140px);overflow:hidden;
-  text-overflow:ellipsis;white-space:nowrap;font-weight:600;color:#555;pointer-events:none}
+  text-overflow:ellipsis;white-space:nowrap;font-weight:600;color:#555}
 .kn-viewer-tools{position:absolute;top:6px;right:8px;display:flex;gap:4px}
 .kn-viewer-note{padding:2em;color:#a33}
 .kn-viewer-bar{position:absolute;left:0;right:0;bottom:0;contain:layout paint;will-change:transform;display:flex;flex-wrap:wrap;align-items:center;
