@@ -346,3 +346,32 @@ def misplaced(page):
     controls."""
     places = page.evaluate(PLACES, PANES)
     return places["wrong"], places
+
+
+def chromium_cpu():
+    """CPU seconds so far of this process's Chromium children, by kind: "renderer", "gpu"
+    (the GPU process: SwiftShader draws there, and the display compositor), "other". Read
+    from /proc (Linux); Chromium rewrites its command lines, so a kind is told by its flags."""
+    children = {}
+    for entry in os.listdir("/proc"):
+        if entry.isdigit():
+            try:
+                stat = pathlib.Path(f"/proc/{entry}/stat").read_text()
+            except OSError:               # gone meanwhile
+                continue
+            children.setdefault(int(stat.rsplit(")", 1)[1].split()[1]), []).append(int(entry))
+    spent, todo, tick = {}, [os.getpid()], os.sysconf("SC_CLK_TCK")
+    while todo:
+        for pid in children.get(todo.pop(), []):
+            todo.append(pid)
+            try:
+                line = pathlib.Path(f"/proc/{pid}/cmdline").read_bytes().decode(errors="replace")
+                fields = pathlib.Path(f"/proc/{pid}/stat").read_text().rsplit(")", 1)[1].split()
+            except OSError:
+                continue
+            if "chromium" not in line and "--type=" not in line and "--gpu-preferences" not in line:
+                continue                  # the Playwright driver (node)
+            kind = ("gpu" if "--gpu-preferences" in line else
+                    "renderer" if "--renderer-client-id" in line else "other")
+            spent[kind] = spent.get(kind, 0.0) + (int(fields[11]) + int(fields[12])) / tick
+    return spent

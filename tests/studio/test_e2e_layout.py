@@ -104,6 +104,11 @@ def test_every_control_lies_in_its_pane_and_every_plot_has_three_ticks(page, stu
     assert {"bar", "palette", "diagram", "plots", "viewer", "side"} <= set(places["panes"])
     viewer_buttons = places["controls"]["viewer"]
     assert len(viewer_buttons) >= 5, viewer_buttons            # play, time, speed, frames, view
+    if width >= 1400:       # the 3-D view's bar in one row (its "view" button wrapped at 1400)
+        rows = page.evaluate("() => [...document.querySelector('.kn-viewer-bar').children]"
+                             ".map(e => Math.round(e.getBoundingClientRect().top + "
+                             "e.getBoundingClientRect().height / 2))")
+        assert max(rows) - min(rows) <= 4, rows
     name = page.locator(f'{tid("file")} b').bounding_box()
     assert name["width"] > 50 and name["x"] + name["width"] <= width
     plots = page.locator(tid("plots")).bounding_box()

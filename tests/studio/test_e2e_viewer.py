@@ -28,10 +28,10 @@ def test_a_chain_is_drawn_in_a_few_calls_with_every_shape_on_its_frame(page, stu
     few = shown_chain(page, studio, 16)
     calls = shown_chain(page, studio, 32)
     # the frames' axes hidden (33 and 65 of them), as the "frames" button says; the ground's
-    # grid, and one call for each kind: cylinders, spheres, rods, the world's axes (shafts
-    # and heads), whatever the number of links
-    assert page.locator(".kn-viewer-bar button.kn-on").count() == 0
-    assert calls == few and calls <= 6, (few, calls)
+    # grid, and one call for each kind: cylinders, spheres, rods, the world's axes (an arrow
+    # each, shaft and head), whatever the number of links
+    assert page.locator(".kn-viewer-tools button.kn-on").count() == 0
+    assert calls == few and calls <= 5, (few, calls)
     info = page.evaluate("() => window.__kinetwork.viewer().renderInfo()")
     # headless Chromium draws with SwiftShader: no multisampling there, which halves its frames
     if "SwiftShader" in info["gpu"]:
@@ -125,6 +125,6 @@ def test_round_shapes_get_the_segments_their_size_on_screen_needs(page, studio):
     for _ in range(12):
         page.mouse.wheel(0, -400)
     page.wait_for_function(f"() => window.__kinetwork.viewer().renderInfo().triangles > {fitted}")
-    page.locator(".kn-viewer-bar button", has_text="view").click()
+    page.locator(".kn-viewer-tools button", has_text="view").click()
     page.wait_for_function(f"() => window.__kinetwork.viewer().renderInfo().triangles === {fitted}")
     assert not page.errors, page.errors

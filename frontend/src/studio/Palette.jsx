@@ -7,9 +7,15 @@ import { DOMAIN_COLORS } from "./model.js";
 import { formatValue } from "./values.js";
 import { DRAG_MIME } from "./Canvas.jsx";
 import { search } from "./search.js";
+import { docParts, plainDoc } from "./doctext.js";
 
 function firstLine(doc) {
   return String(doc || "").trim().split("\n")[0];
+}
+
+/** A docstring's text with its literals (``r``) as code. @param {{text: string}} props */
+function Doc({ text }) {
+  return docParts(text).map((p, i) => (p.code ? <code key={i}>{p.text}</code> : p.text));
 }
 
 export function TypeInfoCard({ info }) {
@@ -24,7 +30,7 @@ export function TypeInfoCard({ info }) {
   return (
     <div className="kn-typeinfo" data-testid="palette-info">
       <div className="kn-typeinfo-title">{info.type}</div>
-      <div className="kn-typeinfo-doc">{String(info.doc || "").trim()}</div>
+      <div className="kn-typeinfo-doc"><Doc text={String(info.doc || "").trim()} /></div>
       {info.ports && info.ports.length > 0 && (
         <>
           <div className="kn-typeinfo-h">Ports</div>
@@ -33,7 +39,7 @@ export function TypeInfoCard({ info }) {
               <li key={p.name}>
                 <span className="kn-dot" style={{ background: DOMAIN_COLORS[p.domain] || "#888" }} />
                 <b>{p.name}</b> <span className="kn-muted">{p.domain}{p.optional ? ", optional" : ""}</span>
-                {p.doc ? <div className="kn-muted kn-small">{p.doc}</div> : null}
+                {p.doc ? <div className="kn-muted kn-small"><Doc text={p.doc} /></div> : null}
               </li>
             ))}
           </ul>
@@ -52,7 +58,7 @@ export function TypeInfoCard({ info }) {
                     {p.required ? "required" : `= ${formatValue(p.default) || "none"}`}
                     {p.min != null ? `, ≥ ${p.min}` : ""}
                     {p.max != null ? `, ≤ ${p.max}` : ""}
-                    {p.doc ? <div className="kn-small">{p.doc}</div> : null}
+                    {p.doc ? <div className="kn-small"><Doc text={p.doc} /></div> : null}
                   </td>
                 </tr>
               ))}
@@ -121,8 +127,8 @@ export default function Palette({ palette, definitions, onAdd }) {
                   onMouseEnter={() => setShown(t.type)}
                   onClick={() => setShown(t.type)}
                   onDoubleClick={() => onAdd(t.type)}
-                  title={`${t.type}\n${firstLine(t.doc)}\n\n${(t.params || [])
-                    .map((p) => `${p.name}${p.unit ? ` [${p.unit}]` : ""}${p.doc ? `: ${p.doc}` : ""}`)
+                  title={`${t.type}\n${plainDoc(firstLine(t.doc))}\n\n${(t.params || [])
+                    .map((p) => `${p.name}${p.unit ? ` [${p.unit}]` : ""}${p.doc ? `: ${plainDoc(p.doc)}` : ""}`)
                     .join("\n")}`}
                 >
                   <TypeIcon type={t.type} subsystem={lib.subsystem || (lib.subsystems && lib.subsystems.has(t.type))} size={0.75} />
@@ -131,7 +137,7 @@ export default function Palette({ palette, definitions, onAdd }) {
                       {t.type.split(".").pop()}
                       {lib.ranked && t.type.includes(".") ? <span className="kn-muted kn-small"> {t.type.split(".")[0]}</span> : null}
                     </div>
-                    <div className="kn-palette-doc">{firstLine(t.doc)}</div>
+                    <div className="kn-palette-doc"><Doc text={firstLine(t.doc)} /></div>
                   </div>
                 </div>
               ))}

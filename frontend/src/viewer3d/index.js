@@ -14,23 +14,23 @@
 // ratio, which playing lowers while frames come slowly and fewer pixels make them faster),
 // centers(kind) (where each body shape of a kind is: its frame's pose applied to its middle).
 //
-// Shapes of one kind (boxes, cylinders, spheres, rods, frame axes) are drawn as one
-// InstancedMesh: a unit geometry scaled, placed and coloured per shape, so a chain of 32
-// links costs a handful of draw calls instead of one per shape.
+// Shapes of one kind (boxes, cylinders, spheres, rods, axes' arrows) are drawn as one
+// InstancedMesh (batches.js), so a chain of 32 links costs a handful of draw calls instead of
+// one per shape.
 import {
-  AmbientLight, BoxGeometry, BufferGeometry, Color, ConeGeometry, CylinderGeometry,
-  DirectionalLight, Float32BufferAttribute, GridHelper, Group, InstancedMesh, Matrix4, Mesh,
-  MeshBasicMaterial, MeshLambertMaterial,
-  MeshStandardMaterial, PerspectiveCamera, Quaternion, Scene, SphereGeometry, TubeGeometry, Curve,
+  AmbientLight, BufferGeometry, Color, DirectionalLight, Float32BufferAttribute, GridHelper,
+  Group, Mesh, MeshStandardMaterial, PerspectiveCamera, Quaternion, Scene, TubeGeometry, Curve,
   Vector2, Vector3, WebGLRenderer,
 } from "three";
 import { OrbitControls } from "three/examples/jsm/controls/OrbitControls.js";
+import { batched, makeBatches } from "./batches.js";
+
+export { segments } from "./batches.js";
 
 const SPEEDS = [0.1, 0.25, 0.5, 1, 2, 4];
 const FRAMES_SHOWN = 24;
 /** ms between updates of the time in the bar while playing */
 const LABEL_MS = 100;
-const AXIS_COLORS = [0xdc3232, 0x28a03c, 0x3250dc];
 const Y = new Vector3(0, 1, 0);
 /** The names WebGL gives a renderer without a GPU behind it. */
 const SOFTWARE = /SwiftShader|llvmpipe|softpipe|Software/i;
@@ -155,10 +155,10 @@ export function createViewer(element, animation, options = {}) {
       i = lo;
       w = t[hi] > t[lo] ? Math.min(Math.max((time - t[lo]) / (t[hi] - t[lo]), 0), 1) : 0;
     }
-    data.frames.forEach((f, k) => {
-      pose(f, i, w, frames[k]);
+    for (let k = 0; k < frames.length; k++) {
+      pose(data.frames[k], i, w, frames[k]);
       frames[k].updateMatrix();
-    });
+    }
     for (const { shape, object } of links) stretch(object, frames[shape.frame].position,
                                                    frames[shape.to].position);
     for (const batch of Object.values(batches)) batch.update(frames);
@@ -191,7 +191,9 @@ export function createViewer(element, animation, options = {}) {
       apply(state.time);
       // the time in the bar and the host's (the plots' cursors) change ten times a second,
       // together, not every frame: any change of the page repaints and re-layers the whole
-      // document (beside a diagram of a hundred blocks: ~15 ms a frame in headless Chromium)
+      // document (beside a diagram of a hundred blocks: ~15 ms a frame in headless Chromium);
+      // the bar is a layer of its own (will-change), so the label's change is not laid into
+      // the page's layers again (a frame that moves it: layerization 2.0-2.5 -> 1.0 ms)
       if (now - state.shown >= LABEL_MS) {
         state.shown = now;
         if (ui) ui.show(state.time);
@@ -300,13 +302,17 @@ export function createViewer(element, animation, options = {}) {
   function buildControls() {
     const bar = document.createElement("div");
     bar.className = "kn-viewer-bar";
-    const button = (label, title, onClick) => {
+    // the view's own buttons sit in its top right corner, off the bar: with them the bar
+    // took two rows in a 3-D pane 333 px wide (a 1400x900 studio)
+    const tools = document.createElement("div");
+    tools.className = "kn-viewer-tools";
+    const button = (label, title, onClick, into = bar) => {
       const b = document.createElement("button");
       b.type = "button";
       b.textContent = label;
       b.title = title;
       b.addEventListener("click", onClick);
-      bar.appendChild(b);
+      into.appendChild(b);
       return b;
     };
     const playButton = button("\u25B6", "Play (space)", () => (state.playing ? pause() : play()));
@@ -333,13 +339,14 @@ export function createViewer(element, animation, options = {}) {
     speed.addEventListener("change", () => setSpeed(Number(speed.value)));
     bar.appendChild(speed);
     const framesButton = button("frames", "Show or hide the axes of every frame",
-                                () => setFramesVisible(!framesButton.classList.contains("kn-on")));
-    button("view", "Back to the first view", () => fitView());
+                                () => setFramesVisible(!framesButton.classList.contains("kn-on")), tools);
+    button("view", "Back to the first view", () => fitView(), tools);
     const title = document.createElement("div");
     title.className = "kn-viewer-title";
     title.textContent = animation.name || "";
-    root.appendChild(title);
-    root.appendChild(bar);
+    // elided beside the buttons in a narrow pane: the whole name on hover
+    title.title = animation.name || "";
+    root.append(title, tools, bar);
     const end = data.t[data.t.length - 1];
     const digits = end - data.t[0] >= 100 ? 1 : 2;
     return {
@@ -385,17 +392,20 @@ export function createViewer(element, animation, options = {}) {
   };
 }
 
-// The pixel ratio while playing, from the time between frames: lowered by steps (to half the
-// screen's at most) while frames come slower than SLOW, kept lower only where that made them
-// faster (a renderer held back by its vertices, not its pixels, keeps its picture), raised
-// again once they come faster than FAST for a while.
+// The pixel ratio while playing, from the time between frames: lowered one step (to three
+// quarters of the screen's, no lower) while frames come slower than SLOW, kept lower only where
+// that made them faster (a renderer held back by its vertices, not its pixels, keeps its
+// picture), raised again once they come faster than FAST for a while. Not two steps: a
+// 32-link chain at load 8 went to 0.56, a picture that looks poor, where the pixels were ~1 ms
+// of a 7 ms frame (SwiftShader, ratio 1 against 0.5) and the machine's load, not the picture,
+// made frames slow (the time between frames cannot tell the two apart).
 const SLOW = 1000 / 45, FAST = 1000 / 57, STEP = 0.75, SETTLE = 30, RISE = 120;
 
 export class PixelBudget {
   constructor(base) {
     this.base = base;
     this.ratio = base;
-    this.floor = base * 0.5;
+    this.floor = base * STEP;
     this.cap = base;
     this.rose = false;
     this.trial = null;
@@ -482,9 +492,9 @@ function pose(frame, i, w, object) {
     object.quaternion.set(q[1], q[2], q[3], q[0]);
     return;
   }
-  const j = Math.min(i + 1, frame.rows - 1);
-  const lerp = k => p[3 * i + k] + w * (p[3 * j + k] - p[3 * i + k]);
-  object.position.set(lerp(0), lerp(1), lerp(2));
+  const j = Math.min(i + 1, frame.rows - 1), a = 3 * i, b = 3 * j;
+  object.position.set(p[a] + w * (p[b] - p[a]), p[a + 1] + w * (p[b + 1] - p[a + 1]),
+                      p[a + 2] + w * (p[b + 2] - p[a + 2]));
   qa.set(q[4 * i + 1], q[4 * i + 2], q[4 * i + 3], q[4 * i]);
   qb.set(q[4 * j + 1], q[4 * j + 2], q[4 * j + 3], q[4 * j]);
   object.quaternion.slerpQuaternions(qa, qb, w);
@@ -543,178 +553,6 @@ function build(shape) {
   return null;
 }
 
-// -- instanced shapes ------------------------------------------------------------------------
-const matrix = new Matrix4(), basis = new Matrix4(), turn = new Quaternion();
-const scaling = new Vector3(), middle = new Vector3();
-
-// Segments round a shape: as many as its size on screen needs, no more. A polygon of n sides
-// round a circle r pixels wide strays r (1 - cos(pi/n)) ~ r pi^2 / 2n^2 from it: under
-// TOLERANCE pixels with n >= pi sqrt(r / 2 TOLERANCE). A software renderer (headless
-// Chromium's SwiftShader) pays per vertex of every instance: a 32-link chain's cylinders,
-// spheres and rods at 32, 14 and 20 segments (12 200 triangles) took 29-31 ms of the GPU
-// process a frame, at 12, 8 and 8 (4 264) 15-18 ms, with no difference to see on links
-// ten pixels wide.
-const TOLERANCE = 0.35;
-const STEPS = [6, 8, 10, 12, 16, 20, 24, 32, 48];
-// Triangles a kind's instances may take together, however near the camera comes.
-const TRIANGLES = 8000;
-
-/**
- * Segments round a kind's shapes: enough for the largest of them, ``radius`` pixels on
- * screen, rounded up to one of a few steps (so zooming rebuilds the geometry seldom), between
- * ``lo`` and ``hi``, and fewer where ``count`` shapes of ``triangles(n)`` triangles each
- * would pass the budget.
- * @param {number} count @param {(n: number) => number} triangles
- * @param {number} lo @param {number} hi @param {number} [radius]
- */
-export function segments(count, triangles, lo, hi, radius = Infinity) {
-  const need = Math.PI * Math.sqrt(Math.max(radius, 0) / (2 * TOLERANCE));
-  const step = STEPS.find(n => n >= need) ?? STEPS[STEPS.length - 1];
-  let n = Math.max(lo, Math.min(hi, step));
-  while (n > lo && Math.max(count, 1) * triangles(n) > TRIANGLES) n = STEPS.filter(k => k < n).pop() ?? lo;
-  return Math.max(lo, n);
-}
-
-// Each kind's unit geometry at ``n`` segments round (boxes have none): a shape is this,
-// scaled by its sizes, turned into its frame's directions and moved to its place (as `build`
-// makes one mesh of its own sizes).
-function unitGeometry(kind, n) {
-  if (kind === "box") return new BoxGeometry(1, 1, 1).translate(0.5, 0, 0);
-  if (kind === "cylinder") return new CylinderGeometry(0.5, 0.5, 1, n).rotateZ(-Math.PI / 2).translate(0.5, 0, 0);
-  if (kind === "sphere") return new SphereGeometry(0.5, n, Math.max(3, n >> 1)).translate(0.5, 0, 0);
-  if (kind === "rod") return new CylinderGeometry(1, 1, 1, n).translate(0, 0.5, 0);
-  if (kind === "shaft") return new CylinderGeometry(1 / 30, 1 / 30, 0.8, 8).translate(0, 0.4, 0);
-  return new ConeGeometry(2.6 / 30, 0.2, 12).translate(0, 0.9, 0);      // an arrow's head
-}
-
-// The round kinds: triangles a shape at n segments, the fewest and the most segments
-const ROUND = {
-  cylinder: [n => 4 * n, 6, 48],
-  sphere: [n => n * Math.max(3, n >> 1) * 2, 6, 32],
-  rod: [n => 4 * n, 6, 24],
-};
-
-// The shapes of one kind, drawn by one InstancedMesh: each on a frame (its matrix there,
-// `local`) or, for a rod, between two frames' origins.
-class Batch {
-  constructor(kind, lit, small = false, soft = false) {
-    this.kind = kind;
-    this.lit = lit;
-    this.small = small;
-    this.soft = soft;
-    this.items = [];
-    this.mesh = null;
-  }
-
-  add(item) { this.items.push(item); }
-
-  finish() {
-    if (!this.items.length) return null;
-    // a software renderer draws Lambert's diffuse light 1.4 times as fast as the physical
-    // material (a 32-link chain: 24-27 frames/s against 17-18, drawing only); the picture
-    // loses the highlights, which shapes a few pixels wide hardly show
-    const paint = !this.lit ? new MeshBasicMaterial({ color: 0xffffff })
-      : this.soft ? new MeshLambertMaterial({ color: 0xffffff })
-        : new MeshStandardMaterial({ color: 0xffffff, roughness: 0.55, metalness: 0.1 });
-    this.segments = this.detail(Infinity);
-    const mesh = new InstancedMesh(unitGeometry(this.kind, this.segments), paint, this.items.length);
-    this.items.forEach((item, i) => mesh.setColorAt(i, new Color(item.color)));
-    // the instances move every frame: a bounding sphere computed once would cull them
-    mesh.frustumCulled = false;
-    this.mesh = mesh;
-    return mesh;
-  }
-
-  /** Segments round at ``pixels`` screen pixels a metre (0 for a kind without any). */
-  detail(pixels) {
-    const round = ROUND[this.kind];
-    if (!round) return 0;
-    const radius = Math.max(...this.items.map(item => item.radius)) * pixels;
-    const [triangles, lo, hi] = round;
-    return segments(this.items.length, triangles, lo, hi, radius);
-  }
-
-  /** The geometry rebuilt for shapes seen at ``pixels`` screen pixels a metre, if need be. */
-  refine(pixels) {
-    if (!this.mesh) return;
-    const n = this.detail(pixels);
-    if (!n || n === this.segments) return;
-    this.segments = n;
-    this.mesh.geometry.dispose();
-    this.mesh.geometry = unitGeometry(this.kind, n);
-  }
-
-  update(frames) {
-    if (!this.mesh) return;
-    this.items.forEach((item, i) => {
-      if (item.to !== undefined) {
-        const a = frames[item.frame].position;
-        direction.subVectors(frames[item.to].position, a);
-        const length = direction.length();
-        if (length > 1e-12) turn.setFromUnitVectors(Y, direction.divideScalar(length));
-        scaling.set(item.radius, length, item.radius);
-        matrix.compose(a, turn, length > 1e-12 ? scaling : scaling.setScalar(0));
-      } else {
-        matrix.multiplyMatrices(frames[item.frame].matrix, item.local);
-      }
-      this.mesh.setMatrixAt(i, matrix);
-    });
-    this.mesh.instanceMatrix.needsUpdate = true;
-  }
-
-  centers() {
-    if (!this.mesh) return [];
-    return this.items.map((item, i) => {
-      this.mesh.getMatrixAt(i, matrix);
-      // the middle of the unit shape (half a length along x, or along y for a rod)
-      return (item.to !== undefined ? middle.set(0, 0.5, 0) : middle.set(0.5, 0, 0)).applyMatrix4(matrix).toArray();
-    });
-  }
-}
-
-function makeBatches(soft) {
-  return {
-    box: new Batch("box", true, false, soft), cylinder: new Batch("cylinder", true, false, soft),
-    sphere: new Batch("sphere", true, false, soft), rod: new Batch("rod", true, false, soft),
-    shaft: new Batch("shaft", false), head: new Batch("head", false),
-    frameShaft: new Batch("shaft", false, true), frameHead: new Batch("head", false, true),
-  };
-}
-
-// Put ``shape`` in its kind's batch; false for what is drawn on its own (springs, mesh files,
-// the ground's grid).
-function batched(shape, batches, small) {
-  const kind = shape.kind;
-  if (kind === "box" || kind === "cylinder" || kind === "sphere") {
-    const { length, width, height } = shape;
-    const l = new Vector3().fromArray(shape.length_direction);
-    const w = new Vector3().fromArray(shape.width_direction);
-    basis.makeBasis(l, w, new Vector3().crossVectors(l, w));
-    const sizes = kind === "box" ? [length, width, height] : kind === "cylinder" ? [length, width, width] : [length, length, length];
-    const local = new Matrix4().compose(new Vector3().fromArray(shape.r_shape),
-                                        new Quaternion().setFromRotationMatrix(basis),
-                                        new Vector3(...sizes));
-    // the radius round the length: what a round kind's segments go round
-    batches[kind].add({ frame: shape.frame, local, color: shape.color, radius: (kind === "sphere" ? length : width) / 2 });
-    return true;
-  }
-  if (kind === "rod") {
-    batches.rod.add({ frame: shape.frame, to: shape.to, radius: shape.diameter / 2, color: shape.color });
-    return true;
-  }
-  if (kind === "axes") {
-    const [shafts, heads] = small ? [batches.frameShaft, batches.frameHead] : [batches.shaft, batches.head];
-    [new Vector3(1, 0, 0), Y, new Vector3(0, 0, 1)].forEach((d, k) => {
-      const local = new Matrix4().compose(new Vector3(), new Quaternion().setFromUnitVectors(Y, d),
-                                          new Vector3(shape.length, shape.length, shape.length));
-      shafts.add({ frame: shape.frame, local, color: AXIS_COLORS[k] });
-      heads.add({ frame: shape.frame, local, color: AXIS_COLORS[k] });
-    });
-    return true;
-  }
-  return false;
-}
-
 function injectStyle() {
   if (document.getElementById("kn-viewer-style")) return;
   const style = document.createElement("style");
@@ -723,15 +561,17 @@ function injectStyle() {
 .kn-viewer{position:relative;width:100%;height:100%;overflow:hidden;outline:none;
   font:13px system-ui,-apple-system,"Segoe UI",sans-serif;color:#333;background:#f4f5f7}
 .kn-viewer canvas{display:block}
-.kn-viewer-title{position:absolute;top:8px;left:12px;font-weight:600;color:#555;pointer-events:none}
+.kn-viewer-title{position:absolute;top:8px;left:12px;max-width:calc(100% - 140px);overflow:hidden;
+  text-overflow:ellipsis;white-space:nowrap;font-weight:600;color:#555}
+.kn-viewer-tools{position:absolute;top:6px;right:8px;display:flex;gap:4px}
 .kn-viewer-note{padding:2em;color:#a33}
-.kn-viewer-bar{position:absolute;left:0;right:0;bottom:0;contain:layout paint;display:flex;flex-wrap:wrap;align-items:center;
+.kn-viewer-bar{position:absolute;left:0;right:0;bottom:0;contain:layout paint;will-change:transform;display:flex;flex-wrap:wrap;align-items:center;
   gap:4px 8px;padding:6px 10px;background:#fff;border-top:1px solid #dde0e4}
-.kn-viewer-bar button{font:inherit;padding:2px 8px;border:1px solid #c8ccd2;border-radius:4px;
+.kn-viewer-bar button,.kn-viewer-tools button{font:inherit;padding:2px 8px;border:1px solid #c8ccd2;border-radius:4px;
   background:#fff;cursor:pointer;min-width:2.2em}
 .kn-viewer-bar button.kn-play{width:2.8em}
-.kn-viewer-bar button:hover{background:#eef1f5}
-.kn-viewer-bar button.kn-on{background:#dbe8fb;border-color:#8fb3e6}
+.kn-viewer-bar button:hover,.kn-viewer-tools button:hover{background:#eef1f5}
+.kn-viewer-tools button.kn-on{background:#dbe8fb;border-color:#8fb3e6}
 .kn-viewer-bar input[type=range]{flex:1 1 60px;min-width:60px}
 .kn-viewer-bar select{font:inherit}
 .kn-time{font-variant-numeric:tabular-nums;white-space:nowrap}`;
