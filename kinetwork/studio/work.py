@@ -98,16 +98,23 @@ def run(data, settings, folder, library, channel):
         _check_size(n_points, 1 + sum(sig.size for sig in system.signals), 1)
         if channel.cancelled():
             return _final("cancelled", phase=phase)
-        phase = "integrating"
-        channel.enter(phase)
         span = t_end if isinstance(t_end, (int, float)) and t_end > 0 else None
 
         def progress(t):
+            # "compiling" until the integration reports: simulate compiles the equations to
+            # C (a cold cache: seconds for EngineV6) before it integrates anything
+            nonlocal phase
+            if phase == "compiling":
+                phase = "integrating"
+                channel.enter(phase)
             channel.report(t / span)
             if t >= span * (1 - 1e-12):
                 # integrated to the end: the probes' outputs follow, results that a cancel
                 # now would lose; they are finished and kept (jobs: no SIGINT in this phase)
                 channel.enter("writing results")
+        if span is None:                # no progress to wait for: integrating from here
+            phase = "integrating"
+            channel.enter(phase)
         results = simulate(system, **settings, cancel=channel.cancelled,
                            progress=progress if span else None)
         phase = "writing results"
@@ -115,6 +122,11 @@ def run(data, settings, folder, library, channel):
         return _final("done", results=results_json(results, model), phase=phase)
     except SimulationError as exc:
         cancelled = channel.cancelled()
+        reached = exc.results is not None and len(exc.results.t) > 1
+        if reached or not cancelled:
+            phase = "integrating"       # (a first chunk that failed reported no progress)
+        if cancelled and not reached:   # cancelled while the equations were compiled to C
+            exc.results = None
         if cancelled and exc.results is not None and exc.results.partial:
             # stopped by the user's cancel (the signal that carried it is a detail)
             exc.results.partial = {**exc.results.partial, "reason": "cancelled"}
