@@ -8,6 +8,8 @@ import bisect
 
 import numpy as np
 
+from .roots import brentq
+
 #: where, as fractions of the interval, an indicator that starts at zero after a restart is
 #: looked for above zero (it leaves zero rising: first right after the start)
 SCAN = np.array([1e-12, 1e-9, 1e-6, 1e-3, *np.arange(1, 16) / 16])
@@ -93,7 +95,6 @@ def root(level, T, g, rate, j):
             t = (a + b) / 2
     if not level(a) > 0 >= level(b):
         return b
-    from scipy.optimize import brentq
     t = brentq(level, a, b, xtol=1e-15, rtol=4 * np.finfo(float).eps, maxiter=200)
     return t if level(t) <= 0 else min(b, t + tiny)
 
@@ -148,8 +149,6 @@ def search(g, rate, t0, t1, crossed, dipped):
     ``rate(t, i)``: (time, element) or None. ``crossed``: elements at or below zero at t1;
     ``dipped``: above zero at both ends with a minimum between, which cross if it reaches
     zero. The time is on the side of the root where the indicator has crossed."""
-    from scipy.optimize import brentq          # 0.3 s to import: only with events
-
     tight = dict(xtol=1e-15, rtol=4 * np.finfo(float).eps, maxiter=200)
     best = None
     for i in dipped:

@@ -22,6 +22,7 @@ import numpy as np
 from ..errors import ModelError
 from ..equations.relations import LEVELS
 from ..equations.system import mapped
+from .roots import brentq
 
 #: points over a run at which indicators not affine in t are looked at
 SCAN = 4096
@@ -89,21 +90,18 @@ class Schedule:
             if rate == 0 or not np.isfinite(rate) or not np.isfinite(a0):
                 return []
             return list(self.t_start + (knots - a0) / rate)
-        from scipy.optimize import brentq
-
+    
         def at(t, shift=0.0):
             return float(_position(float(f(t, p)[0]), knots)) - shift
         grid = np.linspace(self.t_start, self.t_end, SCAN + 1)
         args = np.asarray(mapped(f, len(grid))(grid[None, :], p)[0], dtype=float).ravel()
         level = _position(args, knots)
         return self._located([(at, grid[a], grid[a + 1], level[a], level[a + 1], True)
-                              for a in range(len(grid) - 1)], brentq)
+                              for a in range(len(grid) - 1)])
 
     def _scan(self, f, p, k, others, levels, values, known):
         """The switches of the nodes ``others`` (not affine in t), on SCAN points and the
         instants ``known`` already (where their indicators may jump)."""
-        from scipy.optimize import brentq          # 0.3 s to import: only when needed
-
         grid = np.union1d(np.linspace(self.t_start, self.t_end, SCAN + 1),
                           [t for t in known if self.t_start < t < self.t_end])
         table = np.asarray(mapped(f, len(grid))(grid[None, :], p), dtype=float)
@@ -132,9 +130,9 @@ class Schedule:
                 ends.append((t1, g1))
                 spans.extend((at, ta, tb, ga, gb, level)
                              for (ta, ga), (tb, gb) in zip(ends, ends[1:]))
-        return self._located(spans, brentq)
+        return self._located(spans)
 
-    def _located(self, spans, brentq):
+    def _located(self, spans):
         """The crossings of monotone pieces ``(indicator, ta, tb, ga, gb, level)``, counted
         from their ends' values first: a count beyond MAX_TIME_EVENTS is refused before a
         single one is located (a 1e-8 s period over 1 s: at once, not after a million
@@ -142,7 +140,7 @@ class Schedule:
         self._count(sum(_n_crossings(ga, gb, level) for _, _, _, ga, gb, level in spans))
         out = []
         for at, ta, tb, ga, gb, level in spans:
-            out.extend(_crossings(at, ta, tb, ga, gb, level, brentq))
+            out.extend(_crossings(at, ta, tb, ga, gb, level))
         return out
 
     def next(self, t):
@@ -167,7 +165,7 @@ def _n_crossings(ga, gb, level):
     return len(_wholes(ga, gb))
 
 
-def _crossings(at, ta, tb, ga, gb, level, brentq):
+def _crossings(at, ta, tb, ga, gb, level):
     """Where the indicator ``at`` crosses zero (a level: a whole number) between ta and tb,
     monotone there, with values ga and gb at the ends."""
     if not level:
