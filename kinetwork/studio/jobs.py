@@ -29,9 +29,10 @@ import traceback
 log = logging.getLogger("kinetwork.studio")
 
 #: what the forkserver imports once, so that each child starts with it loaded: scipy.optimize
-#: is what locating events imports on first use (0.3 s a run, 1.2 s on a loaded machine, in
-#: every child of a model with state events); the last one runs a small model there
-#: (``warm``), so that each child starts warm too
+#: (0.3 s to import) is what a loop's start searched for (``equations/loopclose.search``) and
+#: circuit junctions (``equations/junctions``) import on first use (events no longer do:
+#: ``solver/roots.py``); the last one runs a small model there (``warm``), so that each child
+#: starts warm too
 PRELOAD = ["kinetwork", "kinetwork.graph.io", "kinetwork.equations", "kinetwork.solver.driver",
            "scipy.optimize", "kinetwork.studio.jobs", "kinetwork.studio.work",
            "kinetwork.studio.warm"]
