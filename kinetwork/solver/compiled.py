@@ -133,7 +133,7 @@ class Compiled:
             return held.jacobian_function().n_instructions() <= JACOBIAN_JIT_LIMIT
         return self._get("jacobian_small", decide)
 
-    def dae(self, jit=None, jacobian=False):
+    def dae(self, jit=None, jacobian=False, hidden=False):
         """The equations as CasADi's integrators take them, in the time tau since the start of
         a chunk: their parameters are the model's then that start t0 (t = t0 + tau), so one
         integrator serves every chunk of the same length. A dict of SX (VM), or an MX
@@ -141,8 +141,13 @@ class Compiled:
         compile nothing themselves unless handed a compiled Function).
 
         ``jacobian``: the method iterates with Newton. Without (Adams' functional iteration)
-        the equations hide their derivatives in x (``_no_newton``)."""
-        return self._dae("dae", False, jit, jacobian)
+        the equations hide their derivatives in x when their Jacobian is large
+        (``_equations``), or whatever its size when ``hidden``: for an integrator built for
+        one chunk's own grid (after an event), whose creation would otherwise build the
+        Jacobian function that functional iteration never calls (EngineV6: 0.39 ms of CPU an
+        integrator, 0.14 ms hidden, 349 of them in its first run; the hiding node's 0.1-0.3
+        us an evaluation over the chunk's hundred evaluations is less)."""
+        return self._dae("dae", False, jit, jacobian, hidden and not jacobian)
 
     def dae_scaled(self, jit=None, jacobian=False):
         """The equations over a stretch of any length dt, in s = (t - t0) / dt from 0 to 1
@@ -150,7 +155,7 @@ class Compiled:
         (the events' trial times). As ``dae``: SX, or an MX Function around compiled code."""
         return self._dae("dae_scaled", True, jit, jacobian)
 
-    def _dae(self, name, scaled, jit, jacobian):
+    def _dae(self, name, scaled, jit, jacobian, hidden=False):
         """``dae`` (t = t0 + tau) or, ``scaled``, ``dae_scaled`` (t = t0 + s dt, the rates
         times dt), each built once per kind."""
         system, held = self.system, self.held
@@ -162,7 +167,7 @@ class Compiled:
 
         def rates(ode, factor):
             return ode if factor is None else factor * ode
-        if not jit and (jacobian or not self._no_newton_vm()):
+        if not jit and (jacobian or not (hidden or self._no_newton_vm())):
             def build_sx():
                 tau, extra = ca.SX.sym("tau"), ca.SX.sym("extra", n_extra)
                 t, factor = clock(tau, extra)
@@ -176,13 +181,13 @@ class Compiled:
             z = ca.MX.sym("z", system.n_algebraic)
             pt, empty = ca.MX.sym("p", held.p.numel() + n_extra), ca.MX(0, 1)
             t, factor = clock(tau, pt[-n_extra:])
-            ode, alg = self._equations(jit, exact, jacobian, t, x, z, pt[:-n_extra])
+            ode, alg = self._equations(jit, exact, jacobian, t, x, z, pt[:-n_extra], hidden)
             return ca.Function(name, [tau, x, z, pt, ca.MX.sym("u", 0)],
                                [rates(ode, factor), alg, empty, empty], ca.dyn_in(),
                                ca.dyn_out())
-        return self._get((name, bool(jit), exact, jacobian), build)
+        return self._get((name, bool(jit), exact, jacobian, hidden), build)
 
-    def _equations(self, jit, exact, newton, t, x, z, p):
+    def _equations(self, jit, exact, newton, t, x, z, p, hidden=False):
         """(ode, alg) in MX: the compiled code (or, without ``jit``, the SX Function in
         CasADi's VM), with its exact Jacobian when ``exact``.
 
@@ -194,9 +199,10 @@ class Compiled:
         0.04 s there and the run is the same to the last bit. Only where the Jacobian is large
         (``jacobian_small``): the hiding node costs every evaluation of the equations 0.1-0.3
         us in CasADi's virtual machine around the compiled code (8-10 % of the seed's run,
-        ``bench/study_overhead.py``), and a small Jacobian's set-up costs under 1 ms."""
+        ``bench/study_overhead.py``), and a small Jacobian's set-up costs under 1 ms, unless
+        ``hidden`` (``dae``)."""
         held = self.held
-        if not newton and not self.jacobian_small():
+        if not newton and (hidden or not self.jacobian_small()):
             x = ca.stop_diff(x, 1)
         if self.system.n_algebraic:
             f = self._external(held.f_dae, exact, jit) if jit else held.f_dae

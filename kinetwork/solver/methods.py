@@ -239,9 +239,11 @@ class _CasadiRun:
         """(the key its System keeps it by, the function that builds it) of ``integrator``:
         a batch of members maps the very integrator a run builds (``batch.py``)."""
         m, run = self.method, self.run
-        dae = run.compiled.dae(run.jit, m.newton)
         n = len(times)
         step = None if exact else _equal_step(times, self.t, run.spacing)
+        # a grid of its own (after an event) is seldom met again: its integrator is built
+        # on the equations with their derivatives hidden (``Compiled.dae``)
+        dae = run.compiled.dae(run.jit, m.newton, hidden=step is None)
         if step is not None:
             grid = ("uniform", n, step)          # equal intervals: j * step
             # an array, not a list: 8 bytes a time instead of 32 (a grid of millions)

@@ -69,6 +69,38 @@ def test_a_small_model_s_adams_hides_nothing_and_runs_the_same(cache, monkeypatc
                                rtol=0, atol=1e-12)
 
 
+@pytest.mark.parametrize("jit_on", [True, False])
+def test_a_chunk_s_own_grid_hides_the_derivatives_of_a_small_model(cache, jit_on):
+    """An integrator built for one chunk's own grid (after an event) is built on the
+    equations with their derivatives hidden whatever their size (CasADi builds a Jacobian at
+    its creation otherwise: most of EngineV6's 349 such builds), with the same numbers; a
+    grid of equal intervals, kept and met again, keeps them (each evaluation is cheaper)."""
+    from kinetwork.solver.methods import _CasadiRun
+    system = chains.chain(4).compile()
+    c = compiled(system)
+    jit_opts = {"stats": {}} if jit_on else None
+    hidden = c.dae(jit_opts, jacobian=False, hidden=True)
+    plain = c.dae(jit_opts, jacobian=False)
+    assert isinstance(hidden, ca.Function) and hidden.sparsity_jac(1, 0).nnz() == 0
+    assert full_x_nnz(c, jit_opts) > 0
+    assert c.dae(jit_opts, jacobian=True, hidden=True) is c.dae(jit_opts, jacobian=True)
+    times = np.concatenate([[0.03], 0.03 + np.linspace(0.1, 2.0, 20)])     # a head of its own
+    np.testing.assert_allclose(_run(hidden, system, times), _run(plain, system, times),
+                               rtol=0, atol=1e-12)
+
+    class Run:                          # what _CasadiRun.recipe reads of a run
+        compiled, spacing = c, 0.1
+        p_solver = system.param_vector()
+    Run.jit = jit_opts
+    stepper = _CasadiRun(METHODS["cvodes-adams"], Run(), 0.0, system.x0)
+    built = []
+    for grid in (times, np.linspace(0.1, 2.0, 20)):
+        with pytest.MonkeyPatch.context() as mp:
+            mp.setattr(ca, "integrator", lambda *a: built.append(a[2]))
+            stepper.recipe(grid, {})[1]()
+    assert built[0] is hidden and built[1] is (plain if jit_on else c.dae(None, False))
+
+
 def test_the_default_run_of_the_seed_still_meets_its_closed_form(cache):
     """The seed through the default method (Adams, derivatives hidden) against the
     independent reference."""
