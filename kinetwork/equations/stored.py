@@ -94,8 +94,18 @@ def compile(model, loops="projected", baumgarte_rate=None, topology=None):
         for w in said:      # caller's filters
             warnings.warn_explicit(w.message, w.category, w.filename, w.lineno)
     if folder is not None and not said:
+        _found_first(system)
         _store(folder, key, system)
     return system
+
+
+def _found_first(system):
+    """What every run of ``system`` reads first, found before it is kept, so that it is
+    kept with it: the relations its events are located on (EngineV6: 0.07 s of CPU in each
+    process's first run). What cannot be found is left to the run, which says why (a build
+    that only compiles, to count states or linearise, is not refused for it)."""
+    with contextlib.suppress(Exception):
+        system.relations
 
 
 # -- the key ---------------------------------------------------------------------------------
