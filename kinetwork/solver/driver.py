@@ -204,16 +204,17 @@ def _check(system, settings, t_start, max_steps, time_limit, runs=1):
         raise ModelError(f"method {settings['method']!r:.60}: unknown{suggest(key, METHODS)}; "
                          f"methods are {', '.join(METHODS)}")
     rel = system.relations
-    located = [f"friction or stops ({', '.join(c.name for c in system.modes.comps)})"] \
-        if system.modes is not None else []
-    if rel is not None and len(rel.state):
-        located.append(f"a relation on the states, {rel.text(rel.state[0])}; write it in "
-                       f"noEvent(...) to take it as it is")
-    if located and "state" not in METHODS[key].events:
-        raise ModelError(
-            f"method {settings['method']!r} locates no state events, and "
-            f"{system.model.name!r} has them: {'; '.join(located)}. Use 'auto', a CVODES, "
-            f"IDAS or scipy method, 'rk' or 'collocation'")
+    if "state" not in METHODS[key].events:
+        located = [f"friction or stops ({', '.join(c.name for c in system.modes.comps)})"] \
+            if system.modes is not None else []
+        if rel is not None and len(rel.state):      # (its text reads the equations: 10 ms)
+            located.append(f"a relation on the states, {rel.text(rel.state[0])}; write it in "
+                           f"noEvent(...) to take it as it is")
+        if located:
+            raise ModelError(
+                f"method {settings['method']!r} locates no state events, and "
+                f"{system.model.name!r} has them: {'; '.join(located)}. Use 'auto', a "
+                f"CVODES, IDAS or scipy method, 'rk' or 'collocation'")
     if system.n_algebraic and not METHODS[key].dae:
         raise ModelError(
             f"method {settings['method']!r} integrates ODEs only, and {system.model.name!r} "

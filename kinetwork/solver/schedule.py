@@ -53,7 +53,7 @@ class Schedule:
             others = np.flatnonzero(~relations.affine)
             if len(others):
                 found.extend(self._scan(f, p, k, others, levels, values, found))
-        times = np.unique(np.asarray(found, dtype=float))
+        times = np.sort(np.asarray(found, dtype=float))     # (repeats: dropped below)
         times = times[(times > self.t_start + _gap(self.t_start)) &
                       (times < self.t_end - _gap(self.t_end))]
         if len(times) > 1:               # one instant, however it was reached
