@@ -6,10 +6,10 @@ looks its map up again each time: 0.3 ms).
 
 import numpy as np
 
-from ..equations.pointwise import POINTS_PER_CALL, pointwise
+from ..equations.pointwise import pointwise
 
 #: points of one map at most (its arrays are made once and kept), and maps kept per Function
-MOST = POINTS_PER_CALL
+MOST = 4096
 SIZES = 16
 
 
