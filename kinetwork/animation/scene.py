@@ -21,7 +21,7 @@ RUNAWAY = 8.0
 _X, _Y, _Z = np.eye(3)
 
 
-def animation_data(results, fps=None, model=None, resolution=None):
+def animation_data(results, fps=None, model=None, resolution=None, arrays=False):
     """The Animation of ``results``: the scene and the poses of its frames (the format is in
     ``kinetwork.animation``).
 
@@ -37,6 +37,10 @@ def animation_data(results, fps=None, model=None, resolution=None):
         Round positions to this fraction of ``scale`` and quaternions to this much, at a
         power of ten (1e-7: far below a pixel at any zoom), for a player that draws them: the
         JSON is half as long and twice as fast to write; default: every digit.
+    arrays : bool, optional
+        Leave each frame's ``position`` and ``quaternion`` as numpy arrays, for an encoder
+        that writes arrays itself (the studio's: 0.03 s of CPU less for EngineV6's poses than
+        lists of Python floats); default: lists.
 
     Raises
     ------
@@ -74,8 +78,9 @@ def animation_data(results, fps=None, model=None, resolution=None):
         quats = np.round(quats, _decimals(resolution))
     for frame, pos, quat in zip(frames, positions, quats):
         still = np.all(pos == pos[0]) and np.all(quat == quat[0])
-        frame["position"] = (pos[:1] if still else pos).tolist()
-        frame["quaternion"] = (quat[:1] if still else quat).tolist()
+        pos, quat = (pos[:1], quat[:1]) if still else (pos, quat)
+        frame["position"], frame["quaternion"] = (pos, quat) if arrays else \
+            (pos.tolist(), quat.tolist())
     up = _up(system, values)
     scene = Scene(system, results, values, frames, index, bodies, scale, up, (lo, hi))
     shapes = scene.shapes()

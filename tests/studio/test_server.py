@@ -383,6 +383,41 @@ def test_without_the_animation_module_results_say_why_there_is_no_3d_view(root, 
     assert out["animation"] is None and "not installed" in out["animation_note"]
 
 
+@pytest.mark.parametrize("writer", ["orjson", "json"])
+def test_answers_are_the_same_json_by_either_writer(root, monkeypatch, writer):
+    """A run's answer, with the numbers left as numpy arrays (signals, poses), read back is
+    what json writes of the same content as lists: NaN and infinities null, keys that are
+    not strings as strings, an integer past 64 bits and an array of every other point as
+    json writes them; by orjson (the studio's extras) or json (without it)."""
+    import orjson
+    assert results.orjson is orjson
+    if writer == "json":
+        monkeypatch.setattr(results, "orjson", None)
+    model = kn.load(root / SEED)
+    res = kn.simulate(model, t_end=0.5, n_points=6)
+    content = results.results_json(res, model)
+    assert isinstance(content["signals"][0]["values"], np.ndarray)
+    assert isinstance(content["animation"]["frames"][0]["position"], np.ndarray)
+    content["signals"][0]["values"][1:3] = [np.nan, -np.inf]
+    content["extra"] = {1: np.arange(6.0)[::2], "x": np.float64(0.1), "n": np.int64(3),
+                        "nested": [np.array([[1.5, np.inf]])]}
+    got = json.loads(results.encode(content))
+    assert results.encode({"big": [2**70, np.nan]}) == b'{"big":[1180591620717411303424,null]}'
+
+    def as_json(value):           # what json writes: lists, non-finite null, str keys
+        if isinstance(value, np.ndarray):
+            value = value.tolist()
+        if isinstance(value, dict):
+            return {str(k): as_json(v) for k, v in value.items()}
+        if isinstance(value, (list, tuple)):
+            return [as_json(v) for v in value]
+        if isinstance(value, (float, np.floating)):
+            return float(value) if np.isfinite(value) else None
+        return int(value) if isinstance(value, np.integer) else value
+    assert got == as_json(content)
+    assert got["signals"][0]["values"][1:3] == [None, None]
+
+
 def test_a_dense_run_is_resampled_for_the_animation(root, monkeypatch):
     monkeypatch.setattr(results, "MAX_FRAMES", 50)
     model = kn.load(root / SEED)
