@@ -767,6 +767,9 @@ def main():
                         help="only the point-mass chains with a damper (planar and 3-D, N = 2, "
                              "16, 128): auto against the hand-written route, pinocchio and "
                              "MuJoCo RK4 in CPU time (results/work_precision_points.md)")
+    parser.add_argument("--sizes", type=int, nargs="+",
+                        help="with --point-masses: these N instead (results/"
+                             "work_precision_points_sizes.md; 32 64: between the issue's)")
     parser.add_argument("--choice", action="store_true",
                         help="only auto's choice where stability holds the step, against Adams "
                              "(results/work_precision_choice.md)")
@@ -776,7 +779,7 @@ def main():
         return work_precision_points.choice()
     if args.point_masses:
         import work_precision_points
-        return work_precision_points.study(args.quick)
+        return work_precision_points.study(args.quick, args.sizes)
     if args.overheads:
         return overheads()
     if args.casadi:

@@ -16,7 +16,8 @@ CAP s of CPU or once its error is below FLOOR. Time to an accuracy: log-log inte
 each curve's Pareto front (``study_work_precision.time_to``).
 
 Run: ``python bench/study_work_precision.py --point-masses [--quick]``; writes
-``results/work_precision_points.{md,csv}``.
+``results/work_precision_points.{md,csv}``; with ``--sizes 32 64``, the sizes between the
+table's, ``results/work_precision_points_sizes.{md,csv}``.
 """
 
 import math
@@ -115,9 +116,12 @@ def time_to(rows, target):
     return along_front([(r["cpu_s"], r["error"]) for r in rows if r["status"] == "ok"], target)
 
 
-def study(quick=False):
+def study(quick=False, sizes=None):
+    """The study at SIZES (the issue's table), or at ``sizes`` (written to
+    ``NAME_sizes``: the table's and these are each a file of their own)."""
     start = time.perf_counter()
-    sizes = (2, 16) if quick else SIZES
+    name = NAME if not sizes else f"{NAME}_sizes"
+    sizes = (2, 16) if quick else tuple(sizes or SIZES)
     t = np.linspace(0.0, HORIZON, round(HORIZON / SPACING) + 1)
     summary, every, csv_rows, notes = [], [], [], []
     for planar in (True, False):
@@ -157,7 +161,7 @@ def study(quick=False):
                                      "cpu_s": r["cpu_s"], "error": r["error"],
                                      "auto_ran": every[-1][5], "status": r["status"]})
             print(f"  {scene}: done at {time.perf_counter() - start:.0f} s", flush=True)
-    write_csv(NAME, csv_rows)
+    write_csv(name, csv_rows)
     header = ["scene"]
     for e in ACCURACIES:
         header += [f"auto to {e:.0e}", "by hand / auto", "pinocchio / auto", "MuJoCo / auto"]
@@ -176,7 +180,7 @@ def study(quick=False):
         table(header, summary), "", *[f"- {n}" for n in notes], "",
         "## Every run", "",
         table(["scene", "curve", "setting", "CPU ms", "error", "auto ran", "status"], every)]
-    write_markdown(NAME, "\n".join(lines))
+    write_markdown(name, "\n".join(lines))
 
 
 CHOICE_RTOLS = (1e-2, 1e-3, 1e-4, 1e-6)
