@@ -34,6 +34,10 @@ cache on disk and is not counted. Its CPU time by phases: checking the model, co
 (the C code from the cache), integrating, writing the results (the probes' signals, the 3-D
 view's poses, the JSON the page reads).
 
+And the same run through the studio as the page makes it (``studio_walls``): ``kinetwork
+studio`` in a copy of models/, wall time from ``POST /api/run`` to the bytes of the answer
+that says it has ended (results, 3-D poses and all).
+
 Writes ``results/study_engine_cached.md``. Run: ``python bench/study_engine_cached.py
 [--rounds R]``.
 """
@@ -71,7 +75,20 @@ alternating processes of 7 runs, 4 each: 0.57 s (medians 0.547-0.613; 52863 eval
 integrator calls and 339 over a sampled interval), this round's 0.48 s (0.474-0.516; 38997
 evaluations, 349 calls, 1 over a sampled interval: the events located on the chunks' own
 points, the loops' watch compiled). The studio's child then: 1.67 s (integrating 0.97), load
-4.9; its warm-up had failed since simulate moved to solver/plan.py (children started cold)."""
+4.9; its warm-up had failed since simulate moved to solver/plan.py (children started cold).
+Then (idle machine, load 1.0): 0.41 s (kept), the studio's child 1.16 s (checking 0.04,
+compiling 0.16, integrating 0.65, writing results 0.31), after CasADi's clock was skipped in
+kinetwork's sections (solver/casadi_clock.py), the poses of the studio's answer rounded to
+1e-7 of the scene and Python's collector paused while it is built (writing results 0.62 ->
+0.31 s, the 11.5 MB answer 6.1 MB), the studio's 'compiling' lasting until the integration
+first reports (its first chunk included). Of the child's integrating, ~0.18 s built its 349
+integrators, one per chunk's output grid (a chunk after an event starts with a head of its
+own step; a fresh child keeps none). In a new process (import, build, first run; Brent's
+method of kinetwork's own, no scipy.optimize imported): 1.15-1.16 s of CPU, 1.46-1.59 before.
+This table's round: a chunk's own grid gets an integrator on the equations with their
+derivatives hidden (0.39 -> 0.14 ms of CPU each), the System is kept with its relations (0.07
+s a process), the answer written by orjson from numpy arrays (0.13 -> 0.011 s) and the poses
+through maps of 256 points (0.06 -> 0.015 s the first time)."""
 MODEL = common.HERE.parent / "models" / "engine_v6" / "EngineV6.json"
 
 
@@ -194,6 +211,59 @@ def studio_runs(rounds):
     return spent[1:]
 
 
+def studio_walls(rounds):
+    """EngineV6 through the studio as the page runs it: ``kinetwork studio`` started in a
+    folder holding a copy of models/, its forkserver warmed, then ``rounds`` runs, each
+    ``POST /api/run`` and ``GET /api/run/{id}?wait=2`` until it has ended: [(wall seconds to
+    the last answer's bytes, bytes)], the first run (which fills the JIT cache of this
+    checkout, if it is empty) left out."""
+    import re
+    import shutil
+    import subprocess
+    import sys
+    import tempfile
+    import urllib.request
+    with tempfile.TemporaryDirectory() as root:
+        shutil.copytree(common.HERE.parent / "models", os.path.join(root, "models"))
+        server = subprocess.Popen([sys.executable, "-m", "kinetwork", "studio", "--no-browser"],
+                                  cwd=root, stdout=subprocess.PIPE, stderr=subprocess.STDOUT,
+                                  text=True)
+        try:
+            url = None
+            while url is None:
+                line = server.stdout.readline()
+                if not line:
+                    raise RuntimeError("the studio did not start")
+                url = re.search(r"(http://[^/\s]+)/\?token=(\S+)", line)
+            base, token = url.group(1) + "/api", url.group(2)
+
+            def call(method, path, body=None):
+                request = urllib.request.Request(
+                    base + path, method=method, headers={"X-Kinetwork-Token": token,
+                                                         "Content-Type": "application/json"},
+                    data=None if body is None else json.dumps(body).encode())
+                with urllib.request.urlopen(request) as answer:
+                    return answer.read()
+            time.sleep(3.0)                 # the forkserver's warm-up (jobs.PRELOAD)
+            data = json.loads(MODEL.read_text())
+            walls = []
+            for _ in range(rounds + 1):
+                start = time.perf_counter()
+                run = json.loads(call("POST", "/run", {
+                    "model": data, "path": "models/engine_v6/EngineV6.json"}))["run"]
+                while True:
+                    body = call("GET", f"/run/{run}?wait=2")
+                    if not body.startswith(b'{"state":"running"'):
+                        break
+                walls.append((time.perf_counter() - start, len(body)))
+                if json.loads(body)["state"] != "done":
+                    raise RuntimeError(f"the studio's run ended {json.loads(body)['state']}")
+            return walls[1:]
+        finally:
+            server.terminate()
+            server.wait(timeout=10)
+
+
 def study(rounds):
     ways = {"kept": compiled_module.INTEGRATORS_MOST, "64 kept": 64}
     # a System each (each keeps its own integrators); the C code is the same, cached on disk
@@ -235,6 +305,13 @@ def main():
     studio_row = [[f"{statistics.median(r.get(p, 0.0) for r in studio):.2f}"
                    for p in phases]]
     print("   studio", studio_row, flush=True)
+    walls = studio_walls(args.rounds)
+    wall_line = (f"Through the studio's server (``kinetwork studio``, ``POST /api/run`` to the "
+                 f"answer of ``GET /api/run/{{id}}?wait=2``), wall time, {args.rounds} runs: "
+                 f"median {statistics.median(w for w, _ in walls):.2f} s (" +
+                 ", ".join(f"{w:.2f}" for w, _ in walls) + f"), answers of "
+                 f"{walls[0][1] / 1e6:.1f} MB; load {os.getloadavg()[0]:.1f}.")
+    print("  ", wall_line, flush=True)
     rows, work, apart = study(args.rounds)
     text = "\n".join([
         "# EngineV6 cached: where a repeated run spends its CPU time", "",
@@ -253,7 +330,7 @@ def main():
                "indicators with rates"], work),
         "", f"The studio's run (``studio/work.run``) in a child warmed as the studio's are, "
         f"CPU time by phases [s], medians of {args.rounds} children:", "",
-        table(phases, studio_row), "", HISTORY])
+        table(phases, studio_row), "", wall_line, "", HISTORY])
     write_markdown(NAME, text)
     print(f"done in {time.perf_counter() - start:.0f} s", flush=True)
 
