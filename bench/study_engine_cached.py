@@ -171,6 +171,10 @@ class _Channel:
     def cancelled(self):
         return False
 
+    def ahead(self, part, data):
+        """A part of the answer sent ahead (the plots' results, then the 3-D view's): when."""
+        self.phases.append((f"{part} sent", time.process_time() - self.start))
+
 
 def studio_runs(rounds):
     """The studio's run of EngineV6, ``rounds`` + 1 times, each in a child forked from this
@@ -207,16 +211,19 @@ def studio_runs(rounds):
         for (name, begun), (_, ended) in zip(phases, phases[1:]):
             by[name] = by.get(name, 0.0) + ended - begun
         by["total"] = times["end"]
+        by["plots' results sent at"] = times.get("results sent", times["end"])
         spent.append(by)
     return spent[1:]
 
 
 def studio_walls(rounds):
     """EngineV6 through the studio as the page runs it: ``kinetwork studio`` started in a
-    folder holding a copy of models/, its forkserver warmed, then ``rounds`` runs, each
-    ``POST /api/run`` and ``GET /api/run/{id}?wait=2`` until it has ended: [(wall seconds to
-    the last answer's bytes, bytes)], the first run (which fills the JIT cache of this
-    checkout, if it is empty) left out."""
+    folder holding a copy of models/, its forkserver warmed, then ``rounds`` rounds of two
+    runs, each ``POST /api/run`` and polls of ``GET /api/run/{id}?wait=2`` until it has
+    ended: the page's way (``&animation=later``: the plots' results, then ``/animation``
+    for the 3-D view) and the whole answer at once. Wall seconds from the POST to the bytes
+    of each answer, and their sizes: {"results", "view", "whole": [(seconds, bytes)]}. A first
+    run (which fills the JIT cache of this checkout, if it is empty) is left out."""
     import re
     import shutil
     import subprocess
@@ -244,21 +251,30 @@ def studio_walls(rounds):
                     data=None if body is None else json.dumps(body).encode())
                 with urllib.request.urlopen(request) as answer:
                     return answer.read()
-            time.sleep(3.0)                 # the forkserver's warm-up (jobs.PRELOAD)
-            data = json.loads(MODEL.read_text())
-            walls = []
-            for _ in range(rounds + 1):
-                start = time.perf_counter()
-                run = json.loads(call("POST", "/run", {
-                    "model": data, "path": "models/engine_v6/EngineV6.json"}))["run"]
+
+            def polled(path, start):
                 while True:
-                    body = call("GET", f"/run/{run}?wait=2")
+                    body = call("GET", path)
                     if not body.startswith(b'{"state":"running"'):
-                        break
-                walls.append((time.perf_counter() - start, len(body)))
-                if json.loads(body)["state"] != "done":
-                    raise RuntimeError(f"the studio's run ended {json.loads(body)['state']}")
-            return walls[1:]
+                        if not body.startswith(b'{"state":"done"'):
+                            raise RuntimeError(f"the studio's run ended: {body[:200]!r}")
+                        return time.perf_counter() - start, len(body)
+            time.sleep(3.0)                 # the forkserver's warm-up (jobs.PRELOAD)
+            data = {"model": json.loads(MODEL.read_text()),
+                    "path": "models/engine_v6/EngineV6.json"}
+            walls = {"results": [], "view": [], "whole": []}
+            for k in range(rounds + 1):
+                start = time.perf_counter()
+                run = json.loads(call("POST", "/run", data))["run"]
+                results = polled(f"/run/{run}?wait=2&animation=later", start)
+                view = polled(f"/run/{run}/animation?wait=2", start)
+                start = time.perf_counter()
+                run = json.loads(call("POST", "/run", data))["run"]
+                whole = polled(f"/run/{run}?wait=2", start)
+                if k:
+                    for key, value in zip(walls, (results, view, whole)):
+                        walls[key].append(value)
+            return walls
         finally:
             server.terminate()
             server.wait(timeout=10)
@@ -301,16 +317,25 @@ def main():
     args = parser.parse_args()
     start = time.perf_counter()
     studio = studio_runs(args.rounds)   # first: this process has not compiled EngineV6 yet
-    phases = ["checking", "compiling", "integrating", "writing results", "total"]
+    # the phases of the child: "writing results" up to the plots' results sent ahead, then
+    # the 3-D view's poses made and sent, then the whole answer written (jobs.AHEAD)
+    phases = ["checking", "compiling", "integrating", "writing results", "results sent",
+              "animation sent", "total", "plots' results sent at"]
     studio_row = [[f"{statistics.median(r.get(p, 0.0) for r in studio):.2f}"
                    for p in phases]]
     print("   studio", studio_row, flush=True)
     walls = studio_walls(args.rounds)
-    wall_line = (f"Through the studio's server (``kinetwork studio``, ``POST /api/run`` to the "
-                 f"answer of ``GET /api/run/{{id}}?wait=2``), wall time, {args.rounds} runs: "
-                 f"median {statistics.median(w for w, _ in walls):.2f} s (" +
-                 ", ".join(f"{w:.2f}" for w, _ in walls) + f"), answers of "
-                 f"{walls[0][1] / 1e6:.1f} MB; load {os.getloadavg()[0]:.1f}.")
+
+    def median(key):
+        return f"{statistics.median(w for w, _ in walls[key]):.2f} s"
+    wall_line = (f"Through the studio's server (``kinetwork studio``, ``POST /api/run``, then "
+                 f"polls "
+                 f"with ``wait=2``), wall time, medians of {args.rounds} runs each way, load "
+                 f"{os.getloadavg()[0]:.1f}: the page's way, the plots' results "
+                 f"(``?animation=later``, {walls['results'][0][1] / 1e6:.1f} MB) at "
+                 f"{median('results')}, the 3-D view's poses (``/animation``, "
+                 f"{walls['view'][0][1] / 1e6:.1f} MB) at {median('view')}; the whole "
+                 f"answer at once ({walls['whole'][0][1] / 1e6:.1f} MB) at {median('whole')}.")
     print("  ", wall_line, flush=True)
     rows, work, apart = study(args.rounds)
     text = "\n".join([
@@ -329,8 +354,11 @@ def main():
                "steps of 33-point curves checked", "indicators at trial times",
                "indicators with rates"], work),
         "", f"The studio's run (``studio/work.run``) in a child warmed as the studio's are, "
-        f"CPU time by phases [s], medians of {args.rounds} children:", "",
-        table(phases, studio_row), "", wall_line, "", HISTORY])
+        f"CPU time by phases [s], medians of {args.rounds} children (the plots' results are "
+        f"sent ahead of the 3-D view's poses, ``jobs.AHEAD``):", "",
+        table(["checking", "compiling", "integrating", "writing the plots' results",
+               "the 3-D view's poses", "the whole answer", "total",
+               "plots' results sent at"], studio_row), "", wall_line, "", HISTORY])
     write_markdown(NAME, text)
     print(f"done in {time.perf_counter() - start:.0f} s", flush=True)
 

@@ -41,6 +41,9 @@ PRELOAD = ["kinetwork", "kinetwork.graph.io", "kinetwork.equations", "kinetwork.
 ENV_PREFIX = "KINETWORK_"
 #: phases a child reports (Channel.phase), by number
 PHASES = ("starting", "checking", "compiling", "integrating", "writing results")
+#: parts of an answer a child may send ahead of it (``Channel.ahead``): a run's results for
+#: the plots, then its 3-D view's poses, each as soon as it is made
+AHEAD = ("results", "animation")
 #: after a cancel, the seconds a child has to stop by itself before it is ended (then SIGTERM,
 #: and SIGKILL KILL_GRACE seconds after), by the phase it is in: before it computed anything
 #: (nothing is lost), while integrating (it stops at its next chunk and keeps what it
@@ -141,8 +144,15 @@ def warm_up():
 class Channel:
     """What a child shares with the server while it works."""
 
-    def __init__(self, progress, phase, cancel):
+    def __init__(self, progress, phase, cancel, send=None):
         self._progress, self._phase, self._cancel = progress, phase, cancel
+        self._send = send
+
+    def ahead(self, part, data):
+        """A part of the answer sent before the whole (``Child.ahead``): ``part`` one of
+        AHEAD, ``data`` its JSON bytes."""
+        if self._send is not None:
+            self._send((part, data))
 
     def report(self, fraction):
         """Progress, 0..1."""
@@ -174,6 +184,8 @@ class Child:
         send.close()
         self.started = time.monotonic()
         self._answer = None
+        #: the parts of the answer sent ahead of it (AHEAD: JSON bytes), as they came
+        self.ahead = {}
         self._lock = threading.Lock()
 
     @property
@@ -185,8 +197,23 @@ class Child:
         return PHASES[max(0, min(len(PHASES) - 1, self._phase.value))]
 
     def ready(self):
-        """Whether the answer (or the child's end) is there to read."""
-        return self._answer is not None or self._recv.poll() or not self.process.is_alive()
+        """Whether the answer (or the child's end) is there to read; the parts sent ahead of
+        it are taken meanwhile (``ahead``)."""
+        with self._lock:
+            while self._answer is None and not self._recv.closed:
+                try:
+                    if not self._recv.poll():
+                        break
+                    message = self._recv.recv()
+                except (EOFError, OSError):
+                    break
+                if isinstance(message, tuple) and len(message) == 2 and message[0] in AHEAD:
+                    self.ahead[message[0]] = message[1]
+                else:
+                    self._answer = message
+            if self._answer is not None:
+                return True
+        return not self.process.is_alive()
 
     def answer(self, timeout=None):
         """The child's answer, waiting at most ``timeout`` seconds (None: for ever).
@@ -221,12 +248,9 @@ class Child:
         return self._take()
 
     def _take(self):
+        self.ready()                       # what came meanwhile (the answer, parts ahead)
         with self._lock:
-            if self._answer is None:
-                try:
-                    self._answer = self._recv.recv() if self._recv.poll() else None
-                except (EOFError, OSError):
-                    self._answer = None
+            if not self._recv.closed:
                 if self._answer is None:
                     self.process.join(1)
                     code = self.process.exitcode
@@ -305,7 +329,7 @@ def _child_main(fn, args, conn, progress, phase, cancel, env):
     signal.signal(signal.SIGTERM, signal.SIG_DFL)
     _watch_parent()
     try:
-        value = fn(*args, Channel(progress, phase, cancel))
+        value = fn(*args, Channel(progress, phase, cancel, conn.send))
         answer = ("ok", value)
     except BaseException as exc:       # noqa: BLE001 -- every end is an answer
         log.debug("studio child failed:\n%s", traceback.format_exc())

@@ -29,17 +29,26 @@ RESOLUTION = 1e-7
 NO_SCENE = "This model has no multibody parts (it is 1-D only): there is nothing to show in 3-D."
 
 
-def results_json(res, model=None):
+def results_json(res, model=None, with_animation=True):
     """Results as the page reads them: the time grid and every probe signal, values nested
     with n_points first, non-finite values null; and the 3-D animation when it can be made,
-    else ``animation_note`` says why. Numbers are numpy arrays, for ``encode`` (which writes
-    them as nested lists, non-finite values as null)."""
+    else ``animation_note`` says why (both None without ``with_animation``: see
+    ``animation_json``). Numbers are numpy arrays, for ``encode`` (which writes them as nested
+    lists, non-finite values as null)."""
     with paused_collection():
-        return _results_json(res, model)
+        anim, note = animation(res, model) if with_animation else (None, None)
+        return _results_json(res, anim, note)
 
 
-def _results_json(res, model):
-    anim, note = animation(res, model)
+def animation_json(res, model=None):
+    """``{"animation", "animation_note"}`` of ``results_json``, made apart: what
+    ``GET /api/run/{id}/animation`` answers after the plots' results went ahead."""
+    with paused_collection():
+        anim, note = animation(res, model)
+        return {"animation": anim, "animation_note": note}
+
+
+def _results_json(res, anim, note):
     return {
         "t": np.asarray(res.t, dtype=float),
         "signals": [{"name": name, "unit": sig.unit, "shape": list(sig.shape),

@@ -67,14 +67,39 @@ class Job:
                                f"stopped while {phase}: what it had computed could not be "
                                f"kept"})
 
-    def body(self):
-        """What ``GET /api/run/{id}`` answers, as JSON bytes."""
+    def ahead(self, part):
+        """The part of the answer the child sent ahead of it (``jobs.AHEAD``), or None."""
+        return self.child.ahead.get(part)
+
+    def body(self, later=False):
+        """What ``GET /api/run/{id}`` answers, as JSON bytes; with ``later``, the results for
+        the plots as soon as the child sent them, the 3-D view's to be asked for apart
+        (``animation``)."""
         with self._lock:
             if self._final is not None:
                 return self._final
+        if later and self.cancel_at is None:
+            ahead = self.ahead("results")
+            if ahead is not None:
+                return ahead
         return encode({"state": "running", "progress": self.child.progress,
                        "phase": self.child.phase, "cancelling": self.cancel_at is not None,
                        "error": None, "problems": [], "results": None})
+
+    def animation(self):
+        """What ``GET /api/run/{id}/animation`` answers, as JSON bytes: ``{"state": "done",
+        "animation", "animation_note"}`` once the child has sent the 3-D view's poses;
+        ``{"state": "running"}`` until then; once the run has ended without them (failed,
+        cancelled, its worker gone), its state and why there is no view."""
+        part = self.ahead("animation")
+        if part is not None:
+            return part
+        with self._lock:
+            if self._final is None:
+                return encode({"state": "running"})
+            state = self.state
+        return encode({"state": state, "animation": None, "animation_note":
+                       f"The run ended {state} before its 3-D view was made."})
 
     def cancel(self):
         """Stop: asked at once, ended after the grace if it does not stop by itself."""

@@ -289,9 +289,20 @@ def _routes(api, studio):
         return StudioJSON({"run": started.id})
 
     @api.get("/run/{run_id}")
-    async def poll(run_id: str, wait: float = 0.0):
-        return Response(await _waited(studio.runs.get(run_id, "run"), wait),
-                        media_type="application/json")
+    async def poll(run_id: str, wait: float = 0.0, animation: str = "with"):
+        if animation not in ("with", "later"):
+            raise StudioError(400, f"animation: 'with' (the default) or 'later', got "
+                                   f"{animation!r:.40}")
+        later = animation == "later"
+        job = studio.runs.get(run_id, "run")
+        await _waited(job, wait, lambda: later and job.ahead("results") is not None)
+        return Response(job.body(later), media_type="application/json")
+
+    @api.get("/run/{run_id}/animation")
+    async def poll_animation(run_id: str, wait: float = 0.0):
+        job = studio.runs.get(run_id, "run")
+        await _waited(job, wait, lambda: job.ahead("animation") is not None)
+        return Response(job.animation(), media_type="application/json")
 
     @api.post("/run/{run_id}/cancel")
     def cancel(run_id: str):
@@ -331,13 +342,14 @@ def _routes(api, studio):
                                             what="linearising the model"))
 
 
-async def _waited(job, wait):
-    """A job's answer, once it has ended or ``wait`` seconds (at most MAX_WAIT) have passed:
-    a page polling with a wait hears of the end at once."""
+async def _waited(job, wait, enough=lambda: False):
+    """Once ``job`` has ended, ``enough()`` holds or ``wait`` seconds (at most MAX_WAIT) have
+    passed: a page polling with a wait hears of the end at once. Returns ``job.body()``."""
     if not (0.0 <= wait <= MAX_WAIT):
         raise StudioError(400, f"wait: seconds from 0 to {MAX_WAIT:g}, got {wait!r:.40}")
     end = time.monotonic() + wait
-    while job.state == "running" and job.cancel_at is None and time.monotonic() < end:
+    while job.state == "running" and job.cancel_at is None and not enough() and \
+            time.monotonic() < end:
         await asyncio.sleep(0.01)
     return job.body()
 

@@ -41,7 +41,7 @@ def test_a_chain_is_drawn_in_a_few_calls_with_every_shape_on_its_frame(page, stu
     assert info["triangles"] < 16000, info
     screenshot(page.locator(tid("viewer")), "studio-chain32-3d.png")
 
-    animation = K(page, "K.runs[0].results.animation")
+    animation = K(page, "K.animationOf(0)")
     t = animation["t"]
     i = len(t) // 2
     page.evaluate(f"() => window.__kinetwork.viewer().setTime({t[i]!r})")

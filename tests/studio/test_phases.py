@@ -21,6 +21,7 @@ class Recorder:
 
     def __init__(self, cancel_when=lambda channel: False):
         self.phases, self.progress, self.cancel_when = [], [], cancel_when
+        self.sent = []
 
     def enter(self, phase):
         self.phases.append(phase)
@@ -30,6 +31,9 @@ class Recorder:
 
     def cancelled(self):
         return bool(self.cancel_when(self))
+
+    def ahead(self, part, data):
+        self.sent.append((part, self.phases[-1]))
 
 
 def test_the_c_compile_happens_while_the_run_says_compiling(monkeypatch, tmp_path):

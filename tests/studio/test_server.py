@@ -21,7 +21,7 @@ with warnings.catch_warnings():
 
 import kinetwork as kn
 from kinetwork.components.base import REGISTRY
-from kinetwork.studio import launch, results
+from kinetwork.studio import launch, results, runs
 from kinetwork.studio.server import TOKEN_HEADER, create_app
 from tests.studio.helpers import serving
 
@@ -59,7 +59,7 @@ def wait(client, run_id, timeout=120.0):
 
 # -- the token ---------------------------------------------------------------------------------
 API_GETS = ["/api/palette", "/api/schema", "/api/files", "/api/examples",
-            f"/api/open?path={SEED}", "/api/run/r1"]
+            f"/api/open?path={SEED}", "/api/run/r1", "/api/run/r1/animation"]
 API_POSTS = ["/api/validate", "/api/save", "/api/run", "/api/run/r1/cancel"]
 
 
@@ -364,6 +364,76 @@ def test_a_run_gives_what_kn_simulate_gives(client, root):
     angle = next(s for s in results["signals"] if s["name"] == "probe1.angle")
     assert (angle["probe"], angle["quantity"], angle["port"]) == \
         ("probe1", "angle", "shoulder.axis")
+
+
+def test_the_plots_results_can_come_ahead_of_the_3d_view(client, root):
+    """``?animation=later``: the results for the plots as soon as the child has them (done,
+    ``animation_pending``), the 3-D view's poses from ``/animation``; the whole answer, which
+    a poll without it gets, holds the same of both."""
+    data = client.get("/api/open", params={"path": "models/engine_v6/EngineV6.json"}).json()
+    run_id = client.post("/api/run", json={"model": data["model"], "path":
+                                           "models/engine_v6/EngineV6.json"}).json()["run"]
+    end = time.monotonic() + 120
+    while True:
+        ahead = client.get(f"/api/run/{run_id}?wait=2&animation=later").json()
+        if ahead["state"] != "running" or time.monotonic() > end:
+            break
+    assert ahead["state"] == "done", ahead["error"]
+    while True:
+        view = client.get(f"/api/run/{run_id}/animation?wait=2").json()
+        if view["state"] != "running" or time.monotonic() > end:
+            break
+    whole = wait(client, run_id)
+    assert whole == client.get(f"/api/run/{run_id}?animation=later").json()   # ended: whole
+    assert "animation_pending" not in whole["results"]
+    assert view == {"state": "done", "animation": whole["results"]["animation"],
+                    "animation_note": None}
+    assert view["animation"]["frames"]
+    results = ahead["results"]
+    if results.get("animation_pending"):       # (else the run had ended meanwhile)
+        assert results["animation"] is None and results["animation_note"] is None
+        del results["animation_pending"]
+        results.update(animation=view["animation"], animation_note=None)
+    assert ahead == whole
+    assert client.get(f"/api/run/{run_id}?animation=soon").status_code == 400
+    assert client.get("/api/run/r999/animation").status_code == 404
+
+
+def _sends_ahead(channel):
+    channel.ahead("results", b'{"state":"done","results":{"t":[0.0]}}')
+    time.sleep(1.5)
+    channel.ahead("animation", b'{"state":"done","animation":null,"animation_note":"no"}')
+    time.sleep(0.5)
+    return "done", b'{"state":"done","whole":true}'
+
+
+def _answers_alone(channel):
+    raise RuntimeError("broke")
+
+
+def test_a_child_s_parts_sent_ahead_come_before_its_answer():
+    job = runs.Job("r1", "run", _sends_ahead, ())
+    end = time.monotonic() + 60
+    while job.ahead("results") is None and time.monotonic() < end:
+        time.sleep(0.01)
+    assert job.state == "running"
+    assert job.body(later=True) == b'{"state":"done","results":{"t":[0.0]}}'
+    assert json.loads(job.body())["state"] == "running"
+    assert job.animation() == b'{"state":"running"}'
+    while job.ahead("animation") is None and time.monotonic() < end:
+        time.sleep(0.01)
+    assert job.state == "running" and json.loads(job.animation())["animation_note"] == "no"
+    job.thread.join(60)
+    assert job.state == "done"
+    assert job.body() == job.body(later=True) == b'{"state":"done","whole":true}'
+    # a run that ends without its 3-D view says why there is none
+    failed = runs.Job("r2", "run", _answers_alone, ())
+    failed.thread.join(60)
+    assert failed.state == "failed" and failed.ahead("results") is None
+    assert json.loads(failed.body(later=True))["state"] == "failed"
+    assert json.loads(failed.animation()) == {
+        "state": "failed", "animation": None,
+        "animation_note": "The run ended failed before its 3-D view was made."}
 
 
 def test_results_carry_the_animation(client):

@@ -43,6 +43,15 @@ const bus = makeBus((t) => {
 });
 if (TESTING) trace.bus = bus;
 
+/** What the 3-D view shows of run ``run``: its animation, or the note saying why there is
+ * none (yet: its results came ahead of it, ``views``). */
+function viewOf(run, views) {
+  if (!run) return { animation: null, note: null };
+  const results = run.results;
+  if (!results.animation_pending) return { animation: results.animation || null, note: results.animation_note || null };
+  return views[run.id] || { animation: null, note: "The 3-D view is on its way…" };
+}
+
 function onViewer(v) {
   viewerShown = v;
   if (TESTING) trace.viewer = v;
@@ -235,6 +244,7 @@ export default function App() {
   const palette = useStudio((s) => s.palette);
   const validationOk = useStudio((s) => s.validation.ok);
   const runs = useStudio((s) => s.runs);
+  const views = useStudio((s) => s.views);
   const run = useStudio((s) => s.run);
   const panel = useStudio((s) => s.panel);
   const setPanel = useStudio((s) => s.setPanel);
@@ -263,6 +273,7 @@ export default function App() {
 
   const latest = runs[0];
   const shown = latest && latest.kind !== "sweep" ? latest : runs.find((r) => r.kind !== "sweep");
+  const shownView = viewOf(shown, views);
   const placed = (scope.body.components || []).every((c) => scope.posOf(c.name));
   const going = runner.going;
   const [mainRef, mainSize] = useSize();
@@ -298,8 +309,8 @@ export default function App() {
                 ) : (
                   <Viewer
                     key={shown ? `${shown.kind}-${shown.id}` : "none"}
-                    animation={shown ? shown.results.animation || null : null}
-                    reason={shown ? shown.results.animation_note || null : null}
+                    animation={shown ? shownView.animation : null}
+                    reason={shown ? shownView.note : null}
                     bus={bus}
                     onViewer={onViewer}
                   />

@@ -57,8 +57,11 @@ export const api = {
   recovery: (path) => call("GET", path ? `api/recovery?path=${q(path)}` : "api/recovery"),
   discardRecovery: (path) => call("POST", "api/recovery/discard", { path: path || null }),
   run: (model, settings, path) => call("POST", "api/run", { model, settings, path: path || null }),
-  /** A run's state; ``wait``: seconds to wait for its end before answering. */
-  runStatus: (id, wait = 0) => call("GET", `api/run/${q(id)}?wait=${wait}`),
+  /** A run's state; ``wait``: seconds to wait for its end before answering. Its results
+   * come as soon as the plots' are made, the 3-D view's poses after them (``runView``). */
+  runStatus: (id, wait = 0) => call("GET", `api/run/${q(id)}?wait=${wait}&animation=later`),
+  /** A run's 3-D view once its results came ahead of it: {state, animation, animation_note}. */
+  runView: (id, wait = 0) => call("GET", `api/run/${q(id)}/animation?wait=${wait}`),
   sweep: (model, sweep, path) => call("POST", "api/sweep", { model, sweep, path: path || null }),
   sweepStatus: (id, wait = 0) => call("GET", `api/sweep/${q(id)}?wait=${wait}`),
   /** Cancel run or sweep ``id`` (``kind`` "run" or "sweep"). */

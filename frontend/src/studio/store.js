@@ -62,6 +62,8 @@ export const useStudio = create((set, get) => ({
   runs: [],
   /** runs of the model now open (the counter restarts with another model) */
   runCount: 0,
+  /** the 3-D views of runs whose results came ahead of them, by run id: {animation, note} */
+  views: {},
   /** @type {{id: number, message: string, kind: string}[]} */
   toasts: [],
   dialog: null,
@@ -101,6 +103,7 @@ export const useStudio = create((set, get) => ({
       run: null,
       runs: [],
       runCount: 0,
+      views: {},
       time: null,
       menu: null,
       fitRequest: get().fitRequest + 1,

@@ -14,6 +14,8 @@ export function installTestHook(store) {
     validated: () => get().validation.doc === get().hist.present,
     runState: () => get().run,
     runs: () => get().runs,
+    /** the 3-D view of the run i (latest first), whether it came with its results or after */
+    views: () => get().views,
     scopes: () => get().scopes,
     selection: () => get().selection,
     dialog: () => get().dialog,
@@ -50,6 +52,12 @@ export function installTestHook(store) {
   });
   K.store = store;
   K.viewer = () => trace.viewer;
+  /** the animation of the run i (latest first), or null while it is on its way */
+  K.animationOf = (i) => {
+    const run = get().runs[i];
+    if (!run) return null;
+    return run.results.animation_pending ? (get().views[run.id] || {}).animation || null : run.results.animation;
+  };
   /** answers of the routing worker held back (true) or delivered (false) */
   K.holdRouting = (on) => trace.routing.hold(on);
   K.setTime = (t) => {

@@ -71,6 +71,7 @@ function finish(id, kind, st, meta, started) {
     const entry = { n, id, kind, state: st.state, results: kind === "sweep" ? null : results, members: kind === "sweep" ? members : null, meta };
     entry.label = runLabel(entry, s.runs[0]);
     useStudio.setState((x) => ({ runCount: n, runs: [entry, ...x.runs].slice(0, OVERLAY + 1) }));
+    if (kind === "run" && results.animation_pending) fetchView(id);
     if (TESTING) {
       trace.lastRun = results || (members && members[0] && members[0].results);
       trace.timings.runDone = performance.now();
@@ -82,6 +83,33 @@ function finish(id, kind, st, meta, started) {
   else if (st.state === "cancelled") {
     s.toast(hasResults ? `${what} was cancelled: the plots show what it computed (partial)` : `${what} was cancelled before it computed anything${st.phase ? ` (it was ${st.phase})` : ""}`, "info");
   }
+}
+
+// a 3-D view asked for once its run's results came ahead of it: how long it is waited for
+const VIEW_WAIT_S = 2;
+const VIEW_TRIES = 60;
+
+/** The 3-D view of run ``id``, whose results came ahead of it, into ``views`` (the plots are
+ * not drawn again). Followed until it comes, the run is forgotten or another model opens. */
+async function fetchView(id) {
+  const runsNow = () => studio().runs;
+  for (let i = 0; i < VIEW_TRIES && runsNow().some((r) => r.id === id); i++) {
+    let st;
+    try {
+      st = await api.runView(id, VIEW_WAIT_S);
+    } catch (e) {
+      st = { state: "failed", animation: null, animation_note: `The 3-D view could not be had: ${e.message}` };
+    }
+    if (st.state === "running") continue;
+    if (!runsNow().some((r) => r.id === id)) return;
+    useStudio.setState((x) => ({ views: { ...pruned(x.views, x.runs), [id]: { animation: st.animation || null, note: st.animation_note || null } } }));
+    return;
+  }
+}
+
+/** ``views`` of the runs still kept. */
+function pruned(views, runs) {
+  return Object.fromEntries(Object.entries(views).filter(([id]) => runs.some((r) => r.id === id)));
 }
 
 /** What a run is given of the model: its parameter values, to label it beside others. */
