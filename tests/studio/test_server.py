@@ -22,6 +22,7 @@ with warnings.catch_warnings():
 import kinetwork as kn
 from kinetwork.components.base import REGISTRY
 from kinetwork.studio import launch, results, runs
+from kinetwork.studio.checks import plain
 from kinetwork.studio.server import TOKEN_HEADER, create_app
 from tests.studio.helpers import serving
 
@@ -473,18 +474,8 @@ def test_answers_are_the_same_json_by_either_writer(root, monkeypatch, writer):
                         "nested": [np.array([[1.5, np.inf]])]}
     got = json.loads(results.encode(content))
     assert results.encode({"big": [2**70, np.nan]}) == b'{"big":[1180591620717411303424,null]}'
-
-    def as_json(value):           # what json writes: lists, non-finite null, str keys
-        if isinstance(value, np.ndarray):
-            value = value.tolist()
-        if isinstance(value, dict):
-            return {str(k): as_json(v) for k, v in value.items()}
-        if isinstance(value, (list, tuple)):
-            return [as_json(v) for v in value]
-        if isinstance(value, (float, np.floating)):
-            return float(value) if np.isfinite(value) else None
-        return int(value) if isinstance(value, np.integer) else value
-    assert got == as_json(content)
+    # what json writes of it: lists, non-finite numbers null, keys as strings
+    assert got == json.loads(json.dumps(plain(content), allow_nan=False))
     assert got["signals"][0]["values"][1:3] == [None, None]
 
 
