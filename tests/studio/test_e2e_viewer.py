@@ -128,3 +128,35 @@ def test_round_shapes_get_the_segments_their_size_on_screen_needs(page, studio):
     page.locator(".kn-viewer-tools button", has_text="view").click()
     page.wait_for_function(f"() => window.__kinetwork.viewer().renderInfo().triangles === {fitted}")
     assert not page.errors, page.errors
+
+
+def test_the_plots_come_before_the_3d_view_which_starts_where_their_cursor_is(page, studio):
+    """The page asks for a run's results ahead of its 3-D view (``?animation=later``): the
+    plots are drawn while the view says it is on its way, and the view, when it comes, stands
+    at the time the plots' cursor was put meanwhile. Its poses are held back here until the
+    cursor has moved."""
+    import time as clock
+    held = []
+    page.route("**/animation?*", lambda route: held.append(route))
+    open_studio(page, studio, open="models/double_pendulum.json")
+    assert run(page) == "done"
+    assert K(page, "K.runs[0].results.animation_pending") is True
+    note = page.locator(tid("viewer-note"))
+    assert "on its way" in note.text_content()
+    box = page.locator(f'{tid("plot-angle")} .u-over').bounding_box()
+    page.mouse.move(box["x"] + box["width"] * 0.5, box["y"] + box["height"] / 2)
+    page.wait_for_function("() => Math.abs(window.__kinetwork.cursorTime - 5) < 0.2")
+    end = clock.monotonic() + 30
+    while not held and clock.monotonic() < end:
+        page.wait_for_timeout(20)
+    assert held, "the page did not ask for the 3-D view"
+    for route in held:
+        route.continue_()
+    page.unroute("**/animation?*")
+    page.wait_for_selector(f'{tid("viewer")}[data-ready="1"]')
+    page.wait_for_function("() => document.querySelector('.kn-time') && "
+                           "/t = 5\\.\\d\\d|t = 4\\.9\\d/.test("
+                           "document.querySelector('.kn-time').textContent)")
+    animation = K(page, "K.animationOf(0)")
+    assert animation["t"][-1] == K(page, "K.runs[0].results.t")[-1]
+    assert not page.errors, page.errors

@@ -25,7 +25,7 @@ import { openModel, useFiles } from "./hooks/useFiles.js";
 import { useKeyboard } from "./hooks/useKeyboard.js";
 import { useRun } from "./hooks/useRun.js";
 import { useScopeProblems, useValidation } from "./hooks/useValidation.js";
-import { studio, useStudio } from "./store.js";
+import { cursorSinceRun, studio, useStudio } from "./store.js";
 import { TESTING, trace } from "./testing.js";
 
 const PANELS = [
@@ -38,6 +38,7 @@ const PANELS = [
 let viewerShown = null;
 const bus = makeBus((t) => {
   studio().setTime(t);
+  cursorSinceRun.t = t;
   if (TESTING) trace.cursorTime = t;
   if (viewerShown) viewerShown.setTime(t);
 });
@@ -54,6 +55,8 @@ function viewOf(run, views) {
 
 function onViewer(v) {
   viewerShown = v;
+  // a view that came after its plots: where their cursor has been put meanwhile
+  if (v && cursorSinceRun.t != null) v.setTime(cursorSinceRun.t);
   if (TESTING) trace.viewer = v;
 }
 

@@ -138,3 +138,7 @@ export const useStudio = create((set, get) => ({
 
 /** The store's state now, outside React (event handlers, timers). */
 export const studio = () => useStudio.getState();
+
+/** Where the plots' cursor was put since the latest run's results were drawn (null: nowhere
+ * yet): a 3-D view that comes after its plots starts there, as it would have followed it. */
+export const cursorSinceRun = { t: /** @type {number | null} */ (null) };

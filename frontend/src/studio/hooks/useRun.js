@@ -3,7 +3,7 @@
 // it stopped) is plotted, marked partial. One job at a time, for the model now open.
 import { useCallback } from "react";
 import { api } from "../api.js";
-import { studio, useStudio } from "../store.js";
+import { cursorSinceRun, studio, useStudio } from "../store.js";
 import { TESTING, trace } from "../testing.js";
 import { runLabel } from "../runs.js";
 
@@ -70,6 +70,7 @@ function finish(id, kind, st, meta, started) {
     const n = s.runCount + 1;
     const entry = { n, id, kind, state: st.state, results: kind === "sweep" ? null : results, members: kind === "sweep" ? members : null, meta };
     entry.label = runLabel(entry, s.runs[0]);
+    cursorSinceRun.t = null;             // its plots are drawn afresh, without a cursor
     useStudio.setState((x) => ({ runCount: n, runs: [entry, ...x.runs].slice(0, OVERLAY + 1) }));
     if (kind === "run" && results.animation_pending) fetchView(id);
     if (TESTING) {
