@@ -144,6 +144,9 @@ def test_a_kept_system_holds_the_relations_its_runs_locate_events_on(cache, monk
     assert a.ops == b.ops and a.tables == b.tables
     monkeypatch.setattr(type(b), "_text", refused)      # the event log's words: kept too
     assert [b.text(i) for i in range(b.n)] == [a.text(i) for i in range(a.n)]
+    expected = a._jacobian().n_instructions()           # their Jacobian, built afresh
+    monkeypatch.setattr(type(b), "_jacobian", refused)  # its size kept, not built again
+    assert b.jacobian_instructions() == expected
     for name in ("time", "state", "affine"):
         np.testing.assert_array_equal(getattr(b, name), getattr(a, name))
     p = np.append(fresh.param_vector(), np.zeros(a.p.numel() - len(fresh.param_vector())))

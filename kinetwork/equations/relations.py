@@ -34,6 +34,11 @@ import numpy as np
 from ..components.tables import interpolant_knots
 from ..errors import ModelError
 
+#: Jacobians larger than this (instructions) are not compiled to C: Newton iterations use
+#: finite differences of the compiled right-hand side instead (an N = 128 chain's exact
+#: Jacobian is 2.5 million instructions, minutes of gcc). The solver's rule
+#: (``solver.compiled``), here so that a kept System can hold its Jacobian's count
+JACOBIAN_JIT_LIMIT = 200_000
 RELATIONS = (ca.OP_LT, ca.OP_LE)
 #: events on time alone (on the states these are taken literally)
 TIME_ONLY = (ca.OP_FMIN, ca.OP_FMAX, ca.OP_FABS, ca.OP_SIGN, ca.OP_FLOOR, ca.OP_CEIL,
@@ -138,15 +143,35 @@ class Relations:
     def jacobian_function(self):
         """d(xdot)/dx of the held equations, as ``System.jacobian_function``."""
         if not hasattr(self, "_jac"):
-            t, x, z = self._symbols
-            if z.numel():
-                v = ca.vertcat(x, z)
-                self._jac = ca.Function("jacobian_held", [t, x, z, self.p], [ca.densify(
-                    ca.jacobian(ca.vertcat(self.ode, self.alg), v))])
-            else:
-                self._jac = ca.Function("jacobian_held", [t, x, self.p],
-                                        [ca.densify(ca.jacobian(self.ode, x))])
+            self._jac = self._jacobian()
         return self._jac
+
+    def _jacobian(self):
+        t, x, z = self._symbols
+        if z.numel():
+            v = ca.vertcat(x, z)
+            return ca.Function("jacobian_held", [t, x, z, self.p], [ca.densify(
+                ca.jacobian(ca.vertcat(self.ode, self.alg), v))])
+        return ca.Function("jacobian_held", [t, x, self.p],
+                           [ca.densify(ca.jacobian(self.ode, x))])
+
+    def jacobian_instructions(self, most=JACOBIAN_JIT_LIMIT):
+        """The instructions of ``jacobian_function``, or None when a bound says it has more
+        than ``most`` (the equations' instructions times their variables over 20 ``most``:
+        it is not built then; a 1024-link chain's would take GBs). Counted once per ``most``
+        and kept with the Relations, so with a kept System (``stored._found_first``) the
+        count is read back, not the Function (EngineV6: 18 ms to build, 23 to read back)."""
+        counts = self.__dict__.setdefault("_jacobian_instructions", {})
+        if most not in counts:
+            t, x, z = self._symbols
+            f = self._made[1] if hasattr(self, "_made") else ca.Function(
+                "held", [t, x, z, self.p], [self.ode, self.alg])
+            if f.n_instructions() * (x.numel() + z.numel()) > 20 * most:
+                counts[most] = None
+            else:
+                jac = self._jac if hasattr(self, "_jac") else self._jacobian()
+                counts[most] = jac.n_instructions()
+        return counts[most]
 
 
 def find(system):

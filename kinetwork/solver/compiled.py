@@ -17,12 +17,8 @@ import weakref
 import casadi as ca
 import numpy as np
 
+from ..equations.relations import JACOBIAN_JIT_LIMIT
 from . import jit as _jit
-
-#: Jacobians larger than this (instructions) are not compiled to C: Newton iterations use
-#: finite differences of the compiled right-hand side instead (an N = 128 chain's exact
-#: Jacobian is 2.5 million instructions, minutes of gcc)
-JACOBIAN_JIT_LIMIT = 200_000
 
 #: checked run settings kept per System (``Compiled.checked``), least recently used dropped
 SETTINGS_KEPT = 64
@@ -126,6 +122,9 @@ class Compiled:
         operations x states: one that cannot pass is not even built)."""
         def decide():
             system, held = self.system, self.held
+            if held.relations is not None:      # counted when the System was kept
+                count = held.relations.jacobian_instructions(JACOBIAN_JIT_LIMIT)
+                return count is not None and count <= JACOBIAN_JIT_LIMIT
             f = held.f_rhs or held.f_dae
             if f.n_instructions() * (system.n_states + system.n_algebraic) > \
                     20 * JACOBIAN_JIT_LIMIT:
