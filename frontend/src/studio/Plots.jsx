@@ -471,14 +471,15 @@ export default function Plots({ runs, bus, running, progress, status }) {
   // (never so short that the y axis has fewer than three ticks: the grid scrolls instead)
   const plotHeight = Math.max(110, Math.min(240, Math.floor((height - 8) / rows) - 64));
   const big = enlarged && panels.find((p) => p.title === enlarged);
+  const info = latest ? runInfo(latest, runs) : "";
   return (
     <div className="kn-plots" data-testid="plots" data-runs={runs.length}>
       <div className="kn-plots-head" ref={head}>
         <span className="kn-panel-title-inline">Probes</span>
         {latest ? (
-          <span className="kn-muted kn-small kn-runinfo" data-testid="plot-runs" title={runInfo(latest, runs)}>
+          <span className="kn-muted kn-small kn-runinfo" data-testid="plot-runs" title={info}>
             <b>{latest.label}</b>
-            {runInfo(latest, runs).slice(latest.label.length)}
+            {info.slice(latest.label.length)}
           </span>
         ) : null}
         {latest ? (
