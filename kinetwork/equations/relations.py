@@ -147,6 +147,7 @@ class Relations:
         return self._jac
 
     def _jacobian(self):
+        """``jacobian_function``'s Function, built (not kept)."""
         t, x, z = self._symbols
         if z.numel():
             v = ca.vertcat(x, z)

@@ -103,9 +103,8 @@ def _found_first(system):
     """What every run of ``system`` reads first, found before it is kept, so that it is
     kept with it: the relations its events are located on, their words in the run's log of
     events and the size of their Jacobian (EngineV6: 0.07 + 0.013 + 0.018 s of CPU in each
-    process's first run). What cannot be
-    found is left to the run, which says why (a build that only compiles, to count states or
-    linearise, is not refused for it)."""
+    process's first run). What cannot be found is left to the run, which says why (a build
+    that only compiles, to count states or linearise, is not refused for it)."""
     with contextlib.suppress(Exception):
         relations = system.relations
         if relations is not None:
