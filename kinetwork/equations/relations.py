@@ -157,22 +157,29 @@ class Relations:
                            [ca.densify(ca.jacobian(self.ode, x))])
 
     def jacobian_instructions(self, most=JACOBIAN_JIT_LIMIT):
-        """The instructions of ``jacobian_function``, or None when a bound says it has more
-        than ``most`` (the equations' instructions times their variables over 20 ``most``:
-        it is not built then; a 1024-link chain's would take GBs). Counted once per ``most``
-        and kept with the Relations, so with a kept System (``stored._found_first``) the
-        count is read back, not the Function (EngineV6: 18 ms to build, 23 to read back)."""
+        """``jacobian_instructions`` of the held equations: the instructions of
+        ``jacobian_function``, or None when surely more than ``most``. Counted once per
+        ``most`` and kept with the Relations, so with a kept System (``stored._found_first``)
+        the count is read back, not the Function (EngineV6: 18 ms to build, 23 to read)."""
         counts = self.__dict__.setdefault("_jacobian_instructions", {})
         if most not in counts:
             t, x, z = self._symbols
             f = self._made[1] if hasattr(self, "_made") else ca.Function(
                 "held", [t, x, z, self.p], [self.ode, self.alg])
-            if f.n_instructions() * (x.numel() + z.numel()) > 20 * most:
-                counts[most] = None
-            else:
-                jac = self._jac if hasattr(self, "_jac") else self._jacobian()
-                counts[most] = jac.n_instructions()
+            counts[most] = jacobian_instructions(
+                f, x.numel() + z.numel(),
+                lambda: self._jac if hasattr(self, "_jac") else self._jacobian(), most)
         return counts[most]
+
+
+def jacobian_instructions(f, variables, jacobian, most=JACOBIAN_JIT_LIMIT):
+    """The instructions of the Jacobian ``jacobian()`` builds of the equations ``f`` in its
+    ``variables``, or None when it surely has more than ``most``: when ``f``'s instructions
+    times the variables exceed 20 ``most`` it is not built (a 1024-link chain's would take
+    GBs). Whether the solver compiles a Jacobian (``solver.compiled``)."""
+    if f.n_instructions() * variables > 20 * most:
+        return None
+    return jacobian().n_instructions()
 
 
 def find(system):

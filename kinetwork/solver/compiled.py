@@ -17,7 +17,7 @@ import weakref
 import casadi as ca
 import numpy as np
 
-from ..equations.relations import JACOBIAN_JIT_LIMIT
+from ..equations.relations import JACOBIAN_JIT_LIMIT, jacobian_instructions
 from . import jit as _jit
 
 #: checked run settings kept per System (``Compiled.checked``), least recently used dropped
@@ -124,12 +124,11 @@ class Compiled:
             system, held = self.system, self.held
             if held.relations is not None:      # counted when the System was kept
                 count = held.relations.jacobian_instructions(JACOBIAN_JIT_LIMIT)
-                return count is not None and count <= JACOBIAN_JIT_LIMIT
-            f = held.f_rhs or held.f_dae
-            if f.n_instructions() * (system.n_states + system.n_algebraic) > \
-                    20 * JACOBIAN_JIT_LIMIT:
-                return False
-            return held.jacobian_function().n_instructions() <= JACOBIAN_JIT_LIMIT
+            else:
+                count = jacobian_instructions(
+                    held.f_rhs or held.f_dae, system.n_states + system.n_algebraic,
+                    held.jacobian_function, JACOBIAN_JIT_LIMIT)
+            return count is not None and count <= JACOBIAN_JIT_LIMIT
         return self._get("jacobian_small", decide)
 
     def dae(self, jit=None, jacobian=False, hidden=False):

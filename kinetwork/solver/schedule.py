@@ -90,7 +90,7 @@ class Schedule:
             if rate == 0 or not np.isfinite(rate) or not np.isfinite(a0):
                 return []
             return list(self.t_start + (knots - a0) / rate)
-    
+
         def at(t, shift=0.0):
             return float(_position(float(f(t, p)[0]), knots)) - shift
         grid = np.linspace(self.t_start, self.t_end, SCAN + 1)
