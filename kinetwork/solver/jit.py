@@ -99,10 +99,29 @@ _LOCK = threading.RLock()
 _WARNED = set()                               # the reasons already warned of in this process
 _WARNED_LOCK = threading.Lock()               # not _LOCK: a build may hold that for minutes
 _PENDING = {}                                 # quick library -> jit_tiers.Pending
+_WATCHERS = []                                # see ``watching``
 
 
 class JitFallbackWarning(KinetworkWarning):
     """C compilation was not possible: CasADi's virtual machine runs instead (same numbers)."""
+
+
+@contextlib.contextmanager
+def watching(told):
+    """While in it, ``told(True)`` when a C compiler is about to run for a library and
+    ``told(False)`` when a library is ready to load (built, or found in the cache); nothing
+    when none can be had: what the studio's run says it is doing ("compiling" or
+    "integrating", ``studio/work.py``)."""
+    _WATCHERS.append(told)
+    try:
+        yield
+    finally:
+        _WATCHERS.remove(told)
+
+
+def _tell(building):
+    for told in list(_WATCHERS):
+        told(building)
 
 
 def compiler():
@@ -158,6 +177,18 @@ def compile_functions(name, functions, stats=None, deadline=None, cancelled=None
     can be had.
     """
     start = time.perf_counter()
+    lib, hit, tier = _library(name, functions, deadline, cancelled, jacobian)
+    _tell(False)
+    if stats is not None:
+        stats["jit_cached"] = stats.get("jit_cached", True) and hit
+        stats["jit_seconds"] = stats.get("jit_seconds", 0.0) + time.perf_counter() - start
+        if stats.get("jit_tier") != "quick":
+            stats["jit_tier"] = tier
+    return lib
+
+
+def _library(name, functions, deadline, cancelled, jacobian):
+    """``compile_functions``' (library, whether the cache had it, its tier)."""
     with _locked(deadline, cancelled):
         cc = compiler()
         if cc is None:
@@ -175,6 +206,7 @@ def compile_functions(name, functions, stats=None, deadline=None, cancelled=None
             _touch(lib)
         elif _tier(functions) == "optimised":
             lib = optimised
+            _tell(True)
             build(cc, _generated(functions, jacobian, "optimised", deadline, cancelled), lib,
                   deadline, cancelled, COMPILE_TIMEOUT)
             _trim(folder, keep=lib)
@@ -184,6 +216,7 @@ def compile_functions(name, functions, stats=None, deadline=None, cancelled=None
             if hit:
                 _touch(lib)
             else:
+                _tell(True)
                 build(cc, _generated(functions, jacobian, "quick", deadline, cancelled), lib,
                       deadline, cancelled, COMPILE_TIMEOUT)
                 _trim(folder, keep=lib)
@@ -191,12 +224,7 @@ def compile_functions(name, functions, stats=None, deadline=None, cancelled=None
                 pending = jit_tiers.start(optimised, name, serialised, jacobian)
                 if pending is not None:
                     _PENDING[str(lib)] = pending
-    if stats is not None:
-        stats["jit_cached"] = stats.get("jit_cached", True) and hit
-        stats["jit_seconds"] = stats.get("jit_seconds", 0.0) + time.perf_counter() - start
-        if stats.get("jit_tier") != "quick":
-            stats["jit_tier"] = tier
-    return lib
+    return lib, hit, tier
 
 
 def build_optimised(name, functions, lib, jacobian, timeout):

@@ -15,6 +15,7 @@ import numpy as np
 from ..errors import ModelError, SimulationError
 from ..graph.io import loads
 from ..graph.writer import dumps, render_json
+from ..solver import jit
 from ..solver.driver import DEFAULTS
 from ..solver.plan import simulate
 from ..solver.results import TIME
@@ -85,53 +86,45 @@ def render(data, text, folder, library, channel):
 def run(data, settings, folder, library, channel):
     """A run of the model: ``(state, JSON bytes)`` of its final state (done, failed or
     cancelled), with the results it reached."""
-    model, phase = None, "checking"
+    model, phase = None, _Phase(channel, "checking")
     try:
-        channel.enter("checking")
         model = _runnable(data, folder, library, "run")
         sim = {**DEFAULTS, **model.simulation, **settings}
         n_points, t_end = sim.get("n_points"), sim.get("t_end")
         _check_size(n_points, 1, 1, beyond=True)
-        phase = "compiling"
-        channel.enter(phase)
+        phase.enter("compiling")
         system = model.compile()
         _check_size(n_points, 1 + sum(sig.size for sig in system.signals), 1)
         if channel.cancelled():
-            return _final("cancelled", phase=phase)
+            return _final("cancelled", phase=phase.now)
         span = t_end if isinstance(t_end, (int, float)) and t_end > 0 else None
 
         def progress(t):
-            # "compiling" until the integration reports: simulate compiles the equations to
-            # C (a cold cache: seconds for EngineV6) before it integrates anything
-            nonlocal phase
-            if phase == "compiling":
-                phase = "integrating"
-                channel.enter(phase)
+            phase.integrating()
             channel.report(t / span)
             if t >= span * (1 - 1e-12):
                 # integrated to the end: the probes' outputs follow, results that a cancel
                 # now would lose; they are finished and kept (jobs: no SIGINT in this phase)
-                channel.enter("writing results")
+                phase.enter("writing results")
         if span is None:                # no progress to wait for: integrating from here
-            phase = "integrating"
-            channel.enter(phase)
-        results = simulate(system, **settings, cancel=channel.cancelled,
-                           progress=progress if span else None)
-        phase = "writing results"
-        channel.enter(phase)
+            phase.enter("integrating")
+        with jit.watching(phase.compiler):
+            results = simulate(system, **settings, cancel=channel.cancelled,
+                               progress=progress if span else None)
+        phase.enter("writing results")
         # the plots' results ahead of the 3-D view's poses (EngineV6: 0.1 s of CPU and 5.6 of
         # its 6.1 MB), each sent as soon as it is made (GET /api/run/{id}?animation=later)
         plots = results_json(results, model, with_animation=False)
         channel.ahead("results", _final("done", results={**plots, "animation_pending": True},
-                                        phase=phase)[1])
+                                        phase=phase.now)[1])
         view = animation_json(results, model)
         channel.ahead("animation", encode({"state": "done", **view}))
-        return _final("done", results={**plots, **view}, phase=phase)
+        return _final("done", results={**plots, **view}, phase=phase.now)
     except SimulationError as exc:
         cancelled = channel.cancelled()
         reached = exc.results is not None and len(exc.results.t) > 1
-        if reached or not cancelled:
-            phase = "integrating"       # (a first chunk that failed reported no progress)
+        # (a first chunk that failed reported no progress)
+        said = "integrating" if reached or not cancelled else phase.now
         if cancelled and not reached:   # cancelled while the equations were compiled to C
             exc.results = None
         if cancelled and exc.results is not None and exc.results.partial:
@@ -139,11 +132,39 @@ def run(data, settings, folder, library, channel):
             exc.results.partial = {**exc.results.partial, "reason": "cancelled"}
         partial = None if exc.results is None else results_json(exc.results, model)
         return _final("cancelled" if cancelled else "failed", error=None if cancelled else str(exc),
-                      results=partial, phase=phase)
+                      results=partial, phase=said)
     except ModelError as exc:
-        return _final("failed", error=str(exc), problems=checks.problems_of(exc), phase=phase)
+        return _final("failed", error=str(exc), problems=checks.problems_of(exc),
+                      phase=phase.now)
     except KeyboardInterrupt:          # cancelled before the integration kept anything
-        return _final("cancelled", phase=phase)
+        return _final("cancelled", phase=phase.now)
+
+
+class _Phase:
+    """What a run or sweep says it is doing (``jobs.PHASES``), told to its channel as it
+    changes. From "compiling" (the equations derived, then compiled to C) it says
+    "integrating" once the integration reports progress or a library of compiled code is
+    ready, and "compiling" again while a C compiler runs for it (``jit.watching``), so that
+    the page never reads "integrating 0 %" through a compile, nor "compiling" through an
+    integration (EngineV6's cached libraries: ready in milliseconds)."""
+
+    def __init__(self, channel, phase):
+        self.channel, self.now = channel, None
+        self.enter(phase)
+
+    def enter(self, phase):
+        if phase != self.now:
+            self.now = phase
+            self.channel.enter(phase)
+
+    def integrating(self):
+        if self.now == "compiling":
+            self.enter("integrating")
+
+    def compiler(self, building):
+        """``jit.watching``'s listener (called from any of a sweep's threads)."""
+        if self.now in ("compiling", "integrating"):
+            self.enter("compiling" if building else "integrating")
 
 
 def _final(state, error=None, problems=(), results=None, phase=None):
@@ -182,27 +203,29 @@ def sweep(data, spec, folder, library, channel):
     from ..analysis.sweep import sweep as grid_sweep
     model = None
     try:
-        channel.enter("checking")
+        phase = _Phase(channel, "checking")
         model = _runnable(data, folder, library, "sweep")
         kind, names, members = _sweep_spec(spec)
         sim = {**DEFAULTS, **model.simulation}
         _check_size(sim.get("n_points"), 1, members, beyond=True)
-        channel.enter("compiling")
+        phase.enter("compiling")
         system = model.compile()
         _check_size(sim.get("n_points"), 1 + sum(sig.size for sig in system.signals), members)
-        channel.enter("integrating")
 
         def progress(done, total):
+            phase.integrating()
             channel.report(done / total)
-        if kind == "grid":
-            ds = grid_sweep(system, {k: spec["grid"][k] for k in names}, progress=progress)
-        else:
-            dists = {}
-            for k in names:
-                (law, (a, b)), = spec["distributions"][k].items()
-                dists[k] = uniform(a, b) if law == "uniform" else normal(a, b)
-            ds = sample(system, dists, int(spec["n"]), seed=spec.get("seed"), progress=progress)
-        channel.enter("writing results")
+        with jit.watching(phase.compiler):
+            if kind == "grid":
+                ds = grid_sweep(system, {k: spec["grid"][k] for k in names}, progress=progress)
+            else:
+                dists = {}
+                for k in names:
+                    (law, (a, b)), = spec["distributions"][k].items()
+                    dists[k] = uniform(a, b) if law == "uniform" else normal(a, b)
+                ds = sample(system, dists, int(spec["n"]), seed=spec.get("seed"),
+                            progress=progress)
+        phase.enter("writing results")
         out = _members(ds, system, names, kind)
         interrupted = bool(ds.attrs.get("interrupted"))
         state = "cancelled" if interrupted or channel.cancelled() else "done"

@@ -9,10 +9,11 @@ import pathlib
 
 import numpy as np
 
-from kinetwork.solver import jit
+from kinetwork.solver import jit, methods
 from kinetwork.studio import work
 
 SEED = pathlib.Path(__file__).resolve().parents[2] / "models" / "double_pendulum.json"
+ENGINE = SEED.parent / "engine_v6" / "EngineV6.json"
 
 
 class Recorder:
@@ -22,12 +23,20 @@ class Recorder:
     def __init__(self, cancel_when=lambda channel: False):
         self.phases, self.progress, self.cancel_when = [], [], cancel_when
         self.sent = []
+        self.said = []              # ("phase", name) and ("progress", fraction), in order
 
     def enter(self, phase):
         self.phases.append(phase)
+        self.said.append(("phase", phase))
 
     def report(self, fraction):
         self.progress.append(fraction)
+        self.said.append(("progress", fraction))
+
+    def before_first_progress(self):
+        """The phases entered before the first progress report."""
+        first = next(i for i, (kind, _) in enumerate(self.said) if kind == "progress")
+        return [what for kind, what in self.said[:first] if kind == "phase"]
 
     def cancelled(self):
         return bool(self.cancel_when(self))
@@ -36,22 +45,42 @@ class Recorder:
         self.sent.append((part, self.phases[-1]))
 
 
-def test_the_c_compile_happens_while_the_run_says_compiling(monkeypatch, tmp_path):
-    monkeypatch.setenv("KINETWORK_CACHE", str(tmp_path))        # a cold cache: gcc runs
-    channel, seen = Recorder(), []
-    real = jit.compile_functions
+def spy_on_the_compiler(monkeypatch, channel):
+    """The phases the run said while each C compiler ran (gcc, through ``jit.build``)."""
+    seen, real = [], jit.build
 
     def spied(*args, **kwargs):
         seen.append(channel.phases[-1])
         return real(*args, **kwargs)
-    monkeypatch.setattr(jit, "compile_functions", spied)
+    monkeypatch.setattr(jit, "build", spied)
+    return seen
+
+
+def spy_on_the_integrator(monkeypatch, channel):
+    """The phases the run said as each call of a CasADi integrator began."""
+    seen, real = [], methods._CasadiRun.call
+
+    def spied(self, *args, **kwargs):
+        seen.append(channel.phases[-1])
+        return real(self, *args, **kwargs)
+    monkeypatch.setattr(methods._CasadiRun, "call", spied)
+    return seen
+
+
+def test_the_c_compile_happens_while_the_run_says_compiling(monkeypatch, tmp_path):
+    monkeypatch.setenv("KINETWORK_CACHE", str(tmp_path))        # a cold cache: gcc runs
+    channel = Recorder()
+    seen = spy_on_the_compiler(monkeypatch, channel)
+    integrating = spy_on_the_integrator(monkeypatch, channel)
     state, answer = work.run(json.loads(SEED.read_text()), {"t_end": 1.0, "n_points": 11},
                              None, [], channel)
     assert state == "done"
     # the equations before any integration, the probes' outputs after it: never while the
     # page reads "integrating"
-    assert seen and seen[0] == "compiling" and "integrating" not in seen, seen
+    assert seen and set(seen) <= {"compiling", "writing results"}, seen
     assert channel.phases[:3] == ["checking", "compiling", "integrating"]
+    # and "integrating" once the compiled code is there, not at the first chunk's end
+    assert integrating and integrating[0] == "integrating", channel.said
     assert channel.phases[-1] == "writing results"
     assert channel.progress and channel.progress[-1] == 1.0
     assert json.loads(answer)["results"]["t"][-1] == 1.0
@@ -86,3 +115,37 @@ def test_a_cancel_while_integrating_keeps_what_it_reached():
     assert 1 < len(t) < 2001 and t[-1] < 2000.0
     assert out["results"]["partial"]["reason"] == "cancelled"
     assert "integrating" in channel.phases
+
+
+def test_a_run_whose_code_is_cached_says_integrating_as_it_integrates(monkeypatch, tmp_path):
+    """EngineV6 with its System and libraries cached: "compiling" ends as the library is
+    loaded, not once the first chunk is integrated (a cancel the page sent while it read
+    "compiling" found the run integrating, and it kept what it reached)."""
+    monkeypatch.setenv("KINETWORK_CACHE", str(tmp_path))
+    data = json.loads(ENGINE.read_text())
+    settings = {"t_end": 0.05, "n_points": 51}
+    assert work.run(data, settings, ENGINE.parent, [], Recorder())[0] == "done"    # cached
+    channel = Recorder()
+    seen = spy_on_the_compiler(monkeypatch, channel)
+    integrating = spy_on_the_integrator(monkeypatch, channel)
+    assert work.run(data, settings, ENGINE.parent, [], channel)[0] == "done"
+    assert not seen
+    assert integrating and integrating[0] == "integrating", channel.said
+    assert channel.phases[:3] == ["checking", "compiling", "integrating"]
+
+
+def test_a_sweep_says_compiling_while_its_code_is_compiled(monkeypatch, tmp_path):
+    """A sweep's members compile the equations to C as they start: the page reads
+    "compiling" through it, then "integrating" (it read "integrating 0 %" through gcc)."""
+    monkeypatch.setenv("KINETWORK_CACHE", str(tmp_path))
+    channel = Recorder()
+    seen = spy_on_the_compiler(monkeypatch, channel)
+    state, answer = work.sweep(json.loads(SEED.read_text()),
+                               {"kind": "grid", "grid": {"c": [0.5, 1.0, 2.0]}}, None, [],
+                               channel)
+    assert state == "done", answer
+    assert len(json.loads(answer)["members"]) == 3
+    assert seen and set(seen) <= {"compiling", "writing results"}, seen
+    assert channel.before_first_progress()[:2] == ["checking", "compiling"]
+    assert channel.before_first_progress()[-1] == "integrating", channel.said
+    assert channel.phases[-1] == "writing results"
