@@ -1,7 +1,7 @@
 // Problems placed by their fields, never by their text, and said in the user's words.
 import { describe, expect, it } from "vitest";
 import { blockText, pathSteps, placeOf, whereOf } from "../src/studio/problems.js";
-import { differences, memberLabel, runLabel } from "../src/studio/runs.js";
+import { differences, memberLabel, runLabel, runStatus } from "../src/studio/runs.js";
 
 describe("problems", () => {
   it("places a problem on its block and parameter, in the user's words", () => {
@@ -49,5 +49,13 @@ describe("run labels", () => {
   it("names a sweep's members by their values", () => {
     expect(memberLabel({ params: { c: 2, d: 0.123456 } })).toBe("c = 2, d = 0.1235");
     expect(runLabel({ n: 4, kind: "sweep", state: "done", members: [{}, {}, {}] })).toBe("sweep 4 · 3 members");
+  });
+
+  it("says what a run or sweep is doing, the C compile included", () => {
+    expect(runStatus({ kind: "run", state: "running", phase: "compiling", progress: 0 })).toBe("compiling 0 %");
+    expect(runStatus({ kind: "run", state: "running", phase: "integrating", progress: 0.42 })).toBe("running 42 %");
+    expect(runStatus({ kind: "sweep", state: "running", phase: "compiling", progress: 0 })).toBe("compiling 0 %");
+    expect(runStatus({ kind: "sweep", state: "running", phase: "integrating", progress: 0.5 })).toBe("sweeping 50 %");
+    expect(runStatus({ kind: "run", state: "cancelling" })).toBe("cancelling…");
   });
 });

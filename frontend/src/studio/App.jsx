@@ -305,7 +305,7 @@ export default function App() {
           <div className="kn-results" style={{ gridTemplateColumns: `minmax(0, 1fr) ${SPLITTER}px ${sizes.viewer}px` }}>
             {closed.results ? null : (
               <>
-                <Plots runs={runs} bus={bus} running={going} progress={run && run.progress} status={run && run.state === "failed" ? `The run failed: ${run.error}` : null} />
+                <Plots runs={runs} bus={bus} running={going} run={run} status={run && run.state === "failed" ? `The run failed: ${run.error}` : null} />
                 <Splitter pane="viewer" axis="x" side="after" size={sizes.viewer} label="3-D view" />
                 {closed.viewer ? (
                   <div />

@@ -8,7 +8,7 @@ import "uplot/dist/uPlot.min.css";
 import { Modal } from "./Dialogs.jsx";
 import { OVERLAY } from "./hooks/useRun.js";
 import { download, fileName, plotCsv, plotSvg } from "./plotexport.js";
-import { memberLabel } from "./runs.js";
+import { memberLabel, runStatus } from "./runs.js";
 import { useStudio } from "./store.js";
 import { TESTING, trace } from "./testing.js";
 
@@ -430,7 +430,12 @@ function SignalChips({ names, hidden, setHidden, head, height }) {
   );
 }
 
-export default function Plots({ runs, bus, running, progress, status }) {
+/** "compiling 0 %" as the pane says it: "Compiling 0 %". */
+function sentence(text) {
+  return text.charAt(0).toUpperCase() + text.slice(1);
+}
+
+export default function Plots({ runs, bus, running, run, status }) {
   const wrap = useRef(null);
   const [width, setWidth] = useState(600);
   const [height, setHeight] = useState(300);
@@ -492,7 +497,7 @@ export default function Plots({ runs, bus, running, progress, status }) {
       <div className="kn-plots-grid" ref={wrap} style={{ gridTemplateColumns: `repeat(${cols}, 1fr)` }}>
         {!latest && (
           <div className="kn-empty">
-            {running ? `Running… ${Math.round((progress || 0) * 100)} %` : status || "Press Run to simulate: the probes' quantities are plotted here."}
+            {running ? sentence(runStatus(run)) : status || "Press Run to simulate: the probes' quantities are plotted here."}
           </div>
         )}
         {latest && names.length === 0 && <div className="kn-empty">This model has no probes: add a Probe and wire it to a port to record its quantities.</div>}

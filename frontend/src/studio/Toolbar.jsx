@@ -1,28 +1,7 @@
 // The bar above everything: files, undo and redo, Run and Cancel with the run's progress,
 // and the model's name with its file and whether it has unsaved changes.
+import { runStatus } from "./runs.js";
 import { useStudio } from "./store.js";
-import { TESTING, trace } from "./testing.js";
-
-/** What the run's status line says: "compiling 0 %", "running 42 %", "cancelling…", "done". */
-export function runStatus(run) {
-  if (!run) return "";
-  const pct = `${Math.round((run.progress || 0) * 100)} %`;
-  const what = run.kind === "sweep" ? "sweep" : "";
-  switch (run.state) {
-    case "starting":
-      return `starting ${what}`.trim() + "…";
-    case "running":
-      return `${run.phase && run.phase !== "integrating" ? run.phase : what ? "sweeping" : "running"} ${pct}`;
-    case "cancelling":
-      return "cancelling…";
-    case "done":
-      return TESTING && trace.timings.runSeconds ? `done in ${trace.timings.runSeconds.toFixed(2)} s` : "done";
-    case "cancelled":
-      return "cancelled";
-    default:
-      return run.state;
-  }
-}
 
 /**
  * @param {{files: ReturnType<typeof import("./hooks/useFiles.js").useFiles>, edit: import("./hooks/useEditing.js").Edit,

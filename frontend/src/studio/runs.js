@@ -1,5 +1,6 @@
 // Names of runs in the plots: "run 3 · c = 5" says what differs from the run before it;
 // a sweep's members are named by the values they were given.
+import { TESTING, trace } from "./testing.js";
 import { formatValue } from "./values.js";
 
 const MAX_DIFFERENCES = 3;
@@ -40,4 +41,25 @@ export function memberLabel(member) {
   return Object.entries(member.params || {})
     .map(([k, v]) => `${k} = ${typeof v === "number" ? +v.toPrecision(4) : v}`)
     .join(", ");
+}
+
+/** What the run's status line says: "compiling 0 %", "running 42 %", "cancelling…", "done". */
+export function runStatus(run) {
+  if (!run) return "";
+  const pct = `${Math.round((run.progress || 0) * 100)} %`;
+  const what = run.kind === "sweep" ? "sweep" : "";
+  switch (run.state) {
+    case "starting":
+      return `starting ${what}`.trim() + "…";
+    case "running":
+      return `${run.phase && run.phase !== "integrating" ? run.phase : what ? "sweeping" : "running"} ${pct}`;
+    case "cancelling":
+      return "cancelling…";
+    case "done":
+      return TESTING && trace.timings.runSeconds ? `done in ${trace.timings.runSeconds.toFixed(2)} s` : "done";
+    case "cancelled":
+      return "cancelled";
+    default:
+      return run.state;
+  }
 }
