@@ -1,7 +1,8 @@
 // The right-click menu of the diagram: on a block (rename, open, duplicate, rotate, flip, make
 // subsystem, copy, delete), on a selection, on a wire, and on the empty diagram (paste here,
 // select all). Every item is an edit of the model, undone like any other.
-import { useEffect, useRef } from "react";
+import { useRef } from "react";
+import { useClickAway } from "./hooks/useClickAway.js";
 import { useStudio } from "./store.js";
 import { resolveDef } from "./model.js";
 import { findRepeat } from "./fold.js";
@@ -15,14 +16,7 @@ export default function ContextMenu({ edit, scope }) {
   const setMenu = useStudio((s) => s.setMenu);
   const ref = useRef(null);
 
-  useEffect(() => {
-    if (!menu) return undefined;
-    const away = (e) => {
-      if (ref.current && !ref.current.contains(e.target)) setMenu(null);
-    };
-    window.addEventListener("mousedown", away, true);
-    return () => window.removeEventListener("mousedown", away, true);
-  }, [menu, setMenu]);
+  useClickAway(ref, Boolean(menu), () => setMenu(null), true);
 
   if (!menu) return null;
   const { target } = menu;

@@ -6,6 +6,7 @@ import { useEffect, useMemo, useRef, useState } from "react";
 import uPlot from "uplot";
 import "uplot/dist/uPlot.min.css";
 import { Modal } from "./Dialogs.jsx";
+import { useClickAway } from "./hooks/useClickAway.js";
 import { OVERLAY } from "./hooks/useRun.js";
 import { download, fileName, plotCsv, plotSvg } from "./plotexport.js";
 import { memberLabel, runStatus } from "./runs.js";
@@ -397,12 +398,7 @@ function SignalChips({ names, hidden, setHidden, head, height }) {
     ro.observe(el);
     return () => ro.disconnect();
   }, [head]);
-  useEffect(() => {
-    if (!open) return undefined;
-    const away = (e) => pop.current && !pop.current.contains(e.target) && setOpen(false);
-    document.addEventListener("mousedown", away);
-    return () => document.removeEventListener("mousedown", away);
-  }, [open]);
+  useClickAway(pop, open, () => setOpen(false));
   const toggle = (n) =>
     setHidden((h) => {
       const next = new Set(h);
