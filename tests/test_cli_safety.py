@@ -15,6 +15,7 @@ import time
 import numpy as np
 import pytest
 from conftest import double_pendulum
+from procstat import cpu_seconds
 
 import kinetwork as kn
 import kinetwork.graph.model as graph_model
@@ -162,12 +163,6 @@ def test_outputs_never_overwrite_the_model_or_each_other(seed_file, tmp_path, ca
     captured = capsys.readouterr()
     assert "nothing was run" in captured.err and no_traceback(captured)
     assert seed_file.read_bytes() == before and not other.exists()
-
-
-def cpu_seconds(pid):
-    """The CPU seconds (user + system) a running process has used so far, from /proc."""
-    fields = pathlib.Path(f"/proc/{pid}/stat").read_text().rpartition(")")[2].split()
-    return (int(fields[11]) + int(fields[12])) / os.sysconf("SC_CLK_TCK")
 
 
 def children_cpu_seconds():

@@ -11,6 +11,8 @@ import tempfile
 import threading
 import time
 
+from tests import procstat
+
 RUN_TIMEOUT = 240_000          # ms: EngineV6 compiles for ~30 s on a busy 2-core machine
 #: where the screenshots go: a folder of the test run, unless KINETWORK_SCREENSHOTS names
 #: one (`KINETWORK_SCREENSHOTS=docs/images pytest tests/studio` refreshes the docs'); a test
@@ -356,22 +358,22 @@ def chromium_cpu():
     for entry in os.listdir("/proc"):
         if entry.isdigit():
             try:
-                stat = pathlib.Path(f"/proc/{entry}/stat").read_text()
+                parent = int(procstat.stat(entry)[1])
             except OSError:               # gone meanwhile
                 continue
-            children.setdefault(int(stat.rsplit(")", 1)[1].split()[1]), []).append(int(entry))
-    spent, todo, tick = {}, [os.getpid()], os.sysconf("SC_CLK_TCK")
+            children.setdefault(parent, []).append(int(entry))
+    spent, todo = {}, [os.getpid()]
     while todo:
         for pid in children.get(todo.pop(), []):
             todo.append(pid)
             try:
                 line = pathlib.Path(f"/proc/{pid}/cmdline").read_bytes().decode(errors="replace")
-                fields = pathlib.Path(f"/proc/{pid}/stat").read_text().rsplit(")", 1)[1].split()
+                fields = procstat.stat(pid)
             except OSError:
                 continue
             if "chromium" not in line and "--type=" not in line and "--gpu-preferences" not in line:
                 continue                  # the Playwright driver (node)
             kind = ("gpu" if "--gpu-preferences" in line else
                     "renderer" if "--renderer-client-id" in line else "other")
-            spent[kind] = spent.get(kind, 0.0) + (int(fields[11]) + int(fields[12])) / tick
+            spent[kind] = spent.get(kind, 0.0) + procstat.cpu_seconds(fields=fields)
     return spent
