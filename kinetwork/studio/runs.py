@@ -59,11 +59,13 @@ class Job:
             self.state = state
 
     def _stopped(self):
+        # (a run says "compiling" again while a C compiler runs for it: whether anything had
+        # been computed is what it reported, not its phase)
         phase = self.child.phase
         return encode({"state": "cancelled", "progress": None, "phase": phase, "error": None,
                        "problems": [], "results": None, "members": None,
                        "note": f"stopped while {phase}: nothing had been computed yet"
-                               if phase in ("starting", "checking", "compiling") else
+                               if not self.child.progress else
                                f"stopped while {phase}: what it had computed could not be "
                                f"kept"})
 

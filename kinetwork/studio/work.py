@@ -143,13 +143,15 @@ def run(data, settings, folder, library, channel):
 class _Phase:
     """What a run or sweep says it is doing (``jobs.PHASES``), told to its channel as it
     changes. From "compiling" (the equations derived, then compiled to C) it says
-    "integrating" once the integration reports progress or a library of compiled code is
-    ready, and "compiling" again while a C compiler runs for it (``jit.watching``), so that
+    "integrating" once a library of compiled code is ready, and "compiling" again while a C
+    compiler runs for it (``jit.watching``), until the integration first reports progress:
     the page never reads "integrating 0 %" through a compile, nor "compiling" through an
-    integration (EngineV6's cached libraries: ready in milliseconds)."""
+    integration (EngineV6's cached libraries: ready in milliseconds). Once progress is
+    reported, it is "integrating" (a cancel then keeps what was reached: ``jobs.CANCEL_GRACE``
+    is by phase) until the results are written."""
 
     def __init__(self, channel, phase):
-        self.channel, self.now = channel, None
+        self.channel, self.now, self.reported = channel, None, False
         self.enter(phase)
 
     def enter(self, phase):
@@ -158,12 +160,14 @@ class _Phase:
             self.channel.enter(phase)
 
     def integrating(self):
+        """The integration reported progress."""
+        self.reported = True
         if self.now == "compiling":
             self.enter("integrating")
 
     def compiler(self, building):
         """``jit.watching``'s listener (called from any of a sweep's threads)."""
-        if self.now in ("compiling", "integrating"):
+        if not self.reported and self.now in ("compiling", "integrating"):
             self.enter("compiling" if building else "integrating")
 
 

@@ -149,3 +149,23 @@ def test_a_sweep_says_compiling_while_its_code_is_compiled(monkeypatch, tmp_path
     assert channel.before_first_progress()[:2] == ["checking", "compiling"]
     assert channel.before_first_progress()[-1] == "integrating", channel.said
     assert channel.phases[-1] == "writing results"
+
+
+def test_once_progress_is_reported_a_compile_leaves_the_run_integrating():
+    """Before any progress, each C compile says "compiling" and each library ready
+    "integrating"; after, the run is integrating (a cancel's grace is by phase: a compile
+    in the middle of a run must not cut short the keeping of what it reached)."""
+    channel = Recorder()
+    phase = work._Phase(channel, "checking")
+    phase.enter("compiling")
+    for building in (True, False, False, True, False):
+        phase.compiler(building)
+    assert channel.phases == ["checking", "compiling", "integrating", "compiling",
+                              "integrating"]
+    phase.integrating()
+    phase.compiler(True)
+    phase.compiler(False)
+    assert channel.phases[-1] == "integrating" and len(channel.phases) == 5
+    phase.enter("writing results")
+    phase.compiler(True)                        # the probes' outputs compiled at the end
+    assert channel.phases[-1] == "writing results"

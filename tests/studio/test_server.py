@@ -437,6 +437,33 @@ def test_a_child_s_parts_sent_ahead_come_before_its_answer():
         "animation_note": "The run ended failed before its 3-D view was made."}
 
 
+def _stuck_compiling(reported, channel):
+    """A child that says it is compiling (having reported progress or not) and does not stop
+    when asked: it is ended after the phase's grace."""
+    import signal
+    signal.signal(signal.SIGINT, signal.SIG_IGN)
+    channel.enter("compiling")
+    if reported:
+        channel.report(0.3)
+    time.sleep(120)
+
+
+@pytest.mark.parametrize("reported", [False, True])
+def test_a_child_ended_by_a_cancel_says_whether_it_had_computed_anything(reported):
+    job = runs.Job("r1", "run", _stuck_compiling, (reported,))
+    end = time.monotonic() + 60
+    while (job.child.phase != "compiling" or job.child.progress != (0.3 if reported else 0.0)) \
+            and time.monotonic() < end:
+        time.sleep(0.01)
+    job.cancel()
+    job.thread.join(60)
+    answer = json.loads(job.body())
+    assert job.state == answer["state"] == "cancelled" and answer["results"] is None
+    assert answer["note"] == ("stopped while compiling: what it had computed could not be kept"
+                              if reported else "stopped while compiling: nothing had been "
+                                               "computed yet")
+
+
 def test_results_carry_the_animation(client):
     settings = {"t_end": 0.5, "n_points": 6}
     answer = wait(client, client.post("/api/run", json={"model": seed(client),
