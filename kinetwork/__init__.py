@@ -19,6 +19,8 @@ package.
 """
 
 import importlib
+import os
+import sys
 
 from .errors import (AssemblyBranchWarning, IdealisedInertiaWarning,
                      KinetworkDeprecationWarning, KinetworkWarning, ModelError, Problem,
@@ -66,11 +68,34 @@ __all__ = ["AssemblyBranchWarning", "IdealisedInertiaWarning", "KinetworkDepreca
            "KinetworkWarning", "ModelError", "Problem", "SimulationError", *_LAZY]
 
 
+#: OpenBLAS's idle threads (numpy's BLAS) wait 2 ** this many cycles for work before they
+#: sleep: see ``_import_numpy``
+BLAS_THREAD_TIMEOUT = 22
+
+
+def _import_numpy():
+    """numpy imported with OpenBLAS's idle threads waiting 2 ** BLAS_THREAD_TIMEOUT cycles
+    for work (a millisecond or two) before they sleep, rather than its 2 ** 28 (about 0.1 s):
+    they spun that long when numpy loaded, 0.04-0.1 s of CPU in every process (a tenth of
+    EngineV6's cached first answer), and after each threaded BLAS call, which kinetwork's
+    small matrices do not make. Nothing when numpy is in already or the user chose
+    (``OPENBLAS_THREAD_TIMEOUT`` set); OpenBLAS reads it as it loads, and the environment
+    is left as it was, so no process started later inherits it."""
+    if "numpy" in sys.modules or "OPENBLAS_THREAD_TIMEOUT" in os.environ:
+        return
+    os.environ["OPENBLAS_THREAD_TIMEOUT"] = str(BLAS_THREAD_TIMEOUT)
+    try:
+        import numpy  # noqa: F401
+    finally:
+        os.environ.pop("OPENBLAS_THREAD_TIMEOUT", None)
+
+
 def __getattr__(name):
     try:
         module, attribute = _LAZY[name]
     except KeyError:
         raise AttributeError(f"module 'kinetwork' has no attribute {name!r}") from None
+    _import_numpy()
     found = importlib.import_module(f"{__name__}.{module}")
     value = found if attribute is None else getattr(found, attribute)
     globals()[name] = value       # the next use is a plain lookup

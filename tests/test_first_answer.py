@@ -197,3 +197,54 @@ def test_measured_margins_keep_every_text_apart_and_inside(runs, case):
             assert a == b or not overlap(box_a, box_b), (a, box_a, b, box_b)
     assert panel_share(fig) > 0.9 * reference, (panel_share(fig), reference)
     np.testing.assert_array_equal(fig.axes[0].get_lines()[0].get_xdata(), soft.t)
+
+
+BLAS_SEEN = """
+    import os, sys
+    seen = []
+
+    class Watch:                   # what OPENBLAS_THREAD_TIMEOUT is as numpy is imported
+        def find_spec(self, name, path=None, target=None):
+            if name == "numpy":
+                seen.append(os.environ.get("OPENBLAS_THREAD_TIMEOUT"))
+            return None
+    sys.meta_path.insert(0, Watch())
+"""
+
+
+@pytest.mark.parametrize("chosen", [None, "28"])
+def test_numpy_s_blas_threads_sleep_soon_unless_the_user_chose(seed_file, chosen):
+    """OpenBLAS's idle threads spun 2^28 cycles (~0.1 s of CPU in every process) as numpy
+    loaded: kinetwork imports numpy with a shorter wait, leaves the environment as it was,
+    and keeps a value the user set."""
+    env = dict(ENV)
+    env.pop("OPENBLAS_THREAD_TIMEOUT", None)
+    if chosen is not None:
+        env["OPENBLAS_THREAD_TIMEOUT"] = chosen
+    code = BLAS_SEEN + f"""
+    import kinetwork as kn
+    kn.load({str(seed_file)!r})
+    print(seen, os.environ.get("OPENBLAS_THREAD_TIMEOUT"))
+    """
+    done = subprocess.run([sys.executable, "-c", textwrap.dedent(code)], env=env,
+                          capture_output=True, text=True, timeout=300)
+    assert done.returncode == 0, done.stderr
+    during = chosen or str(kn.BLAS_THREAD_TIMEOUT)
+    assert done.stdout.split() == [f"['{during}']", str(chosen)], done.stdout
+
+
+def test_the_command_s_processes_take_kinetwork_s_blas_setting(seed_file, tmp_path):
+    """The ``kinetwork`` command sets it for itself and the processes it starts."""
+    env = dict(ENV)
+    env.pop("OPENBLAS_THREAD_TIMEOUT", None)
+    code = BLAS_SEEN + f"""
+    from kinetwork.cli import main
+    sys.argv = ["kinetwork", "run", {str(seed_file)!r}, "--t-end", "0.1", "--quiet"]
+    code = main()
+    print(code, seen, os.environ.get("OPENBLAS_THREAD_TIMEOUT"))
+    """
+    done = subprocess.run([sys.executable, "-c", textwrap.dedent(code)], env=env, cwd=tmp_path,
+                          capture_output=True, text=True, timeout=300)
+    assert done.returncode == 0, done.stderr
+    timeout = str(kn.BLAS_THREAD_TIMEOUT)
+    assert done.stdout.split()[-2:] == [f"['{timeout}']", timeout], done.stdout
