@@ -18,7 +18,9 @@ script pays for CasADi, networkx and scipy when it builds a model, not when it i
 package.
 """
 
+import contextlib
 import importlib
+import importlib.util
 import os
 import sys
 
@@ -69,25 +71,50 @@ __all__ = ["AssemblyBranchWarning", "IdealisedInertiaWarning", "KinetworkDepreca
 
 
 #: OpenBLAS's idle threads (numpy's BLAS) wait 2 ** this many cycles for work before they
-#: sleep: see ``_import_numpy``
+#: sleep: see ``_QuietBlas``
 BLAS_THREAD_TIMEOUT = 22
 
 
-def _import_numpy():
-    """numpy imported with OpenBLAS's idle threads waiting 2 ** BLAS_THREAD_TIMEOUT cycles
-    for work (a millisecond or two) before they sleep, rather than its 2 ** 28 (about 0.1 s):
-    they spun that long when numpy loaded, 0.04-0.1 s of CPU in every process (a tenth of
-    EngineV6's cached first answer), and after each threaded BLAS call, which kinetwork's
-    small matrices do not make. Nothing when numpy is in already or the user chose
-    (``OPENBLAS_THREAD_TIMEOUT`` set); OpenBLAS reads it as it loads, and the environment
-    is left as it was, so no process started later inherits it."""
-    if "numpy" in sys.modules or "OPENBLAS_THREAD_TIMEOUT" in os.environ:
-        return
-    os.environ["OPENBLAS_THREAD_TIMEOUT"] = str(BLAS_THREAD_TIMEOUT)
-    try:
-        import numpy  # noqa: F401
-    finally:
-        os.environ.pop("OPENBLAS_THREAD_TIMEOUT", None)
+class _QuietBlas:
+    """An import finder for numpy's first import after kinetwork's: it loads numpy with
+    OpenBLAS's idle threads waiting 2 ** BLAS_THREAD_TIMEOUT cycles for work (a millisecond
+    or two) before they sleep, rather than its 2 ** 28 (about 0.1 s). They spun that long
+    as numpy loaded: 0.04-0.1 s of CPU in every process (a tenth of EngineV6's cached first
+    answer), and again after each threaded BLAS call, which kinetwork's small matrices do
+    not make. OpenBLAS reads ``OPENBLAS_THREAD_TIMEOUT`` as it loads: it is set around
+    numpy's import only, so the environment is as it was after it and no process started
+    later inherits it. Nothing when the user set it, or numpy came first. The usual finders
+    find numpy; this one only wraps its loading, once."""
+
+    done = False
+
+    def find_spec(self, name, path=None, target=None):
+        if self.done or name != "numpy":
+            return None
+        # (not out of sys.meta_path here: the import system is going through it)
+        self.done = True
+        if "OPENBLAS_THREAD_TIMEOUT" in os.environ:
+            return None
+        try:
+            spec = importlib.util.find_spec(name)
+            run = spec.loader.exec_module
+        except Exception:          # noqa: BLE001 -- an unusual loader: numpy as it comes
+            return None
+
+        def exec_module(module):
+            os.environ["OPENBLAS_THREAD_TIMEOUT"] = str(BLAS_THREAD_TIMEOUT)
+            try:
+                run(module)
+            finally:
+                os.environ.pop("OPENBLAS_THREAD_TIMEOUT", None)
+                with contextlib.suppress(ValueError):
+                    sys.meta_path.remove(self)
+        spec.loader.exec_module = exec_module
+        return spec
+
+
+if "numpy" not in sys.modules:
+    sys.meta_path.insert(0, _QuietBlas())
 
 
 def __getattr__(name):
@@ -95,7 +122,6 @@ def __getattr__(name):
         module, attribute = _LAZY[name]
     except KeyError:
         raise AttributeError(f"module 'kinetwork' has no attribute {name!r}") from None
-    _import_numpy()
     found = importlib.import_module(f"{__name__}.{module}")
     value = found if attribute is None else getattr(found, attribute)
     globals()[name] = value       # the next use is a plain lookup

@@ -87,11 +87,6 @@ def build_parser():
 
 def main(argv=None):
     """Run the ``kinetwork`` command; returns the exit code."""
-    if argv is None:
-        # the command's own process: OpenBLAS's idle threads sleep soon, in it and in the
-        # processes it starts (its plotting, the studio's runs), unless the user chose (see
-        # kinetwork._import_numpy)
-        os.environ.setdefault("OPENBLAS_THREAD_TIMEOUT", str(kn.BLAS_THREAD_TIMEOUT))
     # the command line's own process (not a call from Python), plotting into a file that is
     # not a PNG: draw it in a second process, importing matplotlib while this one loads and
     # runs the model (PNGs are drawn here, with Pillow, after the run)
