@@ -15,7 +15,8 @@ nothing is installed at import time.
 
 ``import kinetwork`` is quick: the names below are imported on first use (PEP 562), so a
 script pays for CasADi, networkx and scipy when it builds a model, not when it imports the
-package.
+package. What it does do: numpy's first import after it goes through ``_QuietBlas`` (its
+BLAS threads told to sleep soon; the environment left as it was).
 """
 
 import contextlib
