@@ -322,8 +322,9 @@ def _routes(api, studio):
 
     @api.get("/sweep/{sweep_id}")
     async def poll_sweep(sweep_id: str, wait: float = 0.0):
-        return Response(await _waited(studio.runs.get(sweep_id, "sweep"), wait),
-                        media_type="application/json")
+        job = studio.runs.get(sweep_id, "sweep")
+        await _waited(job, wait)
+        return Response(job.body(), media_type="application/json")
 
     @api.post("/sweep/{sweep_id}/cancel")
     def cancel_sweep(sweep_id: str):
@@ -343,15 +344,14 @@ def _routes(api, studio):
 
 
 async def _waited(job, wait, enough=lambda: False):
-    """Once ``job`` has ended, ``enough()`` holds or ``wait`` seconds (at most MAX_WAIT) have
-    passed: a page polling with a wait hears of the end at once. Returns ``job.body()``."""
+    """Until ``job`` has ended, ``enough()`` holds or ``wait`` seconds (at most MAX_WAIT) have
+    passed: a page polling with a wait hears of the end at once."""
     if not (0.0 <= wait <= MAX_WAIT):
         raise StudioError(400, f"wait: seconds from 0 to {MAX_WAIT:g}, got {wait!r:.40}")
     end = time.monotonic() + wait
     while job.state == "running" and job.cancel_at is None and not enough() and \
             time.monotonic() < end:
         await asyncio.sleep(0.01)
-    return job.body()
 
 
 def _rel_or_none(studio, path):
