@@ -45,33 +45,23 @@ class Recorder:
         self.sent.append((part, self.phases[-1]))
 
 
-def spy_on_the_compiler(monkeypatch, channel):
-    """The phases the run said while each C compiler ran (gcc, through ``jit.build``)."""
-    seen, real = [], jit.build
+def phases_at(monkeypatch, channel, owner, name):
+    """The phases the run said as each call of ``owner.name`` began: ``jit.build`` (a C
+    compiler run), ``methods._CasadiRun.call`` (a CasADi integrator's)."""
+    seen, real = [], getattr(owner, name)
 
     def spied(*args, **kwargs):
         seen.append(channel.phases[-1])
         return real(*args, **kwargs)
-    monkeypatch.setattr(jit, "build", spied)
-    return seen
-
-
-def spy_on_the_integrator(monkeypatch, channel):
-    """The phases the run said as each call of a CasADi integrator began."""
-    seen, real = [], methods._CasadiRun.call
-
-    def spied(self, *args, **kwargs):
-        seen.append(channel.phases[-1])
-        return real(self, *args, **kwargs)
-    monkeypatch.setattr(methods._CasadiRun, "call", spied)
+    monkeypatch.setattr(owner, name, spied)
     return seen
 
 
 def test_the_c_compile_happens_while_the_run_says_compiling(monkeypatch, tmp_path):
     monkeypatch.setenv("KINETWORK_CACHE", str(tmp_path))        # a cold cache: gcc runs
     channel = Recorder()
-    seen = spy_on_the_compiler(monkeypatch, channel)
-    integrating = spy_on_the_integrator(monkeypatch, channel)
+    seen = phases_at(monkeypatch, channel, jit, "build")
+    integrating = phases_at(monkeypatch, channel, methods._CasadiRun, "call")
     state, answer = work.run(json.loads(SEED.read_text()), {"t_end": 1.0, "n_points": 11},
                              None, [], channel)
     assert state == "done"
@@ -126,8 +116,8 @@ def test_a_run_whose_code_is_cached_says_integrating_as_it_integrates(monkeypatc
     settings = {"t_end": 0.05, "n_points": 51}
     assert work.run(data, settings, ENGINE.parent, [], Recorder())[0] == "done"    # cached
     channel = Recorder()
-    seen = spy_on_the_compiler(monkeypatch, channel)
-    integrating = spy_on_the_integrator(monkeypatch, channel)
+    seen = phases_at(monkeypatch, channel, jit, "build")
+    integrating = phases_at(monkeypatch, channel, methods._CasadiRun, "call")
     assert work.run(data, settings, ENGINE.parent, [], channel)[0] == "done"
     assert not seen
     assert integrating and integrating[0] == "integrating", channel.said
@@ -139,7 +129,7 @@ def test_a_sweep_says_compiling_while_its_code_is_compiled(monkeypatch, tmp_path
     "compiling" through it, then "integrating" (it read "integrating 0 %" through gcc)."""
     monkeypatch.setenv("KINETWORK_CACHE", str(tmp_path))
     channel = Recorder()
-    seen = spy_on_the_compiler(monkeypatch, channel)
+    seen = phases_at(monkeypatch, channel, jit, "build")
     state, answer = work.sweep(json.loads(SEED.read_text()),
                                {"kind": "grid", "grid": {"c": [0.5, 1.0, 2.0]}}, None, [],
                                channel)
